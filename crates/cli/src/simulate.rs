@@ -1,0 +1,12 @@
+//! `scatterfit simulate` (work in progress: see the open issue that owns it).
+
+use std::process::ExitCode;
+
+/// Arguments of `scatterfit simulate`.
+#[derive(Debug, clap::Args)]
+pub struct Args {}
+
+/// Runs `scatterfit simulate`.
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`scatterfit simulate` is not built yet")
+}

@@ -1,0 +1,10 @@
+//! scatterfit-io: every file format of scatterfit.
+//!
+//! Parsing lives here, at the edge; the physics crates (`scatterfit-optics`, `scatterfit-imaging`,
+//! `scatterfit-mc`) take typed values and buffers and never touch files. Every error names the file,
+//! and where it can the line, column or field, what was wrong and what to do about it.
+//!
+//! Outputs are written atomically ([`atomic::write_atomic`]); inputs are only ever read.
+
+pub mod atomic;
+pub mod spectro;

@@ -1,0 +1,1 @@
+//! Spectrophotometer CSV (to come).
