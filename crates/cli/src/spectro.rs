@@ -10,3 +10,8 @@ pub struct Args {}
 pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
     anyhow::bail!("`scatterfit spectro` is not built yet")
 }
+
+/// Contributes this area's figures to `scatterfit bench`.
+pub fn bench(_args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
+    Ok(Vec::new())
+}
