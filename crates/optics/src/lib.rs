@@ -1,1 +1,31 @@
-//! placeholder
+//! scatterfit-optics: the pure physics of scatterfit. No files, no threads, no CLI.
+//!
+//! Glossary (graphics notation, millimetres; biomedical optics writes μ where we write σ):
+//!
+//! | symbol | name in code | meaning | unit |
+//! |---|---|---|---|
+//! | σa | `sigma_a` | absorption coefficient | mm⁻¹ |
+//! | σ′s | `sigma_s_prime` | reduced scattering coefficient σs(1−g) | mm⁻¹ |
+//! | σ′t | `sigma_t_prime` | σa + σ′s | mm⁻¹ |
+//! | α′ | `albedo_prime` | reduced albedo σ′s/σ′t | 1 |
+//! | σtr | `sigma_tr` | effective transport coefficient √(3σaσ′t) | mm⁻¹ |
+//! | η | `eta` | relative refractive index (material / air) | 1 |
+//! | Fdr | `f_dr` | diffuse Fresnel reflectance | 1 |
+//! | Rd(r) | `rd_profile` | radially resolved diffuse reflectance | mm⁻² |
+//! | Rd | `rd_total` | total diffuse reflectance ∫2πr Rd(r) dr | 1 |
+//!
+//! Modules: [`fresnel`] (exact Fresnel, Schlick, η from a d/8 specular reflectance), [`dipole`]
+//! (Jensen et al. 2001 classical dipole, its total reflectance and the α′ inversion), [`colour`]
+//! (spectra → CIE XYZ → L\*a\*b\* / linear sRGB), [`spectro`] (the spectrophotometer stage).
+
+pub mod colour;
+pub mod dipole;
+pub mod fresnel;
+pub mod spectro;
+
+mod error;
+mod properties;
+mod roots;
+
+pub use error::{OpticsError, Result};
+pub use properties::OpticalProperties;
