@@ -33,23 +33,50 @@ impl<T: Copy> ImageBuf<T> {
     ///
     /// # Errors
     /// [`ShapeError`] if a dimension is zero or `data.len() != width * height * channels`.
-    pub fn new(width: usize, height: usize, channels: usize, data: Vec<T>) -> Result<Self, ShapeError> {
-        let expected = width.checked_mul(height).and_then(|n| n.checked_mul(channels));
+    pub fn new(
+        width: usize,
+        height: usize,
+        channels: usize,
+        data: Vec<T>,
+    ) -> Result<Self, ShapeError> {
+        let expected = width
+            .checked_mul(height)
+            .and_then(|n| n.checked_mul(channels));
         if width == 0 || height == 0 || channels == 0 || expected != Some(data.len()) {
-            return Err(ShapeError { width, height, channels, len: data.len() });
+            return Err(ShapeError {
+                width,
+                height,
+                channels,
+                len: data.len(),
+            });
         }
-        Ok(Self { width, height, channels, data })
+        Ok(Self {
+            width,
+            height,
+            channels,
+            data,
+        })
     }
 
     /// An image filled with `value`.
     ///
     /// # Errors
     /// [`ShapeError`] if a dimension is zero or the size overflows.
-    pub fn filled(width: usize, height: usize, channels: usize, value: T) -> Result<Self, ShapeError> {
+    pub fn filled(
+        width: usize,
+        height: usize,
+        channels: usize,
+        value: T,
+    ) -> Result<Self, ShapeError> {
         let len = width
             .checked_mul(height)
             .and_then(|n| n.checked_mul(channels))
-            .ok_or(ShapeError { width, height, channels, len: 0 })?;
+            .ok_or(ShapeError {
+                width,
+                height,
+                channels,
+                len: 0,
+            })?;
         Self::new(width, height, channels, vec![value; len])
     }
 

@@ -2,7 +2,33 @@
 //!
 //! Camera response recovery and HDR merging (Debevec & Malik 1997), the light spot's centre, and the
 //! radial profile Rd(r). No file formats here: `scatterfit-io` decodes files into [`ImageBuf`]s.
+//!
+//! The pipeline, with its entry points:
+//! 1. [`recover_response`] (or [`ResponseCurve::from_log_exposure`] / [`ResponseCurve::linear`] for a
+//!    known curve) — the camera response g(z) = ln exposure per channel, gauge g(128) = 0;
+//! 2. [`merge`] (8-bit frames and a response) or [`merge_linear_u16`] (linear 16-bit frames) — a
+//!    relative radiance map with a mask of pixels clipped in every exposure;
+//! 3. [`find_spot_center`] (or [`SpotCenter::given`]) — the spot centre, sub-pixel;
+//! 4. [`radial_profile`] — per-ring mean, standard error and count, radius in pixels and mm.
+//!
+//! Pixel coordinates: pixel (x, y) has its centre at (x, y).
 
 pub mod buffer;
+pub mod center;
+pub mod error;
+pub mod merge;
+pub mod profile;
+pub mod response;
 
 pub use buffer::{ImageBuf, ShapeError};
+pub use center::{CenterOptions, SpotCenter, find_spot_center};
+pub use error::{ImagingError, Result};
+pub use merge::{
+    CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MergeOptions, merge,
+    merge_linear_u16,
+};
+pub use profile::{ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
+pub use response::{
+    CalibrateOptions, Calibration, ChannelSolution, LEVELS, ResponseCurve, SamplePixel, gsolve,
+    hat_weight, recover_response, select_samples,
+};

@@ -1,0 +1,3 @@
+//! Benchmarks of scatterfit-imaging (placeholder; filled in below).
+
+fn main() {}

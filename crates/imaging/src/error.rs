@@ -1,0 +1,198 @@
+//! The crate's error type: bad input is refused with a typed, descriptive error, never a panic.
+
+use crate::buffer::ShapeError;
+
+/// Everything the imaging functions refuse. Numerical outcomes that are not errors (pixels clipped in
+/// every exposure, empty rings) are reported in the result types instead.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ImagingError {
+    /// An HDR merge or response recovery needs at least two exposures.
+    #[error(
+        "{got} exposure(s) given; an HDR merge needs at least 2 frames with different exposure times"
+    )]
+    TooFewFrames {
+        /// Number of frames given.
+        got: usize,
+    },
+    /// The number of exposure times differs from the number of frames.
+    #[error("{frames} frames but {times} exposure times; give exactly one time per frame")]
+    TimeCountMismatch {
+        /// Number of frames.
+        frames: usize,
+        /// Number of exposure times.
+        times: usize,
+    },
+    /// An exposure time is zero, negative or not finite.
+    #[error("exposure time of frame {index} is {time_s} s; exposure times must be finite and > 0")]
+    NonPositiveTime {
+        /// Index of the frame in the bracket.
+        index: usize,
+        /// The time given, in seconds.
+        time_s: f64,
+    },
+    /// Two frames have the same exposure time.
+    #[error(
+        "frames {first} and {second} both have exposure time {time_s} s; every frame of a bracket \
+         needs a distinct time"
+    )]
+    DuplicateTime {
+        /// Index of the first frame.
+        first: usize,
+        /// Index of the second frame.
+        second: usize,
+        /// The shared time, in seconds.
+        time_s: f64,
+    },
+    /// An image does not have the shape of the others (frames of a bracket, dark frame, mask).
+    #[error(
+        "{what} is {got_w}×{got_h}×{got_c} (width×height×channels) but {expected_w}×{expected_h}×\
+         {expected_c} was expected; all images of a bracket must have the same size and channels"
+    )]
+    ShapeMismatch {
+        /// Which image ("frame 3", "dark frame", "mask").
+        what: String,
+        /// Expected width.
+        expected_w: usize,
+        /// Expected height.
+        expected_h: usize,
+        /// Expected channel count.
+        expected_c: usize,
+        /// Width found.
+        got_w: usize,
+        /// Height found.
+        got_h: usize,
+        /// Channels found.
+        got_c: usize,
+    },
+    /// The response curve has a different number of channels than the images.
+    #[error(
+        "response curve has {response} channel(s) but the images have {image}; give one curve per \
+         channel (or a single curve for grey images)"
+    )]
+    ChannelMismatch {
+        /// Channels of the response curve.
+        response: usize,
+        /// Channels of the images.
+        image: usize,
+    },
+    /// A given response curve is unusable.
+    #[error("response curve, channel {channel}, code value {z}: {reason}")]
+    InvalidResponse {
+        /// Channel index.
+        channel: usize,
+        /// Code value (0..=255) where the problem is.
+        z: usize,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// An option is out of its domain.
+    #[error("option `{name}` = {value} is invalid: {reason}")]
+    InvalidOption {
+        /// Option name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// The domain it must lie in.
+        reason: &'static str,
+    },
+    /// Not enough usable sample pixels to recover the camera response.
+    #[error(
+        "channel {channel}: only {found} usable sample pixels (at least {needed} needed); the bracket \
+         has too few well-exposed, non-flat pixels — check the exposures or give a known response"
+    )]
+    NotEnoughSamples {
+        /// Channel index.
+        channel: usize,
+        /// Usable pixels found.
+        found: usize,
+        /// Pixels required.
+        needed: usize,
+    },
+    /// The least-squares system for the response is rank deficient or not finite.
+    #[error("channel {channel}: response recovery failed: {reason}")]
+    SolveFailed {
+        /// Channel index.
+        channel: usize,
+        /// What went wrong.
+        reason: &'static str,
+    },
+    /// No light spot could be found in the image.
+    #[error("no light spot found: {reason}")]
+    NoSpot {
+        /// Why.
+        reason: &'static str,
+    },
+    /// A given centre lies outside the image or is not finite.
+    #[error("spot centre ({x}, {y}) px is outside the {width}×{height} image or not finite")]
+    CenterOutside {
+        /// x in pixels.
+        x: f64,
+        /// y in pixels.
+        y: f64,
+        /// Image width.
+        width: usize,
+        /// Image height.
+        height: usize,
+    },
+    /// A buffer could not be built.
+    #[error(transparent)]
+    Shape(#[from] ShapeError),
+}
+
+/// Result with [`ImagingError`].
+pub type Result<T> = std::result::Result<T, ImagingError>;
+
+/// Checks a bracket: at least two frames, one finite positive, distinct time per frame, equal shapes.
+pub(crate) fn check_bracket<T: Copy>(frames: &[crate::ImageBuf<T>], times_s: &[f64]) -> Result<()> {
+    if frames.len() < 2 {
+        return Err(ImagingError::TooFewFrames { got: frames.len() });
+    }
+    if frames.len() != times_s.len() {
+        return Err(ImagingError::TimeCountMismatch {
+            frames: frames.len(),
+            times: times_s.len(),
+        });
+    }
+    for (index, &t) in times_s.iter().enumerate() {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(ImagingError::NonPositiveTime { index, time_s: t });
+        }
+    }
+    for first in 0..times_s.len() {
+        for second in first + 1..times_s.len() {
+            if times_s[first] == times_s[second] {
+                return Err(ImagingError::DuplicateTime {
+                    first,
+                    second,
+                    time_s: times_s[first],
+                });
+            }
+        }
+    }
+    let f0 = &frames[0];
+    for (i, f) in frames.iter().enumerate().skip(1) {
+        check_shape(f0, f, || format!("frame {i}"))?;
+    }
+    Ok(())
+}
+
+/// Checks that `other` has the shape of `reference`; `what` names `other` in the error.
+pub(crate) fn check_shape<T: Copy, U: Copy>(
+    reference: &crate::ImageBuf<T>,
+    other: &crate::ImageBuf<U>,
+    what: impl FnOnce() -> String,
+) -> Result<()> {
+    if reference.same_shape(other) {
+        return Ok(());
+    }
+    Err(ImagingError::ShapeMismatch {
+        what: what(),
+        expected_w: reference.width(),
+        expected_h: reference.height(),
+        expected_c: reference.channels(),
+        got_w: other.width(),
+        got_h: other.height(),
+        got_c: other.channels(),
+    })
+}

@@ -1,0 +1,481 @@
+//! Camera response curves and their recovery from an exposure bracket (Debevec & Malik 1997).
+//!
+//! Glossary: a frame's *code value* Z ∈ 0..=255 is what the camera wrote for a pixel; the camera maps
+//! exposure X = E·Δt (irradiance E times shutter time Δt) to Z = f(X). The *response* stored here is
+//! g(Z) = ln f⁻¹(Z) = ln E + ln Δt (Debevec & Malik 1997, eq. 2), one table of 256 values per channel.
+//! Exposure is only known up to a common factor, so g is only known up to an additive constant: the
+//! *gauge*. Recovered curves use the paper's gauge g(128) = 0 (its appendix, `A(k,129) = 1`), so a
+//! radiance of 1 is the irradiance that gives code 128 in a 1 s exposure.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::ImageBuf;
+use crate::error::{ImagingError, Result, check_bracket};
+
+/// Number of code values of an 8-bit frame.
+pub const LEVELS: usize = 256;
+
+/// The paper's hat weight, Debevec & Malik 1997, eq. (4) with Z_min = 0, Z_max = 255:
+/// w(z) = z − Z_min for z ≤ ½(Z_min + Z_max), Z_max − z otherwise. So w(0) = w(255) = 0 (clipped codes
+/// carry no weight) and w(127) = w(128) = 127.
+pub fn hat_weight(z: u8) -> f64 {
+    let z = f64::from(z);
+    if z <= 127.5 { z } else { 255.0 - z }
+}
+
+/// A camera response: per channel the 256 values g(z) = ln f⁻¹(z) (log exposure for code value z),
+/// Debevec & Malik 1997, eq. (2). Values are defined up to an additive constant per curve (the gauge);
+/// see [`ResponseCurve::gauge_offset`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResponseCurve {
+    g: Vec<[f64; LEVELS]>,
+}
+
+impl ResponseCurve {
+    /// A response from log exposures g(z) = ln X(z), one table per channel (e.g. read from a
+    /// `response.csv`). Any gauge is accepted.
+    ///
+    /// # Errors
+    /// [`ImagingError::InvalidResponse`] if there are no channels, a value is not finite, or g
+    /// decreases somewhere (a camera response is monotonic).
+    pub fn from_log_exposure(g: Vec<[f64; LEVELS]>) -> Result<Self> {
+        if g.is_empty() {
+            return Err(ImagingError::InvalidResponse {
+                channel: 0,
+                z: 0,
+                reason: "no channels given",
+            });
+        }
+        for (channel, table) in g.iter().enumerate() {
+            for (z, v) in table.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(ImagingError::InvalidResponse {
+                        channel,
+                        z,
+                        reason: "value is not finite",
+                    });
+                }
+                if z > 0 && *v < table[z - 1] {
+                    return Err(ImagingError::InvalidResponse {
+                        channel,
+                        z,
+                        reason: "g(z) decreases here; a camera response must be non-decreasing",
+                    });
+                }
+            }
+        }
+        Ok(Self { g })
+    }
+
+    /// A response from linear exposures X(z) = f⁻¹(z) = exp g(z), the form OpenCV's
+    /// `CalibrateDebevec` returns (physics.md §7.2). Every value must be finite and > 0.
+    ///
+    /// # Errors
+    /// [`ImagingError::InvalidResponse`] as for [`ResponseCurve::from_log_exposure`], or a value ≤ 0.
+    pub fn from_linear_exposure(x: Vec<[f64; LEVELS]>) -> Result<Self> {
+        let mut g = Vec::with_capacity(x.len());
+        for (channel, table) in x.iter().enumerate() {
+            let mut t = [0.0; LEVELS];
+            for (z, v) in table.iter().enumerate() {
+                if !(v.is_finite() && *v > 0.0) {
+                    return Err(ImagingError::InvalidResponse {
+                        channel,
+                        z,
+                        reason: "linear exposure must be finite and > 0",
+                    });
+                }
+                t[z] = v.ln();
+            }
+            g.push(t);
+        }
+        Self::from_log_exposure(g)
+    }
+
+    /// The linear response X(z) = z / 128 (so g(128) = 0, the recovery gauge), with X(0) := X(1) as
+    /// OpenCV's `MergeDebevec` does (code 0 has zero weight anyway). For frames that are already linear.
+    ///
+    /// # Errors
+    /// [`ImagingError::InvalidResponse`] if `channels` is 0.
+    pub fn linear(channels: usize) -> Result<Self> {
+        let mut t = [0.0; LEVELS];
+        for (z, v) in t.iter_mut().enumerate() {
+            *v = (z.max(1) as f64 / 128.0).ln();
+        }
+        Self::from_log_exposure(vec![t; channels])
+    }
+
+    /// Number of channels.
+    pub fn channels(&self) -> usize {
+        self.g.len()
+    }
+
+    /// The table g(0..=255) of channel `c`, or `None` if there is no such channel.
+    pub fn log_exposure(&self, c: usize) -> Option<&[f64; LEVELS]> {
+        self.g.get(c)
+    }
+
+    /// All tables, one per channel.
+    pub fn tables(&self) -> &[[f64; LEVELS]] {
+        &self.g
+    }
+
+    /// The gauge of channel `c`: the value g(128) (0 for recovered curves). Subtract it to compare two
+    /// curves.
+    pub fn gauge_offset(&self, c: usize) -> Option<f64> {
+        self.g.get(c).map(|t| t[128])
+    }
+}
+
+/// Options of [`recover_response`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrateOptions {
+    /// Number of sample pixels N per channel (OpenCV's default is 70; Debevec & Malik ask for
+    /// N(P − 1) > 255 with P frames). Default 100.
+    pub samples: usize,
+    /// Smoothness weight λ of the second-difference rows (Debevec & Malik 1997, eq. 3). Default 10,
+    /// OpenCV's default.
+    pub lambda: f64,
+}
+
+impl Default for CalibrateOptions {
+    fn default() -> Self {
+        Self {
+            samples: 100,
+            lambda: 10.0,
+        }
+    }
+}
+
+/// A sample pixel chosen for response recovery.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SamplePixel {
+    /// Column.
+    pub x: usize,
+    /// Row.
+    pub y: usize,
+}
+
+/// One channel's solution of the Debevec–Malik system.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelSolution {
+    /// g(0..=255) in the gauge g(128) = 0.
+    pub g: [f64; LEVELS],
+    /// ln E_i of each sample pixel (same gauge); NaN for a pixel with no unclipped sample.
+    pub ln_e: Vec<f64>,
+    /// Root mean square of the weighted data residuals w(Z_ij)(g(Z_ij) − ln E_i − ln Δt_j).
+    pub rms_residual: f64,
+}
+
+/// The outcome of [`recover_response`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Calibration {
+    /// The recovered response, gauge g(128) = 0 per channel.
+    pub response: ResponseCurve,
+    /// The sample pixels used, per channel.
+    pub samples: Vec<Vec<SamplePixel>>,
+    /// Each channel's solution (g, ln E of the samples, residual).
+    pub solutions: Vec<ChannelSolution>,
+}
+
+/// Solves Debevec & Malik's least-squares system for one channel (the paper's appendix `gsolve`,
+/// physics.md §7.1): unknowns g(0..=255) and ln E_i; data rows w(Z_ij)(g(Z_ij) − ln E_i) = w(Z_ij) ln Δt_j,
+/// the gauge row g(128) = 0, and smoothness rows λ w(z)(g(z−1) − 2g(z) + g(z+1)) = 0 for z = 1..=254,
+/// with the hat weight [`hat_weight`].
+///
+/// `z` holds the code values row by row: pixel i's value in frame j is `z[i * ln_dt.len() + j]`;
+/// `ln_dt[j]` = ln Δt_j.
+///
+/// The ln E_i are eliminated exactly (variable projection: for fixed g each ln E_i is the weighted
+/// mean Σ_j w²(g − ln Δt)/Σ_j w², and each pixel's block of rows is projected onto the complement of
+/// its weight vector), leaving a (N·P + 255) × 256 problem in g that is solved by Householder QR —
+/// the same minimiser as the full (N·P + 257) × (256 + N) system, without forming normal equations.
+///
+/// # Errors
+/// [`ImagingError::InvalidOption`] for a bad λ or mismatched lengths, [`ImagingError::SolveFailed`] if
+/// the system is rank deficient.
+pub fn gsolve(z: &[u8], ln_dt: &[f64], lambda: f64, channel: usize) -> Result<ChannelSolution> {
+    let p = ln_dt.len();
+    if p < 2 {
+        return Err(ImagingError::TooFewFrames { got: p });
+    }
+    if !z.len().is_multiple_of(p) {
+        return Err(ImagingError::InvalidOption {
+            name: "z",
+            value: z.len() as f64,
+            reason: "length must be a multiple of the number of exposures",
+        });
+    }
+    if !(lambda.is_finite() && lambda >= 0.0) {
+        return Err(ImagingError::InvalidOption {
+            name: "lambda",
+            value: lambda,
+            reason: "must be finite and ≥ 0",
+        });
+    }
+    let n = z.len() / p;
+    let rows = n * p + 1 + (LEVELS - 2);
+    let mut a = DMatrix::<f64>::zeros(rows, LEVELS);
+    let mut b = DVector::<f64>::zeros(rows);
+    let mut k = 0;
+    let mut w = vec![0.0; p];
+    for i in 0..n {
+        let zi = &z[i * p..(i + 1) * p];
+        for j in 0..p {
+            w[j] = hat_weight(zi[j]);
+        }
+        let norm2: f64 = w.iter().map(|v| v * v).sum();
+        if norm2 == 0.0 {
+            // No unclipped sample: the pixel carries no information about g.
+            continue;
+        }
+        // Row block W S g − W ℓ, projected by (I − u uᵀ), u = w/|w|, which removes ln E_i exactly.
+        // Projected row j: w_j e_{Z_j} − (w_j/|w|²) Σ_m w_m² e_{Z_m};  rhs likewise with ln Δt.
+        let s_rhs: f64 = (0..p).map(|m| w[m] * w[m] * ln_dt[m]).sum::<f64>() / norm2;
+        for j in 0..p {
+            if w[j] == 0.0 {
+                // The projected row is zero: skip it.
+                k += 1;
+                continue;
+            }
+            a[(k, zi[j] as usize)] += w[j];
+            let f = w[j] / norm2;
+            for m in 0..p {
+                a[(k, zi[m] as usize)] -= f * w[m] * w[m];
+            }
+            b[k] = w[j] * ln_dt[j] - w[j] * s_rhs;
+            k += 1;
+        }
+    }
+    // Gauge g(128) = 0 (appendix: A(k,129) = 1).
+    a[(k, 128)] = 1.0;
+    k += 1;
+    // Smoothness, eq. (3): λ w(z) [g(z−1) − 2 g(z) + g(z+1)] = 0, z = 1..=254.
+    for zz in 1..LEVELS - 1 {
+        let lw = lambda * hat_weight(zz as u8);
+        a[(k, zz - 1)] = lw;
+        a[(k, zz)] = -2.0 * lw;
+        a[(k, zz + 1)] = lw;
+        k += 1;
+    }
+    debug_assert_eq!(k, rows);
+    let g_vec = solve_least_squares(a, b).ok_or(ImagingError::SolveFailed {
+        channel,
+        reason: "the system is rank deficient (too few distinct code values among the samples?)",
+    })?;
+    let mut g = [0.0; LEVELS];
+    g.copy_from_slice(g_vec.as_slice());
+    if g.iter().any(|v| !v.is_finite()) {
+        return Err(ImagingError::SolveFailed {
+            channel,
+            reason: "solution is not finite",
+        });
+    }
+    // Recover ln E_i and the data residual.
+    let mut ln_e = Vec::with_capacity(n);
+    let (mut ss, mut cnt) = (0.0, 0usize);
+    for i in 0..n {
+        let zi = &z[i * p..(i + 1) * p];
+        let (mut num, mut den) = (0.0, 0.0);
+        for j in 0..p {
+            let wj = hat_weight(zi[j]);
+            num += wj * wj * (g[zi[j] as usize] - ln_dt[j]);
+            den += wj * wj;
+        }
+        if den == 0.0 {
+            ln_e.push(f64::NAN);
+            continue;
+        }
+        let le = num / den;
+        for j in 0..p {
+            let r = hat_weight(zi[j]) * (g[zi[j] as usize] - le - ln_dt[j]);
+            ss += r * r;
+            cnt += 1;
+        }
+        ln_e.push(le);
+    }
+    let rms_residual = if cnt > 0 {
+        (ss / cnt as f64).sqrt()
+    } else {
+        0.0
+    };
+    Ok(ChannelSolution {
+        g,
+        ln_e,
+        rms_residual,
+    })
+}
+
+/// Least squares min |A x − b| by Householder QR (A has full column rank or `None`).
+fn solve_least_squares(a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>> {
+    let ncols = a.ncols();
+    let scale = a.amax();
+    let qr = a.qr();
+    let mut qtb = b;
+    qr.q_tr_mul(&mut qtb);
+    let r = qr.r();
+    let tol = scale * 1e-12 * ncols as f64;
+    if (0..ncols).any(|i| r[(i, i)].abs() <= tol) {
+        return None;
+    }
+    let rhs = qtb.rows(0, ncols).into_owned();
+    r.solve_upper_triangular(&rhs)
+}
+
+/// Recovers the camera response of each channel from an 8-bit bracket (Debevec & Malik 1997): picks
+/// [`CalibrateOptions::samples`] pixels per channel with [`select_samples`] and solves [`gsolve`].
+///
+/// # Errors
+/// Bracket errors (fewer than 2 frames, times not one per frame, non-positive or duplicate times,
+/// frames of different shapes), [`ImagingError::InvalidOption`], [`ImagingError::NotEnoughSamples`],
+/// [`ImagingError::SolveFailed`].
+pub fn recover_response(
+    frames: &[ImageBuf<u8>],
+    times_s: &[f64],
+    opts: &CalibrateOptions,
+) -> Result<Calibration> {
+    check_bracket(frames, times_s)?;
+    let ln_dt: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();
+    let p = frames.len();
+    let mut samples = Vec::new();
+    let mut solutions = Vec::new();
+    for c in 0..frames[0].channels() {
+        let picked = select_samples(frames, times_s, c, opts.samples)?;
+        let mut z = Vec::with_capacity(picked.len() * p);
+        for s in &picked {
+            for f in frames {
+                z.push(f.data()[(s.y * f.width() + s.x) * f.channels() + c]);
+            }
+        }
+        solutions.push(gsolve(&z, &ln_dt, opts.lambda, c)?);
+        samples.push(picked);
+    }
+    // Not validated for monotonicity: noise can make an estimated curve dip by a hair, and that is the
+    // estimate's business, not an input error.
+    let response = ResponseCurve {
+        g: solutions.iter().map(|s| s.g).collect(),
+    };
+    Ok(Calibration {
+        response,
+        samples,
+        solutions,
+    })
+}
+
+/// Chooses `n` sample pixels of channel `c` for response recovery, deterministically.
+///
+/// Candidates lie on a regular grid (about 40 000 of them) away from the border. A candidate is
+/// rejected if it is clipped (0 or 255) in every frame. Its *brightness key* is the sum of its code
+/// values over the frames ordered by exposure time — monotonic in scene radiance — and its *flatness*
+/// the sum over frames of its absolute central differences in x and y. The key range is split into `n`
+/// equal strata; from each the flattest candidate is taken (ties to the first in raster order), so the
+/// samples span the radiance range and avoid edges. Strata left empty are filled with the next
+/// flattest candidates of the most populated strata.
+///
+/// # Errors
+/// Bracket errors, [`ImagingError::InvalidOption`] for `n == 0` or a bad channel,
+/// [`ImagingError::NotEnoughSamples`] if fewer than 2 usable candidates exist.
+pub fn select_samples(
+    frames: &[ImageBuf<u8>],
+    times_s: &[f64],
+    c: usize,
+    n: usize,
+) -> Result<Vec<SamplePixel>> {
+    check_bracket(frames, times_s)?;
+    let (w, h, ch) = (frames[0].width(), frames[0].height(), frames[0].channels());
+    if c >= ch {
+        return Err(ImagingError::InvalidOption {
+            name: "channel",
+            value: c as f64,
+            reason: "no such channel",
+        });
+    }
+    if n == 0 {
+        return Err(ImagingError::InvalidOption {
+            name: "samples",
+            value: 0.0,
+            reason: "must be ≥ 1",
+        });
+    }
+    // Candidate grid with a 1-pixel border (for central differences) where possible.
+    let target = 40_000usize;
+    let step = (((w * h) as f64 / target as f64).sqrt().floor() as usize).max(1);
+    let (x0, x1) = if w >= 3 { (1, w - 1) } else { (0, w) };
+    let (y0, y1) = if h >= 3 { (1, h - 1) } else { (0, h) };
+    let at = |f: &ImageBuf<u8>, x: usize, y: usize| i32::from(f.data()[(y * w + x) * ch + c]);
+    struct Cand {
+        key: u32,
+        grad: u32,
+        x: usize,
+        y: usize,
+    }
+    let mut cands = Vec::new();
+    let mut y = y0 + step / 2;
+    while y < y1 {
+        let mut x = x0 + step / 2;
+        while x < x1 {
+            let (mut key, mut grad, mut all_clipped) = (0u32, 0u32, true);
+            for f in frames {
+                let v = at(f, x, y);
+                key += v as u32;
+                if v > 0 && v < 255 {
+                    all_clipped = false;
+                }
+                if w >= 3 {
+                    grad += (at(f, x + 1, y) - at(f, x - 1, y)).unsigned_abs();
+                }
+                if h >= 3 {
+                    grad += (at(f, x, y + 1) - at(f, x, y - 1)).unsigned_abs();
+                }
+            }
+            if !all_clipped {
+                cands.push(Cand { key, grad, x, y });
+            }
+            x += step;
+        }
+        y += step;
+    }
+    let needed = 2;
+    if cands.len() < needed {
+        return Err(ImagingError::NotEnoughSamples {
+            channel: c,
+            found: cands.len(),
+            needed,
+        });
+    }
+    let kmin = cands.iter().map(|c| c.key).min().unwrap_or(0);
+    let kmax = cands.iter().map(|c| c.key).max().unwrap_or(0);
+    let span = u64::from(kmax - kmin) + 1;
+    let mut strata: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, cand) in cands.iter().enumerate() {
+        let s = (u64::from(cand.key - kmin) * n as u64 / span) as usize;
+        strata[s.min(n - 1)].push(i);
+    }
+    for s in &mut strata {
+        // Stable sort keeps raster order among equal gradients.
+        s.sort_by_key(|&i| cands[i].grad);
+    }
+    let mut picked = Vec::with_capacity(n);
+    let mut next = vec![0usize; n];
+    for (s, list) in strata.iter().enumerate() {
+        if let Some(&i) = list.first() {
+            picked.push(i);
+            next[s] = 1;
+        }
+    }
+    // Fill empty strata from the most populated ones.
+    while picked.len() < n.min(cands.len()) {
+        let best = (0..n)
+            .filter(|&s| next[s] < strata[s].len())
+            .max_by_key(|&s| (strata[s].len() - next[s], n - s));
+        let Some(s) = best else { break };
+        picked.push(strata[s][next[s]]);
+        next[s] += 1;
+    }
+    Ok(picked
+        .into_iter()
+        .map(|i| SamplePixel {
+            x: cands[i].x,
+            y: cands[i].y,
+        })
+        .collect())
+}
