@@ -7,4 +7,8 @@
 //! Outputs are written atomically ([`atomic::write_atomic`]); inputs are only ever read.
 
 pub mod atomic;
+pub mod bracket;
+pub mod image_files;
+pub mod profile_csv;
+pub mod response_csv;
 pub mod spectro;

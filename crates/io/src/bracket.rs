@@ -1,0 +1,562 @@
+//! Exposure brackets: the camera frames of one scene at several shutter times, with those times.
+//!
+//! Times come from an `exposures.csv` (header `file,time_s`; a file path relative to the CSV's
+//! folder; a time in seconds, as a decimal `0.0016667` or a fraction `1/600`) or, when no CSV is
+//! given, from each file's EXIF `ExposureTime`. Frames are decoded in parallel (rayon).
+//!
+//! [`read_bracket`] refuses, naming the file and line: fewer than 2 images, an unreadable file, a
+//! missing or non-positive time, two images with the same time, the same file twice, and frames whose
+//! size, channel count or bit depth differ from the first frame's. The frames come back sorted by
+//! exposure time, shortest first.
+
+use std::collections::HashMap;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use crate::image_files::{CameraFrame, ImageFileError, decode_camera_frame, describe_shape};
+
+/// What can go wrong reading a bracket. Every variant names the file (and line) at fault.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BracketError {
+    /// A frame (or dark frame) could not be read or decoded.
+    #[error(transparent)]
+    Image(#[from] ImageFileError),
+    /// The exposures CSV could not be read.
+    #[error("cannot read exposure times from {}: {source}", path.display())]
+    ExposuresRead {
+        /// The CSV file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The exposures CSV lacks the `file` or `time_s` column.
+    #[error(
+        "{}: the header must name the columns `file` and `time_s` (found: {found}); \
+         write e.g. `file,time_s` then one line per image such as `img_01.png,1/600`",
+        path.display()
+    )]
+    ExposuresHeader {
+        /// The CSV file.
+        path: PathBuf,
+        /// The header as found.
+        found: String,
+    },
+    /// A line of the exposures CSV is malformed.
+    #[error("{}, line {line}: {detail}", path.display())]
+    ExposuresLine {
+        /// The CSV file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: u64,
+        /// What was wrong and what to do.
+        detail: String,
+    },
+    /// An exposure time is zero, negative or not finite.
+    #[error(
+        "{where_}: exposure time {time_s} s is not positive; every frame needs its shutter time in \
+         seconds (> 0)"
+    )]
+    NonPositiveTime {
+        /// Where the time came from (`exposures.csv, line 3` or `img.jpg (EXIF ExposureTime)`).
+        where_: String,
+        /// The value found.
+        time_s: f64,
+    },
+    /// No exposure time for an image.
+    #[error("{}: no exposure time: {detail}", image.display())]
+    MissingTime {
+        /// The image.
+        image: PathBuf,
+        /// Why, and what to do.
+        detail: String,
+    },
+    /// Two images have the same exposure time (a bracket needs distinct times).
+    #[error(
+        "{} and {} have the same exposure time {time_s} s; a bracket needs a different shutter time \
+         for every frame (remove the duplicate or correct its time)",
+        first.display(),
+        second.display()
+    )]
+    DuplicateTime {
+        /// The first image.
+        first: PathBuf,
+        /// The second image.
+        second: PathBuf,
+        /// Their common time.
+        time_s: f64,
+    },
+    /// The same file is listed twice.
+    #[error("{} is listed twice; list every frame once", path.display())]
+    DuplicateImage {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Fewer than two images.
+    #[error(
+        "an exposure bracket needs at least 2 images, got {count}; give the frames on the command \
+         line or list them in exposures.csv"
+    )]
+    TooFewImages {
+        /// How many were given.
+        count: usize,
+    },
+    /// A frame's size, channel count or bit depth differs from the first frame's.
+    #[error(
+        "{} is {found} but {} is {expected}; all frames of a bracket (and the dark frame) must have \
+         the same size, channels and bit depth",
+        path.display(),
+        first.display()
+    )]
+    ShapeMismatch {
+        /// The frame that differs.
+        path: PathBuf,
+        /// Its shape, e.g. `640×480 RGB 8-bit`.
+        found: String,
+        /// The reference frame.
+        first: PathBuf,
+        /// The reference shape.
+        expected: String,
+    },
+}
+
+/// One exposure-time entry of an `exposures.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExposureEntry {
+    /// The image, resolved against the CSV's folder.
+    pub path: PathBuf,
+    /// Shutter time Δt [s].
+    pub time_s: f64,
+    /// 1-based line in the CSV.
+    pub line: u64,
+}
+
+/// Reads an `exposures.csv` (header `file,time_s`, other columns ignored). Relative paths are
+/// resolved against the CSV's folder; a time may be a decimal or a fraction (`1/600`).
+///
+/// # Errors
+/// [`BracketError::ExposuresRead`], [`BracketError::ExposuresHeader`], [`BracketError::ExposuresLine`]
+/// (empty file name, unparsable time, short line) and [`BracketError::NonPositiveTime`], each naming
+/// the CSV and the line.
+pub fn read_exposures_csv(path: &Path) -> Result<Vec<ExposureEntry>, BracketError> {
+    let text = std::fs::read_to_string(path).map_err(|source| BracketError::ExposuresRead {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let base = path.parent().unwrap_or(Path::new(""));
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .comment(Some(b'#'))
+        .from_reader(text.as_bytes());
+    let header_err = |found: String| BracketError::ExposuresHeader {
+        path: path.to_path_buf(),
+        found,
+    };
+    let headers = reader
+        .headers()
+        .map_err(|e| header_err(format!("unreadable header: {e}")))?
+        .clone();
+    let column = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
+    let (Some(file_col), Some(time_col)) = (column("file"), column("time_s")) else {
+        let found = headers.iter().collect::<Vec<_>>().join(",");
+        return Err(header_err(if found.is_empty() {
+            "an empty file".into()
+        } else {
+            found
+        }));
+    };
+    let mut entries = Vec::new();
+    for record in reader.records() {
+        let line_err = |line: u64, detail: String| BracketError::ExposuresLine {
+            path: path.to_path_buf(),
+            line,
+            detail,
+        };
+        let record = record.map_err(|e| {
+            let line = csv_line(&text, e.position());
+            line_err(line, format!("malformed CSV: {e}"))
+        })?;
+        let line = csv_line(&text, record.position());
+        if record.iter().all(str::is_empty) {
+            continue;
+        }
+        let file = record.get(file_col).unwrap_or("");
+        if file.is_empty() {
+            return Err(line_err(
+                line,
+                "the `file` field is empty; name the image file".into(),
+            ));
+        }
+        let Some(time_text) = record.get(time_col).filter(|t| !t.is_empty()) else {
+            return Err(line_err(
+                line,
+                format!(
+                    "no `time_s` for {file}; give its shutter time in seconds, e.g. 0.01 or 1/100"
+                ),
+            ));
+        };
+        let time_s = parse_time(time_text).ok_or_else(|| {
+            line_err(
+                line,
+                format!(
+                    "`time_s` = {time_text:?} for {file} is not a number; write seconds as a decimal \
+                     (0.0016667) or a fraction (1/600)"
+                ),
+            )
+        })?;
+        if !(time_s > 0.0 && time_s.is_finite()) {
+            return Err(BracketError::NonPositiveTime {
+                where_: format!("{}, line {line} ({file})", path.display()),
+                time_s,
+            });
+        }
+        entries.push(ExposureEntry {
+            path: base.join(file),
+            time_s,
+            line,
+        });
+    }
+    Ok(entries)
+}
+
+/// The 1-based line of a CSV record, from its byte offset. The `csv` crate's own line counter skips
+/// blank and comment lines, and a record's offset can point at blank or `#` lines before it, so
+/// those are stepped over here.
+pub(crate) fn csv_line(text: &str, position: Option<&csv::Position>) -> u64 {
+    let Some(p) = position else { return 0 };
+    let mut start = usize::try_from(p.byte())
+        .unwrap_or(usize::MAX)
+        .min(text.len());
+    while start < text.len() {
+        let rest = &text[start..];
+        let end = rest.find('\n').map_or(rest.len(), |i| i + 1);
+        let line = rest[..end].trim();
+        if !(line.is_empty() || line.starts_with('#')) || end == rest.len() {
+            break;
+        }
+        start += end;
+    }
+    text.as_bytes()[..start]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count() as u64
+        + 1
+}
+
+/// Parses `0.01`, `1e-3` or `1/600` seconds.
+fn parse_time(text: &str) -> Option<f64> {
+    match text.split_once('/') {
+        Some((num, den)) => {
+            let (num, den) = (
+                num.trim().parse::<f64>().ok()?,
+                den.trim().parse::<f64>().ok()?,
+            );
+            (den != 0.0).then(|| num / den)
+        }
+        None => text.parse::<f64>().ok(),
+    }
+}
+
+/// The EXIF `ExposureTime` [s] of an image file's bytes (JPEG, TIFF, PNG `eXIf`, HEIF, WebP).
+///
+/// # Errors
+/// [`BracketError::MissingTime`] if the file has no EXIF data or no usable `ExposureTime`;
+/// [`BracketError::NonPositiveTime`] if it is zero.
+pub fn exif_exposure_time(bytes: &[u8], path: &Path) -> Result<f64, BracketError> {
+    let missing = |why: String| BracketError::MissingTime {
+        image: path.to_path_buf(),
+        detail: format!(
+            "{why}; give the shutter times in an exposures.csv (header `file,time_s`) with \
+             --exposures"
+        ),
+    };
+    let exif = exif::Reader::new()
+        .read_from_container(&mut Cursor::new(bytes))
+        .map_err(|e| missing(format!("no readable EXIF data ({e})")))?;
+    let field = exif
+        .get_field(exif::Tag::ExposureTime, exif::In::PRIMARY)
+        .ok_or_else(|| missing("the EXIF data has no ExposureTime".into()))?;
+    let time_s = match &field.value {
+        exif::Value::Rational(v) if !v.is_empty() && v[0].denom != 0 => v[0].to_f64(),
+        exif::Value::Rational(v) if !v.is_empty() => {
+            return Err(missing(format!(
+                "EXIF ExposureTime {}/0 has a zero denominator",
+                v[0].num
+            )));
+        }
+        other => {
+            return Err(missing(format!(
+                "EXIF ExposureTime has an unexpected type ({other:?})"
+            )));
+        }
+    };
+    if !(time_s > 0.0 && time_s.is_finite()) {
+        return Err(BracketError::NonPositiveTime {
+            where_: format!("{} (EXIF ExposureTime)", path.display()),
+            time_s,
+        });
+    }
+    Ok(time_s)
+}
+
+/// One frame of a bracket.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BracketFrame {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Shutter time Δt [s].
+    pub time_s: f64,
+    /// The pixels, at the file's bit depth.
+    pub frame: CameraFrame,
+    /// True if the file's alpha channel was dropped.
+    pub dropped_alpha: bool,
+}
+
+/// A validated exposure bracket: at least two frames of one shape and bit depth, with distinct
+/// positive times, sorted by time (shortest first).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bracket {
+    /// The frames, shortest exposure first.
+    pub frames: Vec<BracketFrame>,
+}
+
+impl Bracket {
+    /// Shutter times Δt [s], in frame order.
+    pub fn times_s(&self) -> Vec<f64> {
+        self.frames.iter().map(|f| f.time_s).collect()
+    }
+
+    /// The common shape of the frames, e.g. `6000×4000 RGB 8-bit`.
+    pub fn describe(&self) -> String {
+        self.frames[0].frame.describe()
+    }
+
+    /// Checks that `frame` (e.g. a dark frame read from `path`) has the bracket's size, channel count
+    /// and bit depth.
+    ///
+    /// # Errors
+    /// [`BracketError::ShapeMismatch`] naming both files.
+    pub fn check_same_shape(&self, frame: &CameraFrame, path: &Path) -> Result<(), BracketError> {
+        check_shape(&self.frames[0].frame, &self.frames[0].path, frame, path)
+    }
+}
+
+fn check_shape(
+    first: &CameraFrame,
+    first_path: &Path,
+    frame: &CameraFrame,
+    path: &Path,
+) -> Result<(), BracketError> {
+    let same = first.width() == frame.width()
+        && first.height() == frame.height()
+        && first.channels() == frame.channels()
+        && first.bit_depth() == frame.bit_depth();
+    if same {
+        Ok(())
+    } else {
+        Err(BracketError::ShapeMismatch {
+            path: path.to_path_buf(),
+            found: frame.describe(),
+            first: first_path.to_path_buf(),
+            expected: describe_shape(
+                first.width(),
+                first.height(),
+                first.channels(),
+                first.bit_depth(),
+            ),
+        })
+    }
+}
+
+/// Where a frame's exposure time comes from.
+#[derive(Debug, Clone, PartialEq)]
+enum TimeOf {
+    Known { time_s: f64, where_: String },
+    Exif,
+}
+
+/// Reads an exposure bracket.
+///
+/// - `images` non-empty, `exposures` given: the times of those images are looked up in the CSV
+///   (every image must be listed; extra CSV lines are ignored).
+/// - `images` empty, `exposures` given: every file listed in the CSV is read.
+/// - `exposures` absent: times come from each file's EXIF `ExposureTime`.
+///
+/// Frames are decoded in parallel on rayon's pool; `on_frame_read` is called (from any thread)
+/// after each frame is decoded, e.g. to advance a progress bar.
+///
+/// # Errors
+/// Any [`BracketError`]; the first failing file (in the order given) is reported.
+pub fn read_bracket(
+    images: &[PathBuf],
+    exposures: Option<&Path>,
+    on_frame_read: &(dyn Fn(&Path) + Sync),
+) -> Result<Bracket, BracketError> {
+    let plan: Vec<(PathBuf, TimeOf)> = match exposures {
+        Some(csv) => {
+            let entries = read_exposures_csv(csv)?;
+            if images.is_empty() {
+                entries
+                    .into_iter()
+                    .map(|e| {
+                        let where_ = format!("{}, line {}", csv.display(), e.line);
+                        (
+                            e.path,
+                            TimeOf::Known {
+                                time_s: e.time_s,
+                                where_,
+                            },
+                        )
+                    })
+                    .collect()
+            } else {
+                let mut by_key: HashMap<PathBuf, &ExposureEntry> = HashMap::new();
+                for e in &entries {
+                    by_key.entry(path_key(&e.path)).or_insert(e);
+                }
+                images
+                    .iter()
+                    .map(|image| {
+                        let entry = by_key.get(&path_key(image)).ok_or_else(|| {
+                            BracketError::MissingTime {
+                                image: image.clone(),
+                                detail: format!(
+                                    "it is not listed in {}; add a line `{},<seconds>`",
+                                    csv.display(),
+                                    image.file_name().map_or_else(
+                                        || image.display().to_string(),
+                                        |n| n.to_string_lossy().into_owned()
+                                    )
+                                ),
+                            }
+                        })?;
+                        let where_ = format!("{}, line {}", csv.display(), entry.line);
+                        Ok((
+                            image.clone(),
+                            TimeOf::Known {
+                                time_s: entry.time_s,
+                                where_,
+                            },
+                        ))
+                    })
+                    .collect::<Result<_, BracketError>>()?
+            }
+        }
+        None => images.iter().map(|p| (p.clone(), TimeOf::Exif)).collect(),
+    };
+    if plan.len() < 2 {
+        return Err(BracketError::TooFewImages { count: plan.len() });
+    }
+    let mut seen: HashMap<PathBuf, ()> = HashMap::new();
+    for (path, _) in &plan {
+        if seen.insert(path_key(path), ()).is_some() {
+            return Err(BracketError::DuplicateImage { path: path.clone() });
+        }
+    }
+    // Times known up front are checked before the (slow) decoding.
+    let known: Vec<(PathBuf, f64)> = plan
+        .iter()
+        .filter_map(|(p, t)| match t {
+            TimeOf::Known { time_s, .. } => Some((p.clone(), *time_s)),
+            TimeOf::Exif => None,
+        })
+        .collect();
+    check_distinct_times(&known)?;
+
+    let decoded: Vec<Result<BracketFrame, BracketError>> = plan
+        .par_iter()
+        .map(|(path, time)| {
+            let bytes = std::fs::read(path).map_err(|source| ImageFileError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            let time_s = match time {
+                TimeOf::Known { time_s, .. } => *time_s,
+                TimeOf::Exif => exif_exposure_time(&bytes, path)?,
+            };
+            let decoded = decode_camera_frame(&bytes, path)?;
+            drop(bytes);
+            on_frame_read(path);
+            Ok(BracketFrame {
+                path: path.clone(),
+                time_s,
+                frame: decoded.frame,
+                dropped_alpha: decoded.dropped_alpha,
+            })
+        })
+        .collect();
+    let frames: Vec<BracketFrame> = decoded.into_iter().collect::<Result<_, _>>()?;
+
+    for f in &frames[1..] {
+        check_shape(&frames[0].frame, &frames[0].path, &f.frame, &f.path)?;
+    }
+    let times: Vec<(PathBuf, f64)> = frames.iter().map(|f| (f.path.clone(), f.time_s)).collect();
+    check_distinct_times(&times)?;
+    let mut frames = frames;
+    frames.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    Ok(Bracket { frames })
+}
+
+/// Two times closer than one part in 10⁶ count as the same shutter speed.
+fn check_distinct_times(times: &[(PathBuf, f64)]) -> Result<(), BracketError> {
+    let mut sorted: Vec<&(PathBuf, f64)> = times.iter().collect();
+    sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
+    for pair in sorted.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        if (b.1 - a.1).abs() <= 1e-6 * b.1.abs() {
+            // Report in the order the user gave them.
+            let (first, second) =
+                if times.iter().position(|t| t.0 == a.0) < times.iter().position(|t| t.0 == b.0) {
+                    (a, b)
+                } else {
+                    (b, a)
+                };
+            return Err(BracketError::DuplicateTime {
+                first: first.0.clone(),
+                second: second.0.clone(),
+                time_s: a.1,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A key under which two spellings of one existing file compare equal.
+fn path_key(path: &Path) -> PathBuf {
+    std::fs::canonicalize(path).unwrap_or_else(|_| path.components().collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn times_parse_as_decimals_and_fractions() {
+        assert_eq!(parse_time("0.5"), Some(0.5));
+        assert_eq!(parse_time("1/600"), Some(1.0 / 600.0));
+        assert_eq!(parse_time("2e-3"), Some(2e-3));
+        assert_eq!(parse_time("1/0"), None);
+        assert_eq!(parse_time("fast"), None);
+    }
+
+    #[test]
+    fn equal_times_are_refused_naming_both_files() {
+        let times = vec![
+            (PathBuf::from("a.png"), 0.01),
+            (PathBuf::from("b.png"), 0.02),
+            (PathBuf::from("c.png"), 0.01),
+        ];
+        match check_distinct_times(&times) {
+            Err(BracketError::DuplicateTime { first, second, .. }) => {
+                assert_eq!(
+                    (first, second),
+                    (PathBuf::from("a.png"), PathBuf::from("c.png"))
+                );
+            }
+            other => panic!("expected DuplicateTime, got {other:?}"),
+        }
+    }
+}

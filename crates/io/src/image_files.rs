@@ -1,0 +1,481 @@
+//! Image files: camera frames (PNG, TIFF, JPEG; 8- or 16-bit; grey or RGB) and float radiance maps
+//! (OpenEXR, Radiance HDR).
+//!
+//! Decoding only: no pixel maths happens here (that is `scatterfit-imaging`'s job). A camera frame is
+//! kept at its stored bit depth ([`CameraFrame`]); an alpha channel is dropped and the caller is told
+//! ([`DecodedFrame::dropped_alpha`]). Radiance maps are `ImageBuf<f32>` with 1 (grey, EXR channel
+//! `Y`) or 3 (RGB) channels. Writes go through [`crate::atomic::write_atomic`].
+
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use scatterfit_imaging::ImageBuf;
+
+/// What can go wrong reading or writing an image file. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ImageFileError {
+    /// The file could not be opened or read.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The file could not be written (the target is left untouched).
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The bytes are not an image of a format we read, or the image is corrupt.
+    #[error(
+        "cannot decode {} as an image ({source}); give a PNG, TIFF or JPEG camera frame \
+         (or an EXR/HDR radiance map where one is expected)",
+        path.display()
+    )]
+    Decode {
+        /// The file.
+        path: PathBuf,
+        /// The decoder's error.
+        source: image::ImageError,
+    },
+    /// The OpenEXR library rejected the file.
+    #[error("cannot read or write {} as OpenEXR: {source}", path.display())]
+    Exr {
+        /// The file.
+        path: PathBuf,
+        /// The OpenEXR library's error.
+        source: exr::error::Error,
+    },
+    /// The image decodes but its kind is not the one expected here (e.g. float data as a camera
+    /// frame, 8-bit data as a radiance map, EXR channels that are neither `R,G,B` nor `Y`).
+    #[error("{}: {detail}", path.display())]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// What was found and what to do.
+        detail: String,
+    },
+}
+
+/// A camera frame at its stored bit depth.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraFrame {
+    /// 8 bits per sample (PNG, TIFF, JPEG).
+    U8(ImageBuf<u8>),
+    /// 16 bits per sample (PNG, TIFF).
+    U16(ImageBuf<u16>),
+}
+
+impl CameraFrame {
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        match self {
+            Self::U8(b) => b.width(),
+            Self::U16(b) => b.width(),
+        }
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        match self {
+            Self::U8(b) => b.height(),
+            Self::U16(b) => b.height(),
+        }
+    }
+
+    /// Channels per pixel: 1 (grey) or 3 (RGB).
+    pub fn channels(&self) -> usize {
+        match self {
+            Self::U8(b) => b.channels(),
+            Self::U16(b) => b.channels(),
+        }
+    }
+
+    /// Bits per sample: 8 or 16.
+    pub fn bit_depth(&self) -> u32 {
+        match self {
+            Self::U8(_) => 8,
+            Self::U16(_) => 16,
+        }
+    }
+
+    /// A short description, e.g. `6000×4000 RGB 8-bit`.
+    pub fn describe(&self) -> String {
+        describe_shape(
+            self.width(),
+            self.height(),
+            self.channels(),
+            self.bit_depth(),
+        )
+    }
+}
+
+/// `6000×4000 RGB 8-bit`.
+pub(crate) fn describe_shape(width: usize, height: usize, channels: usize, bits: u32) -> String {
+    let kind = match channels {
+        1 => "grey".to_string(),
+        3 => "RGB".to_string(),
+        n => format!("{n}-channel"),
+    };
+    format!("{width}×{height} {kind} {bits}-bit")
+}
+
+/// A decoded camera frame and what happened on the way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DecodedFrame {
+    /// The pixels.
+    pub frame: CameraFrame,
+    /// True if the file had an alpha channel, which was dropped.
+    pub dropped_alpha: bool,
+}
+
+/// Reads a camera frame (PNG, TIFF or JPEG; 8- or 16-bit; grey, grey+alpha, RGB or RGBA).
+///
+/// # Errors
+/// [`ImageFileError::Read`] if the file cannot be read, [`ImageFileError::Decode`] if it is not a
+/// readable image, [`ImageFileError::Unsupported`] for float images.
+pub fn read_camera_frame(path: &Path) -> Result<DecodedFrame, ImageFileError> {
+    let bytes = read_bytes(path)?;
+    decode_camera_frame(&bytes, path)
+}
+
+/// Decodes a camera frame from the bytes of a file; `path` is only used in error messages.
+///
+/// # Errors
+/// As [`read_camera_frame`].
+pub fn decode_camera_frame(bytes: &[u8], path: &Path) -> Result<DecodedFrame, ImageFileError> {
+    use image::DynamicImage as D;
+    let image = decode_any(bytes, path)?;
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    let buf_err = |e: scatterfit_imaging::ShapeError| ImageFileError::Unsupported {
+        path: path.to_path_buf(),
+        detail: format!("the decoded image is empty or inconsistent ({e}); give a non-empty frame"),
+    };
+    let (frame, dropped_alpha) = match image {
+        D::ImageLuma8(b) => (
+            CameraFrame::U8(ImageBuf::new(w, h, 1, b.into_raw()).map_err(buf_err)?),
+            false,
+        ),
+        D::ImageRgb8(b) => (
+            CameraFrame::U8(ImageBuf::new(w, h, 3, b.into_raw()).map_err(buf_err)?),
+            false,
+        ),
+        D::ImageLuma16(b) => (
+            CameraFrame::U16(ImageBuf::new(w, h, 1, b.into_raw()).map_err(buf_err)?),
+            false,
+        ),
+        D::ImageRgb16(b) => (
+            CameraFrame::U16(ImageBuf::new(w, h, 3, b.into_raw()).map_err(buf_err)?),
+            false,
+        ),
+        D::ImageLumaA8(b) => {
+            let data = drop_alpha(b.as_raw(), 2);
+            (
+                CameraFrame::U8(ImageBuf::new(w, h, 1, data).map_err(buf_err)?),
+                true,
+            )
+        }
+        D::ImageRgba8(b) => {
+            let data = drop_alpha(b.as_raw(), 4);
+            (
+                CameraFrame::U8(ImageBuf::new(w, h, 3, data).map_err(buf_err)?),
+                true,
+            )
+        }
+        D::ImageLumaA16(b) => {
+            let data = drop_alpha(b.as_raw(), 2);
+            (
+                CameraFrame::U16(ImageBuf::new(w, h, 1, data).map_err(buf_err)?),
+                true,
+            )
+        }
+        D::ImageRgba16(b) => {
+            let data = drop_alpha(b.as_raw(), 4);
+            (
+                CameraFrame::U16(ImageBuf::new(w, h, 3, data).map_err(buf_err)?),
+                true,
+            )
+        }
+        D::ImageRgb32F(_) | D::ImageRgba32F(_) => {
+            return Err(ImageFileError::Unsupported {
+                path: path.to_path_buf(),
+                detail: "this is a floating-point image, not a camera frame; an already merged \
+                         radiance map goes straight to `scatterfit profile`"
+                    .into(),
+            });
+        }
+        other => {
+            return Err(ImageFileError::Unsupported {
+                path: path.to_path_buf(),
+                detail: format!(
+                    "pixel layout {:?} is not supported; save the frame as 8- or 16-bit grey or RGB",
+                    other.color()
+                ),
+            });
+        }
+    };
+    Ok(DecodedFrame {
+        frame,
+        dropped_alpha,
+    })
+}
+
+/// Keeps the first `stride − 1` samples of every `stride` (drops a trailing alpha sample).
+fn drop_alpha<T: Copy>(data: &[T], stride: usize) -> Vec<T> {
+    let keep = stride - 1;
+    let mut out = Vec::with_capacity(data.len() / stride * keep);
+    for px in data.chunks_exact(stride) {
+        out.extend_from_slice(&px[..keep]);
+    }
+    out
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageFileError> {
+    std::fs::read(path).map_err(|source| ImageFileError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn decode_any(bytes: &[u8], path: &Path) -> Result<image::DynamicImage, ImageFileError> {
+    let decode_err = |source| ImageFileError::Decode {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|source| ImageFileError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    if reader.format().is_none()
+        && let Ok(format) = image::ImageFormat::from_path(path)
+    {
+        reader.set_format(format);
+    }
+    // A 24-MP RGBA float image is 384 MB, above the `image` crate's default 512 MiB cap only for
+    // larger sensors; a measurement rig's files are trusted input, so allow up to 8 GiB.
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(8 << 30);
+    reader.limits(limits);
+    reader.decode().map_err(decode_err)
+}
+
+/// File formats for float radiance maps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RadianceFormat {
+    /// OpenEXR, 32-bit float samples, channels `R,G,B` or `Y`, lossless (RLE) compression.
+    Exr,
+    /// Radiance RGBE (`.hdr`): RGB only (a grey map is written as three equal channels), about 1 %
+    /// precision (8-bit mantissa, shared exponent).
+    Hdr,
+}
+
+impl RadianceFormat {
+    /// The format a file name asks for: `.exr` or `.hdr` (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "exr" => Some(Self::Exr),
+            "hdr" | "rgbe" | "pic" => Some(Self::Hdr),
+            _ => None,
+        }
+    }
+}
+
+/// Reads a float radiance map: OpenEXR (channels `R,G,B` → 3 channels, or `Y` → 1) or Radiance HDR
+/// (3 channels). Float TIFF is accepted too (through the `image` crate).
+///
+/// # Errors
+/// [`ImageFileError`] naming the file: unreadable, not a float image, or unsupported EXR channels.
+pub fn read_radiance(path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
+    let bytes = read_bytes(path)?;
+    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        return read_exr(&bytes, path);
+    }
+    use image::DynamicImage as D;
+    let image = decode_any(&bytes, path)?;
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    let buf_err = |e: scatterfit_imaging::ShapeError| ImageFileError::Unsupported {
+        path: path.to_path_buf(),
+        detail: format!("decoder returned an inconsistent buffer: {e}"),
+    };
+    match image {
+        D::ImageRgb32F(b) => ImageBuf::new(w, h, 3, b.into_raw()).map_err(buf_err),
+        D::ImageRgba32F(b) => ImageBuf::new(w, h, 3, drop_alpha(b.as_raw(), 4)).map_err(buf_err),
+        other => Err(ImageFileError::Unsupported {
+            path: path.to_path_buf(),
+            detail: format!(
+                "expected a floating-point radiance map (EXR or HDR) but found {:?} integer pixels; \
+                 merge camera frames into a radiance map with `scatterfit merge` first",
+                other.color()
+            ),
+        }),
+    }
+}
+
+fn read_exr(bytes: &[u8], path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
+    use exr::prelude::*;
+    let exr_err = |source| ImageFileError::Exr {
+        path: path.to_path_buf(),
+        source,
+    };
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(exr_err)?;
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let list = &layer.channel_data.list;
+    let find = |name: &str| list.iter().find(|c| c.name.eq_case_insensitive(name));
+    let names: Vec<String> = list.iter().map(|c| c.name.to_string()).collect();
+    let picked: Vec<_> = match (find("R"), find("G"), find("B"), find("Y")) {
+        (Some(r), Some(g), Some(b), _) => vec![r, g, b],
+        (None, None, None, Some(y)) => vec![y],
+        _ => {
+            return Err(ImageFileError::Unsupported {
+                path: path.to_path_buf(),
+                detail: format!(
+                    "OpenEXR channels [{}] are neither R,G,B nor Y; save the radiance map with \
+                     R,G,B (or a single Y) channels",
+                    names.join(", ")
+                ),
+            });
+        }
+    };
+    let channels = picked.len();
+    let planes: Vec<Vec<f32>> = picked
+        .iter()
+        .map(|c| c.sample_data.values_as_f32().collect())
+        .collect();
+    let mut data = vec![0f32; w * h * channels];
+    for (c, plane) in planes.iter().enumerate() {
+        for (dst, &v) in data.iter_mut().skip(c).step_by(channels).zip(plane) {
+            *dst = v;
+        }
+    }
+    ImageBuf::new(w, h, channels, data).map_err(|e| ImageFileError::Unsupported {
+        path: path.to_path_buf(),
+        detail: format!("inconsistent OpenEXR data window: {e}"),
+    })
+}
+
+/// Writes a float radiance map atomically, in the format its extension names (`.exr` or `.hdr`).
+///
+/// EXR keeps 32-bit floats exactly, with channels `R,G,B` (3 channels) or `Y` (1 channel). HDR
+/// (RGBE) keeps about 1 % precision and only RGB: a grey map is written as three equal channels.
+///
+/// # Errors
+/// [`ImageFileError::Unsupported`] for another extension or a channel count other than 1 or 3;
+/// [`ImageFileError::Write`], [`ImageFileError::Exr`] or [`ImageFileError::Decode`] (encoder) if
+/// writing fails, in which case an existing file at `path` is left untouched.
+pub fn write_radiance(path: &Path, image: &ImageBuf<f32>) -> Result<(), ImageFileError> {
+    let format = RadianceFormat::from_path(path).ok_or_else(|| ImageFileError::Unsupported {
+        path: path.to_path_buf(),
+        detail: "cannot tell the radiance format from the file name; end it in .exr or .hdr".into(),
+    })?;
+    if image.channels() != 1 && image.channels() != 3 {
+        return Err(ImageFileError::Unsupported {
+            path: path.to_path_buf(),
+            detail: format!(
+                "a radiance map has 1 or 3 channels, not {}",
+                image.channels()
+            ),
+        });
+    }
+    let bytes = match format {
+        RadianceFormat::Exr => encode_exr(image, path)?,
+        RadianceFormat::Hdr => encode_hdr(image, path)?,
+    };
+    crate::atomic::write_atomic(path, &bytes).map_err(|source| ImageFileError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn encode_exr(image: &ImageBuf<f32>, path: &Path) -> Result<Vec<u8>, ImageFileError> {
+    use exr::prelude::*;
+    let (w, h, n) = (image.width(), image.height(), image.channels());
+    let plane =
+        |c: usize| -> Vec<f32> { image.data().iter().skip(c).step_by(n).copied().collect() };
+    let names: &[&str] = if n == 1 { &["Y"] } else { &["R", "G", "B"] };
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = names
+        .iter()
+        .enumerate()
+        .map(|(c, name)| AnyChannel::new(*name, FlatSamples::F32(plane(c))))
+        .collect();
+    let layer = Layer::new(
+        (w, h),
+        LayerAttributes::named("radiance"),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let mut out = Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut out)
+        .map_err(|source| ImageFileError::Exr {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok(out.into_inner())
+}
+
+fn encode_hdr(image: &ImageBuf<f32>, path: &Path) -> Result<Vec<u8>, ImageFileError> {
+    let (w, h, n) = (image.width(), image.height(), image.channels());
+    let pixels: Vec<image::Rgb<f32>> = image
+        .data()
+        .chunks_exact(n)
+        .map(|px| {
+            if n == 1 {
+                image::Rgb([px[0]; 3])
+            } else {
+                image::Rgb([px[0], px[1], px[2]])
+            }
+        })
+        .collect();
+    let mut out = Vec::new();
+    image::codecs::hdr::HdrEncoder::new(&mut out)
+        .encode(&pixels, w, h)
+        .map_err(|source| ImageFileError::Decode {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn drop_alpha_keeps_colour_samples_in_order() {
+        assert_eq!(
+            drop_alpha(&[1u8, 2, 3, 255, 4, 5, 6, 0], 4),
+            vec![1, 2, 3, 4, 5, 6]
+        );
+        assert_eq!(drop_alpha(&[7u16, 1, 9, 1], 2), vec![7, 9]);
+    }
+
+    #[test]
+    fn radiance_format_follows_the_extension() {
+        assert_eq!(
+            RadianceFormat::from_path(Path::new("a/B.EXR")),
+            Some(RadianceFormat::Exr)
+        );
+        assert_eq!(
+            RadianceFormat::from_path(Path::new("x.hdr")),
+            Some(RadianceFormat::Hdr)
+        );
+        assert_eq!(RadianceFormat::from_path(Path::new("x.png")), None);
+    }
+}
