@@ -1,0 +1,525 @@
+//! The photon tracer: MCML's physics (Wang, Jacques & Zheng 1995; physics.md §4.1) in mm units, run
+//! in fixed-size chunks of photons with one random stream per chunk, so that a seed gives the same
+//! result bit for bit whatever the number of threads.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::beam::{Beam, BeamProfile};
+use crate::error::{Result, check};
+use crate::fresnel::{COSZERO, fresnel_mcml};
+use crate::grid::RadialGrid;
+use crate::phase::sample_hg_cos;
+use crate::rng::{PhotonRng, stream};
+use crate::sample::Sample;
+
+/// MCML's roulette threshold `WEIGHT` (physics.md §4.1).
+pub const ROULETTE_THRESHOLD: f64 = 1e-4;
+/// MCML's roulette survival chance `CHANCE` (physics.md §4.1).
+pub const ROULETTE_CHANCE: f64 = 0.1;
+/// Photons per chunk: the unit of work with its own random stream. Fixed, so that results do not
+/// depend on the thread count; 2048 photons are 0.1–20 ms of work, large against rayon's overhead.
+pub const CHUNK_PHOTONS: u64 = 2048;
+/// Chunks traced in parallel before their tallies are summed (in chunk order). Bounds memory by
+/// `WAVE_CHUNKS` tallies whatever the photon count, and sets how often progress is reported.
+const WAVE_CHUNKS: u64 = 64;
+
+/// A Monte Carlo estimate: the mean over photons and its standard error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// The estimate.
+    pub value: f64,
+    /// Its standard error (one standard deviation of the mean).
+    pub stderr: f64,
+}
+
+impl Estimate {
+    /// Mean and standard error of per-photon scores from their sum `s1`, sum of squares `s2` and count.
+    fn from_moments(s1: f64, s2: f64, n: u64) -> Self {
+        let nf = n as f64;
+        let mean = s1 / nf;
+        let var = (s2 / nf - mean * mean).max(0.0);
+        let stderr = if n > 1 {
+            (var / (nf - 1.0)).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        Self {
+            value: mean,
+            stderr,
+        }
+    }
+
+    fn scaled(self, k: f64) -> Self {
+        Self {
+            value: self.value * k,
+            stderr: self.stderr * k,
+        }
+    }
+}
+
+/// A configured simulation: sample, beam, tally grid, photon count and seed.
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    sample: Sample,
+    beam: Beam,
+    grid: RadialGrid,
+    angle_bins: usize,
+    photons: u64,
+    seed: u64,
+}
+
+impl Simulation {
+    /// A simulation of `photons` photons from `beam` into `sample`, tallying Rd(r) on `grid`.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for zero photons.
+    pub fn new(
+        sample: Sample,
+        beam: Beam,
+        grid: RadialGrid,
+        photons: u64,
+        seed: u64,
+    ) -> Result<Self> {
+        check(photons > 0, "photons", 0.0, "trace at least one photon")?;
+        Ok(Self {
+            sample,
+            beam,
+            grid,
+            angle_bins: 0,
+            photons,
+            seed,
+        })
+    }
+
+    /// Also tallies diffuse reflectance by exit angle in `bins` bins uniform in θ ∈ [0, π/2]
+    /// (MCML's `Rd_a`, per steradian); 0 turns the tally off.
+    #[must_use]
+    pub fn with_angle_bins(mut self, bins: usize) -> Self {
+        self.angle_bins = bins;
+        self
+    }
+
+    /// The sample.
+    pub fn sample(&self) -> &Sample {
+        &self.sample
+    }
+    /// The number of photons.
+    pub fn photons(&self) -> u64 {
+        self.photons
+    }
+
+    /// Runs on the current rayon thread pool.
+    pub fn run(&self) -> SimulationResult {
+        self.run_with_progress(&|_| {})
+    }
+
+    /// Runs on the current rayon thread pool, calling `progress(photons_done)` after every wave of
+    /// chunks (from the calling thread).
+    pub fn run_with_progress(&self, progress: &(dyn Fn(u64) + Sync)) -> SimulationResult {
+        let tracer = Tracer::new(self);
+        let chunks = self.photons.div_ceil(CHUNK_PHOTONS);
+        let mut total = Accum::new(self.grid.bins(), self.angle_bins);
+        let mut first = 0;
+        while first < chunks {
+            let last = (first + WAVE_CHUNKS).min(chunks);
+            let wave: Vec<Accum> = (first..last)
+                .into_par_iter()
+                .map(|c| {
+                    let count = CHUNK_PHOTONS.min(self.photons - c * CHUNK_PHOTONS);
+                    let mut acc = Accum::new(self.grid.bins(), self.angle_bins);
+                    let mut rng = stream(self.seed, c);
+                    for _ in 0..count {
+                        tracer.trace(&mut rng, &mut acc);
+                    }
+                    acc
+                })
+                .collect();
+            for acc in &wave {
+                total.add(acc);
+            }
+            first = last;
+            progress((last * CHUNK_PHOTONS).min(self.photons));
+        }
+        total.finish(self, tracer.specular)
+    }
+}
+
+/// What a simulation measured. All quantities are per incident photon weight (fractions), Rd(r) in
+/// mm⁻², the angular tally per steradian.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimulationResult {
+    /// Photons traced.
+    pub photons: u64,
+    /// Seed of the random streams.
+    pub seed: u64,
+    /// Specular reflectance at entry R_sp (exact, not sampled; not part of `rd_total`).
+    pub specular: f64,
+    /// Total diffuse reflectance Rd (excludes R_sp).
+    pub rd_total: Estimate,
+    /// Total transmittance Tt (includes unscattered light; 0 for a half-space).
+    pub transmittance: Estimate,
+    /// Absorbed fraction A.
+    pub absorbed: Estimate,
+    /// R_sp + Rd + Tt + A, which is 1 up to Russian-roulette noise.
+    pub conservation: Estimate,
+    /// The radial grid [mm].
+    pub grid: RadialGrid,
+    /// Rd(r) per annulus of `grid` [mm⁻²]: reflected weight / (photons × annulus area).
+    pub rd_profile: Vec<Estimate>,
+    /// Exit-angle bin edges θ [radians], empty when the tally is off.
+    pub angle_edges: Vec<f64>,
+    /// Diffuse reflectance per exit-angle bin per steradian of solid angle [sr⁻¹].
+    pub rd_angle: Vec<Estimate>,
+}
+
+/// Per-chunk sums of per-photon scores and their squares.
+#[derive(Debug, Clone)]
+struct Accum {
+    rd_w: Vec<f64>,
+    rd_w2: Vec<f64>,
+    ang_w: Vec<f64>,
+    ang_w2: Vec<f64>,
+    /// [R, R², T, T², A, A², R+T+A, (R+T+A)²]
+    sums: [f64; 8],
+}
+
+impl Accum {
+    fn new(bins: usize, angle_bins: usize) -> Self {
+        Self {
+            rd_w: vec![0.0; bins],
+            rd_w2: vec![0.0; bins],
+            ang_w: vec![0.0; angle_bins],
+            ang_w2: vec![0.0; angle_bins],
+            sums: [0.0; 8],
+        }
+    }
+
+    fn add(&mut self, o: &Accum) {
+        for (a, b) in self.rd_w.iter_mut().zip(&o.rd_w) {
+            *a += b;
+        }
+        for (a, b) in self.rd_w2.iter_mut().zip(&o.rd_w2) {
+            *a += b;
+        }
+        for (a, b) in self.ang_w.iter_mut().zip(&o.ang_w) {
+            *a += b;
+        }
+        for (a, b) in self.ang_w2.iter_mut().zip(&o.ang_w2) {
+            *a += b;
+        }
+        for (a, b) in self.sums.iter_mut().zip(&o.sums) {
+            *a += b;
+        }
+    }
+
+    fn finish(self, sim: &Simulation, specular: f64) -> SimulationResult {
+        let n = sim.photons;
+        let s = &self.sums;
+        let rd_profile = (0..sim.grid.bins())
+            .map(|i| {
+                Estimate::from_moments(self.rd_w[i], self.rd_w2[i], n)
+                    .scaled(1.0 / sim.grid.area(i))
+            })
+            .collect();
+        let nb = sim.angle_bins;
+        let angle_edges: Vec<f64> = if nb > 0 {
+            (0..=nb).map(|i| FRAC_PI_2 * i as f64 / nb as f64).collect()
+        } else {
+            Vec::new()
+        };
+        let rd_angle = (0..nb)
+            .map(|i| {
+                let solid = 2.0 * PI * (angle_edges[i].cos() - angle_edges[i + 1].cos());
+                Estimate::from_moments(self.ang_w[i], self.ang_w2[i], n).scaled(1.0 / solid)
+            })
+            .collect();
+        let mut conservation = Estimate::from_moments(s[6], s[7], n);
+        conservation.value += specular;
+        SimulationResult {
+            photons: n,
+            seed: sim.seed,
+            specular,
+            rd_total: Estimate::from_moments(s[0], s[1], n),
+            transmittance: Estimate::from_moments(s[2], s[3], n),
+            absorbed: Estimate::from_moments(s[4], s[5], n),
+            conservation,
+            grid: sim.grid.clone(),
+            rd_profile,
+            angle_edges,
+            rd_angle,
+        }
+    }
+}
+
+/// A layer prepared for tracing: boundaries, coefficients and the indices on both sides.
+#[derive(Debug, Clone, Copy)]
+struct LayerK {
+    z0: f64,
+    z1: f64,
+    sigma_t: f64,
+    inv_sigma_t: f64,
+    /// σa/σt: the fraction of weight deposited at each interaction (implicit capture).
+    absorb: f64,
+    g: f64,
+    n: f64,
+    n_up: f64,
+    n_down: f64,
+    /// Cosine of the critical angle towards the layer above / below (0 when there is none).
+    cos_crit_up: f64,
+    cos_crit_down: f64,
+}
+
+/// Cosine of the critical angle from index `n_i` into `n_t`: √(1 − (n_t/n_i)²) when n_i > n_t, else 0.
+fn cos_critical(n_i: f64, n_t: f64) -> f64 {
+    if n_i > n_t {
+        (1.0 - (n_t / n_i).powi(2)).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// Everything the inner loop reads, precomputed once per simulation.
+#[derive(Debug)]
+struct Tracer<'a> {
+    layers: Vec<LayerK>,
+    grid: &'a RadialGrid,
+    angle_bins: usize,
+    profile: BeamProfile,
+    /// Footprint stretch 1/cos θi along x for an oblique beam.
+    stretch_x: f64,
+    /// Launch direction in the first layer (refracted beam).
+    ux0: f64,
+    uz0: f64,
+    /// R_sp at entry.
+    specular: f64,
+}
+
+impl<'a> Tracer<'a> {
+    fn new(sim: &'a Simulation) -> Self {
+        let s = &sim.sample;
+        let nl = s.layers().len();
+        let mut z = 0.0;
+        let layers = s
+            .layers()
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let sigma_t = l.sigma_a() + l.sigma_s();
+                let k = LayerK {
+                    z0: z,
+                    z1: z + l.thickness(),
+                    sigma_t,
+                    inv_sigma_t: 1.0 / sigma_t,
+                    absorb: l.sigma_a() / sigma_t,
+                    g: l.g(),
+                    n: l.n(),
+                    n_up: if i == 0 {
+                        s.n_above()
+                    } else {
+                        s.layers()[i - 1].n()
+                    },
+                    n_down: if i + 1 == nl {
+                        s.n_below()
+                    } else {
+                        s.layers()[i + 1].n()
+                    },
+                    cos_crit_up: 0.0,
+                    cos_crit_down: 0.0,
+                };
+                let k = LayerK {
+                    cos_crit_up: cos_critical(k.n, k.n_up),
+                    cos_crit_down: cos_critical(k.n, k.n_down),
+                    ..k
+                };
+                z += l.thickness();
+                k
+            })
+            .collect::<Vec<_>>();
+        let theta_i = sim.beam.incidence();
+        let cos_i = theta_i.cos();
+        // Entry: specular reflection (Fresnel, exact) and refraction of the beam (Snell).
+        let entry = fresnel_mcml(s.n_above(), layers[0].n, cos_i);
+        let sin_t = s.n_above() / layers[0].n * theta_i.sin();
+        Self {
+            grid: &sim.grid,
+            angle_bins: sim.angle_bins,
+            profile: sim.beam.profile(),
+            stretch_x: 1.0 / cos_i,
+            ux0: sin_t,
+            uz0: (1.0 - sin_t * sin_t).sqrt(),
+            specular: entry.reflectance,
+            layers,
+        }
+    }
+
+    /// Traces one photon from launch to death and adds its scores to `acc`. No allocation.
+    #[inline]
+    fn trace(&self, rng: &mut PhotonRng, acc: &mut Accum) {
+        // Launch (MCML `LaunchPhoton`): weight 1 − R_sp at the entry point of the beam.
+        let (mut x, mut y) = match self.profile {
+            BeamProfile::Pencil => (0.0, 0.0),
+            BeamProfile::Disk { radius } => {
+                let rho = radius * rng.uniform().sqrt();
+                let (s, c) = (2.0 * PI * rng.uniform()).sin_cos();
+                (rho * c, rho * s)
+            }
+            BeamProfile::Gaussian { radius } => {
+                // I(ρ) ∝ exp(−2ρ²/w²) ⇒ P(ρ > r) = exp(−2r²/w²) ⇒ ρ = w √(−ln ξ / 2).
+                let rho = radius * (-rng.uniform_open0().ln() * 0.5).sqrt();
+                let (s, c) = (2.0 * PI * rng.uniform()).sin_cos();
+                (rho * c, rho * s)
+            }
+        };
+        x *= self.stretch_x;
+        let mut z = 0.0;
+        let (mut ux, mut uy, mut uz) = (self.ux0, 0.0, self.uz0);
+        let mut w = 1.0 - self.specular;
+        let mut layer = 0usize;
+        let mut sleft = 0.0; // dimensionless leftover step (optical depth), MCML's `sleft`
+        let mut absorbed = 0.0;
+        let mut reflected = 0.0;
+        let mut transmitted = 0.0;
+        let last = self.layers.len() - 1;
+        let mut l = self.layers[0];
+        let mut cos_out = 0.0;
+        loop {
+            // StepSizeInTissue: s = −ln ξ / σt (an Exp(1) variate / σt), or the leftover from a
+            // boundary hit.
+            let s = if sleft == 0.0 {
+                rng.exp1() * l.inv_sigma_t
+            } else {
+                let s = sleft * l.inv_sigma_t;
+                sleft = 0.0;
+                s
+            };
+            // HitBoundary: does the step leave the layer? (Tested on the end point, which spares the
+            // division by u_z on steps that stay inside.)
+            let z_end = z + s * uz;
+            if z_end < l.z0 || z_end > l.z1 {
+                let up = uz < 0.0;
+                let z_face = if up { l.z0 } else { l.z1 };
+                let db = (z_face - z) / uz;
+                sleft = (s - db) * l.sigma_t;
+                x += db * ux;
+                y += db * uy;
+                z = z_face;
+                // CrossOrNot: Fresnel decides reflection or transmission (statistical splitting);
+                // beyond the critical angle the photon is reflected without a draw.
+                let (n_t, cos_crit) = if up {
+                    (l.n_up, l.cos_crit_up)
+                } else {
+                    (l.n_down, l.cos_crit_down)
+                };
+                let cos_i = uz.abs();
+                let transmit = cos_i > cos_crit && {
+                    let f = fresnel_mcml(l.n, n_t, cos_i);
+                    cos_out = f.cos_t;
+                    f.reflectance == 0.0 || rng.uniform() > f.reflectance
+                };
+                if transmit {
+                    if up && layer == 0 {
+                        reflected = w;
+                        self.tally_exit(acc, x, y, cos_out, w);
+                        break;
+                    } else if !up && layer == last {
+                        transmitted = w;
+                        break;
+                    }
+                    // Into the neighbouring layer: refract.
+                    let ratio = l.n / n_t;
+                    ux *= ratio;
+                    uy *= ratio;
+                    if up {
+                        uz = -cos_out;
+                        layer -= 1;
+                    } else {
+                        uz = cos_out;
+                        layer += 1;
+                    }
+                    l = self.layers[layer];
+                } else {
+                    uz = -uz;
+                }
+            } else {
+                // Hop.
+                x += s * ux;
+                y += s * uy;
+                z += s * uz;
+                // Drop (implicit capture): deposit w σa/σt.
+                let dw = w * l.absorb;
+                w -= dw;
+                absorbed += dw;
+                // Spin (Henyey–Greenstein, MCML `Spin`).
+                if l.g == 0.0 {
+                    // Isotropic: the new direction is independent of the old one; Marsaglia 1972's
+                    // uniform direction on the sphere from a point of the unit disk.
+                    let (a, b, s2) = rng.unit_disk();
+                    let k = 2.0 * (1.0 - s2).sqrt();
+                    ux = a * k;
+                    uy = b * k;
+                    uz = 1.0 - 2.0 * s2;
+                } else {
+                    let cos_t = sample_hg_cos(l.g, rng.uniform());
+                    // Azimuth ψ uniform in [0, 2π) from a point (a, b) of the unit disk:
+                    // cos ψ = a/√s, sin ψ = b/√s. Folding sin θ = √(1 − cos²θ) and MCML's
+                    // 1/√(1 − u_z²) into one factor k leaves one square root and one division.
+                    let (a, b, s2) = rng.unit_disk();
+                    let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
+                    if uz.abs() > COSZERO {
+                        let k = (sin2_t / s2).sqrt();
+                        ux = k * a;
+                        uy = k * b;
+                        uz = cos_t * uz.signum();
+                    } else {
+                        let perp2 = 1.0 - uz * uz;
+                        // k = sin θ / (√s · √(1 − u_z²)); MCML's last line uses sin θ cos ψ √(1 − u_z²)
+                        // = k a (1 − u_z²).
+                        let k = (sin2_t / (s2 * perp2)).sqrt();
+                        let nux = k * (ux * uz * a - uy * b) + ux * cos_t;
+                        let nuy = k * (uy * uz * a + ux * b) + uy * cos_t;
+                        uz = -k * a * perp2 + uz * cos_t;
+                        ux = nux;
+                        uy = nuy;
+                    }
+                }
+            }
+            // Roulette (MCML: threshold 1e-4, survival chance 0.1).
+            if w < ROULETTE_THRESHOLD {
+                if w == 0.0 || rng.uniform() >= ROULETTE_CHANCE {
+                    break;
+                }
+                w /= ROULETTE_CHANCE;
+            }
+        }
+        let total = reflected + transmitted + absorbed;
+        let s = &mut acc.sums;
+        s[0] += reflected;
+        s[1] += reflected * reflected;
+        s[2] += transmitted;
+        s[3] += transmitted * transmitted;
+        s[4] += absorbed;
+        s[5] += absorbed * absorbed;
+        s[6] += total;
+        s[7] += total * total;
+    }
+
+    /// Records a photon leaving through the top face at (x, y) with exit cosine `cos_out`.
+    #[inline]
+    fn tally_exit(&self, acc: &mut Accum, x: f64, y: f64, cos_out: f64, w: f64) {
+        let r = (x * x + y * y).sqrt();
+        if let Some(i) = self.grid.find(r) {
+            acc.rd_w[i] += w;
+            acc.rd_w2[i] += w * w;
+        }
+        if self.angle_bins > 0 {
+            let theta = cos_out.clamp(0.0, 1.0).acos();
+            let i =
+                ((theta / FRAC_PI_2 * self.angle_bins as f64) as usize).min(self.angle_bins - 1);
+            acc.ang_w[i] += w;
+            acc.ang_w2[i] += w * w;
+        }
+    }
+}

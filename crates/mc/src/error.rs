@@ -1,0 +1,64 @@
+//! Errors of the Monte Carlo crate.
+
+use std::path::PathBuf;
+
+/// What went wrong while configuring or running a simulation, or reading a table.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum McError {
+    /// A physical or numerical parameter is outside its domain.
+    #[error("invalid parameter {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// The parameter's name as the API spells it, e.g. `sigma_a`.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What the domain is, and what to do.
+        reason: &'static str,
+    },
+    /// A query falls outside what a profile table covers.
+    #[error("{name} = {value} is outside the table's range [{min}, {max}]")]
+    OutOfTable {
+        /// Which coordinate, e.g. `albedo_prime`.
+        name: &'static str,
+        /// The requested value.
+        value: f64,
+        /// The table's lower limit.
+        min: f64,
+        /// The table's upper limit.
+        max: f64,
+    },
+    /// Reading or writing a cache file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or folder involved.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A cache file could not be parsed or serialised.
+    #[error("{path}: not a valid table file: {message}")]
+    Format {
+        /// The file involved.
+        path: PathBuf,
+        /// What was wrong.
+        message: String,
+    },
+}
+
+/// Result type of this crate.
+pub type Result<T> = std::result::Result<T, McError>;
+
+/// Returns `Err(InvalidParameter)` unless `ok`.
+pub(crate) fn check(ok: bool, name: &'static str, value: f64, reason: &'static str) -> Result<()> {
+    if ok {
+        Ok(())
+    } else {
+        Err(McError::InvalidParameter {
+            name,
+            value,
+            reason,
+        })
+    }
+}

@@ -1,0 +1,1 @@
+//! Profile tables (in progress).
