@@ -177,7 +177,10 @@ pub fn resample_to_weight_grid(wavelengths_nm: &[f64], values: &[f64]) -> Result
             values.len()
         )));
     }
-    if let Some(w) = wavelengths_nm.windows(2).find(|w| !(w[1] > w[0])) {
+    if let Some(w) = wavelengths_nm
+        .windows(2)
+        .find(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
         return Err(OpticsError::Spectrum(format!(
             "wavelengths must increase strictly ({} nm is followed by {} nm)",
             w[0], w[1]
