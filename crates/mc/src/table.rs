@@ -1,1 +1,464 @@
-//! Profile tables (in progress).
+//! Profile tables: Monte Carlo Rd(r) of a half-space for a grid of reduced albedos α′ at σ′t = 1
+//! mm⁻¹, for one η and g, scaled to any σ′t by the similarity law, plus total Rd(α′).
+//!
+//! Similarity (pbrt's `TabulatedBSSRDF::Sr`, physics.md §2.3): a half-space with coefficients
+//! σ′t·(σa, σs) is the σ′t = 1 half-space with every length divided by σ′t, so
+//! Rd(r; σ′t, α′) = σ′t² R̂(σ′t r; α′) exactly (same g, η). Tables are cached on disk with the
+//! parameters that made them and a format version; a cached file is reused only when both match.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::beam::Beam;
+use crate::engine::Simulation;
+use crate::error::{McError, Result, check};
+use crate::grid::RadialGrid;
+use crate::sample::{Layer, Sample};
+
+/// Version of the table file format; files of another version are rebuilt.
+pub const FORMAT_VERSION: u32 = 1;
+/// Largest reduced albedo of the default grid: at α′ = 1 a half-space has no absorption and photon
+/// paths have unbounded mean length.
+pub const DEFAULT_MAX_ALBEDO: f64 = 0.999;
+
+/// What a table is made of. Two specs that compare equal give the same table bit for bit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TableSpec {
+    /// Relative refractive index η of the half-space (outside index 1).
+    pub eta: f64,
+    /// Henyey–Greenstein asymmetry g (σs = σ′s/(1 − g)).
+    pub g: f64,
+    /// Reduced albedos α′, strictly increasing, in [0, 1).
+    pub albedos: Vec<f64>,
+    /// Radial bin edges in units of the reduced mean free path 1/σ′t (the radii at σ′t = 1 mm⁻¹).
+    pub radial_edges: Vec<f64>,
+    /// Photons traced per albedo.
+    pub photons_per_albedo: u64,
+    /// Seed; albedo i uses seed + i.
+    pub seed: u64,
+}
+
+impl TableSpec {
+    /// The default layout: `albedo_count` albedos equally spaced in √(1 − α′) from α′ = 0 to
+    /// [`DEFAULT_MAX_ALBEDO`] (dense near 1, where profiles change fastest), 64 radial bins, the
+    /// first [0, 0.005), then logarithmic to 200 mean free paths.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for η not finite and > 0, g outside (−1, 1), fewer than 2 albedos or zero
+    /// photons.
+    pub fn new(eta: f64, g: f64, albedo_count: usize, photons_per_albedo: u64) -> Result<Self> {
+        check(
+            albedo_count >= 2,
+            "albedo_count",
+            albedo_count as f64,
+            "need at least 2 albedos",
+        )?;
+        let u_max = (1.0 - DEFAULT_MAX_ALBEDO).sqrt();
+        let albedos = (0..albedo_count)
+            .map(|i| {
+                let t = i as f64 / (albedo_count - 1) as f64;
+                let u = 1.0 + (u_max - 1.0) * t;
+                1.0 - u * u
+            })
+            .collect();
+        let radial_edges = RadialGrid::logarithmic(0.005, 200.0, 64)?.edges().to_vec();
+        let spec = Self {
+            eta,
+            g,
+            albedos,
+            radial_edges,
+            photons_per_albedo,
+            seed: 1,
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// A coarse table that builds in seconds: 12 albedos × 20 000 photons.
+    ///
+    /// # Errors
+    /// As [`TableSpec::new`].
+    pub fn coarse(eta: f64, g: f64) -> Result<Self> {
+        Self::new(eta, g, 12, 20_000)
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// `InvalidParameter` naming the first bad field.
+    pub fn validate(&self) -> Result<()> {
+        check(
+            self.eta.is_finite() && self.eta > 0.0,
+            "eta",
+            self.eta,
+            "η must be finite and > 0",
+        )?;
+        check(
+            self.g.is_finite() && self.g.abs() < 1.0,
+            "g",
+            self.g,
+            "g must lie in (−1, 1)",
+        )?;
+        check(
+            self.photons_per_albedo > 0,
+            "photons_per_albedo",
+            0.0,
+            "need photons",
+        )?;
+        check(
+            self.albedos.len() >= 2,
+            "albedos",
+            self.albedos.len() as f64,
+            "need ≥ 2 albedos",
+        )?;
+        for w in self.albedos.windows(2) {
+            check(
+                w[1] > w[0],
+                "albedos",
+                w[1],
+                "albedos must be strictly increasing",
+            )?;
+        }
+        let (lo, hi) = (self.albedos[0], self.albedos[self.albedos.len() - 1]);
+        check(lo >= 0.0, "albedo_prime", lo, "albedos must be ≥ 0")?;
+        check(
+            hi < 1.0,
+            "albedo_prime",
+            hi,
+            "albedos must be < 1 (α′ = 1 never ends)",
+        )?;
+        RadialGrid::from_edges(self.radial_edges.clone())?;
+        Ok(())
+    }
+
+    /// A short stable hash of the spec (FNV-1a 64 of its JSON), used in the cache file name.
+    pub fn fingerprint(&self) -> String {
+        let json = serde_json::to_string(self).expect("a spec of numbers always serialises");
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in json.bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        format!("{h:016x}")
+    }
+
+    /// The cache file name for this spec.
+    pub fn file_name(&self) -> String {
+        format!(
+            "mc-table-v{FORMAT_VERSION}-eta{:.4}-g{:.3}-{}.json",
+            self.eta,
+            self.g,
+            self.fingerprint()
+        )
+    }
+}
+
+/// A built table: R̂(ρ; α′) per albedo and radial bin at σ′t = 1, with standard errors, and totals.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProfileTable {
+    format: String,
+    version: u32,
+    spec: TableSpec,
+    /// R̂ per (albedo, bin), row-major [mm⁻² at σ′t = 1].
+    rd: Vec<f64>,
+    rd_stderr: Vec<f64>,
+    rd_total: Vec<f64>,
+    rd_total_stderr: Vec<f64>,
+    /// Area-weighted bin centres (optical radii).
+    centers: Vec<f64>,
+}
+
+/// How [`ProfileTable::load_or_build`] obtained its table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CacheStatus {
+    /// Read from a cache file made with the same spec and format.
+    Loaded,
+    /// Simulated and written to the cache (no usable file was there).
+    Built,
+}
+
+const FORMAT_TAG: &str = "scatterfit-mc-profile-table";
+
+impl ProfileTable {
+    /// Simulates the table on the current rayon pool; `progress(done, total)` counts photons.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad spec.
+    pub fn build(spec: &TableSpec, progress: &(dyn Fn(u64, u64) + Sync)) -> Result<Self> {
+        spec.validate()?;
+        let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
+        let bins = grid.bins();
+        let total = spec.photons_per_albedo * spec.albedos.len() as u64;
+        let mut table = Self {
+            format: FORMAT_TAG.to_owned(),
+            version: FORMAT_VERSION,
+            spec: spec.clone(),
+            rd: Vec::with_capacity(bins * spec.albedos.len()),
+            rd_stderr: Vec::with_capacity(bins * spec.albedos.len()),
+            rd_total: Vec::new(),
+            rd_total_stderr: Vec::new(),
+            centers: (0..bins).map(|i| grid.center(i)).collect(),
+        };
+        for (i, &albedo) in spec.albedos.iter().enumerate() {
+            // σ′t = 1: σ′s = α′, σa = 1 − α′.
+            let layer = Layer::from_reduced(albedo, 1.0 - albedo, spec.g, spec.eta, f64::INFINITY)?;
+            let sample = Sample::slab(layer, 1.0)?;
+            let sim = Simulation::new(
+                sample,
+                Beam::pencil(),
+                grid.clone(),
+                spec.photons_per_albedo,
+                spec.seed.wrapping_add(i as u64),
+            )?;
+            let done = spec.photons_per_albedo * i as u64;
+            let result = sim.run_with_progress(&|n| progress(done + n, total));
+            table.rd.extend(result.rd_profile.iter().map(|e| e.value));
+            table
+                .rd_stderr
+                .extend(result.rd_profile.iter().map(|e| e.stderr));
+            table.rd_total.push(result.rd_total.value);
+            table.rd_total_stderr.push(result.rd_total.stderr);
+        }
+        Ok(table)
+    }
+
+    /// The spec that made the table.
+    pub fn spec(&self) -> &TableSpec {
+        &self.spec
+    }
+
+    /// Area-weighted centres of the radial bins [reduced mean free paths].
+    pub fn centers(&self) -> &[f64] {
+        &self.centers
+    }
+
+    /// R̂ of albedo `i` (an index into `spec().albedos`) per radial bin [mm⁻² at σ′t = 1].
+    pub fn profile(&self, i: usize) -> &[f64] {
+        let b = self.centers.len();
+        &self.rd[i * b..(i + 1) * b]
+    }
+
+    /// Standard errors of [`ProfileTable::profile`].
+    pub fn profile_stderr(&self, i: usize) -> &[f64] {
+        let b = self.centers.len();
+        &self.rd_stderr[i * b..(i + 1) * b]
+    }
+
+    /// Total diffuse reflectance (excluding R_sp) at each tabulated albedo, and standard errors.
+    pub fn totals(&self) -> (&[f64], &[f64]) {
+        (&self.rd_total, &self.rd_total_stderr)
+    }
+
+    /// Bracket of α′ in the albedo grid: (index i, weight t) with value = (1 − t)·f[i] + t·f[i+1],
+    /// linear in u = √(1 − α′) (Rd varies like √(1 − α′) near α′ = 1; Jensen 2001's total Rd).
+    fn albedo_bracket(&self, albedo: f64) -> Result<(usize, f64)> {
+        let a = &self.spec.albedos;
+        let (lo, hi) = (a[0], a[a.len() - 1]);
+        if !(albedo >= lo && albedo <= hi) {
+            return Err(McError::OutOfTable {
+                name: "albedo_prime",
+                value: albedo,
+                min: lo,
+                max: hi,
+            });
+        }
+        let i = a.partition_point(|&x| x <= albedo).clamp(1, a.len() - 1) - 1;
+        let u = |x: f64| (1.0 - x).sqrt();
+        let t = (u(albedo) - u(a[i])) / (u(a[i + 1]) - u(a[i]));
+        Ok((i, t))
+    }
+
+    /// R̂(ρ) of albedo row `i` at optical radius ρ, interpolated between bin centres (log-linear where
+    /// both neighbours are positive, else linear; constant inside the first centre).
+    fn row_at(&self, i: usize, rho: f64) -> f64 {
+        let c = &self.centers;
+        let row = self.profile(i);
+        if rho <= c[0] {
+            return row[0];
+        }
+        let j = c.partition_point(|&x| x <= rho).min(c.len() - 1) - 1;
+        let t = (rho - c[j]) / (c[j + 1] - c[j]);
+        let (a, b) = (row[j], row[j + 1]);
+        if a > 0.0 && b > 0.0 {
+            (a.ln() * (1.0 - t) + b.ln() * t).exp()
+        } else {
+            a * (1.0 - t) + b * t
+        }
+    }
+
+    /// Rd(r) [mm⁻²] of a half-space with reduced extinction σ′t [mm⁻¹] and reduced albedo α′, by the
+    /// similarity law Rd(r; σ′t, α′) = σ′t² R̂(σ′t r; α′) (physics.md §2.3), interpolated linearly
+    /// in √(1 − α′) between tabulated albedos and between bin centres in r.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for r < 0 or σ′t ≤ 0 (or not finite); `OutOfTable` for α′ outside the
+    /// tabulated range or σ′t r beyond the last bin centre.
+    pub fn rd(&self, r: f64, sigma_t_prime: f64, albedo_prime: f64) -> Result<f64> {
+        check(
+            r.is_finite() && r >= 0.0,
+            "r",
+            r,
+            "the radius must be finite and ≥ 0 mm",
+        )?;
+        check(
+            sigma_t_prime.is_finite() && sigma_t_prime > 0.0,
+            "sigma_t_prime",
+            sigma_t_prime,
+            "σ′t must be finite and > 0 mm⁻¹",
+        )?;
+        let rho = r * sigma_t_prime;
+        let last = self.centers[self.centers.len() - 1];
+        if rho > last {
+            return Err(McError::OutOfTable {
+                name: "sigma_t_prime * r",
+                value: rho,
+                min: 0.0,
+                max: last,
+            });
+        }
+        let (i, t) = self.albedo_bracket(albedo_prime)?;
+        let v = (1.0 - t) * self.row_at(i, rho) + t * self.row_at(i + 1, rho);
+        Ok(sigma_t_prime * sigma_t_prime * v)
+    }
+
+    /// Total diffuse reflectance Rd(α′) (excluding R_sp), linear in √(1 − α′) between albedos.
+    ///
+    /// # Errors
+    /// `OutOfTable` for α′ outside the tabulated range.
+    pub fn rd_total(&self, albedo_prime: f64) -> Result<f64> {
+        let (i, t) = self.albedo_bracket(albedo_prime)?;
+        Ok((1.0 - t) * self.rd_total[i] + t * self.rd_total[i + 1])
+    }
+
+    /// The reduced albedo α′ whose total diffuse reflectance is `rd` (the inverse of
+    /// [`ProfileTable::rd_total`]; Rd increases with α′).
+    ///
+    /// # Errors
+    /// `OutOfTable` when `rd` lies outside the tabulated totals.
+    pub fn albedo_from_rd_total(&self, rd: f64) -> Result<f64> {
+        let r = &self.rd_total;
+        let a = &self.spec.albedos;
+        let (lo, hi) = (r[0], r[r.len() - 1]);
+        for i in 0..r.len() - 1 {
+            if rd >= r[i] && rd <= r[i + 1] && r[i + 1] > r[i] {
+                let t = (rd - r[i]) / (r[i + 1] - r[i]);
+                let (u0, u1) = ((1.0 - a[i]).sqrt(), (1.0 - a[i + 1]).sqrt());
+                let u = u0 + t * (u1 - u0);
+                return Ok(1.0 - u * u);
+            }
+        }
+        Err(McError::OutOfTable {
+            name: "rd_total",
+            value: rd,
+            min: lo,
+            max: hi,
+        })
+    }
+
+    /// Reads a table file.
+    ///
+    /// # Errors
+    /// `Io` when it cannot be read, `Format` when it is not a table of this format version.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| McError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        let table: Self = serde_json::from_str(&text).map_err(|e| McError::Format {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        let bins = table.spec.radial_edges.len().saturating_sub(1);
+        let rows = table.spec.albedos.len();
+        if table.format != FORMAT_TAG
+            || table.version != FORMAT_VERSION
+            || table.spec.validate().is_err()
+            || table.centers.len() != bins
+            || table.rd.len() != bins * rows
+            || table.rd_stderr.len() != bins * rows
+            || table.rd_total.len() != rows
+            || table.rd_total_stderr.len() != rows
+        {
+            return Err(McError::Format {
+                path: path.to_owned(),
+                message: format!(
+                    "not a {FORMAT_TAG} of version {FORMAT_VERSION}, or inconsistent sizes"
+                ),
+            });
+        }
+        Ok(table)
+    }
+
+    /// Writes the table atomically: a temporary file in the same folder, synced, then renamed.
+    ///
+    /// # Errors
+    /// `Io` on any file-system error (the target is then untouched).
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let io = |source| McError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let json = serde_json::to_vec(self).map_err(|e| McError::Format {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        let dir = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir).map_err(io)?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+        let result = (|| {
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(&json)?;
+            f.sync_all()?;
+            std::fs::rename(&tmp, path)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        result.map_err(io)
+    }
+
+    /// The table for `spec` from the cache folder `dir` when a file made with the same spec and
+    /// format is there, else simulated and saved there.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad spec, `Io` when the cache cannot be written.
+    pub fn load_or_build(
+        spec: &TableSpec,
+        dir: &Path,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<(Self, CacheStatus, PathBuf)> {
+        spec.validate()?;
+        let path = dir.join(spec.file_name());
+        if let Ok(table) = Self::load(&path)
+            && table.spec == *spec
+        {
+            return Ok((table, CacheStatus::Loaded, path));
+        }
+        let table = Self::build(spec, progress)?;
+        table.save(&path)?;
+        Ok((table, CacheStatus::Built, path))
+    }
+}
+
+/// The cache folder: `$SCATTERFIT_CACHE`, else `$XDG_CACHE_HOME/scatterfit`, else
+/// `$HOME/.cache/scatterfit`; `None` when none of these is set.
+pub fn default_cache_dir() -> Option<PathBuf> {
+    let var = |k| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    var("SCATTERFIT_CACHE")
+        .or_else(|| var("XDG_CACHE_HOME").map(|p| p.join("scatterfit")))
+        .or_else(|| var("HOME").map(|p| p.join(".cache").join("scatterfit")))
+}
