@@ -256,7 +256,7 @@ fn accumulate_row(row: &[u8], lut: &[[f32; 2]], ch: usize, num: &mut [f32], den:
 
 /// Merges a linear 16-bit bracket (raw or linear TIFF) with a linear response: E = (v − v_dark)/Δt,
 /// combined as ln E = Σ_j w(v_j)(ln(v_j − v_dark) − ln Δt_j)/Σ_j w(v_j) (Debevec & Malik 1997, eq. 6
-/// with g = ln), the hat weight stretched to [0, saturation]: w(v) = min(v, saturation − v).
+/// with g = ln), the hat weight stretched to the signal range: w(v) = min(v − v_dark, saturation − v).
 /// Radiance is in digital numbers per second.
 ///
 /// `dark`: an optional dark frame, subtracted from the raw values before the logarithm (linear data:
@@ -285,13 +285,8 @@ pub fn merge_linear_u16(
             reason: "must be ≥ 2",
         });
     }
-    let weight = |v: u16| -> f32 {
-        if v >= sat {
-            0.0
-        } else {
-            f32::from(v.min(sat - v))
-        }
-    };
+    // Hat weight over the signal range [dark, saturation] (called with dark < v < saturation).
+    let weight = |v: u16, vd: u16| -> f32 { f32::from((v - vd).min(sat - v)) };
     let ln_t: Vec<f32> = times_s.iter().map(|t| t.ln() as f32).collect();
     let stride = w * ch;
     let mut radiance = vec![0.0f32; w * h * ch];
@@ -322,7 +317,7 @@ pub fn merge_linear_u16(
                         flag |= CLIPPED_LOW;
                         continue;
                     }
-                    let wv = weight(v);
+                    let wv = weight(v, vd);
                     if wv > 0.0 {
                         nu += wv * (f32::from(v - vd).ln() - lt);
                         de += wv;

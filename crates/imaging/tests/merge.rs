@@ -1,0 +1,230 @@
+//! HDR merge: refusals, linear 16-bit merge, dark frames.
+
+use scatterfit_imaging::{
+    CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, ImageBuf, ImagingError, LinearMergeOptions,
+    MergeOptions, ResponseCurve, merge, merge_linear_u16,
+};
+
+fn frames_u8(n: usize) -> Vec<ImageBuf<u8>> {
+    (0..n)
+        .map(|j| ImageBuf::filled(4, 3, 3, 50 + j as u8).unwrap())
+        .collect()
+}
+
+/// Every refusal of the issue: fewer than 2 frames, a time per frame, positive and distinct times,
+/// same shapes, a response with the images' channel count, a dark frame of the right shape.
+#[test]
+fn merge_refuses_bad_brackets() {
+    let resp = ResponseCurve::linear(3).unwrap();
+    let opts = MergeOptions::default();
+    let f = frames_u8(3);
+    let e = |r: Result<_, ImagingError>| r.unwrap_err();
+    assert!(matches!(
+        e(merge(&f[..1], &[1.0], &resp, None, &opts)),
+        ImagingError::TooFewFrames { got: 1 }
+    ));
+    assert!(matches!(
+        e(merge(&f, &[1.0, 2.0], &resp, None, &opts)),
+        ImagingError::TimeCountMismatch { .. }
+    ));
+    assert!(matches!(
+        e(merge(&f, &[1.0, 0.0, 2.0], &resp, None, &opts)),
+        ImagingError::NonPositiveTime { index: 1, .. }
+    ));
+    assert!(matches!(
+        e(merge(&f, &[1.0, f64::NAN, 2.0], &resp, None, &opts)),
+        ImagingError::NonPositiveTime { index: 1, .. }
+    ));
+    assert!(matches!(
+        e(merge(&f, &[1.0, 2.0, 1.0], &resp, None, &opts)),
+        ImagingError::DuplicateTime {
+            first: 0,
+            second: 2,
+            ..
+        }
+    ));
+    let mut g = frames_u8(2);
+    g.push(ImageBuf::filled(4, 3, 1, 9u8).unwrap());
+    let err = e(merge(&g, &[1.0, 2.0, 3.0], &resp, None, &opts));
+    assert!(
+        matches!(err, ImagingError::ShapeMismatch { ref what, .. } if what == "frame 2"),
+        "{err}"
+    );
+    let resp2 = ResponseCurve::linear(2).unwrap();
+    assert!(matches!(
+        e(merge(&f, &[1.0, 2.0, 3.0], &resp2, None, &opts)),
+        ImagingError::ChannelMismatch { .. }
+    ));
+    let dark = ImageBuf::filled(5, 3, 3, 0u8).unwrap();
+    assert!(matches!(
+        e(merge(&f, &[1.0, 2.0, 3.0], &resp, Some(&dark), &opts)),
+        ImagingError::ShapeMismatch { .. }
+    ));
+    // A one-channel response is applied to all channels.
+    assert!(
+        merge(
+            &f,
+            &[1.0, 2.0, 3.0],
+            &ResponseCurve::linear(1).unwrap(),
+            None,
+            &opts
+        )
+        .is_ok()
+    );
+    let u: Vec<ImageBuf<u16>> = (0..2)
+        .map(|_| ImageBuf::filled(4, 3, 1, 9u16).unwrap())
+        .collect();
+    let lin = LinearMergeOptions::default();
+    assert!(matches!(
+        e(merge_linear_u16(&u, &[1.0, 1.0], None, &lin)),
+        ImagingError::DuplicateTime { .. }
+    ));
+    let bad = LinearMergeOptions {
+        saturation: 1,
+        ..lin
+    };
+    assert!(matches!(
+        e(merge_linear_u16(&u, &[1.0, 2.0], None, &bad)),
+        ImagingError::InvalidOption { .. }
+    ));
+}
+
+/// Linear 16-bit data with a dark offset: E·Δt + dark, rounded and clipped at 60 000 (a sensor that
+/// clips below 65 535). With the dark frame subtracted the merge returns E in counts per second to
+/// 0.1 % wherever some frame has ≥ 1000 counts of signal; without it, a pixel of 2 counts/s is
+/// biased far upwards (check that the subtraction matters). Saturated-everywhere pixels are
+/// flagged high, with the documented lower bound (59 999 − dark)/Δt_min as fill.
+#[test]
+fn linear_u16_merge_with_dark_frame() {
+    let (w, h) = (64, 8);
+    let times = [0.001, 0.01, 0.1, 1.0];
+    let e = |x: usize, y: usize| -> f64 {
+        if y == 0 {
+            1e9
+        } else {
+            2.0 * 10f64.powf(7.0 * x as f64 / (w - 1) as f64)
+        }
+    };
+    let dark_v = |x: usize, y: usize| -> u16 { 400 + ((x * 7 + y * 13) % 50) as u16 };
+    let sat = 60_000u16;
+    let frames: Vec<ImageBuf<u16>> = times
+        .iter()
+        .map(|t| {
+            let data = (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    (e(x, y) * t + f64::from(dark_v(x, y)))
+                        .round()
+                        .min(f64::from(sat)) as u16
+                })
+                .collect();
+            ImageBuf::new(w, h, 1, data).unwrap()
+        })
+        .collect();
+    let dark = ImageBuf::new(
+        w,
+        h,
+        1,
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| dark_v(x, y)))
+            .collect(),
+    )
+    .unwrap();
+    let opts = LinearMergeOptions {
+        saturation: sat,
+        clipped_fill: ClippedFill::LowerBound,
+    };
+    let hdr = merge_linear_u16(&frames, &times, Some(&dark), &opts).unwrap();
+    for y in 1..h {
+        for x in 0..w {
+            let truth = e(x, y);
+            if truth * times[3] < 1000.0 {
+                continue;
+            }
+            let got = f64::from(hdr.radiance.pixel(x, y).unwrap()[0]);
+            assert!(
+                (got / truth - 1.0).abs() < 1e-3,
+                "({x},{y}): {got} vs {truth}"
+            );
+        }
+    }
+    for x in 0..w {
+        assert_eq!(hdr.clipped.pixel(x, 0).unwrap()[0], CLIPPED_HIGH);
+        let bound = f64::from(hdr.radiance.pixel(x, 0).unwrap()[0]);
+        let expected = (f64::from(sat - 1) - f64::from(dark_v(x, 0))) / times[0];
+        assert!((bound / expected - 1.0).abs() < 1e-5);
+    }
+    assert_eq!(hdr.clipped_count, w);
+    let no_dark = merge_linear_u16(&frames, &times, None, &opts).unwrap();
+    let biased = f64::from(no_dark.radiance.pixel(0, 3).unwrap()[0]);
+    assert!(
+        biased > 100.0,
+        "without the dark frame a 2 counts/s pixel reads {biased}"
+    );
+}
+
+/// 8-bit dark frame with a linear response X(z) = z/128: subtracting in the linearised domain
+/// recovers E, a pixel at the dark level in every frame is flagged low, and without the dark frame
+/// the result is biased.
+#[test]
+fn u8_dark_frame_is_subtracted_in_linear_domain() {
+    let times = [0.25, 0.5, 1.0, 2.0];
+    let dark_code = 20.0f64;
+    // E in units of X per second; Z = round(128·(E·Δt) + dark).
+    let es = [0.05f64, 0.2, 0.6, 0.0];
+    let frames: Vec<ImageBuf<u8>> = times
+        .iter()
+        .map(|t| {
+            let data = es
+                .iter()
+                .map(|e| (128.0 * e * t + dark_code).round().min(255.0) as u8)
+                .collect();
+            ImageBuf::new(4, 1, 1, data).unwrap()
+        })
+        .collect();
+    let dark = ImageBuf::filled(4, 1, 1, dark_code as u8).unwrap();
+    let resp = ResponseCurve::linear(1).unwrap();
+    let hdr = merge(
+        &frames,
+        &times,
+        &resp,
+        Some(&dark),
+        &MergeOptions::default(),
+    )
+    .unwrap();
+    for (x, e) in es.iter().enumerate().take(3) {
+        let got = f64::from(hdr.radiance.pixel(x, 0).unwrap()[0]);
+        // Quantisation: ±0.5 code over ≥ 12 codes of signal in the best frames.
+        assert!((got / e - 1.0).abs() < 0.03, "pixel {x}: {got} vs {e}");
+    }
+    assert_eq!(hdr.clipped.pixel(3, 0).unwrap()[0], CLIPPED_LOW);
+    assert!(hdr.radiance.pixel(3, 0).unwrap()[0].is_nan());
+    let raw = merge(&frames, &times, &resp, None, &MergeOptions::default()).unwrap();
+    assert!(f64::from(raw.radiance.pixel(0, 0).unwrap()[0]) > 2.0 * es[0]);
+}
+
+/// The merge formula itself, on a 2-frame, 1-pixel bracket computed by hand (Debevec & Malik 1997,
+/// eq. 6): Z = (64, 200), Δt = (1, 4), g(z) = ln(z/128) ⇒ ln E = [64(ln ½ − 0) + 55(ln(200/128) − ln 4)]/119.
+#[test]
+fn merge_formula_by_hand() {
+    let f = vec![
+        ImageBuf::new(1, 1, 1, vec![64u8]).unwrap(),
+        ImageBuf::new(1, 1, 1, vec![200u8]).unwrap(),
+    ];
+    let hdr = merge(
+        &f,
+        &[1.0, 4.0],
+        &ResponseCurve::linear(1).unwrap(),
+        None,
+        &MergeOptions::default(),
+    )
+    .unwrap();
+    let ln_e = (64.0 * 0.5f64.ln() + 55.0 * ((200.0f64 / 128.0).ln() - 4.0f64.ln())) / 119.0;
+    let got = f64::from(hdr.radiance.data()[0]);
+    assert!(
+        (got / ln_e.exp() - 1.0).abs() < 1e-6,
+        "{got} vs {}",
+        ln_e.exp()
+    );
+    assert_eq!(hdr.clipped_count, 0);
+}
