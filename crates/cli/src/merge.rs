@@ -1,17 +1,648 @@
-//! `scatterfit merge` (work in progress: see the open issue that owns it).
+//! `scatterfit merge`: an exposure bracket → an HDR radiance map (Debevec & Malik 1997).
+//!
+//! Reads the frames (in parallel), recovers the camera response (or takes a known one), merges,
+//! saves the radiance map (EXR or HDR) and the response (CSV), and prints a summary. 8-bit frames use a
+//! response curve; 16-bit frames are merged as linear data (raw or linear TIFF).
 
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use scatterfit_imaging::{
+    CalibrateOptions, ClippedFill, HdrImage, ImageBuf, LEVELS, LinearMergeOptions, MergeOptions,
+    ResponseCurve,
+};
+use scatterfit_io::bracket::{Bracket, read_bracket};
+use scatterfit_io::image_files::{CameraFrame, read_camera_frame, write_radiance};
+use scatterfit_io::response_csv::{ResponseTable, read_response_csv, write_response_csv};
+use serde::Serialize;
+
+/// What to store for a pixel-channel clipped in every exposure (it is always counted and reported).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Fill {
+    /// NaN: the profile and spot finder skip it.
+    Nan,
+    /// The largest radiance the data prove (saturated) or 0 (dark).
+    LowerBound,
+}
 
 /// Arguments of `scatterfit merge`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
-
-/// Runs `scatterfit merge`.
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`scatterfit merge` is not built yet")
+pub struct Args {
+    /// The frames of the bracket (PNG, TIFF or JPEG; 8- or 16-bit; grey or RGB). May be omitted when
+    /// --exposures lists them.
+    pub images: Vec<PathBuf>,
+    /// Exposure times: a CSV with header `file,time_s` (paths relative to the CSV's folder; times in
+    /// seconds, `0.01` or `1/100`). Without it, times come from each file's EXIF ExposureTime.
+    #[arg(long, value_name = "CSV")]
+    pub exposures: Option<PathBuf>,
+    /// A known camera response (CSV `z,g_r,g_g,g_b`, as written by --response-out) instead of
+    /// recovering one. 8-bit frames only.
+    #[arg(long, value_name = "CSV")]
+    pub response: Option<PathBuf>,
+    /// A dark frame (lens capped, same settings), subtracted before merging.
+    #[arg(long, value_name = "IMAGE")]
+    pub dark: Option<PathBuf>,
+    /// Smoothness weight λ of the response recovery (Debevec & Malik 1997, eq. 3).
+    #[arg(long, default_value_t = 10.0)]
+    pub lambda: f64,
+    /// Sample pixels per channel for the response recovery.
+    #[arg(long, default_value_t = 100)]
+    pub samples: usize,
+    /// 16-bit frames: raw value at and above which a sample counts as saturated.
+    #[arg(long, default_value_t = u16::MAX)]
+    pub saturation: u16,
+    /// Value stored for pixels clipped in every exposure.
+    #[arg(long, value_enum, default_value_t = Fill::Nan)]
+    pub clipped_fill: Fill,
+    /// The radiance map to write (.exr: 32-bit float, lossless; .hdr: Radiance RGBE).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Where to save the camera response (default: beside the output, `<name>.response.csv`).
+    #[arg(long, value_name = "CSV")]
+    pub response_out: Option<PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
-/// Contributes this area's figures to `scatterfit bench`.
-pub fn bench(_args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
-    Ok(Vec::new())
+/// The summary `scatterfit merge` prints.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    /// The frames, shortest exposure first.
+    pub frames: Vec<FrameSummary>,
+    /// Image size and kind, e.g. `6000×4000 RGB 8-bit`.
+    pub image: String,
+    /// Width [px].
+    pub width: usize,
+    /// Height [px].
+    pub height: usize,
+    /// `recovered`, `given` (file) or `linear` (16-bit).
+    pub response: String,
+    /// RMS residual of the response fit per channel (recovered responses only).
+    pub response_rms_residual: Vec<f64>,
+    /// Smallest positive finite radiance (relative units).
+    pub radiance_min: f64,
+    /// Largest finite radiance.
+    pub radiance_max: f64,
+    /// Dynamic range radiance_max / radiance_min, in stops (log2).
+    pub dynamic_range_stops: f64,
+    /// Pixel-channels clipped in every exposure (flagged, stored per --clipped-fill).
+    pub clipped_everywhere_samples: usize,
+    /// Pixels with at least one channel clipped in every exposure.
+    pub clipped_everywhere_pixels: usize,
+    /// The radiance map written.
+    pub output: PathBuf,
+    /// The response CSV written (none for a linear 16-bit merge).
+    pub response_out: Option<PathBuf>,
+    /// Wall time for reading the frames [s].
+    pub read_s: f64,
+    /// Wall time for response recovery and merge [s].
+    pub merge_s: f64,
+}
+
+/// One frame in the summary.
+#[derive(Debug, Serialize)]
+pub struct FrameSummary {
+    /// The file.
+    pub file: PathBuf,
+    /// Shutter time [s].
+    pub time_s: f64,
+}
+
+/// A path's identity for "is this output one of the inputs?": canonical folder + file name.
+fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let parent = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (std::fs::canonicalize(parent), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Refuses to write `output` over any of `inputs`.
+pub(crate) fn refuse_overwrite(output: &Path, what: &str, inputs: &[&Path]) -> anyhow::Result<()> {
+    let out = identity(output);
+    if let Some(input) = inputs.iter().find(|i| identity(i) == out) {
+        bail!(
+            "{what} {} is also an input ({}); inputs are never overwritten — choose another output file",
+            output.display(),
+            input.display()
+        );
+    }
+    Ok(())
+}
+
+fn default_response_out(output: &Path) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map_or_else(|| "radiance".into(), |s| s.to_string_lossy().into_owned());
+    output.with_file_name(format!("{stem}.response.csv"))
+}
+
+/// Reads a response CSV into a curve with 256 levels.
+fn load_response(path: &Path) -> anyhow::Result<ResponseCurve> {
+    let table = read_response_csv(path)?;
+    if table.levels() != LEVELS {
+        bail!(
+            "{}: {} rows, but a response for 8-bit frames lists g(z) for z = 0..255 (256 rows)",
+            path.display(),
+            table.levels()
+        );
+    }
+    let g: Vec<[f64; LEVELS]> = table
+        .g
+        .iter()
+        .map(|c| {
+            let mut t = [0.0; LEVELS];
+            t.copy_from_slice(c);
+            t
+        })
+        .collect();
+    ResponseCurve::from_log_exposure(g)
+        .with_context(|| format!("camera response {}", path.display()))
+}
+
+/// The outcome of reading and merging, before anything is written.
+pub(crate) struct Merged {
+    pub hdr: HdrImage,
+    pub response: Option<ResponseCurve>,
+    pub response_kind: &'static str,
+    pub rms: Vec<f64>,
+    pub read_s: f64,
+    pub merge_s: f64,
+    pub frames: Vec<FrameSummary>,
+    pub image: String,
+}
+
+/// Reads the bracket and merges it (shared by `run` and the benchmark).
+pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merged> {
+    let t0 = Instant::now();
+    let bar = if progress && std::io::stderr().is_terminal() {
+        let n = if args.images.is_empty() {
+            0
+        } else {
+            args.images.len() as u64
+        };
+        let bar = indicatif::ProgressBar::new(n);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "reading frames {bar:30} {pos}/{len} {elapsed}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let bracket: Bracket = read_bracket(&args.images, args.exposures.as_deref(), &|_| bar.inc(1))
+        .context("reading the exposure bracket")?;
+    bar.finish_and_clear();
+    for f in bracket.frames.iter().filter(|f| f.dropped_alpha) {
+        eprintln!("note: {}: alpha channel ignored", f.path.display());
+    }
+    let dark = match &args.dark {
+        Some(path) => {
+            let d = read_camera_frame(path).context("reading the dark frame")?;
+            bracket.check_same_shape(&d.frame, path)?;
+            Some(d.frame)
+        }
+        None => None,
+    };
+    let read_s = t0.elapsed().as_secs_f64();
+    let frames: Vec<FrameSummary> = bracket
+        .frames
+        .iter()
+        .map(|f| FrameSummary {
+            file: f.path.clone(),
+            time_s: f.time_s,
+        })
+        .collect();
+    let image = bracket.describe();
+    let times = bracket.times_s();
+    let t1 = Instant::now();
+    let first = bracket.frames[0].frame.bit_depth();
+    let merged = if first == 8 {
+        let bufs: Vec<ImageBuf<u8>> = bracket
+            .frames
+            .into_iter()
+            .filter_map(|f| match f.frame {
+                CameraFrame::U8(b) => Some(b),
+                _ => None,
+            })
+            .collect();
+        let (response, kind, rms) = match &args.response {
+            Some(path) => (load_response(path)?, "given", Vec::new()),
+            None => {
+                let opts = CalibrateOptions {
+                    samples: args.samples,
+                    lambda: args.lambda,
+                };
+                let cal = scatterfit_imaging::recover_response(&bufs, &times, &opts).context(
+                    "recovering the camera response (or give a known one with --response)",
+                )?;
+                let rms = cal.solutions.iter().map(|s| s.rms_residual).collect();
+                (cal.response, "recovered", rms)
+            }
+        };
+        let dark = dark.and_then(|d| match d {
+            CameraFrame::U8(b) => Some(b),
+            _ => None,
+        });
+        let opts = MergeOptions {
+            clipped_fill: fill(args.clipped_fill),
+        };
+        let hdr = scatterfit_imaging::merge(&bufs, &times, &response, dark.as_ref(), &opts)
+            .context("merging the bracket")?;
+        drop(bufs);
+        Merged {
+            hdr,
+            response: Some(response),
+            response_kind: kind,
+            rms,
+            read_s,
+            merge_s: 0.0,
+            frames,
+            image,
+        }
+    } else {
+        if let Some(path) = &args.response {
+            bail!(
+                "{}: a response curve applies to 8-bit frames; these frames are 16-bit and are merged as \
+                 linear data — drop --response",
+                path.display()
+            );
+        }
+        let bufs: Vec<ImageBuf<u16>> = bracket
+            .frames
+            .into_iter()
+            .filter_map(|f| match f.frame {
+                CameraFrame::U16(b) => Some(b),
+                _ => None,
+            })
+            .collect();
+        let dark = dark.and_then(|d| match d {
+            CameraFrame::U16(b) => Some(b),
+            _ => None,
+        });
+        let opts = LinearMergeOptions {
+            saturation: args.saturation,
+            clipped_fill: fill(args.clipped_fill),
+        };
+        let hdr = scatterfit_imaging::merge_linear_u16(&bufs, &times, dark.as_ref(), &opts)
+            .context("merging the 16-bit bracket")?;
+        Merged {
+            hdr,
+            response: None,
+            response_kind: "linear",
+            rms: Vec::new(),
+            read_s,
+            merge_s: 0.0,
+            frames,
+            image,
+        }
+    };
+    Ok(Merged {
+        merge_s: t1.elapsed().as_secs_f64(),
+        ..merged
+    })
+}
+
+fn fill(f: Fill) -> ClippedFill {
+    match f {
+        Fill::Nan => ClippedFill::Nan,
+        Fill::LowerBound => ClippedFill::LowerBound,
+    }
+}
+
+/// Runs `scatterfit merge`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let mut inputs: Vec<&Path> = args.images.iter().map(PathBuf::as_path).collect();
+    inputs.extend(args.exposures.as_deref());
+    inputs.extend(args.response.as_deref());
+    inputs.extend(args.dark.as_deref());
+    if scatterfit_io::image_files::RadianceFormat::from_path(&args.output).is_none() {
+        bail!(
+            "-o {}: the radiance map must end in .exr or .hdr",
+            args.output.display()
+        );
+    }
+    refuse_overwrite(&args.output, "output", &inputs)?;
+    let response_out = args
+        .response_out
+        .clone()
+        .unwrap_or_else(|| default_response_out(&args.output));
+    refuse_overwrite(&response_out, "--response-out", &inputs)?;
+    if identity(&response_out) == identity(&args.output) {
+        bail!(
+            "--response-out and -o are the same file {}; choose two files",
+            args.output.display()
+        );
+    }
+    // Frame paths listed in the CSV are inputs too.
+    if let Some(csv) = &args.exposures {
+        let listed = scatterfit_io::bracket::read_exposures_csv(csv)?;
+        let listed: Vec<&Path> = listed.iter().map(|e| e.path.as_path()).collect();
+        refuse_overwrite(&args.output, "output", &listed)?;
+        refuse_overwrite(&response_out, "--response-out", &listed)?;
+    }
+
+    let merged = read_and_merge(&args, !args.json)?;
+    let Merged {
+        hdr,
+        response,
+        response_kind,
+        rms,
+        read_s,
+        merge_s,
+        frames,
+        image,
+    } = merged;
+    let (width, height) = (hdr.radiance.width(), hdr.radiance.height());
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for (&v, &m) in hdr.radiance.data().iter().zip(hdr.clipped.data()) {
+        let v = f64::from(v);
+        if m == 0 && v.is_finite() && v > 0.0 {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    let ch = hdr.clipped.channels();
+    let clipped_pixels = hdr
+        .clipped
+        .data()
+        .chunks_exact(ch)
+        .filter(|p| p.iter().any(|&m| m != 0))
+        .count();
+    let response_written = match &response {
+        Some(curve) if response_kind != "given" || args.response_out.is_some() => {
+            let table = ResponseTable {
+                g: curve.tables().iter().map(|t| t.to_vec()).collect(),
+            };
+            write_response_csv(&response_out, &table)?;
+            Some(response_out)
+        }
+        _ => None,
+    };
+    write_radiance(&args.output, &hdr.radiance).context("saving the radiance map")?;
+
+    let summary = Summary {
+        frames,
+        image,
+        width,
+        height,
+        response: response_kind.to_string(),
+        response_rms_residual: rms,
+        radiance_min: if lo.is_finite() { lo } else { f64::NAN },
+        radiance_max: if hi > 0.0 { hi } else { f64::NAN },
+        dynamic_range_stops: if lo.is_finite() && hi > 0.0 {
+            (hi / lo).log2()
+        } else {
+            f64::NAN
+        },
+        clipped_everywhere_samples: hdr.clipped_count,
+        clipped_everywhere_pixels: clipped_pixels,
+        output: args.output.clone(),
+        response_out: response_written,
+        read_s,
+        merge_s,
+    };
+    if args.json {
+        crate::output::print_json(&summary)?;
+    } else {
+        print_summary(&summary);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_summary(s: &Summary) {
+    let t_min = s.frames.first().map_or(f64::NAN, |f| f.time_s);
+    let t_max = s.frames.last().map_or(f64::NAN, |f| f.time_s);
+    println!(
+        "frames        {} × {} ({:.3} s read)",
+        s.frames.len(),
+        s.image,
+        s.read_s
+    );
+    println!("times         {} s … {} s", shutter(t_min), shutter(t_max));
+    for f in &s.frames {
+        println!("  {:>10} s  {}", shutter(f.time_s), f.file.display());
+    }
+    let rms = if s.response_rms_residual.is_empty() {
+        String::new()
+    } else {
+        let v: Vec<String> = s
+            .response_rms_residual
+            .iter()
+            .map(|r| format!("{r:.3}"))
+            .collect();
+        format!(" (weighted RMS residual {})", v.join(", "))
+    };
+    println!("response      {}{rms}", s.response);
+    println!("merge         {:.3} s", s.merge_s);
+    println!(
+        "radiance      {:.4e} … {:.4e} (relative), dynamic range {:.1} stops ({:.1} decades)",
+        s.radiance_min,
+        s.radiance_max,
+        s.dynamic_range_stops,
+        s.dynamic_range_stops * std::f64::consts::LOG10_2
+    );
+    println!(
+        "clipped       {} pixels ({} pixel-channels) clipped in every exposure{}",
+        s.clipped_everywhere_pixels,
+        s.clipped_everywhere_samples,
+        if s.clipped_everywhere_samples > 0 {
+            " — flagged, not estimated"
+        } else {
+            ""
+        }
+    );
+    println!("wrote         {}", s.output.display());
+    if let Some(r) = &s.response_out {
+        println!("wrote         {}", r.display());
+    }
+}
+
+/// `1/600` for short times that are whole fractions, else 4 significant digits.
+fn shutter(t: f64) -> String {
+    if t < 0.5 && t > 0.0 {
+        let inv = 1.0 / t;
+        if (inv - inv.round()).abs() < 1e-6 * inv {
+            return format!("1/{}", inv.round());
+        }
+    }
+    if (1e-3..1e4).contains(&t) {
+        let decimals = (3 - t.log10().floor() as i32).max(0) as usize;
+        format!("{t:.decimals$}")
+    } else {
+        format!("{t:.3e}")
+    }
+}
+
+/// A synthetic spot bracket: a radially decaying radiance (a light spot on a translucent sample)
+/// through a gamma-2.2 camera with a 1 % shot-like noise, 13 shutter times 1/600 s … 3 s.
+pub(crate) fn synthetic_bracket(width: usize, height: usize) -> (Vec<ImageBuf<u8>>, Vec<f64>) {
+    use rayon::prelude::*;
+    let n = 13;
+    let times: Vec<f64> = (0..n)
+        .map(|k| (1.0f64 / 600.0) * (1800.0f64).powf(k as f64 / (n - 1) as f64))
+        .collect();
+    let (cx, cy) = (width as f64 * 0.5 + 0.3, height as f64 * 0.5 - 0.2);
+    let scale = width.min(height) as f64 / 40.0;
+    let frames = times
+        .par_iter()
+        .enumerate()
+        .map(|(j, &t)| {
+            let mut data = vec![0u8; width * height * 3];
+            data.par_chunks_mut(width * 3)
+                .enumerate()
+                .for_each(|(y, row)| {
+                    let mut state =
+                        (y as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (j as u64 + 1);
+                    for x in 0..width {
+                        let r = ((x as f64 - cx).powi(2) + (y as f64 - cy).powi(2)).sqrt();
+                        let e = 200.0 * (-r / scale).exp() / (1.0 + r / scale) + 0.002;
+                        for (c, k) in [1.0, 0.7, 0.45].iter().enumerate() {
+                            state ^= state << 13;
+                            state ^= state >> 7;
+                            state ^= state << 17;
+                            let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                            let x_exp = (e * k * t * (1.0 + 0.02 * u)).clamp(0.0, 1.0);
+                            row[x * 3 + c] = (255.0 * x_exp.powf(1.0 / 2.2)).round() as u8;
+                        }
+                    }
+                });
+            ImageBuf::new(width, height, 3, data).expect("width × height × 3 samples")
+        })
+        .collect();
+    (frames, times)
+}
+
+/// Writes a bracket as fast-compressed PNGs plus `exposures.csv` into `dir`.
+pub(crate) fn write_bracket_png(
+    dir: &Path,
+    frames: Vec<ImageBuf<u8>>,
+    times: &[f64],
+) -> anyhow::Result<PathBuf> {
+    use rayon::prelude::*;
+    frames
+        .into_par_iter()
+        .enumerate()
+        .try_for_each(|(j, f)| -> anyhow::Result<()> {
+            let path = dir.join(format!("frame_{j:02}.png"));
+            Ok(scatterfit_io::image_files::write_camera_frame(
+                &path,
+                &CameraFrame::U8(f),
+            )?)
+        })?;
+    let mut csv = String::from("file,time_s\n");
+    for (j, t) in times.iter().enumerate() {
+        csv.push_str(&format!("frame_{j:02}.png,{t}\n"));
+    }
+    let csv_path = dir.join("exposures.csv");
+    scatterfit_io::atomic::write_atomic(&csv_path, csv.as_bytes())
+        .with_context(|| format!("writing {}", csv_path.display()))?;
+    Ok(csv_path)
+}
+
+/// Contributes this area's figures to `scatterfit bench`: the end-to-end merge of a 13-exposure
+/// 24-MP 8-bit RGB bracket (PNG files read from disk, response recovered, merged) and the radial
+/// profile of the 24-MP radiance map. Set `SCATTERFIT_BENCH_BRACKET_DIR` to keep the bracket there
+/// (for timing `scatterfit merge` itself, e.g. under `/usr/bin/time -v`).
+pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
+    use crate::bench::Figure;
+    let (width, height) = if args.quick {
+        (1200, 800)
+    } else {
+        (6000, 4000)
+    };
+    let mp = (width * height) as f64 / 1e6;
+    let threads = rayon::current_num_threads();
+    let (frames, times) = synthetic_bracket(width, height);
+    let keep = std::env::var_os("SCATTERFIT_BENCH_BRACKET_DIR").map(PathBuf::from);
+    let temp = tempfile::tempdir().context("creating a temporary folder for the bracket")?;
+    let dir = match &keep {
+        Some(d) => {
+            std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+            d.clone()
+        }
+        None => temp.path().to_path_buf(),
+    };
+    let csv = write_bracket_png(&dir, frames, &times)?;
+    let merge_args = Args {
+        images: Vec::new(),
+        exposures: Some(csv),
+        response: None,
+        dark: None,
+        lambda: 10.0,
+        samples: 100,
+        saturation: u16::MAX,
+        clipped_fill: Fill::Nan,
+        output: dir.join("radiance.exr"),
+        response_out: None,
+        json: true,
+    };
+    let t0 = Instant::now();
+    let merged = read_and_merge(&merge_args, false)?;
+    let total = t0.elapsed().as_secs_f64();
+    let note = format!("13 × {mp:.0} MP RGB 8-bit PNG, {threads} threads");
+    let mut figures = vec![
+        Figure {
+            name: format!("merge end to end: read + recover + merge, {mp:.0} MP"),
+            value: total,
+            unit: "s".into(),
+            note: format!("{note}; target < 3 s on 2 cores"),
+        },
+        Figure {
+            name: "  of which reading (decode 13 PNG)".into(),
+            value: merged.read_s,
+            unit: "s".into(),
+            note: note.clone(),
+        },
+        Figure {
+            name: "  of which response recovery + merge".into(),
+            value: merged.merge_s,
+            unit: "s".into(),
+            note,
+        },
+    ];
+    let radiance = merged.hdr.radiance;
+    let center = scatterfit_imaging::find_spot_center(&radiance, &Default::default())?;
+    let opts = scatterfit_imaging::ProfileOptions::default();
+    let reps = 10;
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        std::hint::black_box(scatterfit_imaging::radial_profile(
+            &radiance,
+            center.xy(),
+            None,
+            0.1,
+            &opts,
+        )?);
+    }
+    figures.push(Figure {
+        name: format!("radial profile, {mp:.0} MP, r_max 300 px, 1 px rings"),
+        value: t0.elapsed().as_secs_f64() / f64::from(reps) * 1e3,
+        unit: "ms".into(),
+        note: format!("mean of {reps}; target < 50 ms"),
+    });
+    let t0 = Instant::now();
+    std::hint::black_box(scatterfit_imaging::find_spot_center(
+        &radiance,
+        &Default::default(),
+    )?);
+    figures.push(Figure {
+        name: format!("spot centre, {mp:.0} MP"),
+        value: t0.elapsed().as_secs_f64() * 1e3,
+        unit: "ms".into(),
+        note: String::new(),
+    });
+    Ok(figures)
 }

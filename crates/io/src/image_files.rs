@@ -266,6 +266,79 @@ fn decode_any(bytes: &[u8], path: &Path) -> Result<image::DynamicImage, ImageFil
     reader.decode().map_err(decode_err)
 }
 
+/// Writes a camera frame atomically, in the format its extension names: `.png` (8 or 16-bit, fast
+/// compression), `.tif`/`.tiff` (8 or 16-bit) or `.jpg`/`.jpeg` (8-bit, quality 95). For test data,
+/// synthetic brackets and exports; the measurement's own frames are only ever read.
+///
+/// # Errors
+/// [`ImageFileError::Unsupported`] for another extension, a 16-bit JPEG or a channel count other
+/// than 1 or 3; [`ImageFileError::Decode`] (encoder) or [`ImageFileError::Write`] if writing fails.
+pub fn write_camera_frame(path: &Path, frame: &CameraFrame) -> Result<(), ImageFileError> {
+    use image::ExtendedColorType as C;
+    use image::ImageEncoder;
+    let unsupported = |detail: String| ImageFileError::Unsupported {
+        path: path.to_path_buf(),
+        detail,
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let (w, h) = (frame.width() as u32, frame.height() as u32);
+    let (bytes, color): (std::borrow::Cow<'_, [u8]>, C) = match (frame, frame.channels()) {
+        (CameraFrame::U8(b), 1) => (b.data().into(), C::L8),
+        (CameraFrame::U8(b), 3) => (b.data().into(), C::Rgb8),
+        (CameraFrame::U16(b), c @ (1 | 3)) => {
+            // The encoders take 16-bit samples as native-endian bytes.
+            let raw: Vec<u8> = b.data().iter().flat_map(|v| v.to_ne_bytes()).collect();
+            (raw.into(), if c == 1 { C::L16 } else { C::Rgb16 })
+        }
+        (_, c) => {
+            return Err(unsupported(format!(
+                "a camera frame has 1 or 3 channels, not {c}"
+            )));
+        }
+    };
+    let enc_err = |source| ImageFileError::Decode {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut out = Vec::new();
+    match ext.as_str() {
+        "png" => image::codecs::png::PngEncoder::new_with_quality(
+            &mut out,
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Adaptive,
+        )
+        .write_image(&bytes, w, h, color)
+        .map_err(enc_err)?,
+        "tif" | "tiff" => image::codecs::tiff::TiffEncoder::new(Cursor::new(&mut out))
+            .write_image(&bytes, w, h, color)
+            .map_err(enc_err)?,
+        "jpg" | "jpeg" if frame.bit_depth() == 8 => {
+            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, 95)
+                .write_image(&bytes, w, h, color)
+                .map_err(enc_err)?
+        }
+        "jpg" | "jpeg" => {
+            return Err(unsupported(
+                "JPEG holds 8-bit data only; save 16-bit frames as PNG or TIFF".into(),
+            ));
+        }
+        _ => {
+            return Err(unsupported(
+                "cannot tell the image format from the file name; end it in .png, .tif or .jpg"
+                    .into(),
+            ));
+        }
+    }
+    crate::atomic::write_atomic(path, &out).map_err(|source| ImageFileError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// File formats for float radiance maps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RadianceFormat {
