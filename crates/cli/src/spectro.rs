@@ -1,17 +1,241 @@
-//! `scatterfit spectro` (work in progress: see the open issue that owns it).
+//! `scatterfit spectro`: the spectrophotometer stage on one reading.
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use scatterfit_optics::colour::{Lab, Observer};
+use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
+use serde::Serialize;
 
 /// Arguments of `scatterfit spectro`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
-
-/// Runs `scatterfit spectro`.
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`scatterfit spectro` is not built yet")
+pub struct Args {
+    /// Spectrophotometer CSV: `wavelength_nm,sci,sce` (fractions) or `…,sci_pct,sce_pct` (percent).
+    pub file: PathBuf,
+    /// Measured L*a*b* (D65) to use for the colour instead of the SCE spectrum.
+    #[arg(long, num_args = 3, value_names = ["L", "A", "B"], allow_negative_numbers = true)]
+    pub lab: Option<Vec<f64>>,
+    /// Observer of --lab: 10 (the instrument default) or 2.
+    #[arg(long, default_value_t = 10, value_name = "2|10")]
+    pub observer: u32,
+    /// A known η to use instead of the one measured from SCI − SCE (e.g. for matte samples).
+    #[arg(long)]
+    pub eta: Option<f64>,
+    /// Print the full result as JSON on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the full result as JSON to this file (atomically).
+    #[arg(short, long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
 }
 
-/// Contributes this area's figures to `scatterfit bench`.
-pub fn bench(_args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
-    Ok(Vec::new())
+/// The JSON document `scatterfit spectro` writes.
+#[derive(Debug, Serialize)]
+pub struct SpectroReport<'a> {
+    /// The input file.
+    pub file: String,
+    /// The options that shaped the result.
+    pub lab: Option<Lab>,
+    /// Observer of `lab`.
+    pub lab_observer: Option<u32>,
+    /// The analysis.
+    #[serde(flatten)]
+    pub analysis: &'a SpectroAnalysis,
+    /// scatterfit's version.
+    pub version: &'static str,
+}
+
+/// Runs `scatterfit spectro`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let reading = scatterfit_io::spectro::read_spectro_csv(&args.file)?;
+    let options = options_from(&args)?;
+    let analysis =
+        analyse(&reading, &options).with_context(|| format!("{}", args.file.display()))?;
+    if let Some(out) = &args.out {
+        refuse_overwriting_input(out, &args.file)?;
+        crate::output::write_json_file(out, &report(&args, &analysis))?;
+    }
+    if args.json {
+        crate::output::print_json(&report(&args, &analysis))?;
+    } else {
+        print_summary(&args.file, &reading, &analysis);
+    }
+    Ok(if analysis.complete() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
+    let lab = match &args.lab {
+        None => None,
+        Some(v) => {
+            let [l, a, b] = v[..] else {
+                bail!("--lab takes three numbers: L* a* b*")
+            };
+            if !(0.0..=100.0).contains(&l) || !a.is_finite() || !b.is_finite() {
+                bail!("--lab {l} {a} {b}: L* must lie in 0..100 and a*, b* be finite numbers");
+            }
+            let observer = Observer::from_degrees(args.observer)
+                .with_context(|| format!("--observer {}: use 2 or 10", args.observer))?;
+            Some((Lab { l, a, b }, observer))
+        }
+    };
+    if let Some(eta) = args.eta {
+        if !(eta.is_finite() && eta >= 1.0) {
+            bail!("--eta {eta}: the relative refractive index must be a number ≥ 1");
+        }
+    }
+    Ok(SpectroOptions { lab, eta: args.eta })
+}
+
+fn report<'a>(args: &Args, analysis: &'a SpectroAnalysis) -> SpectroReport<'a> {
+    SpectroReport {
+        file: args.file.display().to_string(),
+        lab: analysis_lab(args),
+        lab_observer: args.lab.as_ref().map(|_| args.observer),
+        analysis,
+        version: env!("CARGO_PKG_VERSION"),
+    }
+}
+
+fn analysis_lab(args: &Args) -> Option<Lab> {
+    args.lab.as_ref().map(|v| Lab {
+        l: v[0],
+        a: v[1],
+        b: v[2],
+    })
+}
+
+/// Refuses an output path that is the input file.
+pub fn refuse_overwriting_input(out: &Path, input: &Path) -> anyhow::Result<()> {
+    let same = match (out.canonicalize(), input.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => out == input,
+    };
+    if same {
+        bail!(
+            "refusing to write {} over the input; choose another --out",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) {
+    let wl = &reading.wavelengths_nm;
+    println!(
+        "{}: {} wavelengths, {}–{} nm",
+        file.display(),
+        wl.len(),
+        wl.first().copied().unwrap_or(0.0),
+        wl.last().copied().unwrap_or(0.0)
+    );
+    match a.eta_source {
+        scatterfit_optics::spectro::EtaSource::Given => println!("η = {:.4} (given)", a.eta),
+        scatterfit_optics::spectro::EtaSource::SchlickSciMinusSce => println!(
+            "η = {:.4}  (Schlick at 8° from SCI − SCE = {:.5}, luminance-weighted; exact Fresnel: {})",
+            a.eta,
+            a.specular_mean,
+            a.eta_exact_fresnel
+                .map_or("—".into(), |e| format!("{e:.4}"))
+        ),
+    }
+    let ch = |c: usize| {
+        a.channels[c]
+            .eta_channel
+            .map_or("—".into(), |e| format!("{e:.4}"))
+    };
+    println!(
+        "η per channel: R {}  G {}  B {}  (dispersion {})",
+        ch(0),
+        ch(1),
+        ch(2),
+        if a.dispersion_significant {
+            "significant"
+        } else {
+            "not significant"
+        }
+    );
+    println!(
+        "SCE colour: L*a*b* D65/2° {:.3} {:.3} {:.3}   D65/10° {:.3} {:.3} {:.3}",
+        a.lab_2deg.l, a.lab_2deg.a, a.lab_2deg.b, a.lab_10deg.l, a.lab_10deg.a, a.lab_10deg.b
+    );
+    println!(
+        "            XYZ 2° {:.4} {:.4} {:.4}   10° {:.4} {:.4} {:.4}",
+        a.xyz_2deg.x, a.xyz_2deg.y, a.xyz_2deg.z, a.xyz_10deg.x, a.xyz_10deg.y, a.xyz_10deg.z
+    );
+    let source = match a.colour_source {
+        scatterfit_optics::spectro::ColourSource::SceSpectrum => "SCE spectrum",
+        scatterfit_optics::spectro::ColourSource::Lab2 => "given L*a*b* (2°)",
+        scatterfit_optics::spectro::ColourSource::Lab10 => "given L*a*b* (10°, Bradford to 2°)",
+    };
+    println!(
+        "\nchannel  Rd (linear sRGB, from {source})   α′ (dipole, η = {:.4})",
+        a.eta
+    );
+    for (name, c) in ["R", "G", "B"].iter().zip(&a.channels) {
+        let albedo = c.albedo_prime.map_or("—".to_owned(), |v| format!("{v:.6}"));
+        println!("{name:<8} {:<38.6} {albedo}", c.rd_total);
+    }
+    for c in &a.channels {
+        if let Some(p) = &c.problem {
+            println!("problem: {p}");
+        }
+    }
+    for w in &a.warnings {
+        println!("warning: {w}");
+    }
+}
+
+/// Contributes this area's figures to `scatterfit bench`: the dipole profile with derivatives (300
+/// radii) and the α′ inversion, timed over many repetitions.
+pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
+    use scatterfit_optics::OpticalProperties;
+    use scatterfit_optics::dipole::{Dipole, ProfileSample, albedo_from_rd};
+    use std::hint::black_box;
+
+    let reps = if args.quick { 2_000 } else { 50_000 };
+    let radii: Vec<f64> = (1..=300).map(|i| 0.1 * i as f64).collect();
+    let props = OpticalProperties::new(1.979, 0.0496, 1.2886)?;
+    let mut out = vec![
+        ProfileSample {
+            rd: 0.0,
+            d_sigma_s_prime: 0.0,
+            d_sigma_a: 0.0
+        };
+        radii.len()
+    ];
+    let start = Instant::now();
+    for _ in 0..reps {
+        Dipole::new(black_box(&props)).profile_with_derivatives_into(black_box(&radii), &mut out);
+        black_box(&out);
+    }
+    let profile_us = start.elapsed().as_secs_f64() * 1e6 / reps as f64;
+
+    let rds: Vec<f64> = (1..=99).map(|i| i as f64 / 100.0).collect();
+    let start = Instant::now();
+    for _ in 0..reps / 50 {
+        for &rd in &rds {
+            black_box(albedo_from_rd(black_box(rd), 1.3)?);
+        }
+    }
+    let inversion_us = start.elapsed().as_secs_f64() * 1e6 / ((reps / 50) * rds.len()) as f64;
+    Ok(vec![
+        crate::bench::Figure {
+            name: "dipole Rd(r) + derivatives, 300 radii".into(),
+            value: profile_us,
+            unit: "µs".into(),
+            note: "one thread; issue target < 5 µs".into(),
+        },
+        crate::bench::Figure {
+            name: "α′ inversion (Rd = 0.01…0.99, η = 1.3)".into(),
+            value: inversion_us,
+            unit: "µs".into(),
+            note: "one thread, mean over Rd; issue target < 2 µs".into(),
+        },
+    ])
 }

@@ -24,7 +24,7 @@ pub const SCI_BELOW_SCE_TOLERANCE: f64 = 0.005;
 #[non_exhaustive]
 pub enum SpectroCsvError {
     /// The file could not be read.
-    #[error("{path}: cannot read the spectro CSV: {source}")]
+    #[error("{path}: cannot read the spectro CSV")]
     Io {
         /// The file.
         path: PathBuf,
@@ -207,7 +207,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 reason: "is not a wavelength in nanometres (expected about 360–780)".into(),
             });
         }
-        let mut reflectance = |col: usize, name: &str| -> Result<f64, SpectroCsvError> {
+        let reflectance = |col: usize, name: &str| -> Result<f64, SpectroCsvError> {
             let v = cell(col, name)?;
             if !(0.0..=1.0 / scale).contains(&v) {
                 return Err(SpectroCsvError::BadValue {

@@ -16,7 +16,7 @@ pub enum OpticsError {
     },
     /// A total diffuse reflectance the model cannot produce for this η.
     #[error(
-        "diffuse reflectance Rd = {rd} cannot be produced by the dipole model (η = {eta}): \
+        "diffuse reflectance Rd = {rd:.4} cannot be produced by the dipole model (η = {eta:.4}): \
          it reaches every value in (0, 1] only; {hint}"
     )]
     RdOutOfRange {
