@@ -1,17 +1,268 @@
-//! `scatterfit simulate` (work in progress: see the open issue that owns it).
+//! `scatterfit simulate`: Monte Carlo photon transport (MCML physics) in a slab or half-space, and the
+//! Monte Carlo figures of `scatterfit bench`.
 
+use std::io::IsTerminal;
+use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationResult};
+use serde::Serialize;
 
 /// Arguments of `scatterfit simulate`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
-
-/// Runs `scatterfit simulate`.
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`scatterfit simulate` is not built yet")
+pub struct Args {
+    /// Reduced scattering coefficient σ′s [mm⁻¹].
+    #[arg(long, allow_hyphen_values = true)]
+    pub sigma_s_prime: f64,
+    /// Absorption coefficient σa [mm⁻¹].
+    #[arg(long, allow_hyphen_values = true)]
+    pub sigma_a: f64,
+    /// Relative refractive index η of the material (the outside is air, n = 1).
+    #[arg(long, allow_hyphen_values = true)]
+    pub eta: f64,
+    /// Henyey–Greenstein asymmetry g ∈ (−1, 1); the scattering coefficient is σ′s/(1 − g).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub g: f64,
+    /// Slab thickness [mm]; omit for a half-space.
+    #[arg(long, allow_hyphen_values = true)]
+    pub thickness_mm: Option<f64>,
+    /// Number of photons.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub photons: u64,
+    /// Seed of the random streams (the result is identical for any thread count).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Beam: `pencil`, `disk:R` (uniform disk of radius R mm) or `gauss:R` (Gaussian, 1/e² radius R mm).
+    #[arg(long, default_value = "pencil")]
+    pub beam: String,
+    /// Angle of incidence [degrees] in air (0 = normal).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub incidence_deg: f64,
+    /// Outer radius of the Rd(r) grid [mm].
+    #[arg(long, default_value_t = 10.0)]
+    pub r_max_mm: f64,
+    /// Number of radial bins (uniform width r_max/bins).
+    #[arg(long, default_value_t = 200)]
+    pub bins: usize,
+    /// Also tally reflectance by exit angle in this many bins over [0°, 90°].
+    #[arg(long, default_value_t = 0)]
+    pub angle_bins: usize,
+    /// Accept η < 1 (a material optically thinner than air).
+    #[arg(long)]
+    pub allow_eta_below_one: bool,
+    /// Write the profile as CSV (r_inner_mm, r_outer_mm, r_mm, rd_per_mm2, rd_stderr_per_mm2).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print the whole result as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
-/// Contributes this area's figures to `scatterfit bench`.
-pub fn bench(_args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
-    Ok(Vec::new())
+/// `simulate --json` output: the simulation result plus its inputs and timing.
+#[derive(Debug, Serialize)]
+struct Report<'a> {
+    sigma_s_prime: f64,
+    sigma_a: f64,
+    eta: f64,
+    g: f64,
+    thickness_mm: Option<f64>,
+    beam: &'a str,
+    incidence_deg: f64,
+    elapsed_s: f64,
+    photons_per_s: f64,
+    threads: usize,
+    result: &'a SimulationResult,
+}
+
+/// Parses `pencil`, `disk:R`, `gauss:R` (R in mm).
+fn parse_beam(text: &str) -> anyhow::Result<BeamProfile> {
+    let radius = |r: &str| -> anyhow::Result<f64> {
+        r.trim()
+            .parse::<f64>()
+            .with_context(|| format!("--beam {text}: `{r}` is not a radius in mm"))
+    };
+    match text.split_once(':') {
+        None if text == "pencil" => Ok(BeamProfile::Pencil),
+        Some(("disk", r)) => Ok(BeamProfile::Disk { radius: radius(r)? }),
+        Some(("gauss", r)) | Some(("gaussian", r)) => {
+            Ok(BeamProfile::Gaussian { radius: radius(r)? })
+        }
+        _ => bail!("--beam {text}: expected pencil, disk:R or gauss:R (R in mm)"),
+    }
+}
+
+/// Validated configuration from the flags.
+fn configure(args: &Args) -> anyhow::Result<Simulation> {
+    if args.photons == 0 {
+        bail!("--photons 0: trace at least one photon");
+    }
+    if !(args.eta.is_finite() && args.eta > 0.0) {
+        bail!(
+            "--eta {}: the relative refractive index must be finite and > 0",
+            args.eta
+        );
+    }
+    if args.eta < 1.0 && !args.allow_eta_below_one {
+        bail!(
+            "--eta {}: below 1 means the material is optically thinner than air, which is unusual for \
+             a solid; pass --allow-eta-below-one if you mean it",
+            args.eta
+        );
+    }
+    let thickness = args.thickness_mm.unwrap_or(f64::INFINITY);
+    if args.thickness_mm.is_some_and(|t| !t.is_finite()) {
+        bail!("--thickness-mm must be a finite number of mm (omit it for a half-space)");
+    }
+    let layer = Layer::from_reduced(
+        args.sigma_s_prime,
+        args.sigma_a,
+        args.g,
+        args.eta,
+        thickness,
+    )
+    .context("bad material parameters")?;
+    let sample = Sample::slab(layer, 1.0)?;
+    let beam = Beam::new(parse_beam(&args.beam)?)
+        .context("bad --beam")?
+        .with_incidence(args.incidence_deg.to_radians())
+        .context("bad --incidence-deg (must lie in [0, 90))")?;
+    if args.bins == 0 || !(args.r_max_mm.is_finite() && args.r_max_mm > 0.0) {
+        bail!("--r-max-mm must be > 0 and --bins ≥ 1");
+    }
+    let grid = RadialGrid::uniform(args.r_max_mm / args.bins as f64, args.bins)?;
+    Ok(
+        Simulation::new(sample, beam, grid, args.photons, args.seed)?
+            .with_angle_bins(args.angle_bins),
+    )
+}
+
+/// Runs `scatterfit simulate`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let sim = configure(&args)?;
+    let show = !args.quiet && std::io::stderr().is_terminal();
+    let bar = if show {
+        let bar = indicatif::ProgressBar::new(args.photons);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {human_pos}/{human_len} photons  {per_sec}  ETA {eta}",
+            )
+            .expect("static template"),
+        );
+        Some(bar)
+    } else {
+        None
+    };
+    let start = Instant::now();
+    let result = sim.run_with_progress(&|done| {
+        if let Some(b) = &bar {
+            b.set_position(done);
+        }
+    });
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if let Some(path) = &args.out {
+        let mut csv = String::from("r_inner_mm,r_outer_mm,r_mm,rd_per_mm2,rd_stderr_per_mm2\n");
+        let g = &result.grid;
+        for (i, e) in result.rd_profile.iter().enumerate() {
+            csv.push_str(&format!(
+                "{},{},{},{:e},{:e}\n",
+                g.edges()[i],
+                g.edges()[i + 1],
+                g.center(i),
+                e.value,
+                e.stderr
+            ));
+        }
+        scatterfit_io::atomic::write_atomic(path, csv.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    let rate = args.photons as f64 / elapsed.max(1e-9);
+    if args.json {
+        crate::output::print_json(&Report {
+            sigma_s_prime: args.sigma_s_prime,
+            sigma_a: args.sigma_a,
+            eta: args.eta,
+            g: args.g,
+            thickness_mm: args.thickness_mm,
+            beam: &args.beam,
+            incidence_deg: args.incidence_deg,
+            elapsed_s: elapsed,
+            photons_per_s: rate,
+            threads: rayon::current_num_threads(),
+            result: &result,
+        })?;
+    } else {
+        let e = |x: scatterfit_mc::Estimate| format!("{:.6} ± {:.6}", x.value, x.stderr);
+        println!("photons            {}", result.photons);
+        println!("specular R_sp      {:.6}", result.specular);
+        println!("diffuse Rd         {}", e(result.rd_total));
+        println!("transmitted Tt     {}", e(result.transmittance));
+        println!("absorbed A         {}", e(result.absorbed));
+        println!("sum (should be 1)  {}", e(result.conservation));
+        println!(
+            "speed              {rate:.3e} photons/s on {} threads ({elapsed:.2} s)",
+            rayon::current_num_threads()
+        );
+        if let Some(p) = &args.out {
+            println!("profile            {}", p.display());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The issue's two speed cases: (name, sample, photons at full size).
+fn speed_cases(quick: bool) -> anyhow::Result<Vec<(&'static str, Sample, u64, &'static str)>> {
+    let k = if quick { 10 } else { 1 };
+    Ok(vec![
+        (
+            "10 cm slab n=1.4 μa=0.1/cm μs=10/cm g=0",
+            Sample::slab(Layer::new(0.01, 1.0, 0.0, 1.4, 100.0)?, 1.0)?,
+            200_000 / k,
+            "MCML ≈ 1.0e5 photons/s per core; target ≥ 2e5",
+        ),
+        (
+            "standard slab (van de Hulst) g=0.75 τ=2",
+            Sample::slab(Layer::new(1.0, 9.0, 0.75, 1.0, 0.2)?, 1.0)?,
+            4_000_000 / k,
+            "MCML ≈ 4e6 photons/s per core; target ≥ 8e6",
+        ),
+    ])
+}
+
+/// Contributes this area's figures to `scatterfit bench`: photons/s of both speed cases on one
+/// thread and on all threads (grid 0.1 mm × 200, as MCML's 0.01 cm × 200).
+pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
+    let mut figures = Vec::new();
+    let all = rayon::current_num_threads();
+    for (name, sample, photons, note) in speed_cases(args.quick)? {
+        for threads in [1, all] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()?;
+            let sim = Simulation::new(
+                sample.clone(),
+                Beam::pencil(),
+                RadialGrid::uniform(0.1, 200)?,
+                photons,
+                1,
+            )?;
+            let start = Instant::now();
+            let _ = pool.install(|| sim.run());
+            let rate = photons as f64 / start.elapsed().as_secs_f64();
+            figures.push(crate::bench::Figure {
+                name: format!("mc {name}, {threads} thread(s)"),
+                value: rate,
+                unit: "photons/s".into(),
+                note: format!("{photons} photons; {note}"),
+            });
+        }
+    }
+    Ok(figures)
 }

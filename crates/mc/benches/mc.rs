@@ -1,1 +1,59 @@
-fn main() {}
+//! Photon-transport speed on the two cases (run: `cargo bench -p scatterfit-mc`).
+//!
+//! 1. "10 cm slab": μa = 0.1/cm, μs = 10/cm, g = 0, n = 1.4, d = 10 cm (in mm: σa = 0.01, σs = 1,
+//!    d = 100), radial grid 0.1 mm × 200 — MCML: ~1.0e5 photons/s on one core.
+//! 2. "standard slab": μa = 10/cm, μs = 90/cm, g = 0.75, n = 1, d = 0.02 cm — MCML: ~4e6 photons/s.
+//!
+//! Each iteration traces a fixed number of photons on a one-thread rayon pool; divan reports the
+//! throughput in items (photons) per second.
+
+use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation};
+
+fn main() {
+    divan::main();
+}
+
+fn simulation(thick: bool, photons: u64) -> Simulation {
+    let layer = if thick {
+        Layer::new(0.01, 1.0, 0.0, 1.4, 100.0)
+    } else {
+        Layer::new(1.0, 9.0, 0.75, 1.0, 0.2)
+    }
+    .expect("valid layer");
+    let sample = Sample::slab(layer, 1.0).expect("valid sample");
+    let grid = RadialGrid::uniform(0.1, 200).expect("valid grid");
+    Simulation::new(sample, Beam::pencil(), grid, photons, 1).expect("valid simulation")
+}
+
+fn one_thread() -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool")
+}
+
+/// 10 cm slab, n = 1.4, α = 0.99, g = 0: 20 000 photons per iteration, one thread.
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn slab_10cm_n1_4_one_thread(b: divan::Bencher) {
+    let sim = simulation(true, 20_000);
+    let pool = one_thread();
+    b.counter(divan::counter::ItemsCount::new(20_000usize))
+        .bench_local(|| pool.install(|| sim.run()));
+}
+
+/// Standard slab (van de Hulst): 500 000 photons per iteration, one thread.
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn standard_slab_one_thread(b: divan::Bencher) {
+    let sim = simulation(false, 500_000);
+    let pool = one_thread();
+    b.counter(divan::counter::ItemsCount::new(500_000usize))
+        .bench_local(|| pool.install(|| sim.run()));
+}
+
+/// Standard slab on all cores (rayon's default pool).
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn standard_slab_all_threads(b: divan::Bencher) {
+    let sim = simulation(false, 1_000_000);
+    b.counter(divan::counter::ItemsCount::new(1_000_000usize))
+        .bench_local(|| sim.run());
+}

@@ -76,12 +76,12 @@ impl TableSpec {
         Ok(spec)
     }
 
-    /// A coarse table that builds in seconds: 12 albedos × 20 000 photons.
+    /// A coarse table that builds in seconds: 16 albedos × 50 000 photons.
     ///
     /// # Errors
     /// As [`TableSpec::new`].
     pub fn coarse(eta: f64, g: f64) -> Result<Self> {
-        Self::new(eta, g, 12, 20_000)
+        Self::new(eta, g, 16, 50_000)
     }
 
     /// Checks every field.
@@ -461,4 +461,68 @@ pub fn default_cache_dir() -> Option<PathBuf> {
     var("SCATTERFIT_CACHE")
         .or_else(|| var("XDG_CACHE_HOME").map(|p| p.join("scatterfit")))
         .or_else(|| var("HOME").map(|p| p.join(".cache").join("scatterfit")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn small_spec() -> TableSpec {
+        let mut spec = TableSpec::new(1.3, 0.0, 3, 2_000).unwrap();
+        spec.albedos = vec![0.3, 0.8, 0.95];
+        spec
+    }
+
+    /// A cached table is reused when its spec matches, rebuilt when the spec differs or the file is
+    /// damaged; the file round-trips exactly.
+    #[test]
+    fn cache_reuse_and_rebuild() {
+        let dir = tempfile::tempdir().unwrap();
+        let spec = small_spec();
+        let (a, s1, path) = ProfileTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();
+        assert_eq!(s1, CacheStatus::Built);
+        let (b, s2, _) = ProfileTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();
+        assert_eq!(s2, CacheStatus::Loaded);
+        assert_eq!(a, b);
+        let mut other = spec.clone();
+        other.seed = 2;
+        assert_ne!(other.file_name(), spec.file_name());
+        std::fs::write(&path, b"{ not json").unwrap();
+        let (c, s3, _) = ProfileTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();
+        assert_eq!(s3, CacheStatus::Built);
+        assert_eq!(a, c);
+        // No temporary files are left behind.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// Lookups: exact at albedo nodes and bin centres, σ′t² scaling, clear errors outside the table,
+    /// and α′ from Rd inverts Rd from α′.
+    #[test]
+    fn lookup_and_inversion() {
+        let t = ProfileTable::build(&small_spec(), &|_, _| {}).unwrap();
+        let c = t.centers()[10];
+        let v = t.profile(1)[10];
+        assert!((t.rd(c, 1.0, 0.8).unwrap() - v).abs() <= 1e-15 * v);
+        assert!((t.rd(c / 3.0, 3.0, 0.8).unwrap() - 9.0 * v).abs() <= 1e-12 * v);
+        assert!(matches!(
+            t.rd(c, 1.0, 0.99),
+            Err(McError::OutOfTable { .. })
+        ));
+        assert!(matches!(
+            t.rd(1e6, 1.0, 0.8),
+            Err(McError::OutOfTable { .. })
+        ));
+        assert!(matches!(
+            t.rd(-1.0, 1.0, 0.8),
+            Err(McError::InvalidParameter { .. })
+        ));
+        for a in [0.3, 0.5, 0.8, 0.9, 0.95] {
+            let rd = t.rd_total(a).unwrap();
+            assert!(
+                (t.albedo_from_rd_total(rd).unwrap() - a).abs() < 1e-12,
+                "α′ = {a}"
+            );
+        }
+        assert!(t.albedo_from_rd_total(0.99).is_err());
+    }
 }
