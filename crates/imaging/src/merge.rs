@@ -117,21 +117,13 @@ pub fn merge(
         check_shape(f0, d, || "dark frame".to_string())?;
     }
     let g = |c: usize| &response.tables()[if response.channels() == 1 { 0 } else { c }];
-    // Lookup tables: lut[j][c * 256 + z] = (w(z), w(z)(g_c(z) − ln Δt_j)).
-    let luts: Vec<Vec<[f32; 2]>> = times_s
-        .iter()
-        .map(|t| {
-            let ln_t = t.ln();
-            let mut lut = vec![[0.0f32; 2]; ch * LEVELS];
-            for c in 0..ch {
-                for z in 0..LEVELS {
-                    let wz = hat_weight(z as u8);
-                    lut[c * LEVELS + z] = [wz as f32, (wz * (g(c)[z] - ln_t)) as f32];
-                }
-            }
-            lut
-        })
+    // Lookup tables (all fit in L1): w(z) and, per channel, w(z)·g_c(z); frame j adds
+    // w(g − ln Δt_j) = wg_c(z) − ln Δt_j · w(z).
+    let w_lut: [f32; LEVELS] = std::array::from_fn(|z| hat_weight(z as u8) as f32);
+    let wg_lut: Vec<[f32; LEVELS]> = (0..ch)
+        .map(|c| std::array::from_fn(|z| (hat_weight(z as u8) * g(c)[z]) as f32))
         .collect();
+    let ln_t32: Vec<f32> = times_s.iter().map(|t| t.ln() as f32).collect();
     let lin: Vec<Vec<f64>> = (0..ch)
         .map(|c| g(c).iter().map(|v| v.exp()).collect())
         .collect();
@@ -145,25 +137,14 @@ pub fn merge(
         .zip(mask.par_chunks_mut(stride))
         .enumerate()
         .map_init(
-            || (vec![0.0f32; stride], vec![0.0f32; stride]),
-            |(num, den), (y, (out, m))| {
+            || vec![0.0f32; stride],
+            |den, (y, (out, m))| {
                 let rows: Vec<&[u8]> = frames
                     .iter()
                     .map(|f| &f.data()[y * stride..(y + 1) * stride])
                     .collect();
                 match dark {
-                    None => {
-                        num.fill(0.0);
-                        den.fill(0.0);
-                        for (row, lut) in rows.iter().zip(&luts) {
-                            accumulate_row(row, lut, ch, num, den);
-                        }
-                        for k in 0..stride {
-                            if den[k] > 0.0 {
-                                out[k] = (num[k] / den[k]).exp();
-                            }
-                        }
-                    }
+                    None => merge_row_lut(&rows, &w_lut, &wg_lut, &ln_t32, out, den),
                     Some(d) => {
                         let drow = &d.data()[y * stride..(y + 1) * stride];
                         for k in 0..stride {
@@ -224,31 +205,77 @@ pub fn merge(
     })
 }
 
-/// Adds one frame row's (w, w(g − ln Δt)) into the running sums, with the channel count unrolled
-/// for the common cases.
-fn accumulate_row(row: &[u8], lut: &[[f32; 2]], ch: usize, num: &mut [f32], den: &mut [f32]) {
-    fn go<const N: usize>(row: &[u8], lut: &[[f32; 2]], num: &mut [f32], den: &mut [f32]) {
-        for ((z, nu), de) in row
-            .chunks_exact(N)
-            .zip(num.chunks_exact_mut(N))
-            .zip(den.chunks_exact_mut(N))
-        {
-            for c in 0..N {
-                let [w, wg] = lut[c * LEVELS + z[c] as usize];
-                nu[c] += wg;
-                de[c] += w;
+/// Merges one row with the lookup tables: `out` receives exp(Σ w(g − ln Δt)/Σ w) where Σ w > 0 and
+/// `den` the sums Σ w. Works in blocks of 256 pixels so the running sums stay in L1 while the frames
+/// stream through.
+fn merge_row_lut(
+    rows: &[&[u8]],
+    w_lut: &[f32; LEVELS],
+    wg_lut: &[[f32; LEVELS]],
+    ln_t: &[f32],
+    out: &mut [f32],
+    den: &mut [f32],
+) {
+    fn go<const N: usize>(
+        rows: &[&[u8]],
+        w_lut: &[f32; LEVELS],
+        wg_lut: &[[f32; LEVELS]],
+        ln_t: &[f32],
+        out: &mut [f32],
+        den: &mut [f32],
+    ) {
+        let Some(wg) = wg_lut.first_chunk::<N>() else {
+            return;
+        };
+        let block = 256 * N;
+        let mut start = 0;
+        while start < out.len() {
+            let end = (start + block).min(out.len());
+            let num = &mut out[start..end];
+            let de = &mut den[start..end];
+            num.fill(0.0);
+            de.fill(0.0);
+            for (row, &lt) in rows.iter().zip(ln_t) {
+                let zs = &row[start..end];
+                for ((z, nu), d) in zs
+                    .chunks_exact(N)
+                    .zip(num.chunks_exact_mut(N))
+                    .zip(de.chunks_exact_mut(N))
+                {
+                    for c in 0..N {
+                        let zi = z[c] as usize;
+                        let wv = w_lut[zi];
+                        nu[c] += wg[c][zi] - lt * wv;
+                        d[c] += wv;
+                    }
+                }
             }
+            for (nu, &d) in num.iter_mut().zip(de.iter()) {
+                if d > 0.0 {
+                    *nu = (*nu / d).exp();
+                }
+            }
+            start = end;
         }
     }
-    match ch {
-        1 => go::<1>(row, lut, num, den),
-        3 => go::<3>(row, lut, num, den),
-        4 => go::<4>(row, lut, num, den),
-        _ => {
-            for (k, &z) in row.iter().enumerate() {
-                let [w, wg] = lut[(k % ch) * LEVELS + z as usize];
-                num[k] += wg;
-                den[k] += w;
+    match wg_lut.len() {
+        1 => go::<1>(rows, w_lut, wg_lut, ln_t, out, den),
+        3 => go::<3>(rows, w_lut, wg_lut, ln_t, out, den),
+        4 => go::<4>(rows, w_lut, wg_lut, ln_t, out, den),
+        ch => {
+            out.fill(0.0);
+            den.fill(0.0);
+            for (row, &lt) in rows.iter().zip(ln_t) {
+                for (k, &z) in row.iter().enumerate() {
+                    let wv = w_lut[z as usize];
+                    out[k] += wg_lut[k % ch][z as usize] - lt * wv;
+                    den[k] += wv;
+                }
+            }
+            for (nu, &d) in out.iter_mut().zip(den.iter()) {
+                if d > 0.0 {
+                    *nu = (*nu / d).exp();
+                }
             }
         }
     }
