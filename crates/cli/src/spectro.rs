@@ -84,10 +84,10 @@ fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
             Some((Lab { l, a, b }, observer))
         }
     };
-    if let Some(eta) = args.eta {
-        if !(eta.is_finite() && eta >= 1.0) {
-            bail!("--eta {eta}: the relative refractive index must be a number ≥ 1");
-        }
+    if let Some(eta) = args.eta
+        && !(eta.is_finite() && eta >= 1.0)
+    {
+        bail!("--eta {eta}: the relative refractive index must be a number ≥ 1");
     }
     Ok(SpectroOptions { lab, eta: args.eta })
 }

@@ -231,15 +231,15 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
             reflectance(sci_col, sci_name)?,
             reflectance(sce_col, sce_name)?,
         );
-        if let Some(&previous) = wavelengths.last() {
-            if w <= previous {
-                return Err(SpectroCsvError::Order {
-                    path: p(),
-                    line,
-                    wavelength: w,
-                    previous,
-                });
-            }
+        if let Some(&previous) = wavelengths.last()
+            && w <= previous
+        {
+            return Err(SpectroCsvError::Order {
+                path: p(),
+                line,
+                wavelength: w,
+                previous,
+            });
         }
         if i < e - SCI_BELOW_SCE_TOLERANCE {
             return Err(SpectroCsvError::SciBelowSce {
