@@ -227,35 +227,73 @@ fn merge_row_lut(
         let Some(wg) = wg_lut.first_chunk::<N>() else {
             return;
         };
-        let block = 256 * N;
-        let mut start = 0;
-        while start < out.len() {
-            let end = (start + block).min(out.len());
-            let num = &mut out[start..end];
-            let de = &mut den[start..end];
-            num.fill(0.0);
-            de.fill(0.0);
+        // Pixel-major, four pixels at a time: the 4·N sums stay in registers while the P samples of
+        // each are read, and the four independent dependency chains hide the add latency.
+        const PX: usize = 4;
+        let whole = out.len() / (PX * N) * (PX * N);
+        let (out_a, out_b) = out.split_at_mut(whole);
+        let (den_a, den_b) = den.split_at_mut(whole);
+        for (k, (nu, d)) in out_a
+            .chunks_exact_mut(PX * N)
+            .zip(den_a.chunks_exact_mut(PX * N))
+            .enumerate()
+        {
+            let base = k * PX * N;
+            let mut a = [[0.0f32; N]; PX];
+            let mut dd = [[0.0f32; N]; PX];
             for (row, &lt) in rows.iter().zip(ln_t) {
-                let zs = &row[start..end];
-                for ((z, nu), d) in zs
-                    .chunks_exact(N)
-                    .zip(num.chunks_exact_mut(N))
-                    .zip(de.chunks_exact_mut(N))
-                {
+                let Some(z) = row.get(base..base + PX * N) else {
+                    continue;
+                };
+                for p in 0..PX {
                     for c in 0..N {
-                        let zi = z[c] as usize;
+                        let zi = z[p * N + c] as usize;
                         let wv = w_lut[zi];
-                        nu[c] += wg[c][zi] - lt * wv;
-                        d[c] += wv;
+                        a[p][c] += wg[c][zi] - lt * wv;
+                        dd[p][c] += wv;
                     }
                 }
             }
-            for (nu, &d) in num.iter_mut().zip(de.iter()) {
-                if d > 0.0 {
-                    *nu = (*nu / d).exp();
+            for p in 0..PX {
+                for c in 0..N {
+                    let i = p * N + c;
+                    d[i] = dd[p][c];
+                    nu[i] = if dd[p][c] > 0.0 {
+                        (a[p][c] / dd[p][c]).exp()
+                    } else {
+                        0.0
+                    };
                 }
             }
-            start = end;
+        }
+        // The last few pixels of the row, one at a time.
+        for (k, (nu, d)) in out_b
+            .chunks_exact_mut(N)
+            .zip(den_b.chunks_exact_mut(N))
+            .enumerate()
+        {
+            let base = whole + k * N;
+            let mut a = [0.0f32; N];
+            let mut dd = [0.0f32; N];
+            for (row, &lt) in rows.iter().zip(ln_t) {
+                let Some(z) = row.get(base..base + N) else {
+                    continue;
+                };
+                for c in 0..N {
+                    let zi = z[c] as usize;
+                    let wv = w_lut[zi];
+                    a[c] += wg[c][zi] - lt * wv;
+                    dd[c] += wv;
+                }
+            }
+            for c in 0..N {
+                d[c] = dd[c];
+                nu[c] = if dd[c] > 0.0 {
+                    (a[c] / dd[c]).exp()
+                } else {
+                    0.0
+                };
+            }
         }
     }
     match wg_lut.len() {
