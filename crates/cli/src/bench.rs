@@ -61,9 +61,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&figures)?;
     } else {
-        println!("{:<58} {:>14} {:<10} note", "benchmark", "value", "unit");
+        println!("{:<64} {:>14} {:<10} note", "benchmark", "value", "unit");
         for f in &figures {
-            println!("{:<58} {:>14.4} {:<10} {}", f.name, f.value, f.unit, f.note);
+            println!("{:<64} {:>14.4} {:<10} {}", f.name, f.value, f.unit, f.note);
         }
     }
     Ok(ExitCode::SUCCESS)
