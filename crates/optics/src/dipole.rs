@@ -167,6 +167,10 @@ pub struct Dipole {
     z_v: f64,
     /// zv/zr = 1 + 4A/3.
     k_v: f64,
+    /// ∂α′/∂σ′s = σa/σ′t².
+    da_dsp: f64,
+    /// ∂α′/∂σa = −σ′s/σ′t².
+    da_dsa: f64,
 }
 
 impl Dipole {
@@ -176,6 +180,8 @@ impl Dipole {
         let k_v = 1.0 + 4.0 / 3.0 * a_coefficient(props.eta);
         let z_r = 1.0 / sigma_t;
         Self {
+            da_dsp: props.sigma_a * z_r * z_r,
+            da_dsa: -props.sigma_s_prime * z_r * z_r,
             props: *props,
             albedo_prime: props.sigma_s_prime / sigma_t,
             sigma_tr: (3.0 * props.sigma_a * sigma_t).sqrt(),
@@ -215,94 +221,72 @@ impl Dipole {
     #[inline]
     pub fn rd_with_derivatives(&self, r_mm: f64) -> ProfileSample {
         let r2 = r_mm * r_mm;
-        let st = self.sigma_tr;
-        // Returns (T, ∂T/∂z, −z e^{−σtr d}/d).
-        let source = |z: f64| {
-            let d2 = r2 + z * z;
-            let d = d2.sqrt();
-            let e = (-st * d).exp();
-            let inv_d = 1.0 / d;
-            let inv_d3 = inv_d * inv_d * inv_d;
-            let sd = st * d;
-            let t = z * (sd + 1.0) * e * inv_d3;
-            let dt_dz = (sd + 1.0) * e * inv_d3
-                - z * z * e * (sd * sd + 3.0 * sd + 3.0) * inv_d3 * inv_d * inv_d;
-            let g = -z * e * inv_d;
-            (t, dt_dz, g)
-        };
-        let (t_r, dtr_dz, g_r) = source(self.z_r);
-        let (t_v, dtv_dz, g_v) = source(self.z_v);
+        let d_r = (r2 + self.z_r * self.z_r).sqrt();
+        let d_v = (r2 + self.z_v * self.z_v).sqrt();
+        let e_r = (-self.sigma_tr * d_r).exp();
+        let e_v = (-self.sigma_tr * d_v).exp();
+        self.sample_from_distances(d_r, d_v, e_r, e_v)
+    }
+
+    /// Per source at depth z: (T, ∂T/∂z, −z e^{−σtr d}/d), given d and e = e^{−σtr d} (see
+    /// [`Dipole::rd_with_derivatives`] for the formulas).
+    #[inline(always)]
+    fn source_terms(&self, z: f64, d: f64, e: f64) -> (f64, f64, f64) {
+        let inv_d = 1.0 / d;
+        let inv_d3 = inv_d * inv_d * inv_d;
+        let sd = self.sigma_tr * d;
+        let t = z * (sd + 1.0) * e * inv_d3;
+        let dt_dz = (sd + 1.0) * e * inv_d3
+            - z * z * e * (sd * sd + 3.0 * sd + 3.0) * inv_d3 * inv_d * inv_d;
+        (t, dt_dz, -z * e * inv_d)
+    }
+
+    /// Rd and its derivatives from the distances to the real and virtual sources and their
+    /// exponentials: the chain rule through α′, zr, zv and σtr of [`Dipole::rd_with_derivatives`].
+    #[inline(always)]
+    fn sample_from_distances(&self, d_r: f64, d_v: f64, e_r: f64, e_v: f64) -> ProfileSample {
+        let (t_r, dtr_dz, g_r) = self.source_terms(self.z_r, d_r, e_r);
+        let (t_v, dtv_dz, g_v) = self.source_terms(self.z_v, d_v, e_v);
         let s = t_r + t_v;
-        let sigma_t = self.props.sigma_t_prime();
-        let inv_st2 = 1.0 / (sigma_t * sigma_t);
-        let z_r2 = self.z_r * self.z_r;
-        // Common part of ∂S/∂p through zr and zv (∂zr/∂p = −zr² for both parameters).
-        let ds_z = -z_r2 * (dtr_dz + self.k_v * dtv_dz);
+        let sigma_a = self.props.sigma_a;
+        let sigma_t = sigma_a + self.props.sigma_s_prime;
+        // Common part of ∂S/∂p through zr and zv (∂zr/∂p = −zr², ∂zv/∂p = −k zr² for both p).
+        let ds_z = -self.z_r * self.z_r * (dtr_dz + self.k_v * dtv_dz);
+        // Through σtr: (−z e/d)·(3/2)·{σa for σ′s, σ′t + σa for σa}.
         let g = 1.5 * (g_r + g_v);
-        let ds_dsp = ds_z + g * self.props.sigma_a;
-        let ds_dsa = ds_z + g * (sigma_t + self.props.sigma_a);
         let c = std::f64::consts::FRAC_1_PI * 0.25;
-        let da_dsp = self.props.sigma_a * inv_st2;
-        let da_dsa = -self.props.sigma_s_prime * inv_st2;
+        let a = self.albedo_prime;
         ProfileSample {
-            rd: c * self.albedo_prime * s,
-            d_sigma_s_prime: c * (da_dsp * s + self.albedo_prime * ds_dsp),
-            d_sigma_a: c * (da_dsa * s + self.albedo_prime * ds_dsa),
+            rd: c * a * s,
+            d_sigma_s_prime: c * (self.da_dsp * s + a * (ds_z + g * sigma_a)),
+            d_sigma_a: c * (self.da_dsa * s + a * (ds_z + g * (sigma_t + sigma_a))),
         }
     }
 
     /// [`Dipole::rd_with_derivatives`] at every radius of `radii_mm`, written to `out` (the shorter of
     /// the two sets the count). Same arithmetic as the scalar method, arranged in blocks of 8 radii so
-    /// that the square roots, divisions and polynomial parts vectorise; only the exponentials stay
-    /// scalar. This is the hot path of the fit (one call per Levenberg–Marquardt iteration).
+    /// that the square roots vectorise and the exponentials pipeline. This is the hot path of the fit
+    /// (one call per Levenberg–Marquardt iteration).
     pub fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {
         const B: usize = 8;
         let n = radii_mm.len().min(out.len());
-        let st = self.sigma_tr;
-        let sigma_t = self.props.sigma_t_prime();
-        let inv_st2 = 1.0 / (sigma_t * sigma_t);
-        let c = std::f64::consts::FRAC_1_PI * 0.25;
-        let (zr, zv, kv) = (self.z_r, self.z_v, self.k_v);
-        let z_r2 = zr * zr;
-        let da_dsp = self.props.sigma_a * inv_st2;
-        let da_dsa = -self.props.sigma_s_prime * inv_st2;
-        let (sa, ap) = (self.props.sigma_a, self.albedo_prime);
+        // A local copy keeps every cached constant in registers across the loops.
+        let this = *self;
+        let (zr, zv, st) = (this.z_r, this.z_v, this.sigma_tr);
         for (radii, out) in radii_mm[..n].chunks(B).zip(out[..n].chunks_mut(B)) {
             let m = radii.len();
-            let mut dr = [1.0; B];
-            let mut dv = [1.0; B];
+            let (mut dr, mut dv, mut er, mut ev) = ([1.0; B], [1.0; B], [0.0; B], [0.0; B]);
             for i in 0..m {
                 let r2 = radii[i] * radii[i];
                 dr[i] = (r2 + zr * zr).sqrt();
                 dv[i] = (r2 + zv * zv).sqrt();
             }
-            let mut er = [0.0; B];
-            let mut ev = [0.0; B];
             for i in 0..m {
                 er[i] = (-st * dr[i]).exp();
                 ev[i] = (-st * dv[i]).exp();
             }
             for i in 0..m {
-                // Per source: T, ∂T/∂z and −z e/d, as in `rd_with_derivatives`.
-                let term = |z: f64, d: f64, e: f64| {
-                    let inv_d = 1.0 / d;
-                    let inv_d3 = inv_d * inv_d * inv_d;
-                    let sd = st * d;
-                    let t = z * (sd + 1.0) * e * inv_d3;
-                    let dt_dz = (sd + 1.0) * e * inv_d3
-                        - z * z * e * (sd * sd + 3.0 * sd + 3.0) * inv_d3 * inv_d * inv_d;
-                    (t, dt_dz, -z * e * inv_d)
-                };
-                let (t_r, dtr_dz, g_r) = term(zr, dr[i], er[i]);
-                let (t_v, dtv_dz, g_v) = term(zv, dv[i], ev[i]);
-                let s = t_r + t_v;
-                let ds_z = -z_r2 * (dtr_dz + kv * dtv_dz);
-                let g = 1.5 * (g_r + g_v);
-                out[i] = ProfileSample {
-                    rd: c * ap * s,
-                    d_sigma_s_prime: c * (da_dsp * s + ap * (ds_z + g * sa)),
-                    d_sigma_a: c * (da_dsa * s + ap * (ds_z + g * (sigma_t + sa))),
-                };
+                out[i] = this.sample_from_distances(dr[i], dv[i], er[i], ev[i]);
             }
         }
     }
