@@ -341,9 +341,13 @@ pub fn xyz_to_linear_srgb(xyz: Xyz) -> [f64; 3] {
     mat_vec(&XYZ_TO_SRGB, [xyz.x / 100.0, xyz.y / 100.0, xyz.z / 100.0])
 }
 
-/// Linear sRGB reflectance → XYZ (Y = 100, D65, 2°).
+/// Linear sRGB reflectance → XYZ (Y = 100, D65, 2°): the exact inverse of [`xyz_to_linear_srgb`].
+///
+/// IEC 61966-2-1:1999 eq. (F.8) prints a 4-decimal matrix (0.4124, 0.3576, …) that inverts eq. (F.7)
+/// only to ~1e-4; we invert (F.7) itself so that the two directions round-trip exactly (the synthetic
+/// rig relies on it). The two agree to the printed decimals.
 pub fn linear_srgb_to_xyz(rgb: [f64; 3]) -> Xyz {
-    let v = mat_vec(&SRGB_TO_XYZ, rgb);
+    let v = mat_vec(&mat_inv(&XYZ_TO_SRGB), rgb);
     Xyz {
         x: 100.0 * v[0],
         y: 100.0 * v[1],
@@ -459,6 +463,31 @@ mod tests {
         // Adapting the source white gives the destination white.
         let w = bradford(w10, w10, w2);
         assert!(close(w.x, w2.x, 1e-9) && close(w.y, w2.y, 1e-9) && close(w.z, w2.z, 1e-9));
+    }
+
+    /// The inverse matrix agrees with IEC 61966-2-1 eq. (F.8) to its printed 4 decimals and
+    /// round-trips exactly.
+    #[test]
+    fn srgb_to_xyz_is_the_exact_inverse_and_matches_f8() {
+        let f8 = [
+            [0.4124, 0.3576, 0.1805],
+            [0.2126, 0.7152, 0.0722],
+            [0.0193, 0.1192, 0.9505],
+        ];
+        for (c, col) in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+            .iter()
+            .enumerate()
+        {
+            let xyz = linear_srgb_to_xyz(*col);
+            for (r, v) in [xyz.x, xyz.y, xyz.z].iter().enumerate() {
+                assert!((v / 100.0 - f8[r][c]).abs() < 1.5e-4, "({r},{c}): {v}");
+            }
+        }
+        let rgb = [0.2, 0.5, 0.9];
+        let back = xyz_to_linear_srgb(linear_srgb_to_xyz(rgb));
+        for (a, b) in rgb.iter().zip(back) {
+            assert!((a - b).abs() < 1e-14);
+        }
     }
 
     /// physics.md §6.2 extras: a neutral grey and a saturated green (computed there with the
