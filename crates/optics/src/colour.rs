@@ -328,13 +328,6 @@ const XYZ_TO_SRGB: [[f64; 3]; 3] = [
     [0.0557, -0.2040, 1.0570],
 ];
 
-/// Linear sRGB → XYZ (Y = 1 scale), IEC 61966-2-1:1999 eq. (F.8).
-const SRGB_TO_XYZ: [[f64; 3]; 3] = [
-    [0.4124, 0.3576, 0.1805],
-    [0.2126, 0.7152, 0.0722],
-    [0.0193, 0.1192, 0.9505],
-];
-
 /// XYZ (Y = 100, D65, 2° observer) → linear sRGB reflectance (fractions; may fall outside [0, 1] for
 /// colours outside the sRGB gamut — callers must not clamp silently).
 pub fn xyz_to_linear_srgb(xyz: Xyz) -> [f64; 3] {
