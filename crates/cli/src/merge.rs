@@ -258,6 +258,7 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
         });
         let opts = MergeOptions {
             clipped_fill: fill(args.clipped_fill),
+            ..Default::default()
         };
         let hdr = scatterfit_imaging::merge(&bufs, &times, &response, dark.as_ref(), &opts)
             .context("merging the bracket")?;

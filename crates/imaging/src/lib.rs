@@ -24,8 +24,8 @@ pub use buffer::{ImageBuf, ShapeError};
 pub use center::{CenterOptions, SpotCenter, find_spot_center};
 pub use error::{ImagingError, Result};
 pub use merge::{
-    CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MergeOptions, merge,
-    merge_linear_u16,
+    CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MergeOptions, Weighting,
+    merge, merge_linear_u16,
 };
 pub use profile::{ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{

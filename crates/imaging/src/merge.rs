@@ -1,7 +1,9 @@
-//! HDR merge of an exposure bracket into a per-channel radiance map (Debevec & Malik 1997, eq. 6).
+//! HDR merge of an exposure bracket into a per-channel radiance map.
 //!
-//! ln E = Σ_j w(Z_j)(g(Z_j) − ln Δt_j) / Σ_j w(Z_j), per pixel and channel, with the hat weight
-//! ([`crate::hat_weight`]), so clipped samples (code 0 or the maximum) carry no weight. A pixel-channel
+//! 8-bit: by default the noise-aware linear-domain estimate E = Σ_j w_j Δt_j X(Z_j)/Σ_j w_j Δt_j²
+//! (Robertson, Borman & Stevenson 2003; see [`Weighting::NoiseOptimal`]), or the paper's
+//! ln E = Σ_j w(Z_j)(g(Z_j) − ln Δt_j) / Σ_j w(Z_j) with the hat weight (Debevec & Malik 1997, eq. 6;
+//! [`Weighting::DebevecHat`]). Saturated samples carry no weight. A pixel-channel
 //! clipped in *every* exposure has no estimate: it is flagged in [`HdrImage::clipped`] and its
 //! radiance is set by [`ClippedFill`] (NaN by default, never a made-up number).
 //!
@@ -35,11 +37,36 @@ pub enum ClippedFill {
     LowerBound,
 }
 
+/// How [`merge`] weights the samples of a pixel-channel across the bracket.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Weighting {
+    /// Noise-aware, the default: the maximum-likelihood estimate of Robertson, Borman & Stevenson
+    /// 2003 (J. Electronic Imaging 12(2), §3), E = Σ_j w_j Δt_j X(Z_j) / Σ_j w_j Δt_j², averaged in the
+    /// *linear* domain X = exp g(Z), with inverse-variance weights w_j = Δt_j²·u(Z_j) (Granados et
+    /// al. 2010, CVPR, "Optimal HDR reconstruction with linear digital cameras": w_j = Δt_j²/σ²_j,
+    /// here with a noise σ constant in the linear signal), so each frame counts by Δt² and a short
+    /// frame's noisy low codes barely move the estimate. u(z) = 1 up to code 128 and the upper half
+    /// of the paper's hat above, (255 − z)/127, which fades out codes near the clip where the tone
+    /// curve is compressed (a choice of ours, measured in BENCHMARKS.md); saturated codes (255) are
+    /// dropped; a code-0 sample counts as X = 0 (it is a censored reading, evidence
+    /// that the exposure was at most the first code's), so dark frames no longer bias dim pixels
+    /// upwards. A pixel-channel with no sample above code 0 (or above the dark level) has no estimate.
+    #[default]
+    NoiseOptimal,
+    /// The paper's hat, Debevec & Malik 1997 eq. (6): ln E = Σ w(Z)(g(Z) − ln Δt)/Σ w(Z) with
+    /// w = [`crate::hat_weight`] (codes 0 and 255 dropped). Biased high for pixels whose brightest
+    /// frame stays at a low code (noisy low codes are kept, zero codes dropped); see BENCHMARKS.md.
+    DebevecHat,
+}
+
 /// Options of [`merge`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MergeOptions {
     /// Value of pixel-channels clipped in every exposure.
     pub clipped_fill: ClippedFill,
+    /// Sample weighting (default [`Weighting::NoiseOptimal`]).
+    pub weighting: Weighting,
 }
 
 /// Options of [`merge_linear_u16`].
@@ -117,17 +144,12 @@ pub fn merge(
         check_shape(f0, d, || "dark frame".to_string())?;
     }
     let g = |c: usize| &response.tables()[if response.channels() == 1 { 0 } else { c }];
-    // Lookup tables (all fit in L1): w(z) and, per channel, w(z)·g_c(z); frame j adds
-    // w(g − ln Δt_j) = wg_c(z) − ln Δt_j · w(z).
-    let w_lut: [f32; LEVELS] = std::array::from_fn(|z| hat_weight(z as u8) as f32);
-    let wg_lut: Vec<[f32; LEVELS]> = (0..ch)
-        .map(|c| std::array::from_fn(|z| (hat_weight(z as u8) * g(c)[z]) as f32))
-        .collect();
-    let ln_t32: Vec<f32> = times_s.iter().map(|t| t.ln() as f32).collect();
     let lin: Vec<Vec<f64>> = (0..ch)
         .map(|c| g(c).iter().map(|v| v.exp()).collect())
         .collect();
     let ln_t: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();
+    let weighting = opts.weighting;
+    let tables = Tables::new(weighting, &lin, g, times_s);
     let stride = w * ch;
     let mut radiance = vec![0.0f32; w * h * ch];
     let mut mask = vec![0u8; w * h * ch];
@@ -144,25 +166,40 @@ pub fn merge(
                     .map(|f| &f.data()[y * stride..(y + 1) * stride])
                     .collect();
                 match dark {
-                    None => merge_row_lut(&rows, &w_lut, &wg_lut, &ln_t32, out, den),
+                    None => merge_row_lut(&rows, &tables, out, den),
                     Some(d) => {
                         let drow = &d.data()[y * stride..(y + 1) * stride];
                         for k in 0..stride {
                             let c = k % ch;
-                            let xd = lin[c][drow[k] as usize];
+                            let zd = drow[k];
+                            let xd = lin[c][zd as usize];
                             let (mut nu, mut de) = (0.0f64, 0.0f64);
-                            for (row, lt) in rows.iter().zip(&ln_t) {
+                            for ((row, lt), t) in rows.iter().zip(&ln_t).zip(times_s) {
                                 let z = row[k];
-                                let wz = hat_weight(z);
-                                let x = lin[c][z as usize] - xd;
-                                if wz > 0.0 && x > 0.0 {
-                                    nu += wz * (x.ln() - lt);
-                                    de += wz;
+                                match weighting {
+                                    Weighting::DebevecHat => {
+                                        let wz = hat_weight_above(z, zd);
+                                        let x = lin[c][z as usize] - xd;
+                                        if wz > 0.0 && x > 0.0 {
+                                            nu += wz * (x.ln() - lt);
+                                            de += wz;
+                                        }
+                                    }
+                                    Weighting::NoiseOptimal => {
+                                        let u = f64::from(tables.w[z as usize]);
+                                        let x = tables.x[c][z as usize] - xd;
+                                        nu += t * u * x;
+                                        de += t * t * u;
+                                    }
                                 }
                             }
-                            den[k] = de as f32;
-                            if de > 0.0 {
-                                out[k] = (nu / de).exp() as f32;
+                            let (valid, e) = match weighting {
+                                Weighting::DebevecHat => (de > 0.0, (nu / de).exp()),
+                                Weighting::NoiseOptimal => (nu > 0.0 && de > 0.0, nu / de),
+                            };
+                            den[k] = if valid { de as f32 } else { 0.0 };
+                            if valid {
+                                out[k] = e as f32;
                             }
                         }
                     }
@@ -205,28 +242,107 @@ pub fn merge(
     })
 }
 
-/// Merges one row with the lookup tables: `out` receives exp(Σ w(g − ln Δt)/Σ w) where Σ w > 0 and
-/// `den` the sums Σ w. Works in blocks of 256 pixels so the running sums stay in L1 while the frames
-/// stream through.
-fn merge_row_lut(
-    rows: &[&[u8]],
-    w_lut: &[f32; LEVELS],
-    wg_lut: &[[f32; LEVELS]],
-    ln_t: &[f32],
-    out: &mut [f32],
-    den: &mut [f32],
-) {
-    fn go<const N: usize>(
-        rows: &[&[u8]],
-        w_lut: &[f32; LEVELS],
-        wg_lut: &[[f32; LEVELS]],
-        ln_t: &[f32],
-        out: &mut [f32],
-        den: &mut [f32],
-    ) {
-        let Some(wg) = wg_lut.first_chunk::<N>() else {
+/// The paper's hat over the code range above a dark frame's code `zd`: w = min(z − zd, 255 − z) for
+/// zd < z < 255, else 0 (Debevec & Malik 1997, eq. 4 with Z_min = zd, Z_max = 255, the same
+/// stretching as [`merge_linear_u16`]'s hat over [dark, saturation]). With zd = 0 this is
+/// [`hat_weight`].
+fn hat_weight_above(z: u8, zd: u8) -> f64 {
+    if z <= zd || z == u8::MAX {
+        0.0
+    } else {
+        f64::from((z - zd).min(u8::MAX - z))
+    }
+}
+
+/// Lookup tables of [`merge`] (all fit in L1). Frame j adds to a pixel-channel's numerator
+/// a_j·v_c(z) + b_j·w(z) and to its denominator d_j·w(z); the estimate is then exp(num/den) in the
+/// log domain ([`Weighting::DebevecHat`]: w = hat, v_c = w·g_c, a = 1, b = −ln Δt, d = 1) or
+/// num/den in the linear domain ([`Weighting::NoiseOptimal`]: w = u, v_c = u·X_c, a = Δt, b = 0,
+/// d = Δt², with u(z) the per-code inverse noise variance and X_c(0) = 0).
+struct Tables {
+    w: [f32; LEVELS],
+    v: Vec<[f32; LEVELS]>,
+    /// Linear values X_c(z) used by the noise-aware weighting (X_c(0) = 0).
+    x: Vec<[f64; LEVELS]>,
+    a: Vec<f32>,
+    b: Vec<f32>,
+    d: Vec<f32>,
+    log: bool,
+}
+
+impl Tables {
+    fn new<'a>(
+        weighting: Weighting,
+        lin: &[Vec<f64>],
+        g: impl Fn(usize) -> &'a [f64; LEVELS],
+        times_s: &[f64],
+    ) -> Self {
+        let ch = lin.len();
+        match weighting {
+            Weighting::DebevecHat => Self {
+                w: std::array::from_fn(|z| hat_weight(z as u8) as f32),
+                v: (0..ch)
+                    .map(|c| std::array::from_fn(|z| (hat_weight(z as u8) * g(c)[z]) as f32))
+                    .collect(),
+                x: Vec::new(),
+                a: vec![1.0; times_s.len()],
+                b: times_s.iter().map(|t| -t.ln() as f32).collect(),
+                d: vec![1.0; times_s.len()],
+                log: true,
+            },
+            Weighting::NoiseOptimal => {
+                let x: Vec<[f64; LEVELS]> = lin
+                    .iter()
+                    .map(|l| std::array::from_fn(|z| if z == 0 { 0.0 } else { l[z] }))
+                    .collect();
+                let u = noise_weight();
+                Self {
+                    w: std::array::from_fn(|z| u[z] as f32),
+                    v: x.iter()
+                        .map(|xc| std::array::from_fn(|z| (u[z] * xc[z]) as f32))
+                        .collect(),
+                    x,
+                    a: times_s.iter().map(|&t| t as f32).collect(),
+                    b: vec![0.0; times_s.len()],
+                    d: times_s.iter().map(|&t| (t * t) as f32).collect(),
+                    log: false,
+                }
+            }
+        }
+    }
+}
+
+/// Per-code weight u(z) of the noise-aware merge: 1/σ²_X with a noise constant in the linear signal
+/// (read noise before the tone curve), so u = 1, times the upper half of the paper's hat
+/// (Debevec & Malik 1997, eq. 4) to fade out codes near saturation: u = min(1, (255 − z)/127).
+fn noise_weight() -> [f64; LEVELS] {
+    std::array::from_fn(|z| hat_weight(z.max(128) as u8) / 127.0)
+}
+
+/// Merges one row with the lookup tables: `out` receives the estimate where there is one and `den`
+/// the denominator sums (0 where there is no estimate). Four pixels at a time, pixel-major.
+fn merge_row_lut(rows: &[&[u8]], t: &Tables, out: &mut [f32], den: &mut [f32]) {
+    #[inline(always)]
+    fn finish(log: bool, nu: f32, d: f32) -> (f32, f32) {
+        if log {
+            if d > 0.0 {
+                ((nu / d).exp(), d)
+            } else {
+                (0.0, 0.0)
+            }
+        } else if nu > 0.0 && d > 0.0 {
+            (nu / d, d)
+        } else {
+            (0.0, 0.0)
+        }
+    }
+    fn go<const N: usize>(rows: &[&[u8]], t: &Tables, out: &mut [f32], den: &mut [f32]) {
+        let Some(v) = t.v.first_chunk::<N>() else {
             return;
         };
+        let w_lut = &t.w;
+        let coef: Vec<(f32, f32, f32)> =
+            (0..rows.len()).map(|j| (t.a[j], t.b[j], t.d[j])).collect();
         // Pixel-major, four pixels at a time: the 4·N sums stay in registers while the P samples of
         // each are read, and the four independent dependency chains hide the add latency.
         const PX: usize = 4;
@@ -241,7 +357,7 @@ fn merge_row_lut(
             let base = k * PX * N;
             let mut a = [[0.0f32; N]; PX];
             let mut dd = [[0.0f32; N]; PX];
-            for (row, &lt) in rows.iter().zip(ln_t) {
+            for (row, &(ca, cb, cd)) in rows.iter().zip(&coef) {
                 let Some(z) = row.get(base..base + PX * N) else {
                     continue;
                 };
@@ -249,20 +365,15 @@ fn merge_row_lut(
                     for c in 0..N {
                         let zi = z[p * N + c] as usize;
                         let wv = w_lut[zi];
-                        a[p][c] += wg[c][zi] - lt * wv;
-                        dd[p][c] += wv;
+                        a[p][c] += ca * v[c][zi] + cb * wv;
+                        dd[p][c] += cd * wv;
                     }
                 }
             }
             for p in 0..PX {
                 for c in 0..N {
                     let i = p * N + c;
-                    d[i] = dd[p][c];
-                    nu[i] = if dd[p][c] > 0.0 {
-                        (a[p][c] / dd[p][c]).exp()
-                    } else {
-                        0.0
-                    };
+                    (nu[i], d[i]) = finish(t.log, a[p][c], dd[p][c]);
                 }
             }
         }
@@ -275,45 +386,38 @@ fn merge_row_lut(
             let base = whole + k * N;
             let mut a = [0.0f32; N];
             let mut dd = [0.0f32; N];
-            for (row, &lt) in rows.iter().zip(ln_t) {
+            for (row, &(ca, cb, cd)) in rows.iter().zip(&coef) {
                 let Some(z) = row.get(base..base + N) else {
                     continue;
                 };
                 for c in 0..N {
                     let zi = z[c] as usize;
                     let wv = w_lut[zi];
-                    a[c] += wg[c][zi] - lt * wv;
-                    dd[c] += wv;
+                    a[c] += ca * v[c][zi] + cb * wv;
+                    dd[c] += cd * wv;
                 }
             }
             for c in 0..N {
-                d[c] = dd[c];
-                nu[c] = if dd[c] > 0.0 {
-                    (a[c] / dd[c]).exp()
-                } else {
-                    0.0
-                };
+                (nu[c], d[c]) = finish(t.log, a[c], dd[c]);
             }
         }
     }
-    match wg_lut.len() {
-        1 => go::<1>(rows, w_lut, wg_lut, ln_t, out, den),
-        3 => go::<3>(rows, w_lut, wg_lut, ln_t, out, den),
-        4 => go::<4>(rows, w_lut, wg_lut, ln_t, out, den),
+    match t.v.len() {
+        1 => go::<1>(rows, t, out, den),
+        3 => go::<3>(rows, t, out, den),
+        4 => go::<4>(rows, t, out, den),
         ch => {
             out.fill(0.0);
             den.fill(0.0);
-            for (row, &lt) in rows.iter().zip(ln_t) {
+            for (j, row) in rows.iter().enumerate() {
                 for (k, &z) in row.iter().enumerate() {
-                    let wv = w_lut[z as usize];
-                    out[k] += wg_lut[k % ch][z as usize] - lt * wv;
-                    den[k] += wv;
+                    let wv = t.w[z as usize];
+                    out[k] += t.a[j] * t.v[k % ch][z as usize] + t.b[j] * wv;
+                    den[k] += t.d[j] * wv;
                 }
             }
-            for (nu, &d) in out.iter_mut().zip(den.iter()) {
-                if d > 0.0 {
-                    *nu = (*nu / d).exp();
-                }
+            for (nu, d) in out.iter_mut().zip(den.iter_mut()) {
+                (*nu, *d) = finish(t.log, *nu, *d);
             }
         }
     }

@@ -2,7 +2,7 @@
 
 use scatterfit_imaging::{
     CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, ImageBuf, ImagingError, LinearMergeOptions,
-    MergeOptions, ResponseCurve, merge, merge_linear_u16,
+    MergeOptions, ResponseCurve, Weighting, merge, merge_linear_u16,
 };
 
 fn frames_u8(n: usize) -> Vec<ImageBuf<u8>> {
@@ -216,7 +216,7 @@ fn merge_formula_by_hand() {
         &[1.0, 4.0],
         &ResponseCurve::linear(1).unwrap(),
         None,
-        &MergeOptions::default(),
+        &hat(),
     )
     .unwrap();
     let ln_e = (64.0 * 0.5f64.ln() + 55.0 * ((200.0f64 / 128.0).ln() - 4.0f64.ln())) / 119.0;
@@ -227,4 +227,85 @@ fn merge_formula_by_hand() {
         ln_e.exp()
     );
     assert_eq!(hdr.clipped_count, 0);
+}
+
+fn hat() -> MergeOptions {
+    MergeOptions {
+        weighting: Weighting::DebevecHat,
+        ..Default::default()
+    }
+}
+
+/// The noise-aware merge by hand (Robertson, Borman & Stevenson 2003: E = Σ u Δt X / Σ u Δt², with
+/// u(z) = 1 up to code 128 and the hat's (255 − z)/127 above) on the same bracket: X = z/128,
+/// Z = (64, 200), Δt = (1, 4), u = (1, 55/127) ⇒ E = (0.5 + 4u₂·200/128)/(1 + 16u₂). A code-0 sample
+/// counts as X = 0 with u = 1: adding a frame Δt = 0.5 at code 0 adds 0.25 to the denominator.
+#[test]
+fn noise_aware_formula_by_hand() {
+    let one = |z: u8| ImageBuf::new(1, 1, 1, vec![z]).unwrap();
+    let resp = ResponseCurve::linear(1).unwrap();
+    let opts = MergeOptions::default();
+    assert_eq!(opts.weighting, Weighting::NoiseOptimal);
+    let hdr = merge(&[one(64), one(200)], &[1.0, 4.0], &resp, None, &opts).unwrap();
+    let u2 = 55.0 / 127.0;
+    let expected = (0.5 + 4.0 * u2 * 200.0 / 128.0) / (1.0 + 16.0 * u2);
+    let got = f64::from(hdr.radiance.data()[0]);
+    assert!((got / expected - 1.0).abs() < 1e-6, "{got} vs {expected}");
+    let hdr = merge(
+        &[one(0), one(64), one(200)],
+        &[0.5, 1.0, 4.0],
+        &resp,
+        None,
+        &opts,
+    )
+    .unwrap();
+    let expected = (0.5 + 4.0 * u2 * 200.0 / 128.0) / (1.25 + 16.0 * u2);
+    let got = f64::from(hdr.radiance.data()[0]);
+    assert!((got / expected - 1.0).abs() < 1e-6, "{got} vs {expected}");
+    // Zero in every frame, or saturated in every frame: no estimate, flagged.
+    let hdr = merge(&[one(0), one(0)], &[1.0, 4.0], &resp, None, &opts).unwrap();
+    assert_eq!(hdr.clipped.data()[0], CLIPPED_LOW);
+    assert!(hdr.radiance.data()[0].is_nan());
+    let hdr = merge(&[one(255), one(255)], &[1.0, 4.0], &resp, None, &opts).unwrap();
+    assert_eq!(hdr.clipped.data()[0], CLIPPED_HIGH);
+}
+
+/// With an 8-bit dark frame the hat is taken over the signal range above the dark code, like the
+/// 16-bit path: w = min(z − z_dark, 255 − z). By hand: dark code 20, X = z/128, Z = (64, 200),
+/// Δt = (1, 4) ⇒ w = (44, 55) and ln E = [44 ln(44/128) + 55(ln(180/128) − ln 4)]/99 (with the raw
+/// code's hat the weights would be (64, 55) and ln E differs by 0.1).
+#[test]
+fn u8_dark_frame_hat_uses_signal_above_dark() {
+    let one = |z: u8| ImageBuf::new(1, 1, 1, vec![z]).unwrap();
+    let resp = ResponseCurve::linear(1).unwrap();
+    let dark = one(20);
+    let hdr = merge(
+        &[one(64), one(200)],
+        &[1.0, 4.0],
+        &resp,
+        Some(&dark),
+        &hat(),
+    )
+    .unwrap();
+    let ln_e =
+        (44.0 * (44.0f64 / 128.0).ln() + 55.0 * ((180.0f64 / 128.0).ln() - 4.0f64.ln())) / 99.0;
+    let got = f64::from(hdr.radiance.data()[0]);
+    assert!(
+        (got.ln() - ln_e).abs() < 1e-6,
+        "ln E {} vs {ln_e}",
+        got.ln()
+    );
+    // The noise-aware weighting with the same dark frame: E = Σ u Δt (X − X_dark)/Σ u Δt², u as above.
+    let hdr = merge(
+        &[one(64), one(200)],
+        &[1.0, 4.0],
+        &resp,
+        Some(&dark),
+        &MergeOptions::default(),
+    )
+    .unwrap();
+    let u2 = 55.0 / 127.0;
+    let expected = (44.0 / 128.0 + 4.0 * u2 * 180.0 / 128.0) / (1.0 + 16.0 * u2);
+    let got = f64::from(hdr.radiance.data()[0]);
+    assert!((got / expected - 1.0).abs() < 1e-6, "{got} vs {expected}");
 }
