@@ -252,9 +252,10 @@ impl ProfileTable {
         (&self.rd_total, &self.rd_total_stderr)
     }
 
-    /// Bracket of α′ in the albedo grid: (index i, weight t) with value = (1 − t)·f[i] + t·f[i+1],
-    /// linear in u = √(1 − α′) (Rd varies like √(1 − α′) near α′ = 1; Jensen 2001's total Rd).
-    fn albedo_bracket(&self, albedo: f64) -> Result<(usize, f64)> {
+    /// Catmull-Rom weights of α′ in the albedo grid, in the coordinate x = −√(1 − α′) (increasing
+    /// with α′; Rd varies like √(1 − α′) near α′ = 1, Jensen 2001's total Rd): value =
+    /// Σₖ w[k]·f[i − 1 + k] (pbrt's `CatmullRomWeights`, physics.md §2.3).
+    fn albedo_weights(&self, albedo: f64) -> Result<(usize, [f64; 4])> {
         let a = &self.spec.albedos;
         let (lo, hi) = (a[0], a[a.len() - 1]);
         if !(albedo >= lo && albedo <= hi) {
@@ -265,10 +266,8 @@ impl ProfileTable {
                 max: hi,
             });
         }
-        let i = a.partition_point(|&x| x <= albedo).clamp(1, a.len() - 1) - 1;
-        let u = |x: f64| (1.0 - x).sqrt();
-        let t = (u(albedo) - u(a[i])) / (u(a[i + 1]) - u(a[i]));
-        Ok((i, t))
+        let x = |v: f64| -(1.0 - v).sqrt();
+        Ok(catmull_rom_weights(a.len(), |k| x(a[k]), x(albedo)))
     }
 
     /// R̂(ρ) of albedo row `i` at optical radius ρ, interpolated between bin centres (log-linear where
@@ -290,8 +289,11 @@ impl ProfileTable {
     }
 
     /// Rd(r) [mm⁻²] of a half-space with reduced extinction σ′t [mm⁻¹] and reduced albedo α′, by the
-    /// similarity law Rd(r; σ′t, α′) = σ′t² R̂(σ′t r; α′) (physics.md §2.3), interpolated linearly
-    /// in √(1 − α′) between tabulated albedos and between bin centres in r.
+    /// similarity law Rd(r; σ′t, α′) = σ′t² R̂(σ′t r; α′) (physics.md §2.3). Between albedos: Catmull-Rom
+    /// in √(1 − α′) on ln R̂ (pbrt's table uses Catmull-Rom, physics.md §2.3; the logarithm because
+    /// far from the source R̂ ∝ exp(−√(3(1 − α′))·ρ), which is linear in √(1 − α′) after the log, and
+    /// varies by an order of magnitude between neighbouring default albedos near α′ = 1); on the
+    /// values themselves where one of them is not positive. Between bin centres: log-linear in ρ.
     ///
     /// # Errors
     /// `InvalidParameter` for r < 0 or σ′t ≤ 0 (or not finite); `OutOfTable` for α′ outside the
@@ -319,22 +321,41 @@ impl ProfileTable {
                 max: last,
             });
         }
-        let (i, t) = self.albedo_bracket(albedo_prime)?;
-        let v = (1.0 - t) * self.row_at(i, rho) + t * self.row_at(i + 1, rho);
+        let (i, w) = self.albedo_weights(albedo_prime)?;
+        let mut rows = [0.0; 4];
+        for (k, v) in rows.iter_mut().enumerate() {
+            if w[k] != 0.0 {
+                *v = self.row_at(i + k - 1, rho);
+            }
+        }
+        let used = || (0..4).filter(|&k| w[k] != 0.0);
+        let v = if let Some(k) = (0..4).find(|&k| w[k] == 1.0) {
+            // At a node: the row itself (exp∘ln would round).
+            rows[k]
+        } else if used().all(|k| rows[k] > 0.0) {
+            used().map(|k| w[k] * rows[k].ln()).sum::<f64>().exp()
+        } else {
+            used().map(|k| w[k] * rows[k]).sum::<f64>().max(0.0)
+        };
         Ok(sigma_t_prime * sigma_t_prime * v)
     }
 
-    /// Total diffuse reflectance Rd(α′) (excluding R_sp), linear in √(1 − α′) between albedos.
+    /// Total diffuse reflectance Rd(α′) (excluding R_sp): Catmull-Rom in √(1 − α′) between albedos
+    /// (pbrt's ρ_eff table, physics.md §2.4).
     ///
     /// # Errors
     /// `OutOfTable` for α′ outside the tabulated range.
     pub fn rd_total(&self, albedo_prime: f64) -> Result<f64> {
-        let (i, t) = self.albedo_bracket(albedo_prime)?;
-        Ok((1.0 - t) * self.rd_total[i] + t * self.rd_total[i + 1])
+        let (i, w) = self.albedo_weights(albedo_prime)?;
+        Ok((0..4)
+            .filter(|&k| w[k] != 0.0)
+            .map(|k| w[k] * self.rd_total[i + k - 1])
+            .sum())
     }
 
-    /// The reduced albedo α′ whose total diffuse reflectance is `rd` (the inverse of
-    /// [`ProfileTable::rd_total`]; Rd increases with α′).
+    /// The reduced albedo α′ whose total diffuse reflectance is `rd`: the inverse of
+    /// [`ProfileTable::rd_total`] (Rd increases with α′), found like pbrt's `InvertCatmullRom`
+    /// (physics.md §2.4) by bisection in √(1 − α′) inside the interval whose node totals bracket `rd`.
     ///
     /// # Errors
     /// `OutOfTable` when `rd` lies outside the tabulated totals.
@@ -344,10 +365,27 @@ impl ProfileTable {
         let (lo, hi) = (r[0], r[r.len() - 1]);
         for i in 0..r.len() - 1 {
             if rd >= r[i] && rd <= r[i + 1] && r[i + 1] > r[i] {
-                let t = (rd - r[i]) / (r[i + 1] - r[i]);
-                let (u0, u1) = ((1.0 - a[i]).sqrt(), (1.0 - a[i + 1]).sqrt());
-                let u = u0 + t * (u1 - u0);
-                return Ok(1.0 - u * u);
+                if rd == r[i] {
+                    return Ok(a[i]);
+                }
+                if rd == r[i + 1] {
+                    return Ok(a[i + 1]);
+                }
+                // Bisection on u = √(1 − α′) ∈ [u(a[i+1]), u(a[i])]; Rd decreases with u.
+                let (mut u_lo, mut u_hi) = ((1.0 - a[i + 1]).sqrt(), (1.0 - a[i]).sqrt());
+                for _ in 0..200 {
+                    let u = 0.5 * (u_lo + u_hi);
+                    if u <= u_lo || u >= u_hi {
+                        break;
+                    }
+                    if self.rd_total(1.0 - u * u)? >= rd {
+                        u_lo = u;
+                    } else {
+                        u_hi = u;
+                    }
+                }
+                let u = 0.5 * (u_lo + u_hi);
+                return Ok((1.0 - u * u).clamp(a[i], a[i + 1]));
             }
         }
         Err(McError::OutOfTable {
@@ -448,6 +486,41 @@ impl ProfileTable {
         table.save(&path)?;
         Ok((table, CacheStatus::Built, path))
     }
+}
+
+/// Catmull-Rom weights at `x` over the `n` strictly increasing nodes `node(k)` (pbrt-v3's
+/// `CatmullRomWeights`, physics.md §2.3): returns (i, w) with x ∈ [node(i), node(i + 1)] and the
+/// interpolant Σₖ w[k]·f(i − 1 + k); the end derivatives are one-sided (w[0] or w[3] is then 0).
+/// Cubic Hermite with finite-difference derivatives on non-uniform nodes; exact at the nodes.
+fn catmull_rom_weights(n: usize, node: impl Fn(usize) -> f64, x: f64) -> (usize, [f64; 4]) {
+    // First i with node(i + 1) > x, clamped to the last interval.
+    let mut i = 0;
+    while i + 2 < n && node(i + 1) <= x {
+        i += 1;
+    }
+    let (x0, x1) = (node(i), node(i + 1));
+    let t = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
+    let (t2, t3) = (t * t, t * t * t);
+    let mut w = [0.0, 2.0 * t3 - 3.0 * t2 + 1.0, -2.0 * t3 + 3.0 * t2, 0.0];
+    let w0 = t3 - 2.0 * t2 + t;
+    if i > 0 {
+        let w0 = w0 * (x1 - x0) / (x1 - node(i - 1));
+        w[0] = -w0;
+        w[2] += w0;
+    } else {
+        w[1] -= w0;
+        w[2] += w0;
+    }
+    let w3 = t3 - t2;
+    if i + 2 < n {
+        let w3 = w3 * (x1 - x0) / (node(i + 2) - x0);
+        w[1] -= w3;
+        w[3] = w3;
+    } else {
+        w[1] -= w3;
+        w[2] += w3;
+    }
+    (i, w)
 }
 
 /// The cache folder: `$SCATTERFIT_CACHE`, else `$XDG_CACHE_HOME/scatterfit`, else
