@@ -40,7 +40,10 @@ impl Layer {
             sigma_a + sigma_s > 0.0,
             "sigma_t",
             sigma_a + sigma_s,
-            "σa + σs must be > 0: clear (non-interacting) layers are not supported",
+            "σa + σs must be > 0: clear layers (glass slides) are not supported yet; MCML's \
+             treatment (R_sp with the slide's multiple reflections, launch below the slide) is not \
+             implemented (a slide is not equivalent to changing n_above, which also moves the \
+             critical angle of the light leaving the sample)",
         )?;
         check(
             g.is_finite() && g > -1.0 && g < 1.0,
@@ -183,5 +186,28 @@ impl Sample {
     /// Index of the medium below.
     pub fn n_below(&self) -> f64 {
         self.n_below
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::McError;
+
+    /// A clear layer (σa = σs = 0, a glass slide) is refused with a typed error naming σt, not traced.
+    #[test]
+    fn clear_layer_is_refused() {
+        let e = Layer::new(0.0, 0.0, 0.0, 1.5, 1.0).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                McError::InvalidParameter {
+                    name: "sigma_t",
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("glass"), "{e}");
     }
 }
