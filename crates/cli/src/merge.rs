@@ -543,18 +543,47 @@ pub(crate) fn write_bracket_png(
                 &CameraFrame::U8(f),
             )?)
         })?;
+    write_exposures_csv(dir, "png", "exposures.csv", times)
+}
+
+/// Writes a bracket as JPEGs of the given quality plus `exposures_jpeg.csv` into `dir` (frames are
+/// borrowed: the PNG bracket is written from the same frames afterwards).
+pub(crate) fn write_bracket_jpeg(
+    dir: &Path,
+    frames: &[ImageBuf<u8>],
+    times: &[f64],
+    quality: u8,
+) -> anyhow::Result<PathBuf> {
+    use rayon::prelude::*;
+    frames
+        .par_iter()
+        .enumerate()
+        .try_for_each(|(j, f)| -> anyhow::Result<()> {
+            let path = dir.join(format!("frame_{j:02}.jpg"));
+            Ok(scatterfit_io::image_files::write_jpeg(&path, f, quality)?)
+        })?;
+    write_exposures_csv(dir, "jpg", "exposures_jpeg.csv", times)
+}
+
+fn write_exposures_csv(
+    dir: &Path,
+    ext: &str,
+    name: &str,
+    times: &[f64],
+) -> anyhow::Result<PathBuf> {
     let mut csv = String::from("file,time_s\n");
     for (j, t) in times.iter().enumerate() {
-        csv.push_str(&format!("frame_{j:02}.png,{t}\n"));
+        csv.push_str(&format!("frame_{j:02}.{ext},{t}\n"));
     }
-    let csv_path = dir.join("exposures.csv");
+    let csv_path = dir.join(name);
     scatterfit_io::atomic::write_atomic(&csv_path, csv.as_bytes())
         .with_context(|| format!("writing {}", csv_path.display()))?;
     Ok(csv_path)
 }
 
 /// Contributes this area's figures to `scatterfit bench`: the end-to-end merge of a 13-exposure
-/// 24-MP 8-bit RGB bracket (PNG files read from disk, response recovered, merged) and the radial
+/// 24-MP 8-bit RGB bracket (PNG files read from disk, response recovered, merged; the same from
+/// quality-90 JPEGs) and the radial
 /// profile of the 24-MP radiance map. Set `SCATTERFIT_BENCH_BRACKET_DIR` to keep the bracket there
 /// (for timing `scatterfit merge` itself, e.g. under `/usr/bin/time -v`).
 pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
@@ -576,6 +605,8 @@ pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figu
         }
         None => temp.path().to_path_buf(),
     };
+    // JPEG first (it borrows the frames), quality 90 as a camera would write; then the PNGs.
+    let jpeg_csv = write_bracket_jpeg(&dir, &frames, &times, 90)?;
     let csv = write_bracket_png(&dir, frames, &times)?;
     let merge_args = Args {
         images: Vec::new(),
@@ -614,7 +645,32 @@ pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figu
             note,
         },
     ];
+    drop(merged.hdr.clipped);
     let radiance = merged.hdr.radiance;
+    // The same bracket as quality-90 JPEGs (files as a camera writes them): reading only, then the
+    // whole read + recover + merge. The PNG result is kept for the profile below.
+    let jpeg_args = Args {
+        exposures: Some(jpeg_csv),
+        output: dir.join("radiance_jpeg.exr"),
+        ..merge_args
+    };
+    let t0 = Instant::now();
+    let jpeg = read_and_merge(&jpeg_args, false)?;
+    let jpeg_total = t0.elapsed().as_secs_f64();
+    drop(jpeg.hdr);
+    let jpeg_note = format!("13 × {mp:.0} MP RGB 8-bit JPEG quality 90, {threads} threads");
+    figures.push(Figure {
+        name: format!("merge end to end from JPEG: read + recover + merge, {mp:.0} MP"),
+        value: jpeg_total,
+        unit: "s".into(),
+        note: jpeg_note.clone(),
+    });
+    figures.push(Figure {
+        name: "  of which reading (decode 13 JPEG)".into(),
+        value: jpeg.read_s,
+        unit: "s".into(),
+        note: jpeg_note,
+    });
     let center = scatterfit_imaging::find_spot_center(&radiance, &Default::default())?;
     let opts = scatterfit_imaging::ProfileOptions::default();
     let reps = 10;

@@ -339,6 +339,52 @@ pub fn write_camera_frame(path: &Path, frame: &CameraFrame) -> Result<(), ImageF
     })
 }
 
+/// Writes an 8-bit grey or RGB camera frame atomically as a baseline JPEG of the given quality
+/// (1–100; [`write_camera_frame`] uses 95), whatever the file's extension. For synthetic brackets
+/// and benchmarks that need a camera-like compression level.
+///
+/// # Errors
+/// [`ImageFileError::Unsupported`] for a channel count other than 1 or 3 or a quality outside
+/// 1..=100; [`ImageFileError::Decode`] (encoder) or [`ImageFileError::Write`] if writing fails.
+pub fn write_jpeg(path: &Path, frame: &ImageBuf<u8>, quality: u8) -> Result<(), ImageFileError> {
+    use image::ExtendedColorType as C;
+    use image::ImageEncoder;
+    let unsupported = |detail: String| ImageFileError::Unsupported {
+        path: path.to_path_buf(),
+        detail,
+    };
+    let color = match frame.channels() {
+        1 => C::L8,
+        3 => C::Rgb8,
+        c => {
+            return Err(unsupported(format!(
+                "a camera frame has 1 or 3 channels, not {c}"
+            )));
+        }
+    };
+    if !(1..=100).contains(&quality) {
+        return Err(unsupported(format!(
+            "JPEG quality must be 1–100, not {quality}"
+        )));
+    }
+    let mut out = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, quality)
+        .write_image(
+            frame.data(),
+            frame.width() as u32,
+            frame.height() as u32,
+            color,
+        )
+        .map_err(|source| ImageFileError::Decode {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    crate::atomic::write_atomic(path, &out).map_err(|source| ImageFileError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// File formats for float radiance maps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RadianceFormat {
