@@ -264,15 +264,22 @@ impl Dipole {
     }
 
     /// [`Dipole::rd_with_derivatives`] at every radius of `radii_mm`, written to `out` (the shorter of
-    /// the two sets the count). Same arithmetic as the scalar method, arranged in blocks of 8 radii so
-    /// that the square roots vectorise and the exponentials pipeline. This is the hot path of the fit
-    /// (one call per Levenberg–Marquardt iteration).
+    /// the two sets the count). This is the hot path of the fit (one call per Levenberg–Marquardt
+    /// iteration), so it is arranged for speed: blocks of 8 radii, square roots and exponentials in
+    /// their own loops, and every per-dipole constant hoisted into a local. It repeats the arithmetic of
+    /// [`Dipole::sample_from_distances`] rather than calling it because the call, even inlined, measured
+    /// slower here (3.95 vs 4.85 µs in `scatterfit bench optics`; BENCHMARKS.md);
+    /// `blocked_profile_equals_scalar` pins the two together.
     pub fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {
         const B: usize = 8;
         let n = radii_mm.len().min(out.len());
-        // A local copy keeps every cached constant in registers across the loops.
-        let this = *self;
-        let (zr, zv, st) = (this.z_r, this.z_v, this.sigma_tr);
+        let st = self.sigma_tr;
+        let sigma_t = self.props.sigma_t_prime();
+        let c = std::f64::consts::FRAC_1_PI * 0.25;
+        let (zr, zv, kv) = (self.z_r, self.z_v, self.k_v);
+        let z_r2 = zr * zr;
+        let (da_dsp, da_dsa) = (self.da_dsp, self.da_dsa);
+        let (sa, ap) = (self.props.sigma_a, self.albedo_prime);
         for (radii, out) in radii_mm[..n].chunks(B).zip(out[..n].chunks_mut(B)) {
             let m = radii.len();
             let (mut dr, mut dv, mut er, mut ev) = ([1.0; B], [1.0; B], [0.0; B], [0.0; B]);
@@ -286,7 +293,26 @@ impl Dipole {
                 ev[i] = (-st * dv[i]).exp();
             }
             for i in 0..m {
-                out[i] = this.sample_from_distances(dr[i], dv[i], er[i], ev[i]);
+                // Per source: T, ∂T/∂z and −z e/d, as in `source_terms`.
+                let term = |z: f64, d: f64, e: f64| {
+                    let inv_d = 1.0 / d;
+                    let inv_d3 = inv_d * inv_d * inv_d;
+                    let sd = st * d;
+                    let t = z * (sd + 1.0) * e * inv_d3;
+                    let dt_dz = (sd + 1.0) * e * inv_d3
+                        - z * z * e * (sd * sd + 3.0 * sd + 3.0) * inv_d3 * inv_d * inv_d;
+                    (t, dt_dz, -z * e * inv_d)
+                };
+                let (t_r, dtr_dz, g_r) = term(zr, dr[i], er[i]);
+                let (t_v, dtv_dz, g_v) = term(zv, dv[i], ev[i]);
+                let s = t_r + t_v;
+                let ds_z = -z_r2 * (dtr_dz + kv * dtv_dz);
+                let g = 1.5 * (g_r + g_v);
+                out[i] = ProfileSample {
+                    rd: c * ap * s,
+                    d_sigma_s_prime: c * (da_dsp * s + ap * (ds_z + g * sa)),
+                    d_sigma_a: c * (da_dsa * s + ap * (ds_z + g * (sigma_t + sa))),
+                };
             }
         }
     }
