@@ -28,6 +28,16 @@ pub enum Fill {
     LowerBound,
 }
 
+/// How 8-bit samples are weighted across the bracket.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum WeightingArg {
+    /// Noise-aware linear-domain average (Robertson et al. 2003 / Granados et al. 2010): unbiased for
+    /// dim pixels (BENCHMARKS.md, "dim pixels").
+    NoiseOptimal,
+    /// The paper's hat on ln E (Debevec & Malik 1997, eq. 6), as OpenCV's MergeDebevec.
+    DebevecHat,
+}
+
 /// Arguments of `scatterfit merge`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -57,6 +67,9 @@ pub struct Args {
     /// Value stored for pixels clipped in every exposure.
     #[arg(long, value_enum, default_value_t = Fill::Nan)]
     pub clipped_fill: Fill,
+    /// Sample weighting of 8-bit brackets.
+    #[arg(long, value_enum, default_value_t = WeightingArg::NoiseOptimal)]
+    pub weighting: WeightingArg,
     /// The radiance map to write (.exr: 32-bit float, lossless; .hdr: Radiance RGBE).
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
@@ -258,7 +271,10 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
         });
         let opts = MergeOptions {
             clipped_fill: fill(args.clipped_fill),
-            ..Default::default()
+            weighting: match args.weighting {
+                WeightingArg::NoiseOptimal => scatterfit_imaging::Weighting::NoiseOptimal,
+                WeightingArg::DebevecHat => scatterfit_imaging::Weighting::DebevecHat,
+            },
         };
         let hdr = scatterfit_imaging::merge(&bufs, &times, &response, dark.as_ref(), &opts)
             .context("merging the bracket")?;
@@ -617,6 +633,7 @@ pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figu
         samples: 100,
         saturation: u16::MAX,
         clipped_fill: Fill::Nan,
+        weighting: WeightingArg::NoiseOptimal,
         output: dir.join("radiance.exr"),
         response_out: None,
         json: true,
