@@ -27,7 +27,12 @@ pub struct Args {
     #[arg(long)]
     pub json: bool,
     /// Also write the full result as JSON to this file (atomically).
-    #[arg(short = 'o', long = "output", visible_alias = "out", value_name = "FILE")]
+    #[arg(
+        short = 'o',
+        long = "output",
+        visible_alias = "out",
+        value_name = "FILE"
+    )]
     pub out: Option<PathBuf>,
 }
 
