@@ -309,6 +309,15 @@ mod tests {
         (0..31).map(|i| 400.0 + 10.0 * i as f64).collect()
     }
 
+    /// A spectrally flat reading at 400–700 nm.
+    fn flat(sci: f64, sce: f64) -> SpectroReading {
+        SpectroReading {
+            wavelengths_nm: grid(),
+            sci: vec![sci; 31],
+            sce: vec![sce; 31],
+        }
+    }
+
     /// A sample of η = 1.5 (flat R₀ = 0.04 at 8°) with a flat SCE of 0.5: η comes back, and α′ per
     /// channel inverts Rd = 0.5 at η = 1.5 (a grey: R = G = B up to the sRGB matrix's rounding).
     #[test]
@@ -337,11 +346,7 @@ mod tests {
     /// A given L*a*b* replaces the spectrum for Rd; 10° goes through Bradford.
     #[test]
     fn lab_overrides_spectrum_colour() {
-        let reading = SpectroReading {
-            wavelengths_nm: grid(),
-            sci: vec![0.54; 31],
-            sce: vec![0.5; 31],
-        };
+        let reading = flat(0.54, 0.5);
         let lab = Lab {
             l: 60.0,
             a: 20.0,
@@ -361,11 +366,7 @@ mod tests {
 
     #[test]
     fn no_or_huge_specular_is_an_error_unless_eta_given() {
-        let swapped = SpectroReading {
-            wavelengths_nm: grid(),
-            sci: vec![0.5; 31],
-            sce: vec![0.52; 31],
-        };
+        let swapped = flat(0.5, 0.52);
         let err = analyse(&swapped, &SpectroOptions::default()).unwrap_err();
         assert!(err.to_string().contains("swapped"), "{err}");
         let given = SpectroOptions {
@@ -375,22 +376,14 @@ mod tests {
         let a = analyse(&swapped, &given).unwrap();
         assert_eq!(a.eta, 1.4);
         assert!(a.warnings.iter().any(|w| w.contains("≤ 0")));
-        let metal = SpectroReading {
-            wavelengths_nm: grid(),
-            sci: vec![0.9; 31],
-            sce: vec![0.3; 31],
-        };
+        let metal = flat(0.9, 0.3);
         assert!(analyse(&metal, &SpectroOptions::default()).is_err());
     }
 
     /// A saturated colour outside the sRGB gamut gives a channel problem, not a clamped number.
     #[test]
     fn out_of_gamut_channel_is_reported() {
-        let reading = SpectroReading {
-            wavelengths_nm: grid(),
-            sci: vec![0.54; 31],
-            sce: vec![0.5; 31],
-        };
+        let reading = flat(0.54, 0.5);
         // Very saturated green: linear sRGB red and blue < 0.
         let lab = Lab {
             l: 60.0,
@@ -414,11 +407,7 @@ mod tests {
     /// Low specular reflectance is flagged as a likely underestimate of η.
     #[test]
     fn low_specular_warns() {
-        let reading = SpectroReading {
-            wavelengths_nm: grid(),
-            sci: vec![0.505; 31],
-            sce: vec![0.5; 31],
-        };
+        let reading = flat(0.505, 0.5);
         let a = analyse(&reading, &SpectroOptions::default()).unwrap();
         assert!(
             a.warnings.iter().any(|w| w.contains("underestimated")),
