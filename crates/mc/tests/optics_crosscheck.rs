@@ -33,11 +33,7 @@ fn mcml_fresnel_equals_optics_fresnel() {
 
 #[test]
 fn optics_dipole_matches_reference_vectors() {
-    let props = OpticalProperties {
-        sigma_s_prime: 1.0,
-        sigma_a: 0.01,
-        eta: 1.3,
-    };
+    let props = OpticalProperties::new(1.0, 0.01, 1.3).unwrap();
     let d = Dipole::new(&props);
     for (r, v) in [
         (0.0, 8.26052859e-02),

@@ -177,14 +177,14 @@ impl Dipole {
     /// The dipole for `props` (Jensen et al. 2001, §2.4: zr = 1/σ′t, zv = zr + 4AD = zr(1 + 4A/3)).
     pub fn new(props: &OpticalProperties) -> Self {
         let sigma_t = props.sigma_t_prime();
-        let k_v = 1.0 + 4.0 / 3.0 * a_coefficient(props.eta);
+        let k_v = 1.0 + 4.0 / 3.0 * a_coefficient(props.eta());
         let z_r = 1.0 / sigma_t;
         Self {
-            da_dsp: props.sigma_a * z_r * z_r,
-            da_dsa: -props.sigma_s_prime * z_r * z_r,
+            da_dsp: props.sigma_a() * z_r * z_r,
+            da_dsa: -props.sigma_s_prime() * z_r * z_r,
             props: *props,
-            albedo_prime: props.sigma_s_prime / sigma_t,
-            sigma_tr: (3.0 * props.sigma_a * sigma_t).sqrt(),
+            albedo_prime: props.sigma_s_prime() / sigma_t,
+            sigma_tr: (3.0 * props.sigma_a() * sigma_t).sqrt(),
             z_r,
             z_v: z_r * k_v,
             k_v,
@@ -248,8 +248,8 @@ impl Dipole {
         let (t_r, dtr_dz, g_r) = self.source_terms(self.z_r, d_r, e_r);
         let (t_v, dtv_dz, g_v) = self.source_terms(self.z_v, d_v, e_v);
         let s = t_r + t_v;
-        let sigma_a = self.props.sigma_a;
-        let sigma_t = sigma_a + self.props.sigma_s_prime;
+        let sigma_a = self.props.sigma_a();
+        let sigma_t = sigma_a + self.props.sigma_s_prime();
         // Common part of ∂S/∂p through zr and zv (∂zr/∂p = −zr², ∂zv/∂p = −k zr² for both p).
         let ds_z = -self.z_r * self.z_r * (dtr_dz + self.k_v * dtv_dz);
         // Through σtr: (−z e/d)·(3/2)·{σa for σ′s, σ′t + σa for σa}.
@@ -279,7 +279,7 @@ impl Dipole {
         let (zr, zv, kv) = (self.z_r, self.z_v, self.k_v);
         let z_r2 = zr * zr;
         let (da_dsp, da_dsa) = (self.da_dsp, self.da_dsa);
-        let (sa, ap) = (self.props.sigma_a, self.albedo_prime);
+        let (sa, ap) = (self.props.sigma_a(), self.albedo_prime);
         for (radii, out) in radii_mm[..n].chunks(B).zip(out[..n].chunks_mut(B)) {
             let m = radii.len();
             let (mut dr, mut dv, mut er, mut ev) = ([1.0; B], [1.0; B], [0.0; B], [0.0; B]);
@@ -327,7 +327,7 @@ impl Dipole {
 
     /// Total diffuse reflectance ∫2πr Rd(r) dr of this dipole ([`rd_total`]).
     pub fn rd_total(&self) -> f64 {
-        rd_total(self.albedo_prime, self.props.eta)
+        rd_total(self.albedo_prime, self.props.eta())
     }
 }
 

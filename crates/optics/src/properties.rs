@@ -5,14 +5,33 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, eta_at_least_one, non_negative};
 
 /// The optical properties of a homogeneous material in one colour channel.
+///
+/// Built only through [`OpticalProperties::new`] (or [`OpticalProperties::from_albedo`]); JSON is read
+/// through the same check (`#[serde(try_from)]`), so every value of this type is valid.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawProperties")]
 pub struct OpticalProperties {
     /// Reduced scattering coefficient σ′s = σs(1 − g) [mm⁻¹].
-    pub sigma_s_prime: f64,
+    sigma_s_prime: f64,
     /// Absorption coefficient σa [mm⁻¹].
-    pub sigma_a: f64,
+    sigma_a: f64,
     /// Relative refractive index η = n_material / n_air [1].
-    pub eta: f64,
+    eta: f64,
+}
+
+/// The unchecked shape of [`OpticalProperties`] in files.
+#[derive(Deserialize)]
+struct RawProperties {
+    sigma_s_prime: f64,
+    sigma_a: f64,
+    eta: f64,
+}
+
+impl TryFrom<RawProperties> for OpticalProperties {
+    type Error = crate::OpticsError;
+    fn try_from(raw: RawProperties) -> Result<Self> {
+        Self::new(raw.sigma_s_prime, raw.sigma_a, raw.eta)
+    }
 }
 
 impl OpticalProperties {
@@ -36,6 +55,21 @@ impl OpticalProperties {
             sigma_a,
             eta,
         })
+    }
+
+    /// Reduced scattering coefficient σ′s = σs(1 − g) [mm⁻¹].
+    pub fn sigma_s_prime(&self) -> f64 {
+        self.sigma_s_prime
+    }
+
+    /// Absorption coefficient σa [mm⁻¹].
+    pub fn sigma_a(&self) -> f64 {
+        self.sigma_a
+    }
+
+    /// Relative refractive index η = n_material / n_air [1].
+    pub fn eta(&self) -> f64 {
+        self.eta
     }
 
     /// Reduced extinction coefficient σ′t = σa + σ′s [mm⁻¹].
@@ -71,5 +105,28 @@ impl OpticalProperties {
             sigma_s_prime / albedo_prime - sigma_s_prime,
             eta,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// JSON goes through the checked constructor: a valid value round-trips, an invalid one is refused.
+    #[test]
+    fn deserialisation_is_checked() {
+        let p = OpticalProperties::new(1.2, 0.03, 1.4).unwrap();
+        let json = serde_json::to_string(&p).unwrap();
+        assert_eq!(serde_json::from_str::<OpticalProperties>(&json).unwrap(), p);
+        for bad in [
+            r#"{"sigma_s_prime":-1,"sigma_a":0.1,"eta":1.3}"#,
+            r#"{"sigma_s_prime":1,"sigma_a":-0.1,"eta":1.3}"#,
+            r#"{"sigma_s_prime":1,"sigma_a":0.1,"eta":0.5}"#,
+        ] {
+            assert!(
+                serde_json::from_str::<OpticalProperties>(bad).is_err(),
+                "{bad}"
+            );
+        }
     }
 }
