@@ -11,4 +11,5 @@ pub mod bracket;
 pub mod image_files;
 pub mod profile_csv;
 pub mod response_csv;
+pub mod result_json;
 pub mod spectro;

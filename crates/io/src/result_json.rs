@@ -1,0 +1,424 @@
+//! `result.json`: what `scatterfit measure` writes for one sample, and what `render` and `export`
+//! read back.
+//!
+//! The shape follows ARCHITECTURE.md ("The measurement, as files"); the names listed there are stable,
+//! the others may grow. Units: mm⁻¹ for coefficients, seconds for times. Channels are keyed `"r"`,
+//! `"g"`, `"b"` (linear sRGB). A channel whose fit failed keeps its row with `status = "failed"`, the
+//! reason in `problem` and `null` for the values it could not give.
+//!
+//! ```json
+//! { "name": "pink plastic", "eta": 1.2886, "eta_source": "spectro", "method": "proposed",
+//!   "model": "dipole", "albedo_model": "diffusion",
+//!   "channels": { "r": { "status": "ok", "sigma_s_prime": 1.979, "sigma_s_prime_stderr": 0.004,
+//!                        "sigma_a": 0.000792, "sigma_a_stderr": 0.00002, "albedo_prime": 0.9996,
+//!                        "rd_total": 0.87, "fit_time_s": 1.2e-5, "iterations": 9, "mse": 0.8, … },
+//!                 "g": { … }, "b": { … } },
+//!   "inputs": { "profile": "profile.csv", "mm_per_pixel": 0.05, "spot_radius_mm": 0.5, … },
+//!   "version": "0.1.0" }
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// What can go wrong reading or writing a result file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ResultJsonError {
+    /// The file could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The file could not be written (an existing file is left untouched).
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The file is not a scatterfit result, or a field is missing or out of range.
+    #[error("{}: {detail}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What was wrong, naming the field, and what to do.
+        detail: String,
+    },
+}
+
+/// How one channel's measurement ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum ChannelStatus {
+    /// Parameters found and constrained by the data.
+    Ok,
+    /// The fit ran, but the data do not constrain every parameter (see `unconstrained`): the
+    /// values are the solver's end point, not measurements.
+    Unconstrained,
+    /// No parameters (see `problem`).
+    Failed,
+}
+
+/// The correlation matrix of a channel's fitted parameters (from the Jacobian at the solution).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Correlation {
+    /// Parameter names in matrix order, e.g. `["sigma_s_prime", "scale"]`.
+    pub parameters: Vec<String>,
+    /// Row-major correlation coefficients, `parameters.len()` rows.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+/// One colour channel of a result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChannelResult {
+    /// How the measurement of this channel ended.
+    pub status: ChannelStatus,
+    /// Reduced scattering coefficient σ′s [mm⁻¹].
+    pub sigma_s_prime: Option<f64>,
+    /// Its standard error [mm⁻¹].
+    pub sigma_s_prime_stderr: Option<f64>,
+    /// Absorption coefficient σa [mm⁻¹].
+    pub sigma_a: Option<f64>,
+    /// Its standard error [mm⁻¹].
+    pub sigma_a_stderr: Option<f64>,
+    /// Reduced albedo α′ = σ′s/(σ′s + σa): from the spectrophotometer (proposed method) or from the
+    /// fitted coefficients (existing method).
+    pub albedo_prime: Option<f64>,
+    /// Total diffuse reflectance Rd of the channel from the spectrophotometer (linear sRGB of SCE).
+    pub rd_total: Option<f64>,
+    /// The profile's fitted (or spectro-normalised) scale k: measured = k · model [relative units
+    /// per mm⁻²].
+    #[serde(default)]
+    pub scale: Option<f64>,
+    /// Correlations of the fitted parameters.
+    #[serde(default)]
+    pub correlation: Option<Correlation>,
+    /// Parameters the data do not constrain (empty when every parameter is measured).
+    #[serde(default)]
+    pub unconstrained: Vec<String>,
+    /// Wall time of the fit [s].
+    #[serde(default)]
+    pub fit_time_s: f64,
+    /// Levenberg–Marquardt iterations (residual evaluations).
+    #[serde(default)]
+    pub iterations: usize,
+    /// Why the solver stopped.
+    #[serde(default)]
+    pub termination: String,
+    /// Mean squared difference between the measured profile (in absolute units, divided by the
+    /// scale) and the model over the fitted rings [mm⁻⁴] (Choi et al. 2014, Table 2's quantity).
+    pub mse: Option<f64>,
+    /// Root mean square of ln(measured / model) over the fitted rings (dimensionless; comparable
+    /// between samples).
+    #[serde(default)]
+    pub rms_log_residual: Option<f64>,
+    /// χ² per degree of freedom of the weighted log residuals (1 when the model fits to the noise).
+    #[serde(default)]
+    pub chi2_reduced: Option<f64>,
+    /// Rings the fit used.
+    #[serde(default)]
+    pub rings_used: usize,
+    /// Rings excluded because they lie inside the light spot.
+    #[serde(default)]
+    pub rings_inside_spot: usize,
+    /// Rings excluded because their signal is below what the bracket can detect.
+    #[serde(default)]
+    pub rings_below_detection: usize,
+    /// Rings excluded for having no valid pixel (clipped everywhere, outside the image).
+    #[serde(default)]
+    pub rings_invalid: usize,
+    /// Why the channel failed or what to watch out for.
+    #[serde(default)]
+    pub problem: Option<String>,
+}
+
+/// The three channels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Channels {
+    /// Red.
+    pub r: ChannelResult,
+    /// Green.
+    pub g: ChannelResult,
+    /// Blue.
+    pub b: ChannelResult,
+}
+
+impl Channels {
+    /// The channels in R, G, B order.
+    pub fn as_array(&self) -> [&ChannelResult; 3] {
+        [&self.r, &self.g, &self.b]
+    }
+
+    /// Builds from an array in R, G, B order.
+    pub fn from_array([r, g, b]: [ChannelResult; 3]) -> Self {
+        Self { r, g, b }
+    }
+}
+
+/// A file the result was made from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FileRef {
+    /// The path as given (relative paths are relative to the sample folder).
+    pub path: String,
+    /// SHA-256 of the file's bytes, lower-case hex.
+    pub sha256: String,
+}
+
+/// Provenance: the files and options a result was made from.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Inputs {
+    /// The sample folder.
+    pub sample_dir: String,
+    /// The manifest (`sample.toml`).
+    pub manifest: Option<FileRef>,
+    /// The spectrophotometer reading.
+    pub spectro: Option<FileRef>,
+    /// The exposure bracket's frames.
+    pub frames: Vec<FileRef>,
+    /// An already merged radiance map, when the manifest gave one.
+    pub hdr: Option<FileRef>,
+    /// The radial profile the fit used, relative to the result file's folder (written beside it).
+    pub profile: Option<String>,
+    /// Image scale on the sample [mm per pixel].
+    pub mm_per_pixel: Option<f64>,
+    /// Radius of the light spot the model was convolved with [mm].
+    pub spot_radius_mm: Option<f64>,
+    /// Spot centre [x, y] in pixels.
+    pub center_px: Option<[f64; 2]>,
+    /// Fit options (method, model, ring limits…) as given.
+    pub options: serde_json::Value,
+}
+
+/// A whole result file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeasurementResult {
+    /// The sample's name.
+    pub name: String,
+    /// Relative refractive index η used by the fit.
+    pub eta: f64,
+    /// Where η came from: `spectro` (SCI − SCE) or `given`.
+    #[serde(default)]
+    pub eta_source: String,
+    /// `proposed` or `existing`.
+    pub method: String,
+    /// The forward model of the profile fit, e.g. `dipole`.
+    pub model: String,
+    /// How α′ was obtained from the spectrophotometer's Rd, e.g. `diffusion`.
+    #[serde(default)]
+    pub albedo_model: String,
+    /// Per-channel results.
+    pub channels: Channels,
+    /// Provenance.
+    #[serde(default)]
+    pub inputs: Inputs,
+    /// The scatterfit version that wrote the file.
+    pub version: String,
+}
+
+impl MeasurementResult {
+    /// σ′s, σa per channel (R, G, B) when every channel has both, else the first channel without.
+    ///
+    /// # Errors
+    /// The channel name (`"r"`, `"g"` or `"b"`) lacking a value.
+    pub fn coefficients(&self) -> Result<[(f64, f64); 3], &'static str> {
+        let names = ["r", "g", "b"];
+        let mut out = [(0.0, 0.0); 3];
+        for (k, c) in self.channels.as_array().iter().enumerate() {
+            match (c.sigma_s_prime, c.sigma_a) {
+                (Some(s), Some(a)) => out[k] = (s, a),
+                _ => return Err(names[k]),
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Writes a result atomically as pretty JSON.
+///
+/// # Errors
+/// [`ResultJsonError::Write`].
+pub fn write_result_json(path: &Path, result: &MeasurementResult) -> Result<(), ResultJsonError> {
+    let mut text = serde_json::to_string_pretty(result).map_err(|e| ResultJsonError::Invalid {
+        path: path.to_path_buf(),
+        detail: format!("cannot serialise the result: {e}"),
+    })?;
+    text.push('\n');
+    crate::atomic::write_atomic(path, text.as_bytes()).map_err(|source| ResultJsonError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Reads a result file and checks what a consumer relies on: η ≥ 1, and every coefficient that is
+/// present finite and ≥ 0 (σ′s > 0).
+///
+/// # Errors
+/// [`ResultJsonError`] naming the file and the field.
+pub fn read_result_json(path: &Path) -> Result<MeasurementResult, ResultJsonError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ResultJsonError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_result_json(&text, path)
+}
+
+/// [`read_result_json`] on text already read; `path` names it in errors.
+///
+/// # Errors
+/// As [`read_result_json`].
+pub fn parse_result_json(text: &str, path: &Path) -> Result<MeasurementResult, ResultJsonError> {
+    let invalid = |detail: String| ResultJsonError::Invalid {
+        path: path.to_path_buf(),
+        detail,
+    };
+    let result: MeasurementResult = serde_json::from_str(text).map_err(|e| {
+        invalid(format!(
+            "not a scatterfit result ({e}); expected the JSON that `scatterfit measure` writes \
+             (name, eta, method, model, channels.r/g/b)"
+        ))
+    })?;
+    if !(result.eta.is_finite() && result.eta >= 1.0) {
+        return Err(invalid(format!(
+            "`eta` = {} must be a number ≥ 1 (relative refractive index)",
+            result.eta
+        )));
+    }
+    for (name, c) in ["r", "g", "b"].iter().zip(result.channels.as_array()) {
+        let fields = [
+            ("sigma_s_prime", c.sigma_s_prime),
+            ("sigma_a", c.sigma_a),
+            ("sigma_s_prime_stderr", c.sigma_s_prime_stderr),
+            ("sigma_a_stderr", c.sigma_a_stderr),
+        ];
+        for (field, v) in fields {
+            if let Some(v) = v
+                && !(v.is_finite() && v >= 0.0)
+            {
+                return Err(invalid(format!(
+                    "`channels.{name}.{field}` = {v} must be a finite number ≥ 0 [mm⁻¹]"
+                )));
+            }
+        }
+        if c.sigma_s_prime == Some(0.0) {
+            return Err(invalid(format!(
+                "`channels.{name}.sigma_s_prime` = 0: a scattering material needs σ′s > 0"
+            )));
+        }
+        if let Some(a) = c.albedo_prime
+            && !(a.is_finite() && a > 0.0 && a <= 1.0)
+        {
+            return Err(invalid(format!(
+                "`channels.{name}.albedo_prime` = {a} must lie in (0, 1]"
+            )));
+        }
+    }
+    Ok(result)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn channel(sp: f64, sa: f64) -> ChannelResult {
+        ChannelResult {
+            status: ChannelStatus::Ok,
+            sigma_s_prime: Some(sp),
+            sigma_s_prime_stderr: Some(0.01),
+            sigma_a: Some(sa),
+            sigma_a_stderr: Some(0.001),
+            albedo_prime: Some(sp / (sp + sa)),
+            rd_total: Some(0.5),
+            scale: Some(2.0),
+            correlation: None,
+            unconstrained: vec![],
+            fit_time_s: 1e-5,
+            iterations: 7,
+            termination: "converged".into(),
+            mse: Some(1e-6),
+            rms_log_residual: Some(0.01),
+            chi2_reduced: Some(1.1),
+            rings_used: 250,
+            rings_inside_spot: 10,
+            rings_below_detection: 40,
+            rings_invalid: 0,
+            problem: None,
+        }
+    }
+
+    fn result() -> MeasurementResult {
+        MeasurementResult {
+            name: "pink plastic".into(),
+            eta: 1.2886,
+            eta_source: "spectro".into(),
+            method: "proposed".into(),
+            model: "dipole".into(),
+            albedo_model: "diffusion".into(),
+            channels: Channels::from_array([
+                channel(1.979, 0.000792),
+                channel(1.893, 0.0496),
+                channel(1.992, 0.0227),
+            ]),
+            inputs: Inputs::default(),
+            version: "0.1.0".into(),
+        }
+    }
+
+    #[test]
+    fn round_trip_and_coefficients() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("result.json");
+        let r = result();
+        write_result_json(&path, &r).unwrap();
+        let back = read_result_json(&path).unwrap();
+        assert_eq!(back, r);
+        assert_eq!(back.coefficients().unwrap()[1], (1.893, 0.0496));
+    }
+
+    /// The minimal hand-written file of ARCHITECTURE.md (only the stable names) is accepted.
+    #[test]
+    fn minimal_hand_written_file_reads() {
+        let text = r#"{ "name": "x", "eta": 1.3, "method": "proposed", "model": "dipole",
+          "channels": {
+            "r": { "status": "ok", "sigma_s_prime": 1.0, "sigma_s_prime_stderr": null, "sigma_a": 0.01,
+                   "sigma_a_stderr": null, "albedo_prime": 0.99, "rd_total": 0.6, "mse": null },
+            "g": { "status": "ok", "sigma_s_prime": 1.0, "sigma_s_prime_stderr": null, "sigma_a": 0.02,
+                   "sigma_a_stderr": null, "albedo_prime": 0.98, "rd_total": 0.5, "mse": null },
+            "b": { "status": "failed", "sigma_s_prime": null, "sigma_s_prime_stderr": null, "sigma_a": null,
+                   "sigma_a_stderr": null, "albedo_prime": null, "rd_total": null, "mse": null,
+                   "problem": "out of gamut" } },
+          "version": "0.1.0" }"#;
+        let r = parse_result_json(text, Path::new("hand.json")).unwrap();
+        assert_eq!(r.coefficients(), Err("b"));
+    }
+
+    #[test]
+    fn bad_values_are_refused_with_the_field() {
+        let mut r = result();
+        r.channels.g.sigma_a = Some(-1.0);
+        let text = serde_json::to_string(&r).unwrap();
+        let err = parse_result_json(&text, Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("channels.g.sigma_a"), "{err}");
+        let mut r = result();
+        r.eta = 0.5;
+        let text = serde_json::to_string(&r).unwrap();
+        assert!(
+            parse_result_json(&text, Path::new("r.json"))
+                .unwrap_err()
+                .to_string()
+                .contains("eta")
+        );
+        let err = parse_result_json("{}", Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("not a scatterfit result"), "{err}");
+    }
+}
