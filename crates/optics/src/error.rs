@@ -27,6 +27,22 @@ pub enum OpticsError {
         /// What the user can do about it.
         hint: &'static str,
     },
+    /// A total diffuse reflectance outside what a forward model produces at this η.
+    #[error(
+        "diffuse reflectance Rd = {rd:.6} cannot be produced by the {model} model at η = {eta:.4}: \
+         it reaches (0, {max:.6}] only; check the colour measurement (Rd is a fraction, not a \
+         percentage, and a black or out-of-gamut channel gives Rd ≤ 0), or choose another model"
+    )]
+    RdOutOfModelRange {
+        /// The model's name, e.g. "better dipole".
+        model: &'static str,
+        /// The reflectance asked for.
+        rd: f64,
+        /// The refractive index used.
+        eta: f64,
+        /// The model's largest total reflectance at this η (at α′ = 1).
+        max: f64,
+    },
     /// The specular reflectance SCI − SCE cannot give a refractive index.
     #[error("specular reflectance SCI − SCE = {specular:.6} cannot give η: {reason}")]
     Specular {
@@ -35,6 +51,9 @@ pub enum OpticsError {
         /// Why, and what to do.
         reason: &'static str,
     },
+    /// A forward-model name that is not one of the diffusion models.
+    #[error("unknown forward model {0:?}: expected one of dipole, better-dipole, pbd (or mc)")]
+    UnknownModel(String),
     /// A spectrum that does not cover the range a colour computation needs.
     #[error("spectrum: {0}")]
     Spectrum(String),

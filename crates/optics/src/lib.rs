@@ -14,18 +14,27 @@
 //! | Rd(r) | `rd_profile` | radially resolved diffuse reflectance | mm⁻² |
 //! | Rd | `rd_total` | total diffuse reflectance ∫2πr Rd(r) dr | 1 |
 //!
-//! Modules: [`fresnel`] (exact Fresnel, Schlick, η from a d/8 specular reflectance), [`dipole`]
-//! (Jensen et al. 2001 classical dipole, its total reflectance and the α′ inversion), [`colour`]
-//! (spectra → CIE XYZ → L\*a\*b\* / linear sRGB), [`spectro`] (the spectrophotometer stage).
+//! Modules: [`fresnel`] (exact Fresnel, Schlick, η from a d/8 specular reflectance, pbrt's Fresnel
+//! moments), [`dipole`] (Jensen et al. 2001 classical dipole, its total reflectance and the α′
+//! inversion), [`better_dipole`] (d'Eon 2012), [`pbd`] (photon beam diffusion, Habel et al. 2013 as
+//! pbrt-v4 evaluates it), [`model`] (the [`ProfileModel`] trait every forward model implements, and
+//! [`DiffusionModel`] by name), [`colour`] (spectra → CIE XYZ → L\*a\*b\* / linear sRGB),
+//! [`spectro`] (the spectrophotometer stage).
 
+pub mod better_dipole;
 pub mod colour;
 pub mod dipole;
 pub mod fresnel;
+pub mod model;
+pub mod pbd;
 pub mod spectro;
 
+mod diffusion;
+mod dual;
 mod error;
 mod properties;
 mod roots;
 
 pub use error::{OpticsError, Result};
+pub use model::{AnyDiffusion, DiffusionModel, ProfileModel, ProfileSample};
 pub use properties::OpticalProperties;
