@@ -28,6 +28,14 @@ pub enum McError {
         /// The table's upper limit.
         max: f64,
     },
+    /// A Monte Carlo table could not be smoothed into a model.
+    #[error("cannot smooth the Monte Carlo table at albedo {albedo}: {reason}")]
+    Smoothing {
+        /// The albedo row concerned.
+        albedo: f64,
+        /// Why, and what to do.
+        reason: &'static str,
+    },
     /// Reading or writing a cache file failed.
     #[error("{path}: {source}")]
     Io {

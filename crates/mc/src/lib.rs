@@ -32,10 +32,13 @@ mod engine;
 mod error;
 mod fresnel;
 mod grid;
+pub mod model;
 mod phase;
 mod rng;
 mod sample;
+pub mod smooth;
 pub mod table;
+pub mod white;
 
 pub use beam::{Beam, BeamProfile};
 pub use engine::{
@@ -44,5 +47,6 @@ pub use engine::{
 pub use error::{McError, Result};
 pub use fresnel::{FresnelSample, fresnel_mcml};
 pub use grid::RadialGrid;
+pub use model::{McProfile, McTable, McTableSet, McTableSpec};
 pub use phase::{hg_cdf_cos, hg_pdf_cos, sample_hg_cos};
 pub use sample::{Layer, Sample};

@@ -435,34 +435,11 @@ impl ProfileTable {
     /// # Errors
     /// `Io` on any file-system error (the target is then untouched).
     pub fn save(&self, path: &Path) -> Result<()> {
-        let io = |source| McError::Io {
-            path: path.to_owned(),
-            source,
-        };
         let json = serde_json::to_vec(self).map_err(|e| McError::Format {
             path: path.to_owned(),
             message: e.to_string(),
         })?;
-        let dir = path
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir).map_err(io)?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-        let result = (|| {
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(&json)?;
-            f.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        result.map_err(io)
+        write_atomic(path, &json)
     }
 
     /// The table for `spec` from the cache folder `dir` when a file made with the same spec and
@@ -488,11 +465,47 @@ impl ProfileTable {
     }
 }
 
+/// Writes `bytes` to `path` atomically: a temporary file in the same folder (created if missing),
+/// synced, then renamed over the target. (mc does not depend on io, whose `write_atomic` does the same.)
+///
+/// # Errors
+/// `Io` on any file-system error (the target is then untouched).
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let io = |source| McError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io)
+}
+
 /// Catmull-Rom weights at `x` over the `n` strictly increasing nodes `node(k)` (pbrt-v3's
 /// `CatmullRomWeights`, physics.md §2.3): returns (i, w) with x ∈ [node(i), node(i + 1)] and the
 /// interpolant Σₖ w[k]·f(i − 1 + k); the end derivatives are one-sided (w[0] or w[3] is then 0).
 /// Cubic Hermite with finite-difference derivatives on non-uniform nodes; exact at the nodes.
-fn catmull_rom_weights(n: usize, node: impl Fn(usize) -> f64, x: f64) -> (usize, [f64; 4]) {
+pub(crate) fn catmull_rom_weights(
+    n: usize,
+    node: impl Fn(usize) -> f64,
+    x: f64,
+) -> (usize, [f64; 4]) {
     // First i with node(i + 1) > x, clamped to the last interval.
     let mut i = 0;
     while i + 2 < n && node(i + 1) <= x {

@@ -1,0 +1,959 @@
+//! The `mc` forward model: Rd(r; σ′s, σa) of a half-space from Monte Carlo tables, smooth in the
+//! albedo and the radius, with analytic derivatives of the interpolant.
+//!
+//! * [`McTable`] — one (η, g): a white Monte Carlo run ([`crate::white`]) scored at a grid of
+//!   single-scattering albedos aₖ (σt = 1), each row smoothed by [`crate::smooth::fit_row`] into
+//!   ln R̂(ρ; aₖ) = Sₖ(ln ρ) − κ₀(aₖ)ρ, plus the Monte Carlo total Rd(aₖ). Cached on disk as JSON
+//!   like [`crate::table::ProfileTable`] (same folder, [`crate::table::default_cache_dir`]).
+//! * [`McTableSet`] — tables for several η (same g and layout); interpolates in η.
+//! * [`McProfile`] — the model for one set of optical properties, implementing
+//!   [`scatterfit_optics::ProfileModel`].
+//!
+//! Similarity (pbrt's `TabulatedBSSRDF::Sr`, physics.md §2.3): with σs = σ′s/(1 − g), σt = σa + σs and
+//! a = σs/σt, Rd(r) = σt² R̂(σt r; a) exactly (same η, g). For g = 0, σt = σ′t and a = α′.
+//!
+//! Interpolation: between albedos, Catmull-Rom (pbrt's `CatmullRomWeights`) in x = −√(1 − a) on the
+//! spline coefficients (so on S, after the analytic κ₀(a)ρ is taken out: C¹ in a); between η nodes,
+//! Catmull-Rom in η on the same coefficients (linear with two tables); in ρ, the cubic B-spline itself
+//! (C²). Derivatives ∂Rd/∂σ′s, ∂Rd/∂σa are those of this interpolant: through σt (the σt² factor and
+//! ρ = σt r) and through a (the albedo weights' derivatives and dκ₀/da) — never finite differences.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use scatterfit_optics::{OpticalProperties, ProfileModel, ProfileSample};
+
+use crate::error::{McError, Result, check};
+use crate::smooth::{Knots, SmoothParams, fit_row, kappa0};
+use crate::table::{CacheStatus, catmull_rom_weights, write_atomic};
+use crate::white::{WhiteSpec, WhiteTally, simulate};
+
+/// Version of the `McTable` file format; files of another version are rebuilt.
+pub const MC_TABLE_VERSION: u32 = 1;
+const MC_TABLE_TAG: &str = "scatterfit-mc-white-table";
+
+/// How an [`McTable`] is made: the Monte Carlo run and the smoother.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct McTableSpec {
+    /// Relative refractive index η (outside index 1).
+    pub eta: f64,
+    /// Henyey–Greenstein asymmetry g.
+    pub g: f64,
+    /// Number of albedo nodes, equally spaced in √(1 − a) from `albedo_min` to `albedo_max`.
+    pub albedo_count: usize,
+    /// Smallest single-scattering albedo.
+    pub albedo_min: f64,
+    /// Largest single-scattering albedo.
+    pub albedo_max: f64,
+    /// Inner radius of the log-spaced bins [mean free paths]; below it one bin [0, ρ₀).
+    pub rho_min: f64,
+    /// Outer radius of the last bin [mean free paths].
+    pub rho_max: f64,
+    /// Log-spaced radial bins between `rho_min` and `rho_max`.
+    pub radial_bins: usize,
+    /// Photons traced in each path-length stratum ([`crate::white`]).
+    pub photons: Vec<u64>,
+    /// Interaction counts separating the strata (one fewer than `photons`).
+    pub stratum_bounds: Vec<u64>,
+    /// Seed of the random streams.
+    pub seed: u64,
+    /// The smoother.
+    pub smooth: SmoothParams,
+}
+
+impl McTableSpec {
+    /// The default layout for η and g: 64 albedos from 0.02 to 0.9999 (√(1 − a) spacing 0.0156),
+    /// 216 radial bins (Δ ln ρ = 0.05) from 0.01 to 500 mean free paths, seed 1, and three
+    /// path-length strata: `photons` full-length photons, 4× as many stopped at 1024 interactions and
+    /// 16× as many stopped at 64 (module [`crate::white`]).
+    ///
+    /// # Errors
+    /// `InvalidParameter` for η < 1, g outside (−1, 1) or no photons.
+    pub fn new(eta: f64, g: f64, photons: u64) -> Result<Self> {
+        Self::with_strata(
+            eta,
+            g,
+            vec![16 * photons, 4 * photons, photons],
+            vec![64, 1024],
+        )
+    }
+
+    /// The default layout with explicit strata (`photons[k]` photons, separated at `bounds`).
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad field.
+    pub fn with_strata(eta: f64, g: f64, photons: Vec<u64>, bounds: Vec<u64>) -> Result<Self> {
+        let spec = Self {
+            eta,
+            g,
+            albedo_count: 64,
+            albedo_min: 0.02,
+            albedo_max: 0.9999,
+            rho_min: 0.01,
+            rho_max: 500.0,
+            radial_bins: 216,
+            photons,
+            stratum_bounds: bounds,
+            seed: 1,
+            smooth: SmoothParams::default(),
+        };
+        spec.white()?;
+        Ok(spec)
+    }
+
+    /// The albedo nodes.
+    pub fn albedos(&self) -> Vec<f64> {
+        let (x0, x1) = (
+            (1.0 - self.albedo_max).sqrt(),
+            (1.0 - self.albedo_min).sqrt(),
+        );
+        let n = self.albedo_count.max(2);
+        (0..n)
+            .rev()
+            .map(|i| {
+                let x = x0 + (x1 - x0) * i as f64 / (n - 1) as f64;
+                1.0 - x * x
+            })
+            .collect()
+    }
+
+    /// The radial bin edges [mean free paths].
+    pub fn radial_edges(&self) -> Vec<f64> {
+        let mut e = vec![0.0];
+        let q = (self.rho_max / self.rho_min).ln() / self.radial_bins.max(1) as f64;
+        e.extend((0..=self.radial_bins).map(|i| self.rho_min * (q * i as f64).exp()));
+        e
+    }
+
+    /// The white Monte Carlo run this spec asks for.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad field.
+    pub fn white(&self) -> Result<WhiteSpec> {
+        check(
+            self.albedo_count >= 4,
+            "albedo_count",
+            self.albedo_count as f64,
+            "need at least 4 albedos (Catmull-Rom)",
+        )?;
+        check(
+            self.albedo_min > 0.0 && self.albedo_max < 1.0 && self.albedo_min < self.albedo_max,
+            "albedo_max",
+            self.albedo_max,
+            "need 0 < albedo_min < albedo_max < 1",
+        )?;
+        check(
+            self.rho_min > 0.0 && self.rho_max > self.rho_min && self.radial_bins >= 8,
+            "rho_max",
+            self.rho_max,
+            "need 0 < rho_min < rho_max and at least 8 radial bins",
+        )?;
+        WhiteSpec::new(
+            self.eta,
+            self.g,
+            self.albedos(),
+            self.radial_edges(),
+            &self.photons,
+            &self.stratum_bounds,
+            self.seed,
+        )
+    }
+
+    /// A short stable hash of the spec (FNV-1a 64 of its JSON), used in the cache file name.
+    pub fn fingerprint(&self) -> String {
+        let json = serde_json::to_string(self).expect("a spec of numbers always serialises");
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in json.bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        format!("{h:016x}")
+    }
+
+    /// The cache file name for this spec.
+    pub fn file_name(&self) -> String {
+        format!(
+            "mc-white-v{MC_TABLE_VERSION}-eta{:.4}-g{:.3}-{}.json",
+            self.eta,
+            self.g,
+            self.fingerprint()
+        )
+    }
+}
+
+/// The raw Monte Carlo profiles behind a table (kept in cache files for diagnostics; dropped by
+/// [`McTable::without_raw`] for shipping).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawProfiles {
+    /// Radial bin edges [mean free paths].
+    pub edges: Vec<f64>,
+    /// R̂ per (albedo, bin), row-major.
+    pub rd: Vec<f64>,
+    /// Standard errors of `rd`.
+    pub rd_stderr: Vec<f64>,
+}
+
+/// A smoothed Monte Carlo profile table for one η and g (module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct McTable {
+    format: String,
+    version: u32,
+    spec: McTableSpec,
+    albedos: Vec<f64>,
+    knots: Knots,
+    /// Spline coefficients per albedo, row-major (albedo k, coefficient m).
+    coefs: Vec<f64>,
+    /// Outer radius of the data behind each row [mean free paths].
+    rho_data_max: Vec<f64>,
+    rd_total: Vec<f64>,
+    rd_total_stderr: Vec<f64>,
+    /// χ² per degree of freedom of each row's smoothing fit.
+    chi2_per_bin: Vec<f64>,
+    raw: Option<RawProfiles>,
+}
+
+impl McTable {
+    /// Simulates and smooths the table on the current rayon pool; `progress(done, total)` counts
+    /// photons.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad spec; `Smoothing` if a row has too little data to smooth.
+    pub fn build(spec: &McTableSpec, progress: &(dyn Fn(u64, u64) + Sync)) -> Result<Self> {
+        let white = spec.white()?;
+        let total = white.photons();
+        let tally = simulate(&white, &|done| progress(done, total))?;
+        Self::from_tally(spec, &tally)
+    }
+
+    /// Smooths an existing white tally made from `spec.white()`.
+    ///
+    /// # Errors
+    /// `InvalidParameter` when the tally was not made from this spec; `Smoothing` if a row has too
+    /// little data, or the totals do not increase with the albedo.
+    pub fn from_tally(spec: &McTableSpec, tally: &WhiteTally) -> Result<Self> {
+        let white = spec.white()?;
+        check(
+            tally.spec == white,
+            "tally",
+            0.0,
+            "the tally was made from another spec",
+        )?;
+        let edges = &white.radial_edges;
+        let bins = tally.bins();
+        let knots = Knots::covering(
+            edges[1].ln(),
+            edges[edges.len() - 1].ln(),
+            spec.smooth.knot_spacing,
+        );
+        let mut coefs = Vec::with_capacity(white.albedos.len() * knots.len());
+        let (mut rho_data_max, mut chi2) = (Vec::new(), Vec::new());
+        for (k, &a) in white.albedos.iter().enumerate() {
+            let row = k * bins..(k + 1) * bins;
+            let fit = fit_row(
+                edges,
+                &tally.rd[row.clone()],
+                &tally.rd_stderr[row],
+                kappa0(a, spec.g).0,
+                &knots,
+                &spec.smooth,
+            )
+            .ok_or(McError::Smoothing {
+                albedo: a,
+                reason: "fewer than 4 radial bins with data: trace more photons",
+            })?;
+            coefs.extend_from_slice(&fit.coefs);
+            rho_data_max.push(fit.rho_data_max);
+            chi2.push(fit.chi2 / fit.bins_used as f64);
+        }
+        for (k, w) in tally.rd_total.windows(2).enumerate() {
+            if w[1] <= w[0] {
+                return Err(McError::Smoothing {
+                    albedo: white.albedos[k + 1],
+                    reason: "total Rd does not increase with the albedo: trace more photons",
+                });
+            }
+        }
+        Ok(Self {
+            format: MC_TABLE_TAG.to_owned(),
+            version: MC_TABLE_VERSION,
+            spec: spec.clone(),
+            albedos: white.albedos.clone(),
+            knots,
+            coefs,
+            rho_data_max,
+            rd_total: tally.rd_total.clone(),
+            rd_total_stderr: tally.rd_total_stderr.clone(),
+            chi2_per_bin: chi2,
+            raw: Some(RawProfiles {
+                edges: edges.clone(),
+                rd: tally.rd.clone(),
+                rd_stderr: tally.rd_stderr.clone(),
+            }),
+        })
+    }
+
+    /// The same table without its raw profiles (what a shipped table needs).
+    #[must_use]
+    pub fn without_raw(mut self) -> Self {
+        self.raw = None;
+        self
+    }
+
+    /// The spec that made the table.
+    pub fn spec(&self) -> &McTableSpec {
+        &self.spec
+    }
+
+    /// The albedo nodes.
+    pub fn albedos(&self) -> &[f64] {
+        &self.albedos
+    }
+
+    /// The raw Monte Carlo profiles, when kept.
+    pub fn raw(&self) -> Option<&RawProfiles> {
+        self.raw.as_ref()
+    }
+
+    /// Outer radius of the Monte Carlo data behind each albedo row [mean free paths]; beyond it the
+    /// model is the smoother's extrapolation (a power law times e^{−κ₀ρ}).
+    pub fn rho_data_max(&self) -> &[f64] {
+        &self.rho_data_max
+    }
+
+    /// χ² per bin of each row's smoothing fit (≈ 1 when the smooth curve is within the noise).
+    pub fn chi2_per_bin(&self) -> &[f64] {
+        &self.chi2_per_bin
+    }
+
+    /// Monte Carlo total diffuse reflectance per albedo node (excluding R_sp) and standard errors.
+    pub fn totals(&self) -> (&[f64], &[f64]) {
+        (&self.rd_total, &self.rd_total_stderr)
+    }
+
+    fn row(&self, k: usize) -> &[f64] {
+        let m = self.knots.len();
+        &self.coefs[k * m..(k + 1) * m]
+    }
+
+    /// Catmull-Rom weights (and their derivatives in a) of albedo `a` over the nodes, in
+    /// x = −√(1 − a).
+    fn albedo_weights(&self, a: f64) -> Result<(usize, [f64; 4], [f64; 4])> {
+        let al = &self.albedos;
+        let (lo, hi) = (al[0], al[al.len() - 1]);
+        if !(a >= lo && a <= hi) {
+            return Err(McError::OutOfTable {
+                name: "albedo (σs/σt)",
+                value: a,
+                min: lo,
+                max: hi,
+            });
+        }
+        let x = |v: f64| -(1.0 - v).sqrt();
+        let (i, w, dw_dx) = catmull_rom_weights_d(al.len(), |k| x(al[k]), x(a));
+        let dx_da = 0.5 / (1.0 - a).sqrt();
+        Ok((i, w, dw_dx.map(|d| d * dx_da)))
+    }
+
+    /// Total diffuse reflectance Rd(a) (excluding R_sp): Catmull-Rom in √(1 − a) between the Monte
+    /// Carlo totals of the nodes.
+    ///
+    /// # Errors
+    /// `OutOfTable` for a outside the tabulated albedos.
+    pub fn rd_total(&self, a: f64) -> Result<f64> {
+        let (i, w, _) = self.albedo_weights(a)?;
+        Ok(dot4(&w, |k| self.rd_total[i + k - 1]))
+    }
+}
+
+/// Σₖ w[k]·f(k) over the nonzero weights (index k − 1 relative to the interval start).
+fn dot4(w: &[f64; 4], f: impl Fn(usize) -> f64) -> f64 {
+    (0..4).filter(|&k| w[k] != 0.0).map(|k| w[k] * f(k)).sum()
+}
+
+/// [`catmull_rom_weights`] with the derivatives of the weights in x.
+fn catmull_rom_weights_d(
+    n: usize,
+    node: impl Fn(usize) -> f64,
+    x: f64,
+) -> (usize, [f64; 4], [f64; 4]) {
+    let (i, w) = catmull_rom_weights(n, &node, x);
+    let (x0, x1) = (node(i), node(i + 1));
+    let t = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
+    let inv = 1.0 / (x1 - x0);
+    let t2 = t * t;
+    let mut d = [
+        0.0,
+        (6.0 * t2 - 6.0 * t) * inv,
+        (-6.0 * t2 + 6.0 * t) * inv,
+        0.0,
+    ];
+    let d0 = (3.0 * t2 - 4.0 * t + 1.0) * inv;
+    if i > 0 {
+        let d0 = d0 * (x1 - x0) / (x1 - node(i - 1));
+        d[0] = -d0;
+        d[2] += d0;
+    } else {
+        d[1] -= d0;
+        d[2] += d0;
+    }
+    let d3 = (3.0 * t2 - 2.0 * t) * inv;
+    if i + 2 < n {
+        let d3 = d3 * (x1 - x0) / (node(i + 2) - x0);
+        d[1] -= d3;
+        d[3] = d3;
+    } else {
+        d[1] -= d3;
+        d[2] += d3;
+    }
+    (i, w, d)
+}
+
+/// Monte Carlo tables for several η with the same g and layout; interpolates in η.
+#[derive(Debug, Clone, PartialEq)]
+pub struct McTableSet {
+    tables: Vec<McTable>,
+}
+
+impl McTableSet {
+    /// A set from tables (sorted here by η). All must share g and the albedo and radial layout.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for an empty list, mixed g or layouts, or two tables at one η.
+    pub fn new(mut tables: Vec<McTable>) -> Result<Self> {
+        check(!tables.is_empty(), "tables", 0.0, "need at least one table")?;
+        tables.sort_by(|a, b| a.spec.eta.total_cmp(&b.spec.eta));
+        let first = &tables[0];
+        for t in &tables[1..] {
+            check(
+                t.spec.g == first.spec.g,
+                "g",
+                t.spec.g,
+                "every table of a set must have one g",
+            )?;
+            check(
+                t.albedos == first.albedos && t.knots == first.knots,
+                "eta",
+                t.spec.eta,
+                "every table of a set must have the same albedo nodes and knots",
+            )?;
+        }
+        for w in tables.windows(2) {
+            check(
+                w[1].spec.eta > w[0].spec.eta,
+                "eta",
+                w[1].spec.eta,
+                "two tables at one η",
+            )?;
+        }
+        Ok(Self { tables })
+    }
+
+    /// The tables for `etas` (each from `template` with its η), from the cache folder `dir` where a
+    /// matching file is there, else simulated and saved there. `progress(table, done, total)`.
+    ///
+    /// # Errors
+    /// As [`McTable::load_or_build`] and [`McTableSet::new`].
+    pub fn load_or_build(
+        etas: &[f64],
+        template: &McTableSpec,
+        dir: &Path,
+        progress: &(dyn Fn(usize, u64, u64) + Sync),
+    ) -> Result<Self> {
+        let mut tables = Vec::with_capacity(etas.len());
+        for (i, &eta) in etas.iter().enumerate() {
+            let spec = McTableSpec {
+                eta,
+                ..template.clone()
+            };
+            let (t, _, _) = McTable::load_or_build(&spec, dir, &|d, n| progress(i, d, n))?;
+            tables.push(t);
+        }
+        Self::new(tables)
+    }
+
+    /// The tables, by increasing η.
+    pub fn tables(&self) -> &[McTable] {
+        &self.tables
+    }
+
+    /// The η range covered.
+    pub fn eta_range(&self) -> (f64, f64) {
+        (
+            self.tables[0].spec.eta,
+            self.tables[self.tables.len() - 1].spec.eta,
+        )
+    }
+
+    /// The Henyey–Greenstein g of every table.
+    pub fn g(&self) -> f64 {
+        self.tables[0].spec.g
+    }
+
+    /// Catmull-Rom weights of η over the tables (the single table itself when there is one and η is
+    /// its own).
+    fn eta_weights(&self, eta: f64) -> Result<(usize, [f64; 4])> {
+        let (lo, hi) = self.eta_range();
+        let n = self.tables.len();
+        if n == 1 {
+            return if (eta - lo).abs() <= 1e-9 {
+                Ok((0, [0.0, 1.0, 0.0, 0.0]))
+            } else {
+                Err(McError::OutOfTable {
+                    name: "eta",
+                    value: eta,
+                    min: lo,
+                    max: hi,
+                })
+            };
+        }
+        if !(eta >= lo - 1e-12 && eta <= hi + 1e-12) {
+            return Err(McError::OutOfTable {
+                name: "eta",
+                value: eta,
+                min: lo,
+                max: hi,
+            });
+        }
+        Ok(catmull_rom_weights(n, |k| self.tables[k].spec.eta, eta))
+    }
+
+    /// Total diffuse reflectance Rd(a, η) (excluding R_sp) by Monte Carlo: Catmull-Rom in √(1 − a)
+    /// over the albedo nodes, then in η over the tables. a is the single-scattering albedo (α′ for
+    /// g = 0).
+    ///
+    /// # Errors
+    /// `OutOfTable` for a or η outside the tables.
+    pub fn rd_total(&self, a: f64, eta: f64) -> Result<f64> {
+        let (j, we) = self.eta_weights(eta)?;
+        let mut sum = 0.0;
+        for (q, &w) in we.iter().enumerate() {
+            if w != 0.0 {
+                sum += w * self.tables[j + q - 1].rd_total(a)?;
+            }
+        }
+        Ok(sum)
+    }
+
+    /// The albedo a (α′ for g = 0) whose Monte Carlo total diffuse reflectance at η is `rd`: the
+    /// inverse of [`McTableSet::rd_total`] (increasing in a; checked at every node when a table is
+    /// built), by bisection in √(1 − a) to 1e-14, so the round trip is exact to ~1e-12 in Rd.
+    ///
+    /// # Errors
+    /// `OutOfTable` when `rd` lies outside [Rd(a_min), Rd(a_max)] at this η, or η outside the tables.
+    pub fn albedo_from_rd_total(&self, rd: f64, eta: f64) -> Result<f64> {
+        let a = &self.tables[0].albedos;
+        let (a_lo, a_hi) = (a[0], a[a.len() - 1]);
+        let (r_lo, r_hi) = (self.rd_total(a_lo, eta)?, self.rd_total(a_hi, eta)?);
+        if !(rd >= r_lo && rd <= r_hi) {
+            return Err(McError::OutOfTable {
+                name: "rd_total",
+                value: rd,
+                min: r_lo,
+                max: r_hi,
+            });
+        }
+        let (mut u_lo, mut u_hi) = ((1.0 - a_hi).sqrt(), (1.0 - a_lo).sqrt());
+        for _ in 0..200 {
+            let u = 0.5 * (u_lo + u_hi);
+            if u <= u_lo || u >= u_hi || u_hi - u_lo < 1e-14 {
+                break;
+            }
+            if self.rd_total(1.0 - u * u, eta)? >= rd {
+                u_lo = u;
+            } else {
+                u_hi = u;
+            }
+        }
+        let u = 0.5 * (u_lo + u_hi);
+        Ok((1.0 - u * u).clamp(a_lo, a_hi))
+    }
+}
+
+impl McTable {
+    /// Reads a table file.
+    ///
+    /// # Errors
+    /// `Io` when it cannot be read, `Format` when it is not a table of this format version.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| McError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::from_json(&text).map_err(|message| McError::Format {
+            path: path.to_owned(),
+            message,
+        })
+    }
+
+    /// Parses a table from JSON (a file's text, or one shipped inside a program).
+    ///
+    /// # Errors
+    /// A message when the text is not a consistent table of this format version.
+    pub fn from_json(text: &str) -> std::result::Result<Self, String> {
+        let t: Self = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        let k = t.spec.albedo_count;
+        let ok = t.format == MC_TABLE_TAG
+            && t.version == MC_TABLE_VERSION
+            && t.spec.white().is_ok()
+            && t.albedos == t.spec.albedos()
+            && t.coefs.len() == k * t.knots.len()
+            && t.rho_data_max.len() == k
+            && t.rd_total.len() == k
+            && t.rd_total_stderr.len() == k
+            && t.coefs.iter().all(|c| c.is_finite());
+        if ok {
+            Ok(t)
+        } else {
+            Err(format!(
+                "not a {MC_TABLE_TAG} of version {MC_TABLE_VERSION}, or inconsistent sizes"
+            ))
+        }
+    }
+
+    /// Writes the table atomically (temporary file, sync, rename).
+    ///
+    /// # Errors
+    /// `Io` on any file-system error (the target is then untouched).
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let json = serde_json::to_vec(self).map_err(|e| McError::Format {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        write_atomic(path, &json)
+    }
+
+    /// The table for `spec` from the cache folder `dir` when a file made with the same spec and
+    /// format is there, else simulated and saved there.
+    ///
+    /// # Errors
+    /// As [`McTable::build`], or `Io` when the cache cannot be written.
+    pub fn load_or_build(
+        spec: &McTableSpec,
+        dir: &Path,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<(Self, CacheStatus, PathBuf)> {
+        spec.white()?;
+        let path = dir.join(spec.file_name());
+        if let Ok(table) = Self::load(&path)
+            && table.spec == *spec
+        {
+            return Ok((table, CacheStatus::Loaded, path));
+        }
+        let table = Self::build(spec, progress)?;
+        table.save(&path)?;
+        Ok((table, CacheStatus::Built, path))
+    }
+}
+
+/// The `mc` forward model for one set of optical properties: the table set's interpolant at (a, η)
+/// collapsed into one spline in u = ln ρ with its a-derivative, and the similarity scaling.
+#[derive(Debug, Clone, PartialEq)]
+pub struct McProfile {
+    props: OpticalProperties,
+    knots: Knots,
+    /// S's coefficients at (a, η), and their derivatives in a.
+    coefs: Vec<f64>,
+    dcoefs: Vec<f64>,
+    /// σt, a, κ₀(a), dκ₀/da.
+    sigma_t: f64,
+    kappa: f64,
+    dkappa: f64,
+    /// ∂σt/∂σ′s, ∂a/∂σ′s, ∂a/∂σa (∂σt/∂σa = 1).
+    dst_dsp: f64,
+    da_dsp: f64,
+    da_dsa: f64,
+    /// Smallest optical radius of the spline (below it Rd is held constant).
+    rho_floor: f64,
+    /// Outer radius of the Monte Carlo data at this albedo [mm].
+    r_data_max: f64,
+    rd_total: f64,
+}
+
+impl McProfile {
+    /// The model for `props` (its η, and the set's g) from `set`.
+    ///
+    /// # Errors
+    /// `OutOfTable` when η or the albedo a = σs/σt is outside the tables.
+    pub fn new(set: &McTableSet, props: &OpticalProperties) -> Result<Self> {
+        let g = set.g();
+        let sigma_s = props.sigma_s_prime() / (1.0 - g);
+        let sigma_t = props.sigma_a() + sigma_s;
+        let a = sigma_s / sigma_t;
+        let eta = props.eta();
+        let (j, we) = set.eta_weights(eta)?;
+        let t0 = &set.tables[0];
+        let (i, wa, dwa) = t0.albedo_weights(a)?;
+        let m = t0.knots.len();
+        let (mut coefs, mut dcoefs) = (vec![0.0; m], vec![0.0; m]);
+        let (mut total, mut rho_data) = (0.0, 0.0);
+        for (q, &w_eta) in we.iter().enumerate() {
+            if w_eta == 0.0 {
+                continue;
+            }
+            let t = &set.tables[j + q - 1];
+            for k in 0..4 {
+                if wa[k] == 0.0 && dwa[k] == 0.0 {
+                    continue;
+                }
+                let row = t.row(i + k - 1);
+                let (w, dw) = (w_eta * wa[k], w_eta * dwa[k]);
+                for ((c, d), &b) in coefs.iter_mut().zip(dcoefs.iter_mut()).zip(row) {
+                    *c += w * b;
+                    *d += dw * b;
+                }
+                total += w * t.rd_total[i + k - 1];
+                rho_data += w * t.rho_data_max[i + k - 1];
+            }
+        }
+        let (kappa, dkappa) = kappa0(a, g);
+        let st2 = sigma_t * sigma_t;
+        Ok(Self {
+            props: *props,
+            knots: t0.knots,
+            coefs,
+            dcoefs,
+            sigma_t,
+            kappa,
+            dkappa,
+            dst_dsp: 1.0 / (1.0 - g),
+            da_dsp: props.sigma_a() / ((1.0 - g) * st2),
+            da_dsa: -sigma_s / st2,
+            rho_floor: t0.spec.rho_min,
+            r_data_max: rho_data / sigma_t,
+            rd_total: total,
+        })
+    }
+
+    /// The optical properties of this model.
+    pub fn properties(&self) -> &OpticalProperties {
+        &self.props
+    }
+
+    /// Outer radius of the Monte Carlo data behind the model at this albedo [mm] (interpolated like
+    /// the model): beyond it Rd(r) is the smoother's extrapolation.
+    pub fn r_data_max_mm(&self) -> f64 {
+        self.r_data_max
+    }
+
+    /// ln R̂, ∂ln R̂/∂ρ, ∂ln R̂/∂a at optical radius ρ.
+    #[inline]
+    fn ln_rhat(&self, rho: f64) -> (f64, f64, f64) {
+        let (rho, floor) = if rho < self.rho_floor {
+            (self.rho_floor, true)
+        } else {
+            (rho, false)
+        };
+        let b = self.knots.basis(rho.ln());
+        let c = &self.coefs[b.first..b.first + 4];
+        let dc = &self.dcoefs[b.first..b.first + 4];
+        let mut s = 0.0;
+        let mut s_u = 0.0;
+        let mut s_a = 0.0;
+        for p in 0..4 {
+            s += b.w[p] * c[p];
+            s_u += b.dw[p] * c[p];
+            s_a += b.w[p] * dc[p];
+        }
+        let d_rho = if floor { 0.0 } else { s_u / rho - self.kappa };
+        (s - self.kappa * rho, d_rho, s_a - self.dkappa * rho)
+    }
+
+    /// Rd(r) with its derivatives in σ′s and σa.
+    #[inline]
+    pub fn rd_with_derivatives(&self, r_mm: f64) -> ProfileSample {
+        let st = self.sigma_t;
+        let (l, l_rho, l_a) = self.ln_rhat(st * r_mm);
+        let rd = st * st * l.exp();
+        // ∂Rd/∂σt at fixed a = Rd (2/σt + r ∂ln R̂/∂ρ); ∂Rd/∂a at fixed σt = Rd ∂ln R̂/∂a.
+        let d_st = rd * (2.0 / st + r_mm * l_rho);
+        let d_a = rd * l_a;
+        ProfileSample {
+            rd,
+            d_sigma_s_prime: d_st * self.dst_dsp + d_a * self.da_dsp,
+            d_sigma_a: d_st + d_a * self.da_dsa,
+        }
+    }
+}
+
+impl ProfileModel for McProfile {
+    fn rd(&self, r_mm: f64) -> f64 {
+        let st = self.sigma_t;
+        st * st * self.ln_rhat(st * r_mm).0.exp()
+    }
+
+    fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {
+        for (r, o) in radii_mm.iter().zip(out.iter_mut()) {
+            *o = self.rd_with_derivatives(*r);
+        }
+    }
+
+    /// The Monte Carlo total at this albedo and η (interpolated like the profile; not the integral
+    /// of the smoothed profile, which misses the part beyond the table's last radius).
+    fn rd_total(&self) -> f64 {
+        self.rd_total
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A table that builds in a fraction of a second: 8 albedos 0.3–0.99, 120 bins to 60 mean free
+    /// paths, 30 000 + 6 000 photons.
+    fn small_spec(eta: f64) -> McTableSpec {
+        let mut spec = McTableSpec::with_strata(eta, 0.0, vec![30_000, 6_000], vec![64]).unwrap();
+        spec.albedo_count = 8;
+        spec.albedo_min = 0.3;
+        spec.albedo_max = 0.99;
+        spec.radial_bins = 120;
+        spec.rho_max = 60.0;
+        spec
+    }
+
+    fn small_set(etas: &[f64]) -> McTableSet {
+        McTableSet::new(
+            etas.iter()
+                .map(|&e| McTable::build(&small_spec(e), &|_, _| {}).unwrap())
+                .collect(),
+        )
+        .unwrap()
+    }
+
+    /// Catmull-Rom weight derivatives match central differences of the weights.
+    #[test]
+    fn weight_derivatives_match_finite_differences() {
+        let nodes = [0.0, 0.3, 0.7, 1.2, 2.0, 2.1];
+        for i in 0..100 {
+            let x = 0.001 + 2.098 * i as f64 / 99.0;
+            let (k, _, d) = catmull_rom_weights_d(nodes.len(), |j| nodes[j], x);
+            let h = 1e-7;
+            let (kp, wp) = catmull_rom_weights(nodes.len(), |j| nodes[j], x + h);
+            let (km, wm) = catmull_rom_weights(nodes.len(), |j| nodes[j], x - h);
+            if kp != k || km != k {
+                continue;
+            }
+            for q in 0..4 {
+                assert!((d[q] - (wp[q] - wm[q]) / (2.0 * h)).abs() < 1e-6, "x = {x}");
+            }
+        }
+    }
+
+    /// The model's analytic derivatives (of the interpolant: albedo weights, κ₀(a), the spline in
+    /// ln ρ, similarity) agree with central differences of the model itself, between albedo nodes,
+    /// between η tables, and for g ≠ 0 the chain through σs = σ′s/(1 − g).
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let set = small_set(&[1.0, 1.2, 1.5]);
+        for (sp, sa, eta) in [
+            (1.0, 0.05, 1.0),
+            (2.0, 0.4, 1.33),
+            (0.7, 0.02, 1.5),
+            (1.3, 0.3, 1.2),
+        ] {
+            let model = |sp: f64, sa: f64| {
+                McProfile::new(&set, &OpticalProperties::new(sp, sa, eta).unwrap()).unwrap()
+            };
+            let m = model(sp, sa);
+            for r in [0.02, 0.3, 1.0, 4.0, 12.0] {
+                let got = m.rd_with_derivatives(r);
+                let (h_sp, h_sa) = (1e-6 * sp, 1e-6 * sa);
+                let fd_sp =
+                    (model(sp + h_sp, sa).rd(r) - model(sp - h_sp, sa).rd(r)) / (2.0 * h_sp);
+                let fd_sa =
+                    (model(sp, sa + h_sa).rd(r) - model(sp, sa - h_sa).rd(r)) / (2.0 * h_sa);
+                let tol = |fd: f64| 1e-5 * fd.abs() + 1e-7 * got.rd;
+                assert!(
+                    (got.d_sigma_s_prime - fd_sp).abs() <= tol(fd_sp),
+                    "∂/∂σ′s r = {r} ({sp}, {sa}, {eta}): {} vs {fd_sp}",
+                    got.d_sigma_s_prime
+                );
+                assert!(
+                    (got.d_sigma_a - fd_sa).abs() <= tol(fd_sa),
+                    "∂/∂σa r = {r} ({sp}, {sa}, {eta}): {} vs {fd_sa}",
+                    got.d_sigma_a
+                );
+                assert_eq!(got.rd, m.rd(r));
+            }
+        }
+    }
+
+    /// Similarity: doubling σ′s and σa halves every length, so Rd(r/2) = 4 Rd(r); at a node η the
+    /// set returns that table's own values; between η tables, totals lie between their neighbours;
+    /// out-of-range albedo and η are errors naming the coordinate.
+    #[test]
+    fn similarity_nodes_and_ranges() {
+        let set = small_set(&[1.0, 1.4]);
+        let p1 = OpticalProperties::new(1.0, 0.1, 1.4).unwrap();
+        let p2 = OpticalProperties::new(2.0, 0.2, 1.4).unwrap();
+        let (m1, m2) = (
+            McProfile::new(&set, &p1).unwrap(),
+            McProfile::new(&set, &p2).unwrap(),
+        );
+        for r in [0.1, 1.0, 5.0] {
+            assert!((m2.rd(r / 2.0) / (4.0 * m1.rd(r)) - 1.0).abs() < 1e-12);
+        }
+        let only = McTableSet::new(vec![set.tables()[1].clone()]).unwrap();
+        assert_eq!(McProfile::new(&only, &p1).unwrap().rd(1.0), m1.rd(1.0));
+        let a = 0.9;
+        let (lo, hi) = (set.rd_total(a, 1.0).unwrap(), set.rd_total(a, 1.4).unwrap());
+        let mid = set.rd_total(a, 1.2).unwrap();
+        assert!(mid < lo && mid > hi, "{lo} {mid} {hi}");
+        let e = McProfile::new(&set, &OpticalProperties::new(1.0, 10.0, 1.2).unwrap());
+        assert!(matches!(
+            e,
+            Err(McError::OutOfTable {
+                name: "albedo (σs/σt)",
+                ..
+            })
+        ));
+        let e = McProfile::new(&set, &OpticalProperties::new(1.0, 0.1, 1.6).unwrap());
+        assert!(matches!(e, Err(McError::OutOfTable { name: "eta", .. })));
+        assert!(McProfile::new(&only, &OpticalProperties::new(1.0, 0.1, 1.41).unwrap()).is_err());
+    }
+
+    /// α′ from the Monte Carlo total inverts the total at any η of the set (round trip 1e-12), and an
+    /// Rd outside the tabulated range is refused.
+    #[test]
+    fn albedo_from_total_round_trips_across_eta() {
+        let set = small_set(&[1.0, 1.4]);
+        for eta in [1.0, 1.17, 1.4] {
+            for a in [0.31, 0.5, 0.8, 0.95, 0.989] {
+                let rd = set.rd_total(a, eta).unwrap();
+                let back = set.albedo_from_rd_total(rd, eta).unwrap();
+                assert!(
+                    (set.rd_total(back, eta).unwrap() - rd).abs() < 1e-12,
+                    "η {eta} a {a}"
+                );
+                assert!((back - a).abs() < 1e-9);
+            }
+            assert!(set.albedo_from_rd_total(0.99, eta).is_err());
+            assert!(set.albedo_from_rd_total(0.001, eta).is_err());
+        }
+    }
+
+    /// The cache: built once, then loaded; a damaged file is rebuilt; the compact form (no raw
+    /// profiles) gives the same model and parses back.
+    #[test]
+    fn cache_and_compact_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let spec = small_spec(1.2);
+        let (a, s1, path) = McTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();
+        assert_eq!(s1, CacheStatus::Built);
+        let (b, s2, _) = McTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();
+        assert_eq!((s2, &a), (CacheStatus::Loaded, &b));
+        std::fs::write(&path, b"[1, 2").unwrap();
+        let (c, s3, _) = McTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();
+        assert_eq!((s3, &a), (CacheStatus::Built, &c));
+        let compact = a.clone().without_raw();
+        let json = serde_json::to_string(&compact).unwrap();
+        let back = McTable::from_json(&json).unwrap();
+        let p = OpticalProperties::new(1.0, 0.1, 1.2).unwrap();
+        let (m1, m2) = (
+            McProfile::new(&McTableSet::new(vec![a]).unwrap(), &p).unwrap(),
+            McProfile::new(&McTableSet::new(vec![back]).unwrap(), &p).unwrap(),
+        );
+        assert_eq!(m1.rd(2.0), m2.rd(2.0));
+        assert!(McTable::from_json("{}").is_err());
+    }
+}

@@ -1,0 +1,442 @@
+//! "White" Monte Carlo for a half-space: one photon run serves every albedo.
+//!
+//! At σt = 1 the photon paths in a homogeneous half-space do not depend on the single-scattering
+//! albedo a: with MCML's implicit capture (physics.md §4.1, `Drop`) a photon that leaves the surface
+//! after n interactions carries the weight (1 − R_sp)·aⁿ, whatever else happened. So we trace
+//! non-absorbing photons once and score each escape with aₖⁿ for every albedo aₖ of the table — the
+//! "white Monte Carlo" of Pifferi et al. 1998 (Appl. Opt. 37:2774) and Alerstam, Andersson-Engels &
+//! Svensson 2008 (J. Biomed. Opt. 13:041304), here with MCML's boundary physics: statistical Fresnel
+//! reflection at the surface (`CrossOrNot`), Henyey–Greenstein scattering (`Spin`), leftover step
+//! after a reflection (`sleft`). Without absorption there is no roulette; a photon is stopped after
+//! `max_interactions` interactions instead, which drops weight aⁿ ≤ a_max^max_interactions (chosen
+//! ≤ e⁻¹⁸ by [`WhiteSpec::new`]), a bias below 1e-8 of the total.
+//!
+//! Stratified by path length: a table is the sum of independent runs ("strata") k = 0, 1, …, each
+//! scoring only the escapes after bₖ₋₁ ≤ n < bₖ interactions and stopping its photons at n = bₖ
+//! (b₋₁ = 0, the last bₖ is the cap above). Every escape belongs to exactly one stratum, so the sum is
+//! unbiased, and each stratum gets its own photon count: short paths (near the source, and every
+//! low albedo) are cheap and get many photons, long paths (far from the source at high albedo) are
+//! costly and get fewer. Variances add.
+//!
+//! Scores are per photon, so standard errors come from per-photon second moments, as in the engine;
+//! photons run in chunks with one random stream per chunk, so a seed gives the same tally bit for bit
+//! on any number of threads.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::engine::{CHUNK_PHOTONS, spin};
+use crate::error::{Result, check};
+use crate::fresnel::fresnel_mcml;
+use crate::grid::RadialGrid;
+use crate::rng::{PhotonRng, stream};
+
+/// Survival probability of the interaction-count roulette.
+pub const ROULETTE_SURVIVAL: f64 = 0.25;
+
+/// Chunks traced in parallel before their tallies are summed (in chunk order).
+const WAVE_CHUNKS: u64 = 32;
+
+/// One stratum of a white run: its photons and the interaction count at which they stop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Stratum {
+    /// Photons traced in this stratum.
+    pub photons: u64,
+    /// Photons stop when they reach this many interactions; escapes with n below it (and at least
+    /// the previous stratum's bound) are scored.
+    pub max_interactions: u64,
+}
+
+/// What a white run traces and tallies. Lengths are optical (σt = 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WhiteSpec {
+    /// Relative refractive index η of the half-space (outside index 1).
+    pub eta: f64,
+    /// Henyey–Greenstein asymmetry g.
+    pub g: f64,
+    /// Single-scattering albedos a = σs/σt scored, strictly increasing in (0, 1) (a = α′ when g = 0).
+    pub albedos: Vec<f64>,
+    /// Radial bin edges in mean free paths 1/σt (first edge 0).
+    pub radial_edges: Vec<f64>,
+    /// Seed of the random streams (stratum k uses its own streams derived from it).
+    pub seed: u64,
+    /// The strata, by increasing `max_interactions`; the last one's is the cap.
+    pub strata: Vec<Stratum>,
+    /// Interactions at which the count roulette is played (never, if beyond the cap).
+    pub roulette_interactions: u64,
+}
+
+impl WhiteSpec {
+    /// A spec with strata of `photons[k]` photons separated at the interaction counts `bounds`
+    /// (`bounds.len() == photons.len() − 1`, increasing), the last stratum ending at the cap
+    /// ⌈12/(−ln a_max)⌉ (at most e⁻¹² of a photon's weight dropped at the largest albedo), and the
+    /// roulette where the weight is e⁻¹² at a = min(0.999, a_max), ⌈12/(−ln a)⌉.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad field (see [`WhiteSpec::validate`]).
+    pub fn new(
+        eta: f64,
+        g: f64,
+        albedos: Vec<f64>,
+        radial_edges: Vec<f64>,
+        photons: &[u64],
+        bounds: &[u64],
+        seed: u64,
+    ) -> Result<Self> {
+        check(
+            !photons.is_empty() && bounds.len() + 1 == photons.len(),
+            "bounds",
+            bounds.len() as f64,
+            "need one bound fewer than strata",
+        )?;
+        let a_max = albedos.last().copied().unwrap_or(0.5);
+        let cap = (12.0 / -a_max.ln()).ceil();
+        let roulette = (12.0 / -a_max.min(0.999).ln()).ceil();
+        let cap = if cap.is_finite() { cap as u64 } else { 0 };
+        let strata = photons
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| Stratum {
+                photons: p,
+                max_interactions: bounds.get(k).copied().unwrap_or(cap),
+            })
+            .collect();
+        let spec = Self {
+            eta,
+            g,
+            albedos,
+            radial_edges,
+            seed,
+            strata,
+            roulette_interactions: if roulette.is_finite() {
+                roulette as u64
+            } else {
+                0
+            },
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// Photons over all strata.
+    pub fn photons(&self) -> u64 {
+        self.strata.iter().map(|s| s.photons).sum()
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// `InvalidParameter` naming the first bad field.
+    pub fn validate(&self) -> Result<()> {
+        check(
+            self.eta.is_finite() && self.eta >= 1.0,
+            "eta",
+            self.eta,
+            "η must be finite and ≥ 1",
+        )?;
+        check(
+            self.g.is_finite() && self.g.abs() < 1.0,
+            "g",
+            self.g,
+            "g must lie in (−1, 1)",
+        )?;
+        check(!self.strata.is_empty(), "strata", 0.0, "need a stratum")?;
+        let mut prev = 0;
+        for s in &self.strata {
+            check(s.photons > 0, "photons", 0.0, "every stratum needs photons")?;
+            check(
+                s.max_interactions > prev,
+                "max_interactions",
+                s.max_interactions as f64,
+                "strata must end at increasing interaction counts",
+            )?;
+            prev = s.max_interactions;
+        }
+        check(
+            !self.albedos.is_empty(),
+            "albedos",
+            0.0,
+            "need at least one albedo",
+        )?;
+        for w in self.albedos.windows(2) {
+            check(
+                w[1] > w[0],
+                "albedos",
+                w[1],
+                "albedos must be strictly increasing",
+            )?;
+        }
+        let (lo, hi) = (self.albedos[0], self.albedos[self.albedos.len() - 1]);
+        check(lo > 0.0, "albedos", lo, "albedos must be > 0")?;
+        check(hi < 1.0, "albedos", hi, "albedos must be < 1")?;
+        RadialGrid::from_edges(self.radial_edges.clone())?;
+        Ok(())
+    }
+}
+
+/// The tally of a white run: Rd per albedo and radial bin [per mean free path², at σt = 1], totals,
+/// all with standard errors. Row-major: albedo k, bin j at `k * bins + j`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WhiteTally {
+    /// The spec that made it.
+    pub spec: WhiteSpec,
+    /// R̂(bin; aₖ): reflected weight / (photons × annulus area).
+    pub rd: Vec<f64>,
+    /// Standard errors of `rd`.
+    pub rd_stderr: Vec<f64>,
+    /// Total diffuse reflectance per albedo (excluding R_sp), including photons beyond the last bin.
+    pub rd_total: Vec<f64>,
+    /// Standard errors of `rd_total`.
+    pub rd_total_stderr: Vec<f64>,
+    /// Photons of the last stratum stopped by the interaction cap.
+    pub capped: u64,
+    /// Interactions traced in all (a measure of cost).
+    pub interactions: u64,
+}
+
+impl WhiteTally {
+    /// Number of radial bins.
+    pub fn bins(&self) -> usize {
+        self.spec.radial_edges.len() - 1
+    }
+}
+
+/// Per-chunk sums of per-photon scores and their squares.
+struct Accum {
+    w: Vec<f64>,
+    w2: Vec<f64>,
+    tot: Vec<f64>,
+    tot2: Vec<f64>,
+    capped: u64,
+    interactions: u64,
+}
+
+impl Accum {
+    fn new(k: usize, bins: usize) -> Self {
+        Self {
+            w: vec![0.0; k * bins],
+            w2: vec![0.0; k * bins],
+            tot: vec![0.0; k],
+            tot2: vec![0.0; k],
+            capped: 0,
+            interactions: 0,
+        }
+    }
+
+    fn add(&mut self, o: &Accum) {
+        for (a, b) in self.w.iter_mut().zip(&o.w) {
+            *a += b;
+        }
+        for (a, b) in self.w2.iter_mut().zip(&o.w2) {
+            *a += b;
+        }
+        for (a, b) in self.tot.iter_mut().zip(&o.tot) {
+            *a += b;
+        }
+        for (a, b) in self.tot2.iter_mut().zip(&o.tot2) {
+            *a += b;
+        }
+        self.capped += o.capped;
+        self.interactions += o.interactions;
+    }
+}
+
+/// Runs the white simulation on the current rayon pool, stratum after stratum; `progress(done)`
+/// counts photons over all strata.
+///
+/// # Errors
+/// `InvalidParameter` for a bad spec.
+pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<WhiteTally> {
+    spec.validate()?;
+    let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
+    let bins = grid.bins();
+    let k = spec.albedos.len();
+    let ln_a: Vec<f64> = spec.albedos.iter().map(|a| a.ln()).collect();
+    let cos_crit = if spec.eta > 1.0 {
+        (1.0 - 1.0 / (spec.eta * spec.eta)).sqrt()
+    } else {
+        0.0
+    };
+    // Launch weight 1 − R_sp (MCML `LaunchPhoton`, normal incidence from air).
+    let w0 = 1.0 - ((spec.eta - 1.0) / (spec.eta + 1.0)).powi(2);
+    let mut rd = vec![0.0; k * bins];
+    let mut var = vec![0.0; k * bins];
+    let mut rd_total = vec![0.0; k];
+    let mut var_total = vec![0.0; k];
+    let (mut capped, mut interactions, mut done_before) = (0, 0, 0);
+    let mut min_n = 0;
+    for (si, stratum) in spec.strata.iter().enumerate() {
+        let tracer = Tracer {
+            eta: spec.eta,
+            g: spec.g,
+            cos_crit,
+            min_n,
+            max_n: stratum.max_interactions,
+            roulette_n: spec.roulette_interactions,
+            grid: &grid,
+            ln_a: &ln_a,
+            bins,
+        };
+        let last_stratum = si + 1 == spec.strata.len();
+        let photons = stratum.photons;
+        // Stratum k's streams: (seed mixed with k, chunk index).
+        let seed = spec.seed ^ (si as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let chunks = photons.div_ceil(CHUNK_PHOTONS);
+        let mut total = Accum::new(k, bins);
+        let mut first = 0;
+        while first < chunks {
+            let last = (first + WAVE_CHUNKS).min(chunks);
+            let wave: Vec<Accum> = (first..last)
+                .into_par_iter()
+                .map(|c| {
+                    let count = CHUNK_PHOTONS.min(photons - c * CHUNK_PHOTONS);
+                    let mut acc = Accum::new(k, bins);
+                    let mut rng = stream(seed, c);
+                    let mut w = vec![0.0; k];
+                    for _ in 0..count {
+                        tracer.trace(&mut rng, &mut acc, &mut w);
+                    }
+                    acc
+                })
+                .collect();
+            for acc in &wave {
+                total.add(acc);
+            }
+            first = last;
+            progress(done_before + (last * CHUNK_PHOTONS).min(photons));
+        }
+        done_before += photons;
+        let n = photons as f64;
+        // Mean and variance of the mean of per-photon scores.
+        let moments = |s1: f64, s2: f64| {
+            let mean = s1 / n;
+            let v = if photons > 1 {
+                (s2 / n - mean * mean).max(0.0) / (n - 1.0)
+            } else {
+                f64::INFINITY
+            };
+            (mean, v)
+        };
+        for kk in 0..k {
+            for j in 0..bins {
+                let i = kk * bins + j;
+                let scale = w0 / grid.area(j);
+                let (m, v) = moments(total.w[i], total.w2[i]);
+                rd[i] += m * scale;
+                var[i] += v * scale * scale;
+            }
+            let (m, v) = moments(total.tot[kk], total.tot2[kk]);
+            rd_total[kk] += m * w0;
+            var_total[kk] += v * w0 * w0;
+        }
+        if last_stratum {
+            capped = total.capped;
+        }
+        interactions += total.interactions;
+        min_n = stratum.max_interactions;
+    }
+    Ok(WhiteTally {
+        spec: spec.clone(),
+        rd,
+        rd_stderr: var.iter().map(|v| v.sqrt()).collect(),
+        rd_total,
+        rd_total_stderr: var_total.iter().map(|v| v.sqrt()).collect(),
+        capped,
+        interactions,
+    })
+}
+
+/// What the inner loop reads.
+struct Tracer<'a> {
+    eta: f64,
+    g: f64,
+    cos_crit: f64,
+    min_n: u64,
+    max_n: u64,
+    roulette_n: u64,
+    grid: &'a RadialGrid,
+    ln_a: &'a [f64],
+    bins: usize,
+}
+
+impl Tracer<'_> {
+    /// Traces one non-absorbing photon from a normally incident pencil beam at the origin until it
+    /// leaves through the surface z = 0 (scored if it had at least `min_n` interactions) or reaches
+    /// `max_n` interactions.
+    #[inline]
+    fn trace(&self, rng: &mut PhotonRng, acc: &mut Accum, w: &mut [f64]) {
+        let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut ux, mut uy, mut uz) = (0.0f64, 0.0f64, 1.0f64);
+        let mut n: u64 = 0;
+        let mut weight = 1.0;
+        loop {
+            // Step of Exp(1) optical length at σt = 1 (MCML `StepSizeInTissue`).
+            let s = rng.exp1();
+            let z_end = z + s * uz;
+            if z_end < 0.0 {
+                // Hits the surface (MCML `HitBoundary`): move there, then Fresnel decides
+                // (`CrossOrNot`); on reflection the leftover step continues mirrored.
+                let db = -z / uz;
+                x += db * ux;
+                y += db * uy;
+                let cos_i = -uz;
+                let escapes = cos_i > self.cos_crit && {
+                    let r = fresnel_mcml(self.eta, 1.0, cos_i).reflectance;
+                    r == 0.0 || rng.uniform() > r
+                };
+                if escapes {
+                    acc.interactions += n;
+                    if n >= self.min_n {
+                        self.score(acc, w, n, weight, x, y);
+                    }
+                    return;
+                }
+                let left = s - db;
+                uz = -uz;
+                x += left * ux;
+                y += left * uy;
+                z = left * uz;
+            } else {
+                x += s * ux;
+                y += s * uy;
+                z = z_end;
+            }
+            // Interaction: implicit capture would multiply the weight by a; here n counts them.
+            n += 1;
+            if n >= self.max_n {
+                acc.interactions += n;
+                acc.capped += 1;
+                return;
+            }
+            if n == self.roulette_n {
+                if rng.uniform() >= ROULETTE_SURVIVAL {
+                    acc.interactions += n;
+                    return;
+                }
+                weight /= ROULETTE_SURVIVAL;
+            }
+            (ux, uy, uz) = spin(self.g, ux, uy, uz, rng);
+        }
+    }
+
+    /// Scores an escape after `n` interactions at (x, y): weight·aₖⁿ for every albedo.
+    #[inline]
+    fn score(&self, acc: &mut Accum, w: &mut [f64], n: u64, weight: f64, x: f64, y: f64) {
+        let nf = n as f64;
+        for (wk, la) in w.iter_mut().zip(self.ln_a) {
+            *wk = weight * (nf * la).exp();
+        }
+        for (k, &wk) in w.iter().enumerate() {
+            acc.tot[k] += wk;
+            acc.tot2[k] += wk * wk;
+        }
+        let r = (x * x + y * y).sqrt();
+        if let Some(j) = self.grid.find(r) {
+            for (k, &wk) in w.iter().enumerate() {
+                let i = k * self.bins + j;
+                acc.w[i] += wk;
+                acc.w2[i] += wk * wk;
+            }
+        }
+    }
+}
