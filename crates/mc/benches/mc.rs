@@ -57,3 +57,36 @@ fn standard_slab_all_threads(b: divan::Bencher) {
     b.counter(divan::counter::ItemsCount::new(1_000_000usize))
         .bench_local(|| sim.run());
 }
+
+/// The `mc` forward model: Rd(r) + both derivatives at 300 radii (0.1…30 mm) through the
+/// `ProfileModel` trait, model construction included (η between two tables, α′ between nodes) —
+/// one Levenberg–Marquardt iteration's model work. Uses a small table built once (the evaluation
+/// cost does not depend on the photon count).
+#[divan::bench(sample_count = 100)]
+fn mc_model_profile_with_derivatives_300_radii(b: divan::Bencher) {
+    use scatterfit_mc::model::{McProfile, McTable, McTableSet, McTableSpec};
+    use scatterfit_optics::{OpticalProperties, ProfileModel, ProfileSample};
+    let tables = [1.2, 1.4]
+        .iter()
+        .map(|&eta| {
+            let spec = McTableSpec::with_strata(eta, 0.0, vec![40_000, 8_000], vec![64]).unwrap();
+            McTable::build(&spec, &|_, _| {}).unwrap()
+        })
+        .collect();
+    let set = McTableSet::new(tables).unwrap();
+    let radii: Vec<f64> = (1..=300).map(|i| 0.1 * i as f64).collect();
+    let props = OpticalProperties::new(1.979, 0.0496, 1.2886).unwrap();
+    let mut out = vec![
+        ProfileSample {
+            rd: 0.0,
+            d_sigma_s_prime: 0.0,
+            d_sigma_a: 0.0
+        };
+        radii.len()
+    ];
+    b.bench_local(|| {
+        let m = McProfile::new(&set, divan::black_box(&props)).unwrap();
+        m.profile_with_derivatives_into(&radii, &mut out);
+        divan::black_box(&out);
+    });
+}

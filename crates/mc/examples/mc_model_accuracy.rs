@@ -1,105 +1,173 @@
-//! Accuracy of the `mc` forward model against MCML's independent profiles
-//! (`reference/mcml_profiles.csv`, physics.md §4.5): builds (or loads from the cache) white Monte
-//! Carlo tables at η = 1.0, 1.4, 2.0 and compares each MCML case, bin by bin and pooled in radial
-//! windows, and the totals.
+//! Accuracy of the `mc` forward model (the shipped tables, or those in TABLE_DIR):
+//! 1. against MCML's independent profiles (`reference/mcml_profiles.csv`, physics.md §4.5) at its
+//!    15 (η, α′) points (η = 1.0, 1.4, 2.0 are table nodes; α′ 0.3 … 0.999 lie between albedo nodes):
+//!    weighted mean relative difference ± standard error (MCML noise 1/√(N·2πr·dr·Rd)) and χ²/bins
+//!    in radial windows, and the totals;
+//! 2. against direct simulations with this crate's MCML engine (`Simulation`: per-albedo photons with
+//!    implicit capture and roulette, a different tracer from the white one) at η between the tables
+//!    and α′ between albedo nodes, σ′t = 1 mm⁻¹, on a logarithmic radial grid.
 //!
-//! Run: `cargo run --release -p scatterfit-mc --example mc_model_accuracy -- MCML_CSV PHOTONS [CACHE_DIR]`
+//! Run: `cargo run --release -p scatterfit-mc --example mc_model_accuracy -- MCML_CSV DIRECT_PHOTONS [TABLE_DIR]`
 
-use scatterfit_mc::model::{McProfile, McTableSet, McTableSpec};
+use scatterfit_mc::model::{McProfile, McTable, McTableSet};
+use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation};
 use scatterfit_optics::{OpticalProperties, ProfileModel};
+
+const WINDOWS: [(f64, f64); 7] = [
+    (0.1, 0.5),
+    (0.5, 1.0),
+    (1.0, 2.0),
+    (2.0, 5.0),
+    (5.0, 10.0),
+    (10.0, 20.0),
+    (20.0, 50.0),
+];
+
+/// The model averaged over the annulus [a, b] (8-point Gauss–Legendre in ln r).
+fn annulus_average(m: &dyn ProfileModel, a: f64, b: f64) -> f64 {
+    const GL4: [(f64, f64); 4] = [
+        (-0.861_136_311_594_053, 0.347_854_845_137_454),
+        (-0.339_981_043_584_856, 0.652_145_154_862_546),
+        (0.339_981_043_584_856, 0.652_145_154_862_546),
+        (0.861_136_311_594_053, 0.347_854_845_137_454),
+    ];
+    let mut s = 0.0;
+    // Two panels, so that tiny inner annuli and wide outer ones are both integrated well.
+    let mid = 0.5 * (a + b);
+    for (lo, hi) in [(a, mid), (mid, b)] {
+        for (x, w) in GL4 {
+            let r = 0.5 * (lo + hi) + 0.5 * (hi - lo) * x;
+            s += w * 0.5 * (hi - lo) * 2.0 * std::f64::consts::PI * r * m.rd(r);
+        }
+    }
+    s / (std::f64::consts::PI * (b * b - a * a))
+}
+
+/// Prints windowed comparisons: per bin (r_lo, r_hi, reference value, its relative s.e.).
+fn windows(model: &dyn ProfileModel, bins: &[(f64, f64, f64, f64)]) -> String {
+    let mut line = String::new();
+    for (lo, hi) in WINDOWS {
+        let (mut sw, mut swd, mut chi2, mut n) = (0.0, 0.0, 0.0, 0);
+        for &(a, b, v, rel) in bins {
+            let c = 0.5 * (a + b);
+            if c < lo || c >= hi || v <= 0.0 || rel > 0.3 {
+                continue;
+            }
+            let d = annulus_average(model, a, b) / v - 1.0;
+            let w = 1.0 / (rel * rel);
+            sw += w;
+            swd += w * d;
+            chi2 += d * d * w;
+            n += 1;
+        }
+        if n > 0 {
+            line += &format!(
+                " [{lo},{hi}): {:+.2}±{:.2}% ({:.0}/{n})",
+                100.0 * swd / sw,
+                100.0 / sw.sqrt(),
+                chi2
+            );
+        }
+    }
+    line
+}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let csv = std::fs::read_to_string(&args[1]).expect("read MCML csv");
-    let photons: u64 = args[2].parse().expect("photons");
-    let dir = std::path::PathBuf::from(args.get(3).map_or("/tmp/mc-cache", |s| s.as_str()));
-    let mut cases: Vec<(f64, f64, f64, Vec<(f64, f64)>)> = Vec::new();
+    let direct_photons: u64 = args[2].parse::<f64>().expect("photons") as u64;
+    let set = match args.get(3) {
+        Some(dir) => {
+            let mut tables = Vec::new();
+            for e in std::fs::read_dir(dir).expect("table dir") {
+                let p = e.expect("entry").path();
+                if p.extension().is_some_and(|x| x == "json") {
+                    tables.push(McTable::load(&p).expect("table"));
+                }
+            }
+            McTableSet::new(tables).expect("set")
+        }
+        None => McTableSet::bundled().expect("bundled tables"),
+    };
+    // 1. MCML.
+    let mut cases: Vec<(f64, f64, f64)> = Vec::new();
+    let mut bins: Vec<Vec<(f64, f64, f64, f64)>> = Vec::new();
     for line in csv.lines().filter(|l| !l.starts_with('#')).skip(1) {
-        let f: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
-        let (eta, a, tot, r, v) = (f[0], f[1], f[2], f[4], f[5]);
-        match cases.last_mut() {
-            Some(c) if c.0 == eta && c.1 == a => c.3.push((r, v)),
-            _ => cases.push((eta, a, tot, vec![(r, v)])),
+        let f: Vec<f64> = line
+            .split(',')
+            .map(|x| x.parse().expect("number"))
+            .collect();
+        if cases.last().is_none_or(|c| c.0 != f[0] || c.1 != f[1]) {
+            cases.push((f[0], f[1], f[2]));
+            bins.push(Vec::new());
         }
+        let (r, v) = (f[4], f[5]);
+        let rel = 1.0 / (2e6 * 2.0 * std::f64::consts::PI * r * 0.05 * v).sqrt();
+        bins.last_mut()
+            .expect("a case")
+            .push((r - 0.025, r + 0.025, v, rel));
     }
-    let t0 = std::time::Instant::now();
-    let template = McTableSpec::new(1.0, 0.0, photons).unwrap();
-    let mut sets = Vec::new();
-    for eta in [1.0, 1.4, 2.0] {
-        let set = McTableSet::load_or_build(&[eta], &template, &dir, &|_, _, _| {}).unwrap();
-        let t = &set.tables()[0];
-        let chi = t.chi2_per_bin();
+    println!(
+        "## against MCML (mean model/MCML − 1 ± s.e. (χ²/bins) per window of r in mean free paths)"
+    );
+    for ((eta, a, total), b) in cases.iter().zip(&mut bins) {
+        b.pop(); // overflow bin
+        let p = OpticalProperties::new(*a, 1.0 - a, *eta).expect("props");
+        let m = McProfile::new(&set, &p).expect("model");
         println!(
-            "η {eta}: table ready at {:.1} s; smoothing χ²/bin min {:.2} median {:.2} max {:.2}",
-            t0.elapsed().as_secs_f64(),
-            chi.iter().cloned().fold(f64::INFINITY, f64::min),
-            {
-                let mut c = chi.to_vec();
-                c.sort_by(f64::total_cmp);
-                c[c.len() / 2]
-            },
-            chi.iter().cloned().fold(0.0, f64::max)
-        );
-        sets.push((eta, set));
-    }
-    let windows = [
-        (0.1, 0.5),
-        (0.5, 1.0),
-        (1.0, 2.0),
-        (2.0, 5.0),
-        (5.0, 10.0),
-        (10.0, 20.0),
-    ];
-    println!("case | total MCML / model (diff) | window: mean rel. diff ± s.e. (χ²/bins)");
-    for (eta, a, tot, bins) in &cases {
-        let set = &sets.iter().find(|s| s.0 == *eta).unwrap().1;
-        let props = OpticalProperties::new(*a, 1.0 - a, *eta).unwrap();
-        let m = McProfile::new(set, &props).unwrap();
-        let mut line = format!(
-            "η {eta} α′ {a}: Rd {tot:.5} / {:.5} ({:+.5}) |",
+            "η {eta} α′ {a}: total {total:.5} / model {:.5} ({:+.5}) |{}",
             m.rd_total(),
-            m.rd_total() - tot
+            m.rd_total() - total,
+            windows(&m, b)
         );
-        for (lo, hi) in windows {
-            let (mut sw, mut swd, mut chi2, mut n) = (0.0, 0.0, 0.0, 0);
-            for &(r, v) in &bins[..bins.len() - 1] {
-                if r < lo || r >= hi || v <= 0.0 {
-                    continue;
-                }
-                // Model averaged over the 0.05 mm annulus (4-point Gauss–Legendre in r).
-                let (ra, rb) = (r - 0.025, r + 0.025);
-                let gl = [
-                    (-0.861136311594053, 0.347854845137454),
-                    (-0.339981043584856, 0.652145154862546),
-                    (0.339981043584856, 0.652145154862546),
-                    (0.861136311594053, 0.347854845137454),
-                ];
-                let mut s = 0.0;
-                for (x, w) in gl {
-                    let rr = 0.5 * (ra + rb) + 0.5 * (rb - ra) * x;
-                    s += w * 0.5 * (rb - ra) * 2.0 * std::f64::consts::PI * rr * m.rd(rr);
-                }
-                let model = s / (std::f64::consts::PI * (rb * rb - ra * ra));
-                let rel = 1.0 / (2e6 * 2.0 * std::f64::consts::PI * r * 0.05 * v).sqrt();
-                if rel > 0.3 {
-                    continue;
-                }
-                let d = model / v - 1.0;
-                let w = 1.0 / (rel * rel);
-                sw += w;
-                swd += w * d;
-                chi2 += d * d * w;
-                n += 1;
-            }
-            if n > 0 {
-                line += &format!(
-                    " [{lo},{hi}): {:+.4}±{:.4} ({:.1}/{n})",
-                    swd / sw,
-                    1.0 / sw.sqrt(),
-                    chi2
-                );
-            }
-        }
-        println!("{line}");
+    }
+    // 2. Direct simulations between tables and albedo nodes.
+    println!("## against direct MCML-engine runs ({direct_photons} photons each)");
+    let edges: Vec<f64> = std::iter::once(0.0)
+        .chain((0..=60).map(|i| 0.1 * 500f64.powf(i as f64 / 60.0)))
+        .collect();
+    let grid = RadialGrid::from_edges(edges.clone()).expect("grid");
+    for (eta, a, seed) in [
+        (1.3, 0.5, 1u64),
+        (1.3, 0.95, 2),
+        (1.5, 0.8, 3),
+        (1.5, 0.995, 4),
+        (1.7, 0.9, 5),
+        (1.33, 0.9995, 6),
+        (2.3, 0.98, 7),
+    ] {
+        let t0 = std::time::Instant::now();
+        let half = Sample::slab(
+            Layer::from_reduced(a, 1.0 - a, 0.0, eta, f64::INFINITY).expect("layer"),
+            1.0,
+        )
+        .expect("sample");
+        let d = Simulation::new(half, Beam::pencil(), grid.clone(), direct_photons, seed)
+            .expect("simulation")
+            .run();
+        let b: Vec<(f64, f64, f64, f64)> = d
+            .rd_profile
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                let rel = if e.value > 0.0 {
+                    e.stderr / e.value
+                } else {
+                    f64::INFINITY
+                };
+                (edges[i], edges[i + 1], e.value, rel)
+            })
+            .collect();
+        let p = OpticalProperties::new(a, 1.0 - a, eta).expect("props");
+        let m = McProfile::new(&set, &p).expect("model");
+        println!(
+            "η {eta} α′ {a}: total {:.5}±{:.5} / model {:.5} ({:+.5}) [{:.0} s] |{}",
+            d.rd_total.value,
+            d.rd_total.stderr,
+            m.rd_total(),
+            m.rd_total() - d.rd_total.value,
+            t0.elapsed().as_secs_f64(),
+            windows(&m, &b)
+        );
     }
 }

@@ -28,6 +28,7 @@
 #![forbid(unsafe_code)]
 
 mod beam;
+pub mod bundled;
 mod engine;
 mod error;
 mod fresnel;

@@ -204,7 +204,8 @@ pub struct McTable {
     knots: Knots,
     /// Spline coefficients per albedo, row-major (albedo k, coefficient m).
     coefs: Vec<f64>,
-    /// Outer radius of the data behind each row [mean free paths].
+    /// Inner and outer radius of the data behind each row [mean free paths].
+    rho_data_min: Vec<f64>,
     rho_data_max: Vec<f64>,
     rd_total: Vec<f64>,
     rd_total_stderr: Vec<f64>,
@@ -247,7 +248,7 @@ impl McTable {
             spec.smooth.knot_spacing,
         );
         let mut coefs = Vec::with_capacity(white.albedos.len() * knots.len());
-        let (mut rho_data_max, mut chi2) = (Vec::new(), Vec::new());
+        let (mut rho_data_min, mut rho_data_max, mut chi2) = (Vec::new(), Vec::new(), Vec::new());
         for (k, &a) in white.albedos.iter().enumerate() {
             let row = k * bins..(k + 1) * bins;
             let fit = fit_row(
@@ -263,6 +264,7 @@ impl McTable {
                 reason: "fewer than 4 radial bins with data: trace more photons",
             })?;
             coefs.extend_from_slice(&fit.coefs);
+            rho_data_min.push(fit.rho_data_min);
             rho_data_max.push(fit.rho_data_max);
             chi2.push(fit.chi2 / fit.bins_used as f64);
         }
@@ -281,6 +283,7 @@ impl McTable {
             albedos: white.albedos.clone(),
             knots,
             coefs,
+            rho_data_min,
             rho_data_max,
             rd_total: tally.rd_total.clone(),
             rd_total_stderr: tally.rd_total_stderr.clone(),
@@ -298,6 +301,26 @@ impl McTable {
     pub fn without_raw(mut self) -> Self {
         self.raw = None;
         self
+    }
+
+    /// [`McTable::without_raw`], with the spline coefficients rounded to 1e-9 (they are logarithms
+    /// of R̂, so this changes the model by < 1e-8 relative, far below its Monte Carlo noise) and the
+    /// totals to 1e-9, so that the JSON is about a third as long.
+    #[must_use]
+    pub fn compact(self) -> Self {
+        let round = |v: &mut Vec<f64>| {
+            for x in v.iter_mut() {
+                *x = (*x * 1e9).round() / 1e9;
+            }
+        };
+        let mut t = self.without_raw();
+        round(&mut t.coefs);
+        round(&mut t.rd_total);
+        round(&mut t.rd_total_stderr);
+        round(&mut t.chi2_per_bin);
+        round(&mut t.rho_data_max);
+        round(&mut t.rho_data_min);
+        t
     }
 
     /// The spec that made the table.
@@ -319,6 +342,12 @@ impl McTable {
     /// model is the smoother's extrapolation (a power law times e^{−κ₀ρ}).
     pub fn rho_data_max(&self) -> &[f64] {
         &self.rho_data_max
+    }
+
+    /// Inner radius of the Monte Carlo data behind each albedo row [mean free paths] (the innermost
+    /// annuli are small and noisy at low albedo); inside it the model is extrapolated likewise.
+    pub fn rho_data_min(&self) -> &[f64] {
+        &self.rho_data_min
     }
 
     /// χ² per bin of each row's smoothing fit (≈ 1 when the smooth curve is within the noise).
@@ -519,20 +548,21 @@ impl McTableSet {
     }
 
     /// Total diffuse reflectance Rd(a, η) (excluding R_sp) by Monte Carlo: Catmull-Rom in √(1 − a)
-    /// over the albedo nodes, then in η over the tables. a is the single-scattering albedo (α′ for
-    /// g = 0).
+    /// over the albedo nodes, then Catmull-Rom in η on ln Rd over the tables (on the default η grid
+    /// within 0.2 % of adding-doubling between tables, BENCHMARKS.md). a is the single-scattering
+    /// albedo (α′ for g = 0; for g ≠ 0, α′ = a(1 − g)/(1 − ag)).
     ///
     /// # Errors
     /// `OutOfTable` for a or η outside the tables.
     pub fn rd_total(&self, a: f64, eta: f64) -> Result<f64> {
         let (j, we) = self.eta_weights(eta)?;
-        let mut sum = 0.0;
+        let mut ln_sum = 0.0;
         for (q, &w) in we.iter().enumerate() {
             if w != 0.0 {
-                sum += w * self.tables[j + q - 1].rd_total(a)?;
+                ln_sum += w * self.tables[j + q - 1].rd_total(a)?.ln();
             }
         }
-        Ok(sum)
+        Ok(ln_sum.exp())
     }
 
     /// The albedo a (α′ for g = 0) whose Monte Carlo total diffuse reflectance at η is `rd`: the
@@ -599,6 +629,7 @@ impl McTable {
             && t.albedos == t.spec.albedos()
             && t.coefs.len() == k * t.knots.len()
             && t.rho_data_max.len() == k
+            && t.rho_data_min.len() == k
             && t.rd_total.len() == k
             && t.rd_total_stderr.len() == k
             && t.coefs.iter().all(|c| c.is_finite());
@@ -686,7 +717,7 @@ impl McProfile {
         let (i, wa, dwa) = t0.albedo_weights(a)?;
         let m = t0.knots.len();
         let (mut coefs, mut dcoefs) = (vec![0.0; m], vec![0.0; m]);
-        let (mut total, mut rho_data) = (0.0, 0.0);
+        let mut rho_data = 0.0;
         for (q, &w_eta) in we.iter().enumerate() {
             if w_eta == 0.0 {
                 continue;
@@ -702,7 +733,6 @@ impl McProfile {
                     *c += w * b;
                     *d += dw * b;
                 }
-                total += w * t.rd_total[i + k - 1];
                 rho_data += w * t.rho_data_max[i + k - 1];
             }
         }
@@ -721,7 +751,7 @@ impl McProfile {
             da_dsa: -sigma_s / st2,
             rho_floor: t0.spec.rho_min,
             r_data_max: rho_data / sigma_t,
-            rd_total: total,
+            rd_total: set.rd_total(a, eta)?,
         })
     }
 

@@ -258,7 +258,7 @@ pub fn fit_row(
     let max2 = params.max_rel_se * params.max_rel_se;
     let (mut best, mut start) = ((0, 0), None);
     for j in 1..=bins {
-        let ok = j < bins && avg[j] <= max2;
+        let ok = avg.get(j).is_some_and(|&v| v <= max2);
         match (ok, start) {
             (true, None) => start = Some(j),
             (false, Some(s)) => {
