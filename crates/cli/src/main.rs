@@ -5,13 +5,20 @@
 //! failed (the tool ran, the sample did not yield parameters), 2 bad usage or bad input.
 
 mod bench;
+mod common;
 mod demo;
+mod figures;
+mod measure;
 mod merge;
 mod output;
+mod plot;
 mod profile;
+mod report;
 mod simulate;
 mod spectro;
+mod synth;
 mod table;
+mod twin;
 
 use std::process::ExitCode;
 
@@ -31,6 +38,8 @@ struct Cli {
 enum Command {
     /// Run the pipeline on built-in example measurements.
     Demo(demo::Args),
+    /// Measure a sample folder: σ′s, σa and η per RGB channel (spectro → HDR → profile → fit).
+    Measure(measure::Args),
     /// Spectrophotometer stage: η from SCI−SCE, colour, Rd and reduced albedo α′ per RGB channel.
     Spectro(spectro::Args),
     /// Monte Carlo photon transport (MCML physics) in a slab or half-space.
@@ -41,6 +50,8 @@ enum Command {
     Merge(merge::Args),
     /// Radial profile Rd(r) around the light spot of a radiance map.
     Profile(profile::Args),
+    /// The rig twin: write a synthetic sample folder (Monte Carlo spectro reading and bracket).
+    Synth(synth::Args),
     /// Measure the speed of the hot paths on this machine.
     Bench(bench::Args),
 }
@@ -59,7 +70,11 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(err) => {
             eprintln!("error: {err:#}");
-            ExitCode::from(2)
+            ExitCode::from(if common::is_measurement_failure(&err) {
+                1
+            } else {
+                2
+            })
         }
     }
 }
@@ -67,11 +82,13 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Demo(args) => demo::run(args),
+        Command::Measure(args) => measure::run(args),
         Command::Spectro(args) => spectro::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Table(args) => table::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Profile(args) => profile::run(args),
+        Command::Synth(args) => synth::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

@@ -448,9 +448,17 @@ fn print_summary(s: &Summary) {
         s.image,
         s.read_s
     );
-    println!("times         {} s … {} s", shutter(t_min), shutter(t_max));
+    println!(
+        "times         {} s … {} s",
+        crate::common::shutter(t_min),
+        crate::common::shutter(t_max)
+    );
     for f in &s.frames {
-        println!("  {:>10} s  {}", shutter(f.time_s), f.file.display());
+        println!(
+            "  {:>10} s  {}",
+            crate::common::shutter(f.time_s),
+            f.file.display()
+        );
     }
     let rms = if s.response_rms_residual.is_empty() {
         String::new()
@@ -484,22 +492,6 @@ fn print_summary(s: &Summary) {
     println!("wrote         {}", s.output.display());
     if let Some(r) = &s.response_out {
         println!("wrote         {}", r.display());
-    }
-}
-
-/// `1/600` for short times that are whole fractions, else 4 significant digits.
-fn shutter(t: f64) -> String {
-    if t < 0.5 && t > 0.0 {
-        let inv = 1.0 / t;
-        if (inv - inv.round()).abs() < 1e-6 * inv {
-            return format!("1/{}", inv.round());
-        }
-    }
-    if (1e-3..1e4).contains(&t) {
-        let decimals = (3 - t.log10().floor() as i32).max(0) as usize;
-        format!("{t:.decimals$}")
-    } else {
-        format!("{t:.3e}")
     }
 }
 

@@ -13,4 +13,6 @@ pub mod manifest;
 pub mod profile_csv;
 pub mod response_csv;
 pub mod result_json;
+pub mod result_table;
+pub mod sample_folder;
 pub mod spectro;

@@ -252,7 +252,11 @@ pub fn read_manifest(path_or_dir: &Path) -> Result<SampleManifest, ManifestError
 ///
 /// # Errors
 /// [`ManifestError`] naming the file and the key.
-pub fn parse_manifest(text: &str, path: &Path, dir: PathBuf) -> Result<SampleManifest, ManifestError> {
+pub fn parse_manifest(
+    text: &str,
+    path: &Path,
+    dir: PathBuf,
+) -> Result<SampleManifest, ManifestError> {
     let mut m: SampleManifest = toml::from_str(text).map_err(|e| ManifestError::Syntax {
         path: path.to_path_buf(),
         message: e.to_string().trim_end().replace('\n', "\n  "),
@@ -332,7 +336,8 @@ pub fn parse_manifest(text: &str, path: &Path, dir: PathBuf) -> Result<SampleMan
     {
         return Err(invalid(
             "camera.hdr",
-            "is given together with a bracket (exposures/images/dark): give one or the other".into(),
+            "is given together with a bracket (exposures/images/dark): give one or the other"
+                .into(),
         ));
     }
     if let Some(d) = m.camera.spot_diameter_mm
@@ -346,7 +351,10 @@ pub fn parse_manifest(text: &str, path: &Path, dir: PathBuf) -> Result<SampleMan
     if let Some([x, y]) = m.camera.center_px
         && !(x.is_finite() && y.is_finite())
     {
-        return Err(invalid("camera.center_px", "must be two finite numbers [x, y]".into()));
+        return Err(invalid(
+            "camera.center_px",
+            "must be two finite numbers [x, y]".into(),
+        ));
     }
     if let Some(r) = m.fit.r_max_px
         && !(r.is_finite() && r >= 2.0 && r <= 1e5)
@@ -476,13 +484,17 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
 ///
 /// # Errors
 /// [`ManifestError::Write`].
-pub fn write_manifest(path: &Path, m: &SampleManifest, extra_comment: &str) -> Result<(), ManifestError> {
-    crate::atomic::write_atomic(path, manifest_to_toml(m, extra_comment).as_bytes()).map_err(|source| {
-        ManifestError::Write {
+pub fn write_manifest(
+    path: &Path,
+    m: &SampleManifest,
+    extra_comment: &str,
+) -> Result<(), ManifestError> {
+    crate::atomic::write_atomic(path, manifest_to_toml(m, extra_comment).as_bytes()).map_err(
+        |source| ManifestError::Write {
             path: path.to_path_buf(),
             source,
-        }
-    })
+        },
+    )
 }
 
 #[cfg(test)]
@@ -512,7 +524,10 @@ r_max_px = 300
     fn round_trip() {
         let m = parse(GOOD).unwrap();
         assert_eq!(m.fit.method, Some(MethodName::Existing));
-        assert_eq!(m.resolve(Path::new("spectro.csv")), PathBuf::from("s/spectro.csv"));
+        assert_eq!(
+            m.resolve(Path::new("spectro.csv")),
+            PathBuf::from("s/spectro.csv")
+        );
         let back = parse(&manifest_to_toml(&m, "made by a test")).unwrap();
         assert_eq!(back.spectro, m.spectro);
         assert_eq!(back.camera, m.camera);
@@ -524,14 +539,35 @@ r_max_px = 300
     #[test]
     fn mistakes_name_the_key() {
         let cases: [(&str, &str); 8] = [
-            (&GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = -1"), "camera.mm_per_pixel"),
-            (&GOOD.replace("mm_per_pixel = 0.05", ""), "camera.mm_per_pixel"),
-            (&GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = \"0.05\""), "mm_per_pixel"),
-            (&GOOD.replace("method = \"existing\"", "method = \"proposd\""), "proposd"),
-            (&GOOD.replace("model = \"dipole\"", "modle = \"dipole\""), "modle"),
+            (
+                &GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = -1"),
+                "camera.mm_per_pixel",
+            ),
+            (
+                &GOOD.replace("mm_per_pixel = 0.05", ""),
+                "camera.mm_per_pixel",
+            ),
+            (
+                &GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = \"0.05\""),
+                "mm_per_pixel",
+            ),
+            (
+                &GOOD.replace("method = \"existing\"", "method = \"proposd\""),
+                "proposd",
+            ),
+            (
+                &GOOD.replace("model = \"dipole\"", "modle = \"dipole\""),
+                "modle",
+            ),
             (&GOOD.replace("file = \"spectro.csv\"", ""), "spectro.file"),
-            (&GOOD.replace("exposures = \"exposures.csv\"", ""), "camera.exposures"),
-            (&GOOD.replace("r_max_px = 300", "r_max_px = 0"), "fit.r_max_px"),
+            (
+                &GOOD.replace("exposures = \"exposures.csv\"", ""),
+                "camera.exposures",
+            ),
+            (
+                &GOOD.replace("r_max_px = 300", "r_max_px = 0"),
+                "fit.r_max_px",
+            ),
         ];
         for (text, key) in cases {
             let err = parse(text).unwrap_err().to_string();

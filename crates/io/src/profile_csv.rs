@@ -7,8 +7,9 @@
 //! ```
 //! `value` is the mean radiance of the ring's valid pixels (relative units), `stderr` its standard
 //! error, `count` the number of pixels averaged. A grey map has the single channel `y`. A ring with no
-//! valid pixel has count 0 and empty value and stderr fields. Numbers are written in Rust's shortest
-//! round-trip form.
+//! valid pixel has count 0 and empty value and stderr fields. An optional `limit_<c>` column holds the
+//! bracket's detection limit (same units as `value`): a ring below it was not measured. Numbers are
+//! written in Rust's shortest round-trip form.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -54,6 +55,8 @@ pub struct ProfileColumn {
     pub stderr: Vec<f64>,
     /// Pixels averaged per ring.
     pub count: Vec<u64>,
+    /// Detection limit per ring (empty when unknown; then no `limit_<c>` column).
+    pub limit: Vec<f64>,
 }
 
 /// A radial profile: ring radii and per-channel columns.
@@ -82,10 +85,12 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
     let rings = table.r_mm.len();
     let consistent = !table.channels.is_empty()
         && table.r_px.len() == rings
-        && table
-            .channels
-            .iter()
-            .all(|c| c.value.len() == rings && c.stderr.len() == rings && c.count.len() == rings);
+        && table.channels.iter().all(|c| {
+            c.value.len() == rings
+                && c.stderr.len() == rings
+                && c.count.len() == rings
+                && (c.limit.is_empty() || c.limit.len() == rings)
+        });
     if !consistent {
         return Err(ProfileCsvError::Invalid {
             path: path.to_path_buf(),
@@ -96,6 +101,9 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
     text.push_str("r_mm,r_px");
     for c in &table.channels {
         let _ = write!(text, ",value_{0},stderr_{0},count_{0}", c.name);
+        if !c.limit.is_empty() {
+            let _ = write!(text, ",limit_{}", c.name);
+        }
     }
     text.push('\n');
     for i in 0..rings {
@@ -108,6 +116,10 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
             text.push(',');
             number(&mut text, c.stderr[i]);
             let _ = write!(text, ",{}", c.count[i]);
+            if !c.limit.is_empty() {
+                text.push(',');
+                number(&mut text, c.limit[i]);
+            }
         }
         text.push('\n');
     }
@@ -159,7 +171,7 @@ pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
                     "channel `{name}` needs columns value_{name}, stderr_{name} and count_{name}"
                 )));
             };
-            channels.push((name.to_string(), v, s, n));
+            channels.push((name.to_string(), v, s, n, find(&format!("limit_{name}"))));
         }
     }
     if channels.is_empty() {
@@ -177,6 +189,7 @@ pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
                 value: vec![],
                 stderr: vec![],
                 count: vec![],
+                limit: vec![],
             })
             .collect(),
     };
@@ -200,9 +213,12 @@ pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
             Some(c) => float(c, true)?,
             None => f64::NAN,
         });
-        for (column, (_, v, s, n)) in table.channels.iter_mut().zip(&channels) {
+        for (column, (_, v, s, n, l)) in table.channels.iter_mut().zip(&channels) {
             column.value.push(float(*v, true)?);
             column.stderr.push(float(*s, true)?);
+            if let Some(l) = l {
+                column.limit.push(float(*l, true)?);
+            }
             let field = record.get(*n).unwrap_or("");
             column.count.push(field.parse::<u64>().map_err(|_| {
                 invalid(format!(

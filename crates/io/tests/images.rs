@@ -442,6 +442,7 @@ fn profile_csv_round_trip_keeps_empty_rings() {
         value: vec![k * 1.5, k * 0.25, f64::NAN],
         stderr: vec![0.01, 0.002, f64::NAN],
         count: vec![8, 16, 0],
+        limit: vec![],
     };
     let table = ProfileTable {
         r_mm: vec![0.05, 0.15, 0.25],
@@ -461,4 +462,23 @@ fn profile_csv_round_trip_keeps_empty_rings() {
     assert_eq!(back.channels[1].value[..2], table.channels[1].value[..2]);
     assert!(back.channels[2].value[2].is_nan());
     assert_eq!(back.channels[2].count, vec![8, 16, 0]);
+    assert!(
+        back.channels[0].limit.is_empty(),
+        "no limit column was written"
+    );
+    // With detection limits: a `limit_<c>` column that reads back exactly.
+    let mut with_limit = table.clone();
+    for c in &mut with_limit.channels {
+        c.limit = vec![1e-3, 1e-3, 1e-3];
+    }
+    write_profile_csv(&path, &with_limit).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.starts_with("r_mm,r_px,value_r,stderr_r,count_r,limit_r,value_g"),
+        "{text}"
+    );
+    assert_eq!(
+        read_profile_csv(&path).unwrap().channels[2].limit,
+        vec![1e-3; 3]
+    );
 }

@@ -147,7 +147,11 @@ impl RigSpec {
             return bad("mm_per_pixel", self.mm_per_pixel, "must be finite and > 0");
         }
         if !(self.spot_radius_mm.is_finite() && self.spot_radius_mm > 0.0) {
-            return bad("spot radius [mm]", self.spot_radius_mm, "must be finite and > 0");
+            return bad(
+                "spot radius [mm]",
+                self.spot_radius_mm,
+                "must be finite and > 0",
+            );
         }
         if self.times_s.len() < 2
             || self.times_s.windows(2).any(|w| w[1] <= w[0])
@@ -361,7 +365,8 @@ fn save_atomic(path: &Path, bytes: &[u8]) -> Result<(), SynthError> {
     std::fs::create_dir_all(dir).map_err(io)?;
     let tmp: PathBuf = dir.join(format!(
         ".{}.tmp-{}",
-        path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        path.file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
         std::process::id()
     ));
     let result = (|| {
@@ -578,7 +583,8 @@ pub fn render_bracket(
         .flat_map_iter(|y| {
             let smooth = &smooth;
             (0..w).flat_map(move |x| {
-                let r = ((x as f64 - center_px[0]).hypot(y as f64 - center_px[1])) * rig.mm_per_pixel;
+                let r =
+                    ((x as f64 - center_px[0]).hypot(y as f64 - center_px[1])) * rig.mm_per_pixel;
                 (0..3).map(move |c| smooth[c].at(r) as f32)
             })
         })
@@ -684,7 +690,12 @@ mod tests {
         };
         let s = SmoothProfile::new(&p).unwrap();
         for r in [0.05, 0.3, 1.0, 2.5, 7.7, 20.0] {
-            assert!((s.at(r) / f(r) - 1.0).abs() < 2e-3, "r = {r}: {} vs {}", s.at(r), f(r));
+            assert!(
+                (s.at(r) / f(r) - 1.0).abs() < 2e-3,
+                "r = {r}: {} vs {}",
+                s.at(r),
+                f(r)
+            );
         }
     }
 }
