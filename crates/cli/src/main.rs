@@ -4,16 +4,20 @@
 //! the outcome to the exit code documented in `ARCHITECTURE.md`: 0 success, 1 a measurement that
 //! failed (the tool ran, the sample did not yield parameters), 2 bad usage or bad input.
 
+mod batch;
 mod bench;
 mod common;
+mod compare;
 mod demo;
 mod figures;
+mod fit;
 mod measure;
 mod merge;
 mod output;
 mod plot;
 mod profile;
 mod report;
+mod runner;
 mod simulate;
 mod spectro;
 mod synth;
@@ -40,6 +44,12 @@ enum Command {
     Demo(demo::Args),
     /// Measure a sample folder: σ′s, σa and η per RGB channel (spectro → HDR → profile → fit).
     Measure(measure::Args),
+    /// Fit a radial profile you already have (a profile CSV), given η and α′.
+    Fit(fit::Args),
+    /// Measure many sample folders in parallel; summary.csv / summary.md like the paper's Table 1.
+    Batch(batch::Args),
+    /// Both methods (proposed, existing) on the same data: Table 2 and Figure 6 of the paper.
+    Compare(compare::Args),
     /// Spectrophotometer stage: η from SCI−SCE, colour, Rd and reduced albedo α′ per RGB channel.
     Spectro(spectro::Args),
     /// Monte Carlo photon transport (MCML physics) in a slab or half-space.
@@ -69,7 +79,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", common::error_text(&err));
             ExitCode::from(if common::is_measurement_failure(&err) {
                 1
             } else {
@@ -83,6 +93,9 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Demo(args) => demo::run(args),
         Command::Measure(args) => measure::run(args),
+        Command::Fit(args) => fit::run(args),
+        Command::Batch(args) => batch::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::Spectro(args) => spectro::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Table(args) => table::run(args),

@@ -5,90 +5,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use scatterfit_io::manifest::{MethodName, ModelName};
-use scatterfit_pipeline::{Overrides, Stage, measure_sample};
+use scatterfit_pipeline::{Stage, measure_sample};
 use serde::Serialize;
 
-use crate::common::bar;
-
-/// The fitting method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    /// Choi et al. 2014: α′ from the spectrophotometer, σ′s (and the profile's scale) fitted.
-    Proposed,
-    /// Jensen et al. 2001: σ′s, σa (and the scale) fitted.
-    Existing,
-}
-
-impl From<MethodArg> for MethodName {
-    fn from(m: MethodArg) -> Self {
-        match m {
-            MethodArg::Proposed => MethodName::Proposed,
-            MethodArg::Existing => MethodName::Existing,
-        }
-    }
-}
-
-/// The forward model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ModelArg {
-    /// The classical dipole, Jensen et al. 2001 (the paper's).
-    Dipole,
-    /// d'Eon 2012 (not available yet).
-    BetterDipole,
-    /// Photon beam diffusion (not available yet).
-    Pbd,
-    /// Monte Carlo tables (not available yet).
-    Mc,
-}
-
-impl From<ModelArg> for ModelName {
-    fn from(m: ModelArg) -> Self {
-        match m {
-            ModelArg::Dipole => ModelName::Dipole,
-            ModelArg::BetterDipole => ModelName::BetterDipole,
-            ModelArg::Pbd => ModelName::Pbd,
-            ModelArg::Mc => ModelName::Mc,
-        }
-    }
-}
-
-/// Options shared by `measure`, `batch` and `compare`: what overrides the manifests' `[fit]`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct FitArgs {
-    /// The fitting method (default: the manifest's `fit.method`, else proposed).
-    #[arg(long, value_enum)]
-    pub method: Option<MethodArg>,
-    /// The forward model (default: the manifest's `fit.model`, else dipole).
-    #[arg(long, value_enum)]
-    pub model: Option<ModelArg>,
-    /// A known η instead of the one measured from SCI − SCE [1, 3].
-    #[arg(long)]
-    pub eta: Option<f64>,
-    /// Proposed method: fix the profile's scale by the spectrophotometer's Rd instead of fitting it.
-    #[arg(long)]
-    pub normalise_with_spectro: bool,
-}
-
-impl FitArgs {
-    /// The pipeline's overrides.
-    ///
-    /// # Errors
-    /// An η outside [1, 3].
-    pub fn overrides(&self) -> anyhow::Result<Overrides> {
-        if let Some(e) = self.eta
-            && !(e.is_finite() && (1.0..=3.0).contains(&e))
-        {
-            anyhow::bail!("--eta {e}: the relative refractive index must lie in [1, 3]");
-        }
-        Ok(Overrides {
-            method: self.method.map(Into::into),
-            model: self.model.map(Into::into),
-            eta: self.eta,
-            normalise_with_spectro: self.normalise_with_spectro.then_some(true),
-        })
-    }
-}
+use crate::common::{FitArgs, bar};
 
 /// Arguments of `scatterfit measure`.
 #[derive(Debug, clap::Args)]

@@ -125,34 +125,6 @@ pub struct FrameSummary {
     pub time_s: f64,
 }
 
-/// A path's identity for "is this output one of the inputs?": canonical folder + file name.
-fn identity(path: &Path) -> PathBuf {
-    if let Ok(p) = std::fs::canonicalize(path) {
-        return p;
-    }
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    match (std::fs::canonicalize(parent), path.file_name()) {
-        (Ok(dir), Some(name)) => dir.join(name),
-        _ => path.to_path_buf(),
-    }
-}
-
-/// Refuses to write `output` over any of `inputs`.
-pub(crate) fn refuse_overwrite(output: &Path, what: &str, inputs: &[&Path]) -> anyhow::Result<()> {
-    let out = identity(output);
-    if let Some(input) = inputs.iter().find(|i| identity(i) == out) {
-        bail!(
-            "{what} {} is also an input ({}); inputs are never overwritten — choose another output file",
-            output.display(),
-            input.display()
-        );
-    }
-    Ok(())
-}
-
 fn default_response_out(output: &Path) -> PathBuf {
     let stem = output
         .file_stem()
@@ -351,13 +323,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.output.display()
         );
     }
-    refuse_overwrite(&args.output, "output", &inputs)?;
+    crate::common::refuse_overwrite(&args.output, "output", &inputs)?;
     let response_out = args
         .response_out
         .clone()
         .unwrap_or_else(|| default_response_out(&args.output));
-    refuse_overwrite(&response_out, "--response-out", &inputs)?;
-    if identity(&response_out) == identity(&args.output) {
+    crate::common::refuse_overwrite(&response_out, "--response-out", &inputs)?;
+    if crate::common::identity(&response_out) == crate::common::identity(&args.output) {
         bail!(
             "--response-out and -o are the same file {}; choose two files",
             args.output.display()
@@ -367,8 +339,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(csv) = &args.exposures {
         let listed = scatterfit_io::bracket::read_exposures_csv(csv)?;
         let listed: Vec<&Path> = listed.iter().map(|e| e.path.as_path()).collect();
-        refuse_overwrite(&args.output, "output", &listed)?;
-        refuse_overwrite(&response_out, "--response-out", &listed)?;
+        crate::common::refuse_overwrite(&args.output, "output", &listed)?;
+        crate::common::refuse_overwrite(&response_out, "--response-out", &listed)?;
     }
 
     let merged = read_and_merge(&args, !args.json)?;

@@ -89,7 +89,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.mm_per_pixel
         );
     }
-    crate::merge::refuse_overwrite(&args.output, "output", &[args.radiance.as_path()])?;
+    crate::common::refuse_overwrite(&args.output, "output", &[args.radiance.as_path()])?;
     let image = read_radiance(&args.radiance)?;
     let limits = args.detection_limit.map_or_else(Vec::new, |l| l.to_vec());
     let stage = profile_stage(

@@ -10,16 +10,6 @@ use scatterfit_io::result_json::{ChannelStatus, MeasurementResult, write_result_
 use scatterfit_io::result_table::{sig4, table1_csv, table1_markdown};
 use scatterfit_pipeline::Measurement;
 
-/// The files a measurement writes into its output folder.
-pub const RESULT_FILES: [&str; 6] = [
-    "result.json",
-    "result.csv",
-    "result.md",
-    "profile.csv",
-    "fit.svg",
-    "fit.png",
-];
-
 /// Writes every result file of `m` into `dir` (created if missing); returns the result and the
 /// paths written.
 ///

@@ -205,6 +205,36 @@ pub fn measure_sample(
 }
 
 impl Measurement {
+    /// The same sample fitted with another method (the spectrophotometer stage, the merge and the
+    /// profile are reused): what `compare` needs.
+    ///
+    /// # Errors
+    /// [`PipelineError::Input`] as [`fit_settings`].
+    pub fn refit(&self, method: MethodName) -> Result<Measurement> {
+        let mut settings = self.settings;
+        settings.method = method;
+        if method == MethodName::Existing {
+            settings.normalise_with_spectro = false;
+        }
+        let model = model_for(settings.model)?;
+        let t = Instant::now();
+        let data: Vec<ProfileData> = (0..3)
+            .map(|c| self.profile.channel_data(c))
+            .collect::<Result<_>>()?;
+        let fits = fit_stage(&data, &self.spectro, &settings, model);
+        let mut timings = self.timings;
+        timings.fit_s = t.elapsed().as_secs_f64();
+        Ok(Measurement {
+            manifest: self.manifest.clone(),
+            settings,
+            spectro: self.spectro.clone(),
+            hdr: self.hdr.clone(),
+            profile: self.profile.clone(),
+            fits,
+            timings,
+        })
+    }
+
     /// True when every channel gave constrained parameters.
     pub fn complete(&self) -> bool {
         self.fits.iter().all(ChannelOutcome::is_measurement)
