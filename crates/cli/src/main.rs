@@ -6,6 +6,7 @@
 
 mod bench;
 mod demo;
+mod export;
 mod merge;
 mod output;
 mod profile;
@@ -41,6 +42,8 @@ enum Command {
     Merge(merge::Args),
     /// Radial profile Rd(r) around the light spot of a radiance map.
     Profile(profile::Args),
+    /// Export a measured result as a pbrt-v4, Mitsuba 3, Blender or JSON material.
+    Export(export::Args),
     /// Measure the speed of the hot paths on this machine.
     Bench(bench::Args),
 }
@@ -72,6 +75,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Table(args) => table::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Profile(args) => profile::run(args),
+        Command::Export(args) => export::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }
