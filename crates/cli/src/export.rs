@@ -89,7 +89,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(out) = &args.output {
         check_output(out, format, &args.result, args.force)?;
     }
-    let result = read_result_json(&args.result)?;
+    // The error's message already includes its cause; flatten it so `{:#}` does not repeat it.
+    let result = read_result_json(&args.result).map_err(|e| anyhow::anyhow!("{e}"))?;
     let exported = match export(&result, format, unit) {
         Ok(e) => e,
         Err(err @ ExportError::FailedChannel { .. }) => {

@@ -504,8 +504,9 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
 /// - **Base Color = Rd** per channel, the measured total diffuse reflectance in linear sRGB (Blender's
 ///   default scene-linear space has the sRGB primaries), so the rendered diffuse colour matches the
 ///   measured one by construction of Cycles' remap.
-/// - IOR and Subsurface IOR = η; Subsurface Anisotropy = 0; Subsurface Weight = 1; Roughness = 0
-///   (a smooth boundary, as in the other exports).
+/// - IOR = η (Subsurface IOR is used only by `'RANDOM_WALK_SKIN'` and is disabled otherwise);
+///   Subsurface Anisotropy = 0; Subsurface Weight = 1; Roughness = 0 (a smooth boundary, as in the
+///   other exports).
 ///
 /// # Where it is approximate
 /// Cycles' remap was fitted to its own random walk, not to a smooth Fresnel boundary of index η, so the
@@ -525,7 +526,7 @@ pub struct BlenderValues {
     pub subsurface_scale: f64,
     /// 1/σ′t per channel [scene units] (= radius · scale).
     pub mfp: [f64; 3],
-    /// IOR and Subsurface IOR: η.
+    /// IOR: η.
     pub ior: f64,
 }
 
@@ -581,8 +582,8 @@ it creates (or updates) the material and leaves assigning it to objects to you.
 | channel | Base Color = Rd (linear sRGB) | 1/sigma_t' [{u}] | Subsurface Radius | sigma_a [1/{u}] | sigma_s' [1/{u}] | 1/sigma_tr [{u}] |
 |---|---|---|---|---|---|---|
 {rows}
-Subsurface Scale = {scale} {u} (the largest 1/sigma_t'); IOR = Subsurface IOR = {ior}; eta is relative
-to air. Subsurface Weight = 1, Subsurface Anisotropy = 0, Roughness = 0 (smooth), method Random Walk.
+Subsurface Scale = {scale} {u} (the largest 1/sigma_t'); IOR = eta = {ior} (relative to air).
+Subsurface Weight = 1, Subsurface Anisotropy = 0, Roughness = 0 (smooth), method Random Walk.
 
 Mapping: Cycles' random walk sets the extinction sigma_t' = 1/(Subsurface Radius * Subsurface Scale)
 and derives the single-scattering albedo from Base Color (Chiang, Kutz & Burley 2016), so Radius *
@@ -626,7 +627,6 @@ def apply(values=VALUES):
         "Subsurface Weight": 1.0,
         "Subsurface Radius": values["subsurface_radius"],
         "Subsurface Scale": values["subsurface_scale"],
-        "Subsurface IOR": values["ior"],
         "Subsurface Anisotropy": 0.0,
         "IOR": values["ior"],
         "Roughness": 0.0,
