@@ -9,7 +9,8 @@ The scene: FRAGMENT.xml (what `scatterfit export --to mitsuba` writes) is <inclu
 T thick, its top face at z = 0, gets the fragment's dielectric BSDF as its boundary and its medium as its
 interior. A constant environment of radiance 1 lights it from every direction, and an orthographic
 camera looks straight down at the middle of the top face (a square W/10 wide), volpath integrator with
-unbounded depth (Russian roulette), box pixel filter so that pixels are independent estimates.
+unbounded depth and Russian roulette only after ln(1e-3)/ln(albedo) scatterings, box pixel filter so
+that pixels are independent estimates.
 With --backing, a black plane T/10 below the box (10 W wide) hides the lower hemisphere (Mitsuba offsets
 spawned rays by about 1e-4 (1 + |p|) scene units, so the gap and the slab must be much thicker than that).
 
@@ -54,6 +55,13 @@ def main():
     if len(bsdf) != 1 or len(medium) != 1:
         sys.exit(f"{fragment}: expected one <bsdf> and one <medium> at the top level")
     bsdf_id, medium_id = bsdf[0].get("id"), medium[0].get("id")
+    albedo = [e for e in medium[0] if e.tag == "rgb" and e.get("name") == "albedo"]
+    alpha = max(float(x) for x in albedo[0].get("value").split(",")) if albedo else 0.99
+    # Russian roulette only once every channel's throughput is below 1e-3: Mitsuba's volpath
+    # survives a roulette with q = min(max throughput, 0.95), so at albedos above 0.95 early
+    # roulette leaves the long paths that carry much of Rd (α' = 0.999: hundreds of scatterings)
+    # to rare samples with huge weights, and finite renders come out low.
+    rr_depth = max(5, math.ceil(math.log(1e-3) / math.log(alpha))) if alpha < 1 else 100000
 
     w, t = args.width, args.thickness
     backing = ""
@@ -70,6 +78,7 @@ def main():
     <include filename="{os.path.basename(fragment)}"/>
     <integrator type="volpath">
         <integer name="max_depth" value="-1"/>
+        <integer name="rr_depth" value="{rr_depth}"/>
     </integrator>
     <sensor type="orthographic">
         <transform name="to_world">
@@ -124,6 +133,7 @@ def main():
                 "pixels": n,
                 "spp": args.spp,
                 "seconds": seconds,
+                "rr_depth": rr_depth,
                 "mitsuba": mi.__version__,
             }
         )

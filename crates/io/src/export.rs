@@ -430,7 +430,8 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
 /// medium's `scale` (σt = scale · rgb, per scene unit): Mitsuba's documentation of `homogeneous`
 /// notes that RGB values have to lie in [0, 1] (spectral variants refuse others), and `scale` exists for
 /// this. `sample_emitters` is off: shadow rays cannot pass the dielectric boundary (the plugin's
-/// documentation recommends it for subsurface scattering).
+/// documentation recommends it for subsurface scattering). The usage comment names the `rr_depth` the
+/// integrator needs for this albedo ([`roulette_depth`]).
 pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     let id = identifier(&params.name);
     let u = params.unit.symbol();
@@ -439,6 +440,7 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     let rgb = |v: [f64; 3]| format!("{}, {}, {}", num(v[0]), num(v[1]), num(v[2]));
     let sigma_t_rgb = rgb(chans.map(|c| c.sigma_t / scale));
     let albedo_rgb = rgb(chans.map(|c| c.albedo));
+    let rr = roulette_depth(chans.iter().map(|c| c.albedo).fold(0.0, f64::max));
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
     s.push_str(&xml_comment(&format!(
         "  scatterfit export for Mitsuba 3: \"{}\"\n\
@@ -456,7 +458,10 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     )));
     s.push_str(&xml_comment(&channel_table_comment(params, "  ")));
     s.push_str(&xml_comment(&format!(
-        "\n  Use with the volpath integrator (max_depth -1: high albedos need long paths):\n\
+        "\n  Use with the volpath integrator, max_depth -1 and rr_depth {rr} (Russian roulette only once\n\
+         \x20 the albedo has taken the throughput below 1e-3: Mitsuba's roulette survival is capped at\n\
+         \x20 0.95 per scattering, which at albedos near 1 leaves the long paths carrying much of the\n\
+         \x20 diffuse reflectance to rare, heavy samples and makes short renders too dark):\n\
          \x20   <include filename=\"this-file.xml\"/>\n\
          \x20   <shape type=\"...\">\n\
          \x20       <ref id=\"{id}_boundary\"/>\n\
@@ -486,47 +491,68 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     s
 }
 
+/// The number of scatterings after which the throughput of a path in a medium of single-scattering
+/// albedo `albedo` is below 10⁻³, ⌈ln 10⁻³ / ln α⌉ (at least 5, Mitsuba's default `rr_depth`): from
+/// there on Russian roulette costs little variance. 100 000 for α = 1 (no absorption).
+pub fn roulette_depth(albedo: f64) -> u64 {
+    if albedo >= 1.0 {
+        return 100_000;
+    }
+    // Bounded: 1e5 covers α up to 1 − 7e-5.
+    ((1e-3_f64.ln() / albedo.ln()).ceil()).clamp(5.0, 100_000.0) as u64
+}
+
+/// Largest reduced albedo used for the Blender radius: σa = 0 would make the diffusion length
+/// unbounded; Cycles clamps its own dipole inversion at the same value.
+const BLENDER_MAX_ALBEDO: f64 = 0.999_999;
+
 /// The values [`blender_script`] sets on a Principled BSDF, in the scene's unit.
 ///
-/// # The mapping (Blender ≥ 4.0, Cycles, `subsurface_method = 'RANDOM_WALK'`)
-/// Cycles turns the Principled BSDF's inputs into volume coefficients per channel in
-/// `subsurface_random_walk_remap` (`intern/cycles/kernel/integrator/subsurface_random_walk.h`): the
-/// extinction is σ′t = 1/(Subsurface Radius · Subsurface Scale) (σt = σ′t/(1 − g) with g the
-/// Subsurface Anisotropy), and the single-scattering albedo comes from Base Color through the fit of
-/// Chiang, Kutz & Burley 2016 ("Practical and Controllable Subsurface Scattering for Production Path
-/// Tracing", SIGGRAPH Talks), chosen so that the rendered multiple-scattering albedo is Base Color.
-/// Hence:
-/// - **Subsurface Radius · Subsurface Scale = 1/σ′t**, the transport mean free path (not the diffusion
-///   length 1/σtr: Cycles reads the radius as a mean free path, so 1/σtr — up to 30× longer at
-///   α′ = 0.999 — would make the medium that much too thin). The radius is written normalised
-///   to a largest component of 1 and its magnitude, in scene units, is the Subsurface Scale — Blender's own
-///   split (a colour-like radius and a distance).
+/// # The mapping (Blender ≥ 4.0, Cycles, `subsurface_method = 'RANDOM_WALK_SKIN'`)
+/// Cycles does not take σs and σa: it derives a random walk's coefficients from Base Color and the
+/// Subsurface Radius (`bssrdf_setup_radius` in `intern/cycles/kernel/closure/bssrdf.h` and
+/// `subsurface_random_walk_remap` in `kernel/integrator/subsurface_random_walk.h`):
+/// - In Random Walk (Skin) mode the radius (times Subsurface Scale) is read as the **diffusion length
+///   ℓ = 1/σtr**: Cycles inverts the classical dipole's total reflectance (Jensen et al. 2001, eq. 5 with
+///   the Fdr polynomial and Subsurface IOR — the same formula as `scatterfit_optics::dipole`) for the
+///   albedo α′d of Base Color and sets the mean free path 1/σ′t = ℓ·√(3(1 − α′d)).
+/// - In plain Random Walk and Christensen–Burley modes it reads the radius as a mean free path scaled by
+///   1/(4π) ("to look like the older Cubic/Gaussian/Burley models"), i.e. 1/σ′t = radius/(4π).
+///
+/// We use the Skin mode, whose radius is a physical quantity the measurement gives:
+/// - **Subsurface Radius · Subsurface Scale = ℓ = 1/σtr = 1/√(3σaσ′t)** per channel (α′ capped at
+///   [`BLENDER_MAX_ALBEDO`] for σa = 0). The radius is written normalised to a largest component of 1
+///   and its magnitude, in scene units, is the Subsurface Scale — Blender's own split (a colour-like
+///   radius and a distance). Cycles then recovers our 1/σ′t exactly when Base Color is the dipole's
+///   Rd(α′) — results measured with `albedo_model = diffusion` — and within the dipole's albedo bias
+///   otherwise. 1/σ′t itself would be the wrong length here: Cycles would read it as a diffusion length
+///   √(3(1 − α′)) times too short (18× at α′ = 0.999).
 /// - **Base Color = Rd** per channel, the measured total diffuse reflectance in linear sRGB (Blender's
-///   default scene-linear space has the sRGB primaries), so the rendered diffuse colour matches the
-///   measured one by construction of Cycles' remap.
-/// - IOR = η (Subsurface IOR is used only by `'RANDOM_WALK_SKIN'` and is disabled otherwise);
-///   Subsurface Anisotropy = 0; Subsurface Weight = 1; Roughness = 0 (a smooth boundary, as in the
-///   other exports).
+///   default scene-linear space has the sRGB primaries).
+/// - Subsurface IOR = IOR = η; Subsurface Anisotropy = 0; Subsurface Weight = 1; Roughness = 0 (a
+///   smooth boundary, as in the other exports).
 ///
 /// # Where it is approximate
-/// Cycles' remap was fitted to its own random walk, not to a smooth Fresnel boundary of index η, so the
-/// single-scattering albedo it derives from Rd is not our α′ (σ′t is exact): the medium's diffusion
-/// length, and with it the translucency, differs from the measured one where the two albedo relations
-/// differ (ARCHITECTURE.md, "exports", gives numbers). Blender's Principled BSDF also puts its dielectric
-/// specular layer over the subsurface base, so the diffuse part is dimmed by that layer's transmission;
-/// the measured Rd already includes the boundary's losses. Christensen–Burley (`'BURLEY'`) is a
-/// diffusion profile, further from exact transport than the random walk.
+/// The walk's single-scattering albedo is not α′: Cycles derives it from Base Color with the fit of
+/// Chiang, Kutz & Burley 2016 ("Practical and Controllable Subsurface Scattering for Production Path
+/// Tracing"), made for its own walk, which gives a lower albedo than exact transport behind a Fresnel
+/// boundary needs for the same Rd. Measured with Blender 4.2 on half-spaces (BENCHMARKS.md, "exports"):
+/// the rendered total reflectance is 6–9 % below R0 + Rd, and the glow beyond a light edge decays 1.25–
+/// 1.7× faster than exact transport (the material looks less translucent). A Blender render of the export
+/// is a close match, not a measurement-grade one; the Mitsuba and pbrt volumetric exports are exact.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BlenderValues {
     /// Base Color (linear sRGB): the measured Rd per channel (or the classical dipole's Rd(α′, η)).
     pub base_color: [f64; 3],
     /// Subsurface Radius, normalised to a largest component of 1.
     pub subsurface_radius: [f64; 3],
-    /// Subsurface Scale [scene units]: the largest 1/σ′t.
+    /// Subsurface Scale [scene units]: the largest diffusion length.
     pub subsurface_scale: f64,
-    /// 1/σ′t per channel [scene units] (= radius · scale).
+    /// Diffusion length ℓ = 1/σtr per channel [scene units] (= radius · scale).
+    pub diffusion_length: [f64; 3],
+    /// Transport mean free path 1/σ′t per channel [scene units], for reference.
     pub mfp: [f64; 3],
-    /// IOR: η.
+    /// IOR and Subsurface IOR: η.
     pub ior: f64,
 }
 
@@ -535,14 +561,18 @@ impl BlenderValues {
     pub fn new(params: &RendererParameters) -> Self {
         let chans = params.channels.as_array();
         let mfp = chans.map(|c| c.mfp);
-        let scale = mfp.iter().copied().fold(0.0_f64, f64::max);
+        // ℓ = 1/σtr = (1/σ′t)/√(3(1 − α′)) (Jensen et al. 2001, §2.4), α′ capped.
+        let diffusion_length =
+            chans.map(|c| c.mfp / (3.0 * (1.0 - c.albedo.min(BLENDER_MAX_ALBEDO))).sqrt());
+        let scale = diffusion_length.iter().copied().fold(0.0_f64, f64::max);
         Self {
             base_color: chans.map(|c| {
                 c.rd_total
                     .unwrap_or_else(|| scatterfit_optics::dipole::rd_total(c.albedo, params.eta))
             }),
-            subsurface_radius: mfp.map(|m| m / scale),
+            subsurface_radius: diffusion_length.map(|l| l / scale),
             subsurface_scale: scale,
+            diffusion_length,
             mfp,
             ior: params.eta,
         }
@@ -550,7 +580,7 @@ impl BlenderValues {
 }
 
 /// A Blender (≥ 4.0) Python script that creates or updates the material named after the sample with a
-/// Principled BSDF set to [`BlenderValues`] (Cycles random walk); its docstring holds the values as a
+/// Principled BSDF set to [`BlenderValues`] (Cycles Random Walk (Skin)); its docstring holds the values as a
 /// Markdown table and the mapping in words. Run it with `blender --python FILE` or from the Text Editor.
 pub fn blender_script(params: &RendererParameters, v: &BlenderValues) -> String {
     let u = params.unit.symbol();
@@ -562,14 +592,11 @@ pub fn blender_script(params: &RendererParameters, v: &BlenderValues) -> String 
         rows.push_str(&format!(
             "| {label} | {} | {} | {} | {} | {} | {} |\n",
             num(v.base_color[k]),
-            num(v.mfp[k]),
+            num(v.diffusion_length[k]),
             num(v.subsurface_radius[k]),
+            num(v.mfp[k]),
             num(chans[k].sigma_a),
             num(chans[k].sigma_s),
-            chans[k]
-                .diffusion_length
-                .map(num)
-                .unwrap_or_else(|| "inf".into()),
         ));
     }
     format!(
@@ -579,19 +606,22 @@ pub fn blender_script(params: &RendererParameters, v: &BlenderValues) -> String 
 Scene unit: 1 Blender unit = 1 {u}. Run with `blender --python THIS.py` or from the Text Editor;
 it creates (or updates) the material and leaves assigning it to objects to you.
 
-| channel | Base Color = Rd (linear sRGB) | 1/sigma_t' [{u}] | Subsurface Radius | sigma_a [1/{u}] | sigma_s' [1/{u}] | 1/sigma_tr [{u}] |
+| channel | Base Color = Rd (linear sRGB) | 1/sigma_tr [{u}] | Subsurface Radius | 1/sigma_t' [{u}] | sigma_a [1/{u}] | sigma_s' [1/{u}] |
 |---|---|---|---|---|---|---|
 {rows}
-Subsurface Scale = {scale} {u} (the largest 1/sigma_t'); IOR = eta = {ior} (relative to air).
-Subsurface Weight = 1, Subsurface Anisotropy = 0, Roughness = 0 (smooth), method Random Walk.
+Subsurface Scale = {scale} {u} (the largest diffusion length 1/sigma_tr); IOR = Subsurface IOR = eta =
+{ior} (relative to air). Subsurface Weight = 1, Subsurface Anisotropy = 0, Roughness = 0 (smooth),
+method Random Walk (Skin).
 
-Mapping: Cycles' random walk sets the extinction sigma_t' = 1/(Subsurface Radius * Subsurface Scale)
-and derives the single-scattering albedo from Base Color (Chiang, Kutz & Burley 2016), so Radius *
-Scale is the transport mean free path 1/sigma_t' (not the diffusion length 1/sigma_tr) and Base Color
-the measured diffuse reflectance Rd. Approximate: Cycles' albedo fit assumes its own boundary, not a
-smooth Fresnel boundary of index eta, so the internal albedo (and the translucency) only approximates
-the measured medium; the Principled specular layer dims the diffuse part slightly. For exact transport
-use the Mitsuba or pbrt volumetric export.
+Mapping: in Random Walk (Skin) mode Cycles reads Subsurface Radius * Scale as the diffusion length
+1/sigma_tr and recovers the mean free path 1/sigma_t' from it with the classical dipole's albedo of
+Base Color and Subsurface IOR (Jensen et al. 2001) - exactly scatterfit's sigma_t' when the result's
+albedo model is the dipole. Base Color is the measured diffuse reflectance Rd.
+Approximate: Cycles derives the walk's single-scattering albedo from Base Color with its own fit
+(Chiang, Kutz & Burley 2016), lower than exact transport behind a Fresnel boundary needs; measured with
+Blender 4.2, renders come out 6-9 % darker in total reflectance and less translucent (the glow beyond
+a shadow edge decays 1.25-1.7x faster) than the measured material. For exact transport use the Mitsuba
+or pbrt volumetric export.
 """
 
 import bpy
@@ -621,12 +651,13 @@ def apply(values=VALUES):
         raise RuntimeError(
             "this script needs Blender 4.0 or newer (Principled BSDF with Subsurface Weight/Scale)"
         )
-    bsdf.subsurface_method = "RANDOM_WALK"
+    bsdf.subsurface_method = "RANDOM_WALK_SKIN"
     settings = {{
         "Base Color": (*values["base_color"], 1.0),
         "Subsurface Weight": 1.0,
         "Subsurface Radius": values["subsurface_radius"],
         "Subsurface Scale": values["subsurface_scale"],
+        "Subsurface IOR": values["ior"],
         "Subsurface Anisotropy": 0.0,
         "IOR": values["ior"],
         "Roughness": 0.0,
@@ -960,33 +991,43 @@ mod tests {
                     .to_string()
             };
             assert_eq!(ior("int_ior"), "1.5");
+            // α′ = 0.999042 (R): ln(1e-3)/ln(α′) = 7207.6.
+            assert!(text.contains("rr_depth 7208"), "{text}");
             assert_eq!(ior("ext_ior"), "1");
         }
     }
 
-    /// Blender: radius · scale = 1/σ′t in scene units, base colour = the measured Rd.
+    /// Blender: radius · scale = 1/σtr in scene units (physics.md §1.5: the marble's 1/σtr is 8.509,
+    /// 5.566, 3.951 mm), base colour = the measured Rd.
     #[test]
     fn blender_values_and_script() {
         let r = marble();
         for (unit, k) in [(SceneUnit::Millimetre, 1.0), (SceneUnit::Metre, 1000.0)] {
             let (p, _) = RendererParameters::from_result(&r, unit).unwrap();
             let v = BlenderValues::new(&p);
-            for c in 0..3 {
-                let mfp = 1.0 / ((SP[c] + SA[c]) * k);
-                assert!(close(
-                    v.subsurface_radius[c] * v.subsurface_scale,
-                    mfp,
-                    1e-12
-                ));
+            for (c, want_mm) in [8.509, 5.566, 3.951].into_iter().enumerate() {
+                let got_mm = v.subsurface_radius[c] * v.subsurface_scale * k;
+                assert!((got_mm - want_mm).abs() < 5e-4, "{got_mm}");
                 assert!(v.subsurface_radius[c] <= 1.0);
             }
             assert_eq!(v.base_color, [0.8302, 0.7910, 0.7526]);
             let text = export(&r, Format::Blender, unit).unwrap().text;
             assert!(text.contains("\"subsurface_scale\": "));
-            assert!(text.contains("bsdf.subsurface_method = \"RANDOM_WALK\""));
+            assert!(text.contains("bsdf.subsurface_method = \"RANDOM_WALK_SKIN\""));
             assert!(text.contains("\"material\": \"marble\""));
             assert!(text.contains(&format!("1 Blender unit = 1 {}", unit.symbol())));
         }
+        // σa = 0: the diffusion length is capped, not infinite.
+        let mut r = marble();
+        r.channels.g.sigma_a = Some(0.0);
+        let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
+        let v = BlenderValues::new(&p);
+        assert!(v.subsurface_scale.is_finite());
+        assert!(close(
+            v.diffusion_length[1],
+            1.0 / 2.62 / (3e-6_f64).sqrt(),
+            1e-6
+        ));
     }
 
     /// Without rd_total the base colour falls back to the dipole's Rd, with a warning: at the marble's
