@@ -8,7 +8,10 @@ environment that .ci/run makes (`pip install mitsuba`). Standard library + mitsu
 The scene: FRAGMENT.xml (what `scatterfit export --to mitsuba` writes) is <include>d; a box W wide and
 T thick, its top face at z = 0, gets the fragment's dielectric BSDF as its boundary and its medium as its
 interior. A constant environment of radiance 1 lights it from every direction, and an orthographic
-camera looks straight down at the middle of the top face (a square W/10 wide), volpath integrator with
+camera 1 scene unit above the top face looks straight down at its middle (a square W/500 wide: Mitsuba
+offsets rays it spawns at a surface by about 1e-4 (1 + |p|) scene units, which shifts the first
+scattering deeper and, with coordinates of 100 mean free paths, lowers Rd by ~1 % at low albedo; near
+the origin the shift is negligible, and the slab is uniform, so any patch of it will do), volpath integrator with
 unbounded depth and Russian roulette only after ln(1e-3)/ln(albedo) scatterings, box pixel filter so
 that pixels are independent estimates.
 With --backing, a black plane T/10 below the box (10 W wide) hides the lower hemisphere (Mitsuba offsets
@@ -82,8 +85,8 @@ def main():
     </integrator>
     <sensor type="orthographic">
         <transform name="to_world">
-            <scale x="{w / 20}" y="{w / 20}" z="1"/>
-            <lookat origin="0, 0, {w}" target="0, 0, 0" up="0, 1, 0"/>
+            <scale x="{w / 1000}" y="{w / 1000}" z="1"/>
+            <lookat origin="0, 0, 1" target="0, 0, 0" up="0, 1, 0"/>
         </transform>
         <film type="hdrfilm">
             <integer name="width" value="{args.res}"/>

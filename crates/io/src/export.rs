@@ -441,6 +441,7 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     let sigma_t_rgb = rgb(chans.map(|c| c.sigma_t / scale));
     let albedo_rgb = rgb(chans.map(|c| c.albedo));
     let rr = roulette_depth(chans.iter().map(|c| c.albedo).fold(0.0, f64::max));
+    let mfp = num(chans.iter().map(|c| c.mfp).fold(f64::INFINITY, f64::min));
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
     s.push_str(&xml_comment(&format!(
         "  scatterfit export for Mitsuba 3: \"{}\"\n\
@@ -461,7 +462,9 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
         "\n  Use with the volpath integrator, max_depth -1 and rr_depth {rr} (Russian roulette only once\n\
          \x20 the albedo has taken the throughput below 1e-3: Mitsuba's roulette survival is capped at\n\
          \x20 0.95 per scattering, which at albedos near 1 leaves the long paths carrying much of the\n\
-         \x20 diffuse reflectance to rare, heavy samples and makes short renders too dark):\n\
+         \x20 diffuse reflectance to rare, heavy samples and makes short renders too dark). Mitsuba\n\
+         \x20 offsets rays leaving a surface by about 1e-4 (1 + |p|) scene units: keep that well below\n\
+         \x20 the mean free path 1/sigma_t ({mfp} {u} here) or low-albedo renders come out dark.\n\
          \x20   <include filename=\"this-file.xml\"/>\n\
          \x20   <shape type=\"...\">\n\
          \x20       <ref id=\"{id}_boundary\"/>\n\
