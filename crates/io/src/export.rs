@@ -29,8 +29,8 @@
 //!   and a `homogeneous` medium (`sigma_t`, `albedo`, `scale`, an `hg` phase with g = 0; names from the
 //!   plugin documentation of `src/media/homogeneous.cpp`) to reference as a shape's boundary and
 //!   interior.
-//! - [`Format::Blender`]: a bpy script that sets a Principled BSDF (Blender ≥ 4.0, Cycles random walk);
-//!   see [`blender_script`] for the mapping and where it is approximate.
+//! - [`Format::Blender`]: a bpy script that sets a Principled BSDF (Blender ≥ 4.0, Cycles Random Walk
+//!   (Skin)); see [`BlenderValues`] for the mapping and where it is approximate.
 //! - [`Format::Json`]: [`RendererParameters`], every derived quantity per channel.
 
 use serde::{Deserialize, Serialize};
@@ -155,19 +155,19 @@ pub struct Export {
 pub struct ChannelParameters {
     /// `ok` or `unconstrained` (see the result file).
     pub status: ChannelStatus,
-    /// Absorption coefficient σa [L⁻¹].
+    /// Absorption coefficient σa [1/L].
     pub sigma_a: f64,
-    /// Scattering coefficient σs [L⁻¹] for the phase function's g = 0: the measured σ′s.
+    /// Scattering coefficient σs [1/L] for the phase function's g = 0: the measured σ′s.
     pub sigma_s: f64,
-    /// Extinction σt = σa + σs [L⁻¹].
+    /// Extinction σt = σa + σs [1/L].
     pub sigma_t: f64,
     /// Single-scattering albedo σs/σt (with g = 0 the reduced albedo α′).
     pub albedo: f64,
-    /// Mean free path 1/σt [L] (with g = 0 the transport mean free path 1/σ′t).
+    /// Mean free path 1/σt [L, the scene unit] (with g = 0 the transport mean free path 1/σ′t).
     pub mfp: f64,
-    /// Effective transport coefficient σtr = √(3σaσ′t) [L⁻¹] (Jensen et al. 2001, §2.4).
+    /// Effective transport coefficient σtr = √(3σaσ′t) [1/L] (Jensen et al. 2001, §2.4).
     pub sigma_tr: f64,
-    /// Diffusion length 1/σtr [L]: how far light spreads sideways before it is absorbed; `None` for
+    /// Diffusion length 1/σtr [L, the scene unit]: how far light spreads sideways before it is absorbed; `None` for
     /// σa = 0 (no absorption, unbounded).
     pub diffusion_length: Option<f64>,
     /// Total diffuse reflectance Rd of the channel from the spectrophotometer (linear sRGB), when the
@@ -507,7 +507,7 @@ pub fn roulette_depth(albedo: f64) -> u64 {
 
 /// Largest reduced albedo used for the Blender radius: σa = 0 would make the diffusion length
 /// unbounded; Cycles clamps its own dipole inversion at the same value.
-const BLENDER_MAX_ALBEDO: f64 = 0.999_999;
+pub const BLENDER_MAX_ALBEDO: f64 = 0.999_999;
 
 /// The values [`blender_script`] sets on a Principled BSDF, in the scene's unit.
 ///
