@@ -12,6 +12,7 @@ mod demo;
 mod figures;
 mod fit;
 mod measure;
+mod export;
 mod merge;
 mod output;
 mod plot;
@@ -62,6 +63,8 @@ enum Command {
     Profile(profile::Args),
     /// The rig twin: write a synthetic sample folder (Monte Carlo spectro reading and bracket).
     Synth(synth::Args),
+    /// Export a measured result as a pbrt-v4, Mitsuba 3, Blender or JSON material.
+    Export(export::Args),
     /// Measure the speed of the hot paths on this machine.
     Bench(bench::Args),
 }
@@ -102,6 +105,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Merge(args) => merge::run(args),
         Command::Profile(args) => profile::run(args),
         Command::Synth(args) => synth::run(args),
+        Command::Export(args) => export::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

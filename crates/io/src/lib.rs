@@ -8,6 +8,7 @@
 
 pub mod atomic;
 pub mod bracket;
+pub mod export;
 pub mod image_files;
 pub mod manifest;
 pub mod profile_csv;
