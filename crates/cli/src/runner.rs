@@ -60,6 +60,9 @@ pub fn measure_many(
     Ok(outcomes)
 }
 
+/// Samples that failed, with why.
+pub type Failures = Vec<(PathBuf, String)>;
+
 /// One sample compared: (existing, proposed).
 pub type Pair = (MeasurementResult, MeasurementResult);
 
@@ -75,7 +78,7 @@ pub fn compare_dirs(
     jobs: usize,
     quiet: bool,
     write_results: bool,
-) -> anyhow::Result<(Vec<Pair>, Vec<(PathBuf, String)>)> {
+) -> anyhow::Result<(Vec<Pair>, Failures)> {
     let mut overrides = fit.overrides()?;
     overrides.method = Some(MethodName::Proposed);
     let outcomes = measure_many(dirs, &overrides, jobs, quiet, &|_, _| {})?;

@@ -529,6 +529,20 @@ fn path_key(path: &Path) -> PathBuf {
     std::fs::canonicalize(path).unwrap_or_else(|_| path.components().collect())
 }
 
+/// Writes an `exposures.csv` (`file,time_s`; file names as given, relative to the CSV's folder)
+/// atomically. Times are written in Rust's shortest round-trip form, so they read back exactly.
+///
+/// # Errors
+/// The I/O error, with the path.
+pub fn write_exposures_csv(path: &Path, entries: &[(String, f64)]) -> std::io::Result<()> {
+    let mut text = String::from("file,time_s\n");
+    for (file, t) in entries {
+        text.push_str(&format!("{file},{t}\n"));
+    }
+    crate::atomic::write_atomic(path, text.as_bytes())
+        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -559,18 +573,4 @@ mod tests {
             other => panic!("expected DuplicateTime, got {other:?}"),
         }
     }
-}
-
-/// Writes an `exposures.csv` (`file,time_s`; file names as given, relative to the CSV's folder)
-/// atomically. Times are written in Rust's shortest round-trip form, so they read back exactly.
-///
-/// # Errors
-/// The I/O error, with the path.
-pub fn write_exposures_csv(path: &Path, entries: &[(String, f64)]) -> std::io::Result<()> {
-    let mut text = String::from("file,time_s\n");
-    for (file, t) in entries {
-        text.push_str(&format!("{file},{t}\n"));
-    }
-    crate::atomic::write_atomic(path, text.as_bytes())
-        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
 }

@@ -357,7 +357,7 @@ pub fn parse_manifest(
         ));
     }
     if let Some(r) = m.fit.r_max_px
-        && !(r.is_finite() && r >= 2.0 && r <= 1e5)
+        && !(r.is_finite() && (2.0..=1e5).contains(&r))
     {
         return Err(invalid(
             "fit.r_max_px",

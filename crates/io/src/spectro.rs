@@ -290,6 +290,36 @@ fn check_coverage(wavelengths: &[f64]) -> Result<(), String> {
     Ok(())
 }
 
+/// Writes a reading as a spectrophotometer CSV (`wavelength_nm,sci,sce`, fractions with 6
+/// decimals, as instruments export them) atomically, with `comment` as `#` lines on top.
+///
+/// # Errors
+/// [`SpectroCsvError::Io`] when the file cannot be written.
+pub fn write_spectro_csv(
+    path: &Path,
+    reading: &SpectroReading,
+    comment: &str,
+) -> Result<(), SpectroCsvError> {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    for line in comment.lines() {
+        let _ = writeln!(text, "# {line}");
+    }
+    text.push_str("wavelength_nm,sci,sce\n");
+    for ((w, sci), sce) in reading
+        .wavelengths_nm
+        .iter()
+        .zip(&reading.sci)
+        .zip(&reading.sce)
+    {
+        let _ = writeln!(text, "{w},{sci:.6},{sce:.6}");
+    }
+    crate::atomic::write_atomic(path, text.as_bytes()).map_err(|source| SpectroCsvError::Io {
+        path: path.to_owned(),
+        source,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -418,34 +448,4 @@ mod tests {
             "{e}"
         );
     }
-}
-
-/// Writes a reading as a spectrophotometer CSV (`wavelength_nm,sci,sce`, fractions with 6
-/// decimals, as instruments export them) atomically, with `comment` as `#` lines on top.
-///
-/// # Errors
-/// [`SpectroCsvError::Io`] when the file cannot be written.
-pub fn write_spectro_csv(
-    path: &Path,
-    reading: &SpectroReading,
-    comment: &str,
-) -> Result<(), SpectroCsvError> {
-    use std::fmt::Write as _;
-    let mut text = String::new();
-    for line in comment.lines() {
-        let _ = writeln!(text, "# {line}");
-    }
-    text.push_str("wavelength_nm,sci,sce\n");
-    for ((w, sci), sce) in reading
-        .wavelengths_nm
-        .iter()
-        .zip(&reading.sci)
-        .zip(&reading.sce)
-    {
-        let _ = writeln!(text, "{w},{sci:.6},{sce:.6}");
-    }
-    crate::atomic::write_atomic(path, text.as_bytes()).map_err(|source| SpectroCsvError::Io {
-        path: path.to_owned(),
-        source,
-    })
 }

@@ -72,6 +72,7 @@ impl PipelineError {
                     | ImagingError::DuplicateTime { .. }
                     | ImagingError::InvalidOption { .. }
                     | ImagingError::InvalidResponse { .. }
+                    | ImagingError::CenterOutside { .. }
             ),
             PipelineError::Spectro { source, .. } => matches!(source, OpticsError::Specular { .. }),
             _ => false,

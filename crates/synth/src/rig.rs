@@ -564,7 +564,7 @@ pub fn render_bracket(
         .iter()
         .map(SmoothProfile::new)
         .collect::<Result<_, _>>()?;
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x5eed_0f_c0ffee);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x5eed_0fc0_ffee);
     let center_px = [
         0.5 * (rig.width as f64 - 1.0) + rng.random_range(-3.0..3.0),
         0.5 * (rig.height as f64 - 1.0) + rng.random_range(-3.0..3.0),
