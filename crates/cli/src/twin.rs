@@ -23,14 +23,19 @@ pub struct Material {
     pub eta: f64,
 }
 
-/// Synthesises `m` on the paper's rig, with a progress bar per channel.
+/// Synthesises `m` on the paper's rig (or the quick one), with a progress bar.
 pub fn synthesize(
     m: &Material,
     seed: u64,
     cache: Option<&Path>,
     quiet: bool,
+    quick: bool,
 ) -> anyhow::Result<SyntheticSample> {
-    let rig = RigSpec::paper();
+    let rig = if quick {
+        RigSpec::quick()
+    } else {
+        RigSpec::paper()
+    };
     let bar = bar(
         3,
         &format!("{} {{msg}} {{bar:30}} {{percent}}% {{elapsed}}", m.name),
