@@ -8,6 +8,8 @@ mod bench;
 mod demo;
 mod merge;
 mod output;
+#[allow(dead_code)] // plot figures for `measure`, `compare`, `batch` and `demo` (callers to come)
+mod plot;
 mod profile;
 mod simulate;
 mod spectro;
