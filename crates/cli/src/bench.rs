@@ -16,6 +16,8 @@ pub enum Area {
     Mc,
     /// HDR merge and radial profile.
     Imaging,
+    /// The profile fit per channel and a whole sample's measurement.
+    Fit,
 }
 
 /// Arguments of `scatterfit bench`.
@@ -57,6 +59,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if all || args.area == Area::Imaging {
         figures.extend(crate::merge::bench(&args)?);
+    }
+    if all || args.area == Area::Fit {
+        figures.extend(crate::measure::bench(&args)?);
     }
     if args.json {
         crate::output::print_json(&figures)?;
