@@ -8,8 +8,10 @@
 
 pub mod atomic;
 pub mod bracket;
+pub mod budget;
 pub mod image_files;
 pub mod profile_csv;
 pub mod response_csv;
 pub mod result_json;
 pub mod spectro;
+pub mod text;
