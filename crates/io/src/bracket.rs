@@ -107,6 +107,24 @@ pub enum BracketError {
         /// How many were given.
         count: usize,
     },
+    /// The decoded bracket would not fit the memory budget ([`crate::budget`]).
+    #[error(
+        "the {frames} frames of this bracket ({shape}) need about {} once decoded, more than the \
+         memory budget of {}; {}",
+        crate::budget::describe_bytes(*needed),
+        crate::budget::describe_bytes(*budget),
+        crate::budget::how_to_raise()
+    )]
+    TooLarge {
+        /// Number of frames.
+        frames: usize,
+        /// The first frame's header, e.g. `6000×4000 Rgb8`.
+        shape: String,
+        /// Bytes needed.
+        needed: u64,
+        /// The budget.
+        budget: u64,
+    },
     /// A frame's size, channel count or bit depth differs from the first frame's.
     #[error(
         "{} is {found} but {} is {expected}; all frames of a bracket (and the dark frame) must have \
@@ -477,6 +495,7 @@ pub fn read_bracket(
         })
         .collect();
     check_distinct_times(&known)?;
+    check_bracket_budget(&plan, crate::budget::memory_budget_bytes())?;
 
     let decoded: Vec<Result<BracketFrame, BracketError>> = plan
         .par_iter()
@@ -510,6 +529,45 @@ pub fn read_bracket(
     let mut frames = frames;
     frames.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     Ok(Bracket { frames })
+}
+
+/// Reads the frames' headers (not their pixels) and refuses a bracket whose decoded frames would
+/// not fit `budget` bytes: all frames at once, plus one transient copy (alpha dropped) per decoding
+/// thread. A header that cannot be read is left for the decoder to report.
+fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), BracketError> {
+    use image::ImageDecoder;
+    let mut total = 0u64;
+    let mut largest = 0u64;
+    let mut shape = String::new();
+    for (path, _) in plan {
+        let Ok(reader) = image::ImageReader::open(path).and_then(|r| r.with_guessed_format())
+        else {
+            continue;
+        };
+        let Ok(decoder) = reader.into_decoder() else {
+            continue;
+        };
+        let (w, h) = decoder.dimensions();
+        let bytes = u64::from(w)
+            .saturating_mul(u64::from(h))
+            .saturating_mul(u64::from(decoder.color_type().bytes_per_pixel()));
+        if shape.is_empty() {
+            shape = format!("{w}×{h} {:?}", decoder.color_type());
+        }
+        total = total.saturating_add(bytes);
+        largest = largest.max(bytes);
+    }
+    let threads = rayon::current_num_threads() as u64;
+    let needed = total.saturating_add(largest.saturating_mul(threads));
+    if needed > budget {
+        return Err(BracketError::TooLarge {
+            frames: plan.len(),
+            shape,
+            needed,
+            budget,
+        });
+    }
+    Ok(())
 }
 
 /// Two times closer than one part in 10⁶ count as the same shutter speed.
