@@ -341,7 +341,10 @@ fn timed(parser: Parser, bytes: &[u8]) -> Result<String, String> {
     r
 }
 
-const CSV_PARSERS: [(&str, Parser, fn() -> String); 4] = [
+/// A format's name, parser and valid file.
+type Format = (&'static str, Parser, fn() -> String);
+
+const CSV_PARSERS: [Format; 4] = [
     ("spectro", spectro, valid_spectro),
     ("exposures", exposures, valid_exposures),
     ("response", response, valid_response),
