@@ -7,6 +7,7 @@
 mod bench;
 mod demo;
 mod merge;
+mod numeric;
 mod output;
 mod profile;
 mod simulate;
