@@ -22,9 +22,13 @@ pub const ROULETTE_CHANCE: f64 = 0.1;
 /// Photons per chunk: the unit of work with its own random stream. Fixed, so that results do not
 /// depend on the thread count; 2048 photons are 0.1–20 ms of work, large against rayon's overhead.
 pub const CHUNK_PHOTONS: u64 = 2048;
-/// Chunks traced in parallel before their tallies are summed (in chunk order). Bounds memory by
-/// `WAVE_CHUNKS` tallies whatever the photon count, and sets how often progress is reported.
+/// Most chunks traced in parallel before their tallies are summed (in chunk order). Bounds memory by
+/// `WAVE_CHUNKS` tallies whatever the photon count.
 const WAVE_CHUNKS: u64 = 64;
+/// Interactions a wave aims at, so that progress is reported every few seconds even when photons
+/// are expensive (a wave is never less than one chunk per thread). Waves only group chunks: the
+/// tallies are summed in chunk order whatever the wave size, so results do not depend on it.
+const WAVE_INTERACTIONS: f64 = 1e8;
 
 /// Bytes of one chunk tally per tally bin (radial or angular): a sum and a sum of squares, f64 each.
 const TALLY_BYTES_PER_BIN: u64 = 16;
@@ -208,9 +212,13 @@ impl Simulation {
         let tracer = Tracer::new(self);
         let chunks = self.photons.div_ceil(CHUNK_PHOTONS);
         let mut total = Accum::new(self.grid.bins(), self.angle_bins);
+        let per_chunk = interactions_per_photon(&self.sample) * CHUNK_PHOTONS as f64;
+        let wave_chunks = ((WAVE_INTERACTIONS / per_chunk) as u64)
+            .max(rayon::current_num_threads() as u64)
+            .clamp(1, WAVE_CHUNKS);
         let mut first = 0;
         while first < chunks {
-            let last = (first + WAVE_CHUNKS).min(chunks);
+            let last = (first + wave_chunks).min(chunks);
             let wave: Vec<Accum> = (first..last)
                 .into_par_iter()
                 .map(|c| {
