@@ -14,6 +14,7 @@ mod figures;
 mod fit;
 mod measure;
 mod merge;
+mod numeric;
 mod output;
 mod plot;
 mod profile;

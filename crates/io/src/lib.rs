@@ -8,6 +8,7 @@
 
 pub mod atomic;
 pub mod bracket;
+pub mod budget;
 pub mod export;
 pub mod image_files;
 pub mod manifest;
@@ -17,3 +18,4 @@ pub mod result_json;
 pub mod result_table;
 pub mod sample_folder;
 pub mod spectro;
+pub mod text;

@@ -14,6 +14,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
+
 /// What can go wrong reading or writing a profile CSV.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -34,6 +36,9 @@ pub enum ProfileCsvError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The file is not text we read (UTF-16 without BOM, a workbook, binary data, too large).
+    #[error(transparent)]
+    Text(TextError),
     /// The table is malformed (header, a line, or inconsistent column lengths on write).
     #[error("{}: {detail}", path.display())]
     Invalid {
@@ -134,18 +139,37 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
 /// # Errors
 /// [`ProfileCsvError`] naming the file and line.
 pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ProfileCsvError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = read_text_file(path).map_err(text_error)?;
+    parse_profile_csv(&text.text, path)
+}
+
+/// [`read_profile_csv`] on the bytes of a file (any accepted encoding, [`crate::text`]).
+///
+/// # Errors
+/// As [`read_profile_csv`].
+pub fn parse_profile_bytes(bytes: &[u8], path: &Path) -> Result<ProfileTable, ProfileCsvError> {
+    let text = decode_text(bytes, path).map_err(text_error)?;
+    parse_profile_csv(&text.text, path)
+}
+
+fn text_error(e: TextError) -> ProfileCsvError {
+    match e {
+        TextError::Io { path, source } => ProfileCsvError::Read { path, source },
+        other => ProfileCsvError::Text(other),
+    }
+}
+
+/// [`read_profile_csv`] on decoded text; `path` names it in messages.
+///
+/// # Errors
+/// As [`read_profile_csv`].
+pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, ProfileCsvError> {
     let invalid = |detail: String| ProfileCsvError::Invalid {
         path: path.to_path_buf(),
         detail,
     };
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(text.as_bytes());
+    let dialect = CsvDialect::detect(text);
+    let mut reader = dialect.reader_builder().from_reader(text.as_bytes());
     let headers = reader
         .headers()
         .map_err(|e| invalid(format!("unreadable header ({e})")))?
@@ -193,20 +217,31 @@ pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
             })
             .collect(),
     };
+    let mut lines = LineCounter::new(text);
     for record in reader.records() {
-        let record = record.map_err(|e| invalid(format!("malformed CSV: {e}")))?;
-        let line = crate::bracket::csv_line(&text, record.position());
+        let record = record.map_err(|e| {
+            invalid(format!(
+                "line {}: malformed CSV: {}",
+                lines.line(e.position()),
+                crate::spectro::csv_message(&e, &dialect)
+            ))
+        })?;
+        let line = lines.line(record.position());
         let float = |col: usize, allow_empty: bool| -> Result<f64, ProfileCsvError> {
             let field = record.get(col).unwrap_or("");
             if field.is_empty() && allow_empty {
                 return Ok(f64::NAN);
             }
-            field.parse::<f64>().map_err(|_| {
-                invalid(format!(
-                    "line {line}: `{}` = {field:?} is not a number",
-                    names[col]
-                ))
-            })
+            // Non-finite values are written as empty fields, so `NaN` or `inf` text is refused.
+            dialect
+                .parse_f64(field)
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    invalid(format!(
+                        "line {line}: `{}` = {field:?} is not a finite number",
+                        names[col]
+                    ))
+                })
         };
         table.r_mm.push(float(r_mm_col, false)?);
         table.r_px.push(match r_px_col {

@@ -62,18 +62,7 @@ impl PipelineError {
     /// reflection is too.
     pub fn is_measurement_failure(&self) -> bool {
         match self {
-            PipelineError::Imaging { source, .. } => !matches!(
-                source,
-                ImagingError::ShapeMismatch { .. }
-                    | ImagingError::ChannelMismatch { .. }
-                    | ImagingError::TooFewFrames { .. }
-                    | ImagingError::TimeCountMismatch { .. }
-                    | ImagingError::NonPositiveTime { .. }
-                    | ImagingError::DuplicateTime { .. }
-                    | ImagingError::InvalidOption { .. }
-                    | ImagingError::InvalidResponse { .. }
-                    | ImagingError::CenterOutside { .. }
-            ),
+            PipelineError::Imaging { source, .. } => source.is_failed_measurement(),
             PipelineError::Spectro { source, .. } => matches!(source, OpticsError::Specular { .. }),
             _ => false,
         }
