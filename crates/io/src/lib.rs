@@ -9,6 +9,7 @@
 pub mod atomic;
 pub mod bracket;
 pub mod image_files;
+pub mod mesh;
 pub mod profile_csv;
 pub mod response_csv;
 pub mod result_json;
