@@ -9,6 +9,7 @@ mod demo;
 mod merge;
 mod output;
 mod profile;
+mod render;
 mod simulate;
 mod spectro;
 mod table;
@@ -41,6 +42,8 @@ enum Command {
     Merge(merge::Args),
     /// Radial profile Rd(r) around the light spot of a radiance map.
     Profile(profile::Args),
+    /// Render measured parameters on a mesh by the paper's two methods; validate against the profile.
+    Render(render::Args),
     /// Measure the speed of the hot paths on this machine.
     Bench(bench::Args),
 }
@@ -72,6 +75,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Table(args) => table::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Profile(args) => profile::run(args),
+        Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

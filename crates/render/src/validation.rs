@@ -202,7 +202,7 @@ pub fn compare_profiles(
 }
 
 /// Linear interpolation of (xs, ys) at x (xs increasing; non-finite entries skipped); None outside.
-fn interpolate(xs: &[f64], ys: &[f64], x: f64) -> Option<f64> {
+pub fn interpolate(xs: &[f64], ys: &[f64], x: f64) -> Option<f64> {
     let pts: Vec<(f64, f64)> = xs
         .iter()
         .zip(ys)
