@@ -18,6 +18,7 @@ use crate::mesh::Mesh;
 use crate::profile::Material;
 use crate::render::{Method, RenderOptions, Rendered, render};
 use crate::scene::{Camera, Light, Projection, Scene};
+use crate::texture_space::DipoleParams;
 
 /// The measurement geometry to reproduce.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,7 +109,8 @@ pub struct RenderedProfile {
 }
 
 /// Renders the spot on the slab by the texture-space method (`opts.width/height` are replaced by
-/// the setup's image size) and takes its radial profile (1-pixel rings).
+/// the setup's image size, the specular term is left out) and takes its radial profile (1-pixel
+/// rings).
 ///
 /// # Errors
 /// As [`spot_scene`] and [`render`].
@@ -120,9 +122,14 @@ pub fn render_spot_profile(
 ) -> Result<(Rendered, RenderedProfile)> {
     let scene = spot_scene(setup)?;
     let n = setup.image_size();
+    // No specular term: the profile is the subsurface light (the fit skips the spot itself).
     let opts = RenderOptions {
         width: n,
         height: n,
+        dipole: DipoleParams {
+            specular: false,
+            ..opts.dipole
+        },
         ..*opts
     };
     let rendered = render(&scene, material, Method::Dipole, &opts, progress)?;
