@@ -165,10 +165,14 @@ pub struct Args {
     /// Tone-curve white: the exposed luminance shown as display white (≥ 1).
     #[arg(long, default_value_t = 4.0)]
     pub white: f64,
-    /// Validate against the measured profile (Table 2): render the measurement's slab and spot,
-    /// and report the MSE per channel. Uses the result's `inputs.profile` unless a CSV is given.
-    #[arg(long, num_args = 0..=1, default_missing_value = "", value_name = "CSV")]
-    pub profile: Option<PathBuf>,
+    /// Validate against the measured profile (Table 2): render the measurement's slab and spot
+    /// by the texture-space method, and report the MSE per channel against the result's
+    /// `inputs.profile` divided by the fitted scale k.
+    #[arg(long)]
+    pub profile: bool,
+    /// The measured profile CSV for --profile, instead of the result's `inputs.profile`.
+    #[arg(long, value_name = "CSV", requires = "profile")]
+    pub measured_profile: Option<PathBuf>,
     /// Light-spot radius for --profile [mm] (default: the result's `inputs.spot_radius_mm`).
     #[arg(long, value_name = "MM")]
     pub spot_radius_mm: Option<f64>,
@@ -423,7 +427,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .unwrap_or_default();
         match ext.as_str() {
             "png" | "exr" => {}
-            "csv" if args.profile.is_some() => {}
+            "csv" if args.profile => {}
             "csv" => bail!(
                 "-o {}: a .csv output is the profile comparison; add --profile, or write .png/.exr",
                 out.display()
@@ -431,11 +435,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             _ => bail!(
                 "-o {}: write .png (tone-mapped sRGB) or .exr (linear radiance){}",
                 out.display(),
-                if args.profile.is_some() {
-                    " or .csv"
-                } else {
-                    ""
-                }
+                if args.profile { " or .csv" } else { "" }
             ),
         }
         if out.exists() && !args.force {
@@ -497,7 +497,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         exposure_ev: args.exposure,
         white: args.white,
     };
-    if args.profile.is_some() {
+    if args.profile {
         return run_profile(&args, &params[0], &opts, &tone);
     }
 
@@ -834,7 +834,7 @@ fn run_profile(
     opts: &RenderOptions,
     tone: &ToneMap,
 ) -> anyhow::Result<ExitCode> {
-    let given = args.profile.as_ref().filter(|p| !p.as_os_str().is_empty());
+    let given = args.measured_profile.as_ref();
     let Some((result, folder)) = &p.result else {
         bail!(
             "--profile needs a result.json (its fitted scales and measured profile); `{}` is a \
@@ -847,7 +847,7 @@ fn run_profile(
         None => match &result.inputs.profile {
             Some(rel) => folder.join(rel),
             None => bail!(
-                "{}: no `inputs.profile`; give the measured profile with --profile FILE.csv",
+                "{}: no `inputs.profile`; give the measured profile with --measured-profile FILE.csv",
                 p.source
             ),
         },
