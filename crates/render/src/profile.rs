@@ -136,6 +136,7 @@ pub struct RdTable {
     values: Vec<[f64; 3]>,
     q_scale: f64,
     r_cut: f64,
+    half_width: f64,
 }
 
 const TABLE_NODES: usize = 8192;
@@ -162,6 +163,17 @@ impl RdTable {
             }
         }
         let r_cut = hi.min(1000.0);
+        // Half-width: where Rd falls to half its peak (peaked at 0 for the dipole; bisection).
+        let (mut lo_h, mut hi_h) = (0.0, r_cut);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo_h + hi_h);
+            if profile.rd(mid) > 0.5 * peak {
+                lo_h = mid;
+            } else {
+                hi_h = mid;
+            }
+        }
+        let half_width = hi_h.max(1e-6);
         let q_max = r_cut.sqrt();
         let values = (0..=TABLE_NODES)
             .map(|i| {
@@ -185,7 +197,13 @@ impl RdTable {
             values,
             q_scale: TABLE_NODES as f64 / q_max,
             r_cut,
+            half_width,
         }
+    }
+
+    /// The radius where Rd has fallen to half its peak [mm]: the profile's finest length scale.
+    pub fn half_width(&self) -> f64 {
+        self.half_width
     }
 
     /// The radius beyond which the table is 0 [mm].

@@ -11,10 +11,12 @@ use scatterfit_optics::fresnel::fresnel_dielectric;
 use crate::bvh::Ray;
 use crate::colour::{ColourParams, Layer, rho_s, tangent, translucent_falloff, ward_specular};
 use crate::error::{Result, invalid};
-use crate::profile::Material;
+use crate::profile::{Material, RdTable};
 use crate::rng::stream;
 use crate::scene::{Scene, SurfacePoint};
-use crate::texture_space::{DipoleParams, Evaluation, PointCloud, irradiance_points};
+use crate::texture_space::{
+    DipoleParams, Evaluation, PointCloud, auto_light_rays, irradiance_points,
+};
 
 /// Which of the paper's methods shades the surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,7 +53,10 @@ pub struct RenderOptions {
     /// Image height [pixels].
     pub height: usize,
     /// Camera samples per pixel: 1 is the pixel centre; a perfect square is stratified (jittered
-    /// grid); other counts are uniform random. Box filter.
+    /// grid); other counts are uniform random. Box filter. The texture-space method evaluates the
+    /// subsurface sum B once per pixel and surface patch (samples within one pixel footprint of the
+    /// first and facing the same way reuse it, as the paper's irradiance texture would) and the
+    /// per-sample terms (Ft(ωo), specular) for every sample.
     pub spp: usize,
     /// Seed of every random stream.
     pub seed: u64,
@@ -79,7 +84,7 @@ impl Default for RenderOptions {
 pub struct Timings {
     /// Shooting the lights' rays for the irradiance points (dipole method).
     pub irradiance_s: f64,
-    /// Building the point hierarchy and the profile tables (dipole method).
+    /// Tabulating the profiles and building the point hierarchy (dipole method).
     pub tree_s: f64,
     /// Camera rays and shading.
     pub shading_s: f64,
@@ -88,11 +93,14 @@ pub struct Timings {
 /// What a render reports besides its image.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RenderStats {
+    /// Rays shot per light (dipole method).
+    pub light_rays: usize,
     /// Irradiance points (dipole method).
     pub irradiance_points: usize,
     /// Nodes of the point hierarchy (dipole method).
     pub tree_nodes: usize,
-    /// Mean nodes + points visited per camera sample that hit the mesh (hierarchical dipole).
+    /// Mean nodes + points visited per camera sample that hit the mesh (dipole method; samples
+    /// that reuse their pixel's B count 0).
     pub mean_visited: f64,
     /// Fraction of camera samples that hit the mesh.
     pub hit_fraction: f64,
@@ -166,12 +174,20 @@ pub fn render(
         },
         Method::Dipole => {
             let t0 = Instant::now();
-            let points = irradiance_points(scene, eta, opts.dipole.light_rays, opts.seed);
+            let tables = [0, 1, 2].map(|c| RdTable::new(material.profile(c)));
+            let tables_s = t0.elapsed().as_secs_f64();
+            let rays = opts
+                .dipole
+                .light_rays
+                .unwrap_or_else(|| auto_light_rays(scene, &tables));
+            stats.light_rays = rays;
+            let t0 = Instant::now();
+            let points = irradiance_points(scene, eta, rays, opts.seed);
             timings.irradiance_s = t0.elapsed().as_secs_f64();
             stats.irradiance_points = points.len();
             let t0 = Instant::now();
-            let cloud = PointCloud::new(points, material);
-            timings.tree_s = t0.elapsed().as_secs_f64();
+            let cloud = PointCloud::with_tables(points, tables);
+            timings.tree_s = tables_s + t0.elapsed().as_secs_f64();
             stats.tree_nodes = cloud.node_count();
             Shader::Dipole {
                 cloud,
@@ -198,6 +214,8 @@ pub fn render(
             for i in 0..w {
                 let mut rng = stream(opts.seed, (j * w + i) as u64);
                 let mut sum = [0.0f64; 3];
+                // (position, normal, footprint², B) of the pixel's first dipole evaluation.
+                let mut cache: Option<(DVec3, DVec3, f64, [f64; 3])> = None;
                 for s in 0..spp {
                     let (dx, dy) = if spp == 1 {
                         (0.5, 0.5)
@@ -232,7 +250,21 @@ pub fn render(
                             material,
                             eval,
                             specular,
-                        } => shade_dipole(scene, cloud, material, *eval, specular, &sp, wo),
+                        } => {
+                            let reuse = cache.filter(|(p, n, f2, _)| {
+                                (sp.p - *p).length_squared() <= *f2 && sp.ns.dot(*n) > 0.9
+                            });
+                            let (b, visited) = match reuse {
+                                Some((.., b)) => (b, 0),
+                                None => {
+                                    let (b, v) = subsurface(cloud, material, *eval, sp.p);
+                                    let f = scene.camera().pixel_footprint(hit.t, h);
+                                    cache = Some((sp.p, sp.ns, f * f, b));
+                                    (b, v)
+                                }
+                            };
+                            (shade_dipole(scene, material, b, specular, &sp, wo), visited)
+                        }
                     };
                     counts.1 += visited;
                     for c in 0..3 {
@@ -343,21 +375,28 @@ fn shade_colour(
     out
 }
 
-/// Texture-space dipole at one surface point: Ft(η, ωo)·B(xo)/π (+ the specular term); returns
-/// the radiance and the number of nodes visited.
-fn shade_dipole(
-    scene: &Scene,
+/// B(xo) = Σ Φk Rd(‖xk − xo‖) and the number of nodes and points visited.
+fn subsurface(
     cloud: &PointCloud,
     material: &Material,
     eval: Evaluation,
+    x: DVec3,
+) -> ([f64; 3], usize) {
+    match eval {
+        Evaluation::Direct => (cloud.eval_direct(x, material), cloud.points().len()),
+        Evaluation::Hierarchical { max_angle } => cloud.eval_hierarchical(x, max_angle),
+    }
+}
+
+/// Texture-space dipole at one surface point: Ft(η, ωo)·B(xo)/π (+ the specular term).
+fn shade_dipole(
+    scene: &Scene,
+    material: &Material,
+    b: [f64; 3],
     specular: &Option<(f64, ColourParams)>,
     sp: &SurfacePoint,
     wo: DVec3,
-) -> ([f64; 3], usize) {
-    let (b, visited) = match eval {
-        Evaluation::Direct => (cloud.eval_direct(sp.p, material), cloud.points().len()),
-        Evaluation::Hierarchical { max_angle } => cloud.eval_hierarchical(sp.p, max_angle),
-    };
+) -> [f64; 3] {
     let cos_o = sp.ns.dot(wo).clamp(0.0, 1.0);
     let ft = 1.0 - fresnel_dielectric(cos_o, material.eta());
     let mut out = b.map(|v| ft * v * std::f64::consts::FRAC_1_PI);
@@ -385,5 +424,5 @@ fn shade_dipole(
             }
         }
     }
-    (out, visited)
+    out
 }

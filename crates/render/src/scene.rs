@@ -50,6 +50,17 @@ impl Camera {
         }
     }
 
+    /// The width of one pixel's footprint [mm] at distance `t` along a camera ray, for an image
+    /// `height` pixels tall.
+    pub fn pixel_footprint(&self, t: f64, height: usize) -> f64 {
+        match self.projection {
+            Projection::Perspective { fov_y_deg } => {
+                2.0 * t * (0.5 * fov_y_deg).to_radians().tan() / height as f64
+            }
+            Projection::Orthographic { height_mm } => height_mm / height as f64,
+        }
+    }
+
     /// The primary ray through image position (x, y) [pixels, continuous: pixel (i, j) spans
     /// [i, i+1) × [j, j+1), y down] of a `width × height` image.
     pub fn ray(&self, x: f64, y: f64, width: usize, height: usize) -> Ray {

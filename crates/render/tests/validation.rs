@@ -47,7 +47,7 @@ fn spot_on_slab_matches_the_model() {
             spp: 1,
             seed,
             dipole: scatterfit_render::texture_space::DipoleParams {
-                light_rays: 4096,
+                light_rays: Some(4096),
                 ..Default::default()
             },
             ..RenderOptions::default()
@@ -131,7 +131,7 @@ fn deterministic_finite_and_non_negative() {
         spp: 4,
         seed: 9,
         dipole: scatterfit_render::texture_space::DipoleParams {
-            light_rays: 20_000,
+            light_rays: Some(20_000),
             ..Default::default()
         },
         ..RenderOptions::default()
