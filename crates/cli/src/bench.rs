@@ -16,6 +16,8 @@ pub enum Area {
     Mc,
     /// HDR merge and radial profile.
     Imaging,
+    /// Validation renderer: BVH, both rendering methods at 512×512 on a 100k-triangle mesh.
+    Render,
 }
 
 /// Arguments of `scatterfit bench`.
@@ -57,6 +59,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if all || args.area == Area::Imaging {
         figures.extend(crate::merge::bench(&args)?);
+    }
+    if all || args.area == Area::Render {
+        figures.extend(crate::render::bench(&args)?);
     }
     if args.json {
         crate::output::print_json(&figures)?;

@@ -174,7 +174,9 @@ pub fn render(
         },
         Method::Dipole => {
             let t0 = Instant::now();
-            let tables = [0, 1, 2].map(|c| RdTable::new(material.profile(c)));
+            // Distances between surface points never exceed the mesh's bounding-box diagonal.
+            let diameter = scene.bvh().bounds().extent().length();
+            let tables = [0, 1, 2].map(|c| RdTable::new(material.profile(c), diameter));
             let tables_s = t0.elapsed().as_secs_f64();
             let rays = opts
                 .dipole
@@ -204,6 +206,17 @@ pub fn render(
     let grid = (spp as f64).sqrt().round() as usize;
     let stratified = grid * grid == spp && spp > 1;
     let t0 = Instant::now();
+    // The texture-space method's B on a grid of anchors every second pixel (the paper's irradiance
+    // texture, in screen space), interpolated where the surface is continuous.
+    let anchors = match &shader {
+        Shader::Dipole {
+            cloud,
+            material,
+            eval,
+            ..
+        } if opts.dipole.interpolate => Some(Anchors::new(scene, cloud, material, *eval, w, h)),
+        _ => None,
+    };
     let mut data = vec![0f32; w * h * 3];
     // Per row: (samples that hit, nodes visited, invalid samples).
     let counters: Vec<(usize, usize, usize)> = data
@@ -251,14 +264,22 @@ pub fn render(
                             eval,
                             specular,
                         } => {
-                            let reuse = cache.filter(|(p, n, f2, _)| {
-                                (sp.p - *p).length_squared() <= *f2 && sp.ns.dot(*n) > 0.9
-                            });
+                            let f = scene.camera().pixel_footprint(hit.t, h);
+                            let reuse = anchors
+                                .as_ref()
+                                .and_then(|a| a.interpolate(i as f64 + dx, j as f64 + dy, &sp, f))
+                                .or_else(|| {
+                                    cache
+                                        .filter(|(p, n, f2, _)| {
+                                            (sp.p - *p).length_squared() <= *f2
+                                                && sp.ns.dot(*n) > 0.9
+                                        })
+                                        .map(|c| c.3)
+                                });
                             let (b, visited) = match reuse {
-                                Some((.., b)) => (b, 0),
+                                Some(b) => (b, 0),
                                 None => {
                                     let (b, v) = subsurface(cloud, material, *eval, sp.p);
-                                    let f = scene.camera().pixel_footprint(hit.t, h);
                                     cache = Some((sp.p, sp.ns, f * f, b));
                                     (b, v)
                                 }
@@ -286,8 +307,9 @@ pub fn render(
     timings.shading_s = t0.elapsed().as_secs_f64();
     let hits: usize = counters.iter().map(|c| c.0).sum();
     stats.hit_fraction = hits as f64 / (w * h * spp) as f64;
+    let anchor_visits = anchors.as_ref().map_or(0, |a| a.visited);
     stats.mean_visited = if hits > 0 {
-        counters.iter().map(|c| c.1).sum::<usize>() as f64 / hits as f64
+        (counters.iter().map(|c| c.1).sum::<usize>() + anchor_visits) as f64 / hits as f64
     } else {
         0.0
     };
@@ -373,6 +395,95 @@ fn shade_colour(
         }
     }
     out
+}
+
+/// Anchors whose B differ by more than this factor in a channel are not interpolated (1.05: half
+/// the error, 1.5× the time; no limit: twice the error at the 99th percentile, 3× at the worst).
+const MAX_ANCHOR_RATIO: f64 = 1.2;
+
+/// B at the centres of pixels (2i, 2j): position, shading normal, B.
+struct Anchors {
+    aw: usize,
+    ah: usize,
+    data: Vec<Option<(DVec3, DVec3, [f64; 3])>>,
+    visited: usize,
+}
+
+impl Anchors {
+    fn new(
+        scene: &Scene,
+        cloud: &PointCloud,
+        material: &Material,
+        eval: Evaluation,
+        w: usize,
+        h: usize,
+    ) -> Self {
+        let (aw, ah) = (w / 2 + 2, h / 2 + 2);
+        let rows: Vec<(Vec<Option<(DVec3, DVec3, [f64; 3])>>, usize)> = (0..ah)
+            .into_par_iter()
+            .map(|aj| {
+                let mut visited = 0;
+                let row = (0..aw)
+                    .map(|ai| {
+                        let (x, y) = (2.0 * ai as f64 + 0.5, 2.0 * aj as f64 + 0.5);
+                        let ray = scene.camera().ray(x, y, w, h);
+                        let hit = scene.intersect(&ray, f64::INFINITY)?;
+                        let mut sp = scene.surface(&ray, &hit);
+                        if sp.ng.dot(ray.dir) > 0.0 {
+                            sp.ns = -sp.ns;
+                        }
+                        let (b, v) = subsurface(cloud, material, eval, sp.p);
+                        visited += v;
+                        Some((sp.p, sp.ns, b))
+                    })
+                    .collect();
+                (row, visited)
+            })
+            .collect();
+        let visited = rows.iter().map(|r| r.1).sum();
+        Self {
+            aw,
+            ah,
+            data: rows.into_iter().flat_map(|r| r.0).collect(),
+            visited,
+        }
+    }
+
+    /// Bilinear interpolation of B at image position (x, y) from the four surrounding anchors, if
+    /// all four see the same smooth surface as `sp` (within 6 pixel footprints `f` of it, normals
+    /// within 18°) and their B agree within 20 % in every channel; None otherwise (the caller
+    /// evaluates B itself).
+    fn interpolate(&self, x: f64, y: f64, sp: &SurfacePoint, f: f64) -> Option<[f64; 3]> {
+        let (u, v) = (((x - 0.5) / 2.0).max(0.0), ((y - 0.5) / 2.0).max(0.0));
+        let (i, j) = (u as usize, v as usize);
+        if i + 1 >= self.aw || j + 1 >= self.ah {
+            return None;
+        }
+        let (fu, fv) = (u - i as f64, v - j as f64);
+        let reach2 = (6.0 * f).powi(2);
+        let mut out = [0.0; 3];
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [0.0f64; 3]);
+        for (di, dj, wgt) in [
+            (0, 0, (1.0 - fu) * (1.0 - fv)),
+            (1, 0, fu * (1.0 - fv)),
+            (0, 1, (1.0 - fu) * fv),
+            (1, 1, fu * fv),
+        ] {
+            let (p, n, b) = self.data[(j + dj) * self.aw + i + di]?;
+            if (p - sp.p).length_squared() > reach2 || n.dot(sp.ns) < 0.95 {
+                return None;
+            }
+            for c in 0..3 {
+                out[c] += wgt * b[c];
+                lo[c] = lo[c].min(b[c]);
+                hi[c] = hi[c].max(b[c]);
+            }
+        }
+        // Where B changes fast (shadow edges seen through short profiles) evaluate instead.
+        (0..3)
+            .all(|c| hi[c] <= MAX_ANCHOR_RATIO * lo[c])
+            .then_some(out)
+    }
 }
 
 /// B(xo) = Σ Φk Rd(‖xk − xo‖) and the number of nodes and points visited.

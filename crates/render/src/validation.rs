@@ -109,7 +109,7 @@ pub struct RenderedProfile {
 }
 
 /// Renders the spot on the slab by the texture-space method (`opts.width/height` are replaced by
-/// the setup's image size, the specular term is left out) and takes its radial profile (1-pixel
+/// the setup's image size, the specular term is left out and B evaluated at every pixel) and takes its radial profile (1-pixel
 /// rings).
 ///
 /// # Errors
@@ -128,6 +128,7 @@ pub fn render_spot_profile(
         height: n,
         dipole: DipoleParams {
             specular: false,
+            interpolate: false,
             ..opts.dipole
         },
         ..*opts
