@@ -298,15 +298,12 @@ const QUADRUPOLE_TOLERANCE: f64 = 0.1;
 const NEGLIGIBLE: f64 = 1e-4;
 
 impl PointCloud {
-    /// Builds the tree over `points` and tabulates the material's profiles (out to the points'
-    /// diameter; evaluate only at points within their bounds).
+    /// Builds the tree over `points` and tabulates the material's profiles (at any distance; the
+    /// renderer uses [`PointCloud::with_tables`] with tables limited to the scene's size).
     pub fn new(points: Vec<IrradiancePoint>, material: &Material) -> Self {
-        let b = points.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.p));
-        let limit = b.extent().length().max(1e-3);
-        let limit = if limit.is_finite() { limit } else { 1e-3 };
         Self::with_tables(
             points,
-            [0, 1, 2].map(|c| RdTable::new(material.profile(c), limit)),
+            [0, 1, 2].map(|c| RdTable::new(material.profile(c), f64::INFINITY)),
         )
     }
 
