@@ -113,7 +113,6 @@ fn read_obj(path: &Path) -> Result<Parsed, MeshError> {
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     // Materials are irrelevant here: never open the .mtl files an OBJ names.
     let (models, _) = tobj::load_obj_buf(&mut std::io::Cursor::new(text), &opts, |_| {

@@ -198,9 +198,8 @@ impl Canvas {
                 }
                 let i = (py as usize * self.w + px as usize) * 3;
                 let c = c.clamp(0.0, 1.0);
-                for k in 0..3 {
-                    let v = self.data[i + k] as f32 * (1.0 - c) + ink[k] as f32 * c;
-                    self.data[i + k] = v.round() as u8;
+                for (d, &k) in self.data[i..i + 3].iter_mut().zip(&ink) {
+                    *d = (*d as f32 * (1.0 - c) + k as f32 * c).round() as u8;
                 }
             });
         }

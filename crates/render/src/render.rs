@@ -401,11 +401,14 @@ fn shade_colour(
 /// the error, 1.5× the time; no limit: twice the error at the 99th percentile, 3× at the worst).
 const MAX_ANCHOR_RATIO: f64 = 1.2;
 
-/// B at the centres of pixels (2i, 2j): position, shading normal, B.
+/// One anchor: position, shading normal, B.
+type Anchor = (DVec3, DVec3, [f64; 3]);
+
+/// B at the centres of pixels (2i, 2j).
 struct Anchors {
     aw: usize,
     ah: usize,
-    data: Vec<Option<(DVec3, DVec3, [f64; 3])>>,
+    data: Vec<Option<Anchor>>,
     visited: usize,
 }
 
@@ -419,7 +422,7 @@ impl Anchors {
         h: usize,
     ) -> Self {
         let (aw, ah) = (w / 2 + 2, h / 2 + 2);
-        let rows: Vec<(Vec<Option<(DVec3, DVec3, [f64; 3])>>, usize)> = (0..ah)
+        let rows: Vec<(Vec<Option<Anchor>>, usize)> = (0..ah)
             .into_par_iter()
             .map(|aj| {
                 let mut visited = 0;
@@ -530,8 +533,8 @@ fn shade_dipole(
                 params.alpha_x,
                 params.alpha_y,
             ) * cos_t;
-            for c in 0..3 {
-                out[c] += inc.e[c] * f;
+            for (o, e) in out.iter_mut().zip(inc.e) {
+                *o += e * f;
             }
         }
     }

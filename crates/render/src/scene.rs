@@ -194,7 +194,7 @@ impl Light {
             } => (Some(direction), irradiance, radius),
         };
         if let Some(d) = dir
-            && !((d.length() - 1.0).abs() < 1e-9)
+            && ((d.length() - 1.0).abs() >= 1e-9 || !d.is_finite())
         {
             return Err(invalid("light direction", d, "must be a unit vector"));
         }

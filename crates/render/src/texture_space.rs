@@ -137,6 +137,9 @@ pub fn auto_light_rays(scene: &Scene, tables: &[RdTable; 3]) -> usize {
     }
 }
 
+/// Maps a point of the unit square to a light ray and the flux it carries.
+type Sampler = dyn Fn(f64, f64) -> Option<(Ray, [f64; 3])> + Sync;
+
 /// Shoots each light's stratified ray grid at the scene and returns the irradiance points, in a
 /// deterministic order for a given seed (whatever the thread count).
 pub fn irradiance_points(
@@ -151,7 +154,7 @@ pub fn irradiance_points(
     let mut out = Vec::new();
     for (li, light) in scene.lights().iter().enumerate() {
         // Per light: a sampler from the unit square to (ray, flux of the ray).
-        let sampler: Box<dyn Fn(f64, f64) -> Option<(Ray, [f64; 3])> + Sync> = match *light {
+        let sampler: Box<Sampler> = match *light {
             Light::Directional {
                 direction,
                 irradiance,
@@ -373,8 +376,8 @@ impl PointCloud {
                 let first = node.start as usize;
                 for p in &self.points[first..first + node.count as usize] {
                     let q = (p.p - x).length_squared().sqrt().sqrt();
-                    for c in 0..3 {
-                        acc[c] += p.power[c] * self.tables[c].rd_q(q);
+                    for ((a, t), w) in acc.iter_mut().zip(&self.tables).zip(p.power) {
+                        *a += w * t.rd_q(q);
                     }
                 }
                 visited += node.count as usize;
@@ -400,11 +403,11 @@ impl PointCloud {
                 let mut v = [0.0; 3];
                 let mut ok = true;
                 let q = d2.sqrt().sqrt();
-                for c in 0..3 {
-                    let [f, g1, f2] = self.tables[c].with_curvature_q(q);
+                for (vc, t) in v.iter_mut().zip(&self.tables) {
+                    let [f, g1, f2] = t.with_curvature_q(q);
                     let corr = 0.5 * (f2 * s_uu + g1 * (trace - s_uu));
                     ok &= corr.abs() <= QUADRUPOLE_TOLERANCE * f;
-                    v[c] = f + corr;
+                    *vc = f + corr;
                 }
                 if ok {
                     for c in 0..3 {
@@ -445,8 +448,8 @@ fn build(points: &mut [IrradiancePoint], start: usize, nodes: &mut Vec<PNode>) -
     let mut weighted = DVec3::ZERO;
     let mut weight = 0.0;
     for p in points.iter() {
-        for c in 0..3 {
-            power[c] += p.power[c];
+        for (a, w) in power.iter_mut().zip(p.power) {
+            *a += w;
         }
         let w = p.power[0] + p.power[1] + p.power[2];
         weighted += p.p * w;

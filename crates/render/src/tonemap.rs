@@ -119,7 +119,7 @@ mod tests {
         assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-4);
         assert!((w[1] - 0.7152).abs() < 1e-3);
         // A white Lambertian surface under irradiance 1: radiance 1/π → Y = 1 → Y′ = (1 + 1/16)/2.
-        let img = ImageBuf::new(2, 1, 3, vec![std::f32::consts::FRAC_1_PI; 3].repeat(2)).unwrap();
+        let img = ImageBuf::new(2, 1, 3, vec![std::f32::consts::FRAC_1_PI; 6]).unwrap();
         let out = tone_map(&img, &ToneMap::default()).unwrap();
         let expected = (255.0 * srgb_encode(0.5 * (1.0 + 1.0 / 16.0))).round() as u8;
         assert_eq!(out.data()[0], expected);

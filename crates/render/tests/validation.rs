@@ -84,8 +84,8 @@ fn spot_on_slab_matches_the_model() {
             let i = x as usize;
             grid[i] + (x - i as f64) * (grid[i + 1] - grid[i])
         };
-        for k in 0..rings {
-            let expected = ring_r[k].iter().map(|&r| at(r)).sum::<f64>() / ring_r[k].len() as f64;
+        for (k, radii) in ring_r.iter().enumerate() {
+            let expected = radii.iter().map(|&r| at(r)).sum::<f64>() / radii.len() as f64;
             let values: Vec<f64> = runs.iter().map(|p| p.rd[ch][k]).collect();
             let mean = values.iter().sum::<f64>() / seeds as f64;
             let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (seeds as f64 - 1.0);
