@@ -631,13 +631,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .collect::<anyhow::Result<_>>()?;
             let title = (params.len() == 2).then(|| {
                 format!(
-                    "{} ({}) vs {} ({}) — σ′s, σa per channel; η {:.4} / {:.4}",
-                    params[0].name,
-                    params[0].method,
-                    params[1].name,
-                    params[1].method,
-                    params[0].eta,
-                    params[1].eta
+                    "{} ({}) vs {} ({}) — Choi et al. 2014, Figure 5 layout",
+                    params[0].name, params[0].method, params[1].name, params[1].method
                 )
             });
             let style = FigureStyle {
