@@ -160,13 +160,10 @@ pub struct Args {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub g: f64,
     /// Exposure [EV]; at 0 a white diffuser facing a light of irradiance 1 is the reference white.
-    #[arg(
-        long,
-        default_value_t = 0.0,
-        allow_hyphen_values = true,
-        value_name = "EV"
-    )]
-    pub exposure: f64,
+    /// Default 0, except with --profile, where the slab image is exposed so that the glow at twice
+    /// the spot radius shows as white.
+    #[arg(long, allow_hyphen_values = true, value_name = "EV")]
+    pub exposure: Option<f64>,
     /// Tone-curve white: the exposed luminance shown as display white (≥ 1).
     #[arg(long, default_value_t = 4.0)]
     pub white: f64,
@@ -503,7 +500,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     opts.colour.validate().context("shading coefficients")?;
     opts.dipole.validate().context("texture-space options")?;
     let tone = ToneMap {
-        exposure_ev: args.exposure,
+        exposure_ev: args.exposure.unwrap_or(0.0),
         white: args.white,
     };
     if args.profile {
@@ -686,8 +683,8 @@ fn render_summary(p: &Params, r: &Rendered, opts: &RenderOptions) -> RenderSumma
         eta: p.eta,
         sigma_s_prime: p.coefficients.map(|c| c.0),
         sigma_a: p.coefficients.map(|c| c.1),
-        width: opts.width,
-        height: opts.height,
+        width: r.image.width(),
+        height: r.image.height(),
         spp: opts.spp,
         seed: opts.seed,
         irradiance_s,
@@ -932,6 +929,9 @@ fn run_profile(
     let t0 = Instant::now();
     let popts = RenderOptions { spp: 1, ..*opts };
     let (rendered, prof) = render_spot_profile(&material, &setup, &popts, &|k| bar.inc(k as u64))?;
+    // Rd_render = norm · L (see scatterfit_render::validation).
+    let ft = 1.0 - scatterfit_optics::fresnel::fresnel_dielectric(1.0, p.eta);
+    let norm = 1.0 / (ft * ft * std::f64::consts::PI * spot * spot) * std::f64::consts::PI;
     let render_s = t0.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let mut mses = Vec::new();
@@ -997,14 +997,38 @@ fn run_profile(
                     .with_context(|| format!("writing {}", out.display()))?;
             }
             "exr" => write_radiance(out, &rendered.image)?,
-            _ => write_png(out, &tone_map(&rendered.image, tone)?)?,
+            _ => {
+                // Expose the spot's glow: the profile at twice the spot radius shows as white.
+                let tone = match args.exposure {
+                    Some(_) => *tone,
+                    None => {
+                        let w = scatterfit_render::tonemap::luminance_weights();
+                        let k = ((2.0 * spot / mm_per_pixel) as usize).min(prof.r_mm.len() - 1);
+                        let y: f64 = (0..3).map(|c| w[c] * prof.rd[c][k]).sum::<f64>() / norm;
+                        ToneMap {
+                            exposure_ev: if y > 0.0 {
+                                (tone.white / (std::f64::consts::PI * y))
+                                    .log2()
+                                    .clamp(-60.0, 60.0)
+                            } else {
+                                0.0
+                            },
+                            ..*tone
+                        }
+                    }
+                };
+                write_png(out, &tone_map(&rendered.image, &tone)?)?
+            }
         }
     }
     let summary = Summary {
         mesh: MeshSummary {
             source: "built-in slab (measurement geometry)".into(),
             triangles: 12,
-            size_mm: [0.0; 3],
+            size_mm: {
+                let side = setup.image_size() as f64 * mm_per_pixel + 20.0;
+                [side, 50.0, side]
+            },
             bvh_build_s: 0.0,
         },
         renders: vec![render_summary(p, &rendered, &popts)],

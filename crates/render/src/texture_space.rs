@@ -12,7 +12,7 @@
 //! Sampling N surface points with pdf p(xi) = E(xi)/Φ, Φ = ∫E dA the total transmitted flux, gives
 //! B ≈ (Φ/N) Σ Rd(rk) and eq. (6), L = Ft E′avg Σ Rd/(Nπ) — which holds only when "E′avg" is the
 //! total flux Φ (physics.md §9; the printed symbol suggests an average irradiance, which would be off
-//! by the lit area). The unit test [`tests::uniform_plane_gives_ft_e_rd_over_pi`] checks the
+//! by the lit area). The unit test `uniform_plane_gives_ft_e_rd_over_pi` checks the
 //! normalisation: uniform E on a plane gives L = Ft·E·Rd/π.
 //!
 //! **Sampling E** (Chang et al.'s importance sampling, without a texture atlas): each light shoots a
