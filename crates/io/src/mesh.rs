@@ -20,12 +20,12 @@ use std::path::{Path, PathBuf};
 #[non_exhaustive]
 pub enum MeshError {
     /// The file could not be read.
-    #[error("cannot read mesh {}: {source}", path.display())]
+    #[error("cannot read mesh {}: {error}", path.display())]
     Read {
         /// The file.
         path: PathBuf,
-        /// The underlying error.
-        source: std::io::Error,
+        /// The underlying error (in the message, not repeated as a source).
+        error: std::io::Error,
     },
     /// The extension names no mesh format we read.
     #[error("{}: {detail}", path.display())]
@@ -104,9 +104,9 @@ fn invalid(path: &Path, detail: String) -> MeshError {
 }
 
 fn read_obj(path: &Path) -> Result<Parsed, MeshError> {
-    let text = std::fs::read(path).map_err(|source| MeshError::Read {
+    let text = std::fs::read(path).map_err(|error| MeshError::Read {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let opts = tobj::LoadOptions {
         triangulate: false,
@@ -160,9 +160,9 @@ fn read_obj(path: &Path) -> Result<Parsed, MeshError> {
 fn read_ply(path: &Path) -> Result<Parsed, MeshError> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Read {
+    let bytes = std::fs::read(path).map_err(|error| MeshError::Read {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut std::io::Cursor::new(bytes))

@@ -251,6 +251,7 @@ pub fn render(
                         // Seen from behind (an open mesh): shade the side facing the camera.
                         sp.ng = -sp.ng;
                         sp.ns = -sp.ns;
+                        sp.p_shadow = sp.p;
                     }
                     let (l, visited) = match &shader {
                         Shader::Colour {
@@ -342,7 +343,7 @@ fn shade_colour(
         let l = inc.l;
         if sp.ng.dot(l) > 0.0 {
             // Facing the light: lit unless shadowed; the layer under it is the chord along −l.
-            let origin = sp.p + sp.ng * eps;
+            let origin = sp.p_shadow + sp.ng * eps;
             if scene.occluded(origin, l, inc.dist) {
                 continue;
             }
@@ -384,7 +385,7 @@ fn shade_colour(
             let Some(inc_e) = light.incident(entry.p) else {
                 continue;
             };
-            if scene.occluded(entry.p + entry.ng * eps, l, inc_e.dist) {
+            if scene.occluded(entry.p_shadow + entry.ng * eps, l, inc_e.dist) {
                 continue;
             }
             let d = hit.t;
@@ -520,7 +521,8 @@ fn shade_dipole(
             let Some(inc) = light.incident(sp.p) else {
                 continue;
             };
-            if sp.ng.dot(inc.l) <= 0.0 || scene.occluded(sp.p + sp.ng * eps, inc.l, inc.dist) {
+            if sp.ng.dot(inc.l) <= 0.0 || scene.occluded(sp.p_shadow + sp.ng * eps, inc.l, inc.dist)
+            {
                 continue;
             }
             let cos_t = sp.ns.dot(inc.l).max(0.0);

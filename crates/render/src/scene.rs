@@ -231,6 +231,10 @@ pub struct SurfacePoint {
     pub ng: DVec3,
     /// Shading normal (interpolated vertex normals), unit, on the same side as `ng`.
     pub ns: DVec3,
+    /// Origin for shadow rays: the point lifted onto the smooth surface the vertex normals describe
+    /// (Hanika 2021, "Hacking the Shadow Terminator", Ray Tracing Gems II ch. 4), so that coarse
+    /// meshes do not show faceted shadow terminators; `p` where the surface is locally concave.
+    pub p_shadow: DVec3,
 }
 
 impl Scene {
@@ -299,15 +303,21 @@ impl Scene {
         let [ia, ib, ic] = self.mesh.triangles()[t];
         let n = self.mesh.normals();
         let w = 1.0 - hit.u - hit.v;
-        let mut ns =
-            (n[ia as usize] * w + n[ib as usize] * hit.u + n[ic as usize] * hit.v).normalize_or(ng);
+        let (na, nb, nc) = (n[ia as usize], n[ib as usize], n[ic as usize]);
+        let mut ns = (na * w + nb * hit.u + nc * hit.v).normalize_or(ng);
         if ns.dot(ng) < 0.0 {
             ns = ng;
         }
+        let p = ray.origin + ray.dir * hit.t;
+        // Hanika 2021: project p onto each vertex's tangent plane, interpolate barycentrically.
+        let lift = |v: DVec3, nv: DVec3| p - nv * (p - v).dot(nv);
+        let q = lift(a, na) * w + lift(b, nb) * hit.u + lift(c, nc) * hit.v;
+        let p_shadow = if (q - p).dot(ng) > 0.0 { q } else { p };
         SurfacePoint {
-            p: ray.origin + ray.dir * hit.t,
+            p,
             ng,
             ns,
+            p_shadow,
         }
     }
 }
