@@ -69,6 +69,9 @@ pub enum LightArg {
     Back,
     /// A point light above the front left, giving irradiance 1 at the model's centre.
     Point,
+    /// A collimated spot of 2 mm radius from the key light's direction, aimed at the model's
+    /// centre (irradiance 1), like the measurement rig's: light spreading under the surface.
+    Spot,
 }
 
 /// Arguments of `scatterfit render`.
@@ -797,6 +800,15 @@ fn lights(kind: LightArg, bounds: &scatterfit_render::mesh::Aabb) -> Vec<Light> 
                 intensity: [d2; 3],
             }]
         }
+        LightArg::Spot => match studio[0] {
+            Light::Directional { direction, .. } => vec![Light::Spot {
+                center: bounds.center(),
+                direction,
+                radius: 2.0,
+                irradiance: [1.0; 3],
+            }],
+            other => vec![other],
+        },
     }
 }
 
