@@ -18,6 +18,8 @@ pub enum Area {
     Imaging,
     /// The profile fit per channel and a whole sample's measurement.
     Fit,
+    /// Validation renderer: BVH, both rendering methods at 512×512 on a 100k-triangle mesh.
+    Render,
 }
 
 /// Arguments of `scatterfit bench`.
@@ -62,6 +64,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if all || args.area == Area::Fit {
         figures.extend(crate::measure::bench(&args)?);
+    }
+    if all || args.area == Area::Render {
+        figures.extend(crate::render::bench(&args)?);
     }
     if args.json {
         crate::output::print_json(&figures)?;

@@ -18,6 +18,7 @@ mod numeric;
 mod output;
 mod plot;
 mod profile;
+mod render;
 mod report;
 mod runner;
 mod simulate;
@@ -66,6 +67,8 @@ enum Command {
     Synth(synth::Args),
     /// Export a measured result as a pbrt-v4, Mitsuba 3, Blender or JSON material.
     Export(export::Args),
+    /// Render measured parameters on a mesh by the paper's two methods; validate against the profile.
+    Render(render::Args),
     /// Measure the speed of the hot paths on this machine.
     Bench(bench::Args),
 }
@@ -107,6 +110,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Profile(args) => profile::run(args),
         Command::Synth(args) => synth::run(args),
         Command::Export(args) => export::run(args),
+        Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

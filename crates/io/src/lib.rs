@@ -12,6 +12,7 @@ pub mod budget;
 pub mod export;
 pub mod image_files;
 pub mod manifest;
+pub mod mesh;
 pub mod profile_csv;
 pub mod response_csv;
 pub mod result_json;
