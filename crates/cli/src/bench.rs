@@ -16,6 +16,10 @@ pub enum Area {
     Mc,
     /// HDR merge and radial profile.
     Imaging,
+    /// The profile fit per channel and a whole sample's measurement.
+    Fit,
+    /// Validation renderer: BVH, both rendering methods at 512×512 on a 100k-triangle mesh.
+    Render,
 }
 
 /// Arguments of `scatterfit bench`.
@@ -57,6 +61,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if all || args.area == Area::Imaging {
         figures.extend(crate::merge::bench(&args)?);
+    }
+    if all || args.area == Area::Fit {
+        figures.extend(crate::measure::bench(&args)?);
+    }
+    if all || args.area == Area::Render {
+        figures.extend(crate::render::bench(&args)?);
     }
     if args.json {
         crate::output::print_json(&figures)?;

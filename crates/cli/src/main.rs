@@ -4,14 +4,28 @@
 //! the outcome to the exit code documented in `ARCHITECTURE.md`: 0 success, 1 a measurement that
 //! failed (the tool ran, the sample did not yield parameters), 2 bad usage or bad input.
 
+mod batch;
 mod bench;
+mod common;
+mod compare;
 mod demo;
+mod export;
+mod figures;
+mod fit;
+mod measure;
 mod merge;
+mod numeric;
 mod output;
+mod plot;
 mod profile;
+mod render;
+mod report;
+mod runner;
 mod simulate;
 mod spectro;
+mod synth;
 mod table;
+mod twin;
 
 use std::process::ExitCode;
 
@@ -31,6 +45,14 @@ struct Cli {
 enum Command {
     /// Run the pipeline on built-in example measurements.
     Demo(demo::Args),
+    /// Measure a sample folder: σ′s, σa and η per RGB channel (spectro → HDR → profile → fit).
+    Measure(measure::Args),
+    /// Fit a radial profile you already have (a profile CSV), given η and α′.
+    Fit(fit::Args),
+    /// Measure many sample folders in parallel; summary.csv / summary.md like the paper's Table 1.
+    Batch(batch::Args),
+    /// Both methods (proposed, existing) on the same data: Table 2 and Figure 6 of the paper.
+    Compare(compare::Args),
     /// Spectrophotometer stage: η from SCI−SCE, colour, Rd and reduced albedo α′ per RGB channel.
     Spectro(spectro::Args),
     /// Monte Carlo photon transport (MCML physics) in a slab or half-space.
@@ -41,6 +63,12 @@ enum Command {
     Merge(merge::Args),
     /// Radial profile Rd(r) around the light spot of a radiance map.
     Profile(profile::Args),
+    /// The rig twin: write a synthetic sample folder (Monte Carlo spectro reading and bracket).
+    Synth(synth::Args),
+    /// Export a measured result as a pbrt-v4, Mitsuba 3, Blender or JSON material.
+    Export(export::Args),
+    /// Render measured parameters on a mesh by the paper's two methods; validate against the profile.
+    Render(render::Args),
     /// Measure the speed of the hot paths on this machine.
     Bench(bench::Args),
 }
@@ -58,8 +86,12 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(err) => {
-            eprintln!("error: {err:#}");
-            ExitCode::from(2)
+            eprintln!("error: {}", common::error_text(&err));
+            ExitCode::from(if common::is_measurement_failure(&err) {
+                1
+            } else {
+                2
+            })
         }
     }
 }
@@ -67,11 +99,18 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Demo(args) => demo::run(args),
+        Command::Measure(args) => measure::run(args),
+        Command::Fit(args) => fit::run(args),
+        Command::Batch(args) => batch::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::Spectro(args) => spectro::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Table(args) => table::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Profile(args) => profile::run(args),
+        Command::Synth(args) => synth::run(args),
+        Command::Export(args) => export::run(args),
+        Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

@@ -1,18 +1,17 @@
 //! `scatterfit profile`: the radial profile Rd(r) around the light spot of a radiance map.
 //!
 //! Reads an EXR or HDR radiance map, finds the spot centre (or takes `--center`), averages concentric
-//! rings, and writes `r_mm,r_px,value_<c>,stderr_<c>,count_<c>` per channel (see
-//! `scatterfit_io::profile_csv`). Pixels stored as NaN (clipped in every exposure) are skipped.
+//! rings, and writes `r_mm,r_px,value_<c>,stderr_<c>,count_<c>[,limit_<c>]` per channel (see
+//! `scatterfit_io::profile_csv`). Pixels stored as NaN (clipped in every exposure) are skipped. The
+//! work is `scatterfit_pipeline::profile::profile_stage`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use scatterfit_imaging::{
-    CenterOptions, ProfileOptions, SpotCenter, find_spot_center, radial_profile,
-};
 use scatterfit_io::image_files::read_radiance;
-use scatterfit_io::profile_csv::{ProfileColumn, ProfileTable, write_profile_csv};
+use scatterfit_io::profile_csv::write_profile_csv;
+use scatterfit_pipeline::profile::{CenterSource, ProfileSettings, profile_stage};
 use serde::Serialize;
 
 /// Arguments of `scatterfit profile`.
@@ -32,6 +31,10 @@ pub struct Args {
     /// Ring width [px].
     #[arg(long, default_value_t = 1.0, value_name = "PX")]
     pub ring_width_px: f64,
+    /// The bracket's detection limit per channel R,G,B (relative radiance, as `scatterfit merge`
+    /// prints it): written as `limit_<c>` columns so that `scatterfit fit` leaves out rings below it.
+    #[arg(long, value_name = "R,G,B", value_parser = crate::common::parse_rgb)]
+    pub detection_limit: Option<[f64; 3]>,
     /// The profile CSV to write.
     #[arg(short, long, value_name = "CSV")]
     pub output: PathBuf,
@@ -86,68 +89,33 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.mm_per_pixel
         );
     }
-    crate::merge::refuse_overwrite(&args.output, "output", &[args.radiance.as_path()])?;
+    crate::common::refuse_overwrite(&args.output, "output", &[args.radiance.as_path()])?;
     let image = read_radiance(&args.radiance)?;
-    let (center, source) = match args.center {
-        Some([x, y]) => (
-            SpotCenter::given(&image, x, y)
-                .with_context(|| format!("--center for {}", args.radiance.display()))?,
-            "given",
-        ),
-        None => (
-            find_spot_center(&image, &CenterOptions::default()).with_context(|| {
-                format!(
-                    "finding the spot centre in {} (or give it with --center X,Y)",
-                    args.radiance.display()
-                )
-            })?,
-            "found",
-        ),
-    };
-    let opts = ProfileOptions {
-        ring_width_px: args.ring_width_px,
-        r_max_px: args.r_max_px,
-    };
-    let profile = radial_profile(&image, center.xy(), None, args.mm_per_pixel, &opts)
-        .context("computing the radial profile (check --ring-width-px and --r-max-px)")?;
-    let names: &[&str] = match profile.channels() {
-        1 => &["y"],
-        3 => &["r", "g", "b"],
-        n => bail!(
-            "{}: {n} channels; a radiance map has 1 or 3",
-            args.radiance.display()
-        ),
-    };
-    let table = ProfileTable {
-        r_mm: (0..profile.rings.len())
-            .filter_map(|k| profile.r_mm(k))
-            .collect(),
-        r_px: profile.rings.iter().map(|r| r.r_px).collect(),
-        channels: names
-            .iter()
-            .enumerate()
-            .map(|(c, name)| ProfileColumn {
-                name: (*name).to_string(),
-                value: profile.rings.iter().map(|r| r.channels[c].mean).collect(),
-                stderr: profile
-                    .rings
-                    .iter()
-                    .map(|r| r.channels[c].std_err)
-                    .collect(),
-                count: profile
-                    .rings
-                    .iter()
-                    .map(|r| r.channels[c].count as u64)
-                    .collect(),
-            })
-            .collect(),
-    };
+    let limits = args.detection_limit.map_or_else(Vec::new, |l| l.to_vec());
+    let stage = profile_stage(
+        &image,
+        None,
+        &limits,
+        &ProfileSettings {
+            mm_per_pixel: args.mm_per_pixel,
+            r_max_px: args.r_max_px,
+            ring_width_px: args.ring_width_px,
+            center_px: args.center,
+        },
+    )
+    .with_context(|| format!("{}", args.radiance.display()))?;
+    let table = stage.to_table();
     write_profile_csv(&args.output, &table)?;
+    let profile = &stage.profile;
     let summary = Summary {
         radiance: args.radiance.clone(),
-        center_px: center.xy(),
-        center_source: source.into(),
-        spot_pixels: center.spot_pixels,
+        center_px: stage.center.xy(),
+        center_source: match stage.center_source {
+            CenterSource::Found => "found",
+            CenterSource::Given => "given",
+        }
+        .into(),
+        spot_pixels: stage.center.spot_pixels,
         rings: profile.rings.len(),
         empty_rings: profile
             .rings
@@ -166,7 +134,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             summary.center_px[0],
             summary.center_px[1],
             summary.center_source,
-            if source == "found" {
+            if stage.center_source == CenterSource::Found {
                 format!(" ({} spot pixels)", summary.spot_pixels)
             } else {
                 String::new()

@@ -10,55 +10,68 @@ use anyhow::{Context, bail};
 use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationResult};
 use serde::Serialize;
 
-/// Arguments of `scatterfit simulate`.
+/// Arguments of `scatterfit simulate`. Every number is checked before any work (exit 2 when out of
+/// range); the run's memory and expected work are checked against `--max-memory-mib` and
+/// `--max-interactions` before it starts.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Reduced scattering coefficient σ′s [mm⁻¹].
-    #[arg(long, allow_hyphen_values = true)]
+    /// Reduced scattering coefficient σ′s [mm⁻¹]: finite, ≥ 0.
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub sigma_s_prime: f64,
-    /// Absorption coefficient σa [mm⁻¹].
-    #[arg(long, allow_hyphen_values = true)]
+    /// Absorption coefficient σa [mm⁻¹]: finite, ≥ 0; > 0 for a half-space (no --thickness-mm),
+    /// where a photon without absorption never has to stop.
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub sigma_a: f64,
-    /// Relative refractive index η of the material (the outside is air, n = 1).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Relative refractive index η of the material (the outside is air, n = 1): 1 to 10 (below 1
+    /// with --allow-eta-below-one).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub eta: f64,
-    /// Henyey–Greenstein asymmetry g ∈ (−1, 1); the scattering coefficient is σ′s/(1 − g).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    /// Henyey–Greenstein asymmetry g, in (−1, 1); the scattering coefficient is σ′s/(1 − g), so the
+    /// work grows like 1/(1 − g) as g → 1.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub g: f64,
-    /// Slab thickness [mm]; omit for a half-space.
-    #[arg(long, allow_hyphen_values = true)]
+    /// Slab thickness [mm]: finite, > 0; omit for a half-space.
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub thickness_mm: Option<f64>,
-    /// Number of photons.
-    #[arg(long, default_value_t = 1_000_000)]
+    /// Number of photons: a count ≥ 1 (1e6 is fine); the expected work must fit --max-interactions.
+    #[arg(long, default_value = "1000000", value_parser = crate::numeric::parse_count)]
     pub photons: u64,
-    /// Seed of the random streams (the result is identical for any thread count).
+    /// Seed of the random streams, 0 to 2⁶⁴ − 1 (the result is identical for any thread count).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Beam: `pencil`, `disk:R` (uniform disk of radius R mm) or `gauss:R` (Gaussian, 1/e² radius R mm).
+    /// Beam: `pencil`, `disk:R` (uniform disk of radius R mm, R > 0) or `gauss:R` (Gaussian, 1/e²
+    /// radius R mm, R > 0).
     #[arg(long, default_value = "pencil")]
     pub beam: String,
-    /// Angle of incidence [degrees] in air (0 = normal).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    /// Angle of incidence [degrees] in air, in [0, 90) (0 = normal).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub incidence_deg: f64,
-    /// Outer radius of the Rd(r) grid [mm].
-    #[arg(long, default_value_t = 10.0)]
+    /// Outer radius of the Rd(r) grid [mm]: finite, > 0.
+    #[arg(long, default_value_t = 10.0, value_parser = crate::numeric::parse_finite)]
     pub r_max_mm: f64,
-    /// Number of radial bins (uniform width r_max/bins).
-    #[arg(long, default_value_t = 200)]
+    /// Number of radial bins (uniform width r_max/bins): a count ≥ 1, within the memory budget
+    /// (about 1 KiB per bin; 8 GiB holds 8 million).
+    #[arg(long, default_value = "200", value_parser = crate::numeric::parse_size)]
     pub bins: usize,
-    /// Also tally reflectance by exit angle in this many bins over [0°, 90°].
-    #[arg(long, default_value_t = 0)]
+    /// Also tally reflectance by exit angle in this many bins over [0°, 90°]: a count, 0 (off) or
+    /// more, within the memory budget with --bins.
+    #[arg(long, default_value = "0", value_parser = crate::numeric::parse_size)]
     pub angle_bins: usize,
     /// Accept η < 1 (a material optically thinner than air).
     #[arg(long)]
     pub allow_eta_below_one: bool,
+    #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
+          help = crate::numeric::MAX_INTERACTIONS_HELP)]
+    pub max_interactions: u64,
+    #[arg(long, value_parser = crate::numeric::parse_count, help = crate::numeric::MAX_MEMORY_HELP)]
+    pub max_memory_mib: Option<u64>,
     /// Write the profile as CSV (r_inner_mm, r_outer_mm, r_mm, rd_per_mm2, rd_stderr_per_mm2).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Print the whole result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
-    /// No progress bar.
+    /// No progress bar and no cost estimate on stderr.
     #[arg(long)]
     pub quiet: bool,
 }
@@ -96,17 +109,37 @@ fn parse_beam(text: &str) -> anyhow::Result<BeamProfile> {
     }
 }
 
-/// Validated configuration from the flags.
+/// Largest η accepted: beyond any solid's (diamond 2.42, germanium in the infrared 4).
+const MAX_ETA: f64 = 10.0;
+
+/// Validated configuration from the flags: every range, then the memory of the tallies (before the
+/// grid is made) and the expected work (before any photon is traced).
 fn configure(args: &Args) -> anyhow::Result<Simulation> {
-    if args.photons == 0 {
-        bail!("--photons 0: trace at least one photon");
-    }
-    if !(args.eta.is_finite() && args.eta > 0.0) {
-        bail!(
-            "--eta {}: the relative refractive index must be finite and > 0",
-            args.eta
-        );
-    }
+    let range = |ok: bool, flag: &str, value: f64, rule: &str| -> anyhow::Result<()> {
+        if ok {
+            Ok(())
+        } else {
+            bail!("{flag} {value}: {rule}")
+        }
+    };
+    range(
+        args.sigma_s_prime >= 0.0,
+        "--sigma-s-prime",
+        args.sigma_s_prime,
+        "the reduced scattering coefficient must be ≥ 0 mm⁻¹",
+    )?;
+    range(
+        args.sigma_a >= 0.0,
+        "--sigma-a",
+        args.sigma_a,
+        "the absorption coefficient must be ≥ 0 mm⁻¹",
+    )?;
+    range(
+        args.eta > 0.0 && args.eta <= MAX_ETA,
+        "--eta",
+        args.eta,
+        "the relative refractive index must lie in (0, 10]",
+    )?;
     if args.eta < 1.0 && !args.allow_eta_below_one {
         bail!(
             "--eta {}: below 1 means the material is optically thinner than air, which is unusual for \
@@ -114,10 +147,56 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
             args.eta
         );
     }
-    let thickness = args.thickness_mm.unwrap_or(f64::INFINITY);
-    if args.thickness_mm.is_some_and(|t| !t.is_finite()) {
-        bail!("--thickness-mm must be a finite number of mm (omit it for a half-space)");
+    range(
+        args.g > -1.0 && args.g < 1.0,
+        "--g",
+        args.g,
+        "the Henyey–Greenstein asymmetry must lie in (−1, 1)",
+    )?;
+    if let Some(t) = args.thickness_mm {
+        range(
+            t > 0.0,
+            "--thickness-mm",
+            t,
+            "the slab thickness must be > 0 mm (omit it for a half-space)",
+        )?;
     }
+    range(
+        (0.0..90.0).contains(&args.incidence_deg),
+        "--incidence-deg",
+        args.incidence_deg,
+        "the angle of incidence must lie in [0, 90) degrees",
+    )?;
+    range(
+        args.r_max_mm > 0.0,
+        "--r-max-mm",
+        args.r_max_mm,
+        "the outer radius must be > 0 mm",
+    )?;
+    if args.photons == 0 {
+        bail!("--photons 0: trace at least one photon");
+    }
+    if args.bins == 0 {
+        bail!("--bins 0: the radial grid needs at least one bin");
+    }
+    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    crate::numeric::check_memory(
+        &format!(
+            "tallying {} radial and {} angular bins",
+            args.bins, args.angle_bins
+        ),
+        Simulation::tally_memory_bytes(args.bins, args.angle_bins),
+        budget,
+    )?;
+    if args.sigma_a == 0.0 && args.thickness_mm.is_none() {
+        bail!(
+            "--sigma-a 0 without --thickness-mm: in a half-space a photon without absorption \
+             has no finite mean path (it must wander back to the surface), so the simulation would \
+             never end; give a slab thickness with --thickness-mm, or a small absorption such as \
+             --sigma-a 1e-4 (the run's cost is then estimated and checked before it starts)"
+        );
+    }
+    let thickness = args.thickness_mm.unwrap_or(f64::INFINITY);
     let layer = Layer::from_reduced(
         args.sigma_s_prime,
         args.sigma_a,
@@ -131,20 +210,51 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
         .context("bad --beam")?
         .with_incidence(args.incidence_deg.to_radians())
         .context("bad --incidence-deg (must lie in [0, 90))")?;
-    if args.bins == 0 || !(args.r_max_mm.is_finite() && args.r_max_mm > 0.0) {
-        bail!("--r-max-mm must be > 0 and --bins ≥ 1");
-    }
     let grid = RadialGrid::uniform(args.r_max_mm / args.bins as f64, args.bins)?;
-    Ok(
-        Simulation::new(sample, beam, grid, args.photons, args.seed)?
-            .with_angle_bins(args.angle_bins),
-    )
+    let sim = Simulation::new(sample, beam, grid, args.photons, args.seed)?
+        .with_angle_bins(args.angle_bins);
+    let cost = sim.cost_estimate();
+    if cost.interactions > args.max_interactions as f64 {
+        bail!(
+            "this run is expected to take about {:.1e} interactions ({:.3e} per photon × {} \
+             photons; σs = σ′s/(1 − g) = {:.4e} mm⁻¹, σa = {} mm⁻¹{}), about {} on {} threads, \
+             more than the work budget of {:.1e} (--max-interactions); use fewer photons, a larger \
+             σa{}, a g further from 1, or raise --max-interactions if you mean it",
+            cost.interactions,
+            cost.interactions_per_photon,
+            args.photons,
+            layer.sigma_s(),
+            args.sigma_a,
+            args.thickness_mm
+                .map_or_else(|| ", half-space".to_owned(), |t| format!(", {t} mm thick")),
+            crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
+            rayon::current_num_threads(),
+            args.max_interactions as f64,
+            if args.thickness_mm.is_some() {
+                ", a thinner slab"
+            } else {
+                ""
+            },
+        );
+    }
+    Ok(sim)
 }
 
 /// Runs `scatterfit simulate`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let sim = configure(&args)?;
     let show = !args.quiet && std::io::stderr().is_terminal();
+    let cost = sim.cost_estimate();
+    let expected_s = cost.seconds(rayon::current_num_threads());
+    if !args.quiet && expected_s > 10.0 {
+        eprintln!(
+            "expected work: {:.1e} interactions ({:.3e} per photon), about {} on {} threads",
+            cost.interactions,
+            cost.interactions_per_photon,
+            crate::numeric::describe_seconds(expected_s),
+            rayon::current_num_threads()
+        );
+    }
     let bar = if show {
         let bar = indicatif::ProgressBar::new(args.photons);
         bar.set_style(
@@ -201,6 +311,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         let e = |x: scatterfit_mc::Estimate| format!("{:.6} ± {:.6}", x.value, x.stderr);
         println!("photons            {}", result.photons);
+        println!(
+            "interactions       {} ({:.1} per photon)",
+            result.interactions,
+            result.interactions as f64 / result.photons as f64
+        );
         println!("specular R_sp      {:.6}", result.specular);
         println!("diffuse Rd         {}", e(result.rd_total));
         println!("transmitted Tt     {}", e(result.transmittance));
@@ -225,13 +340,13 @@ fn speed_cases(quick: bool) -> anyhow::Result<Vec<(&'static str, Sample, u64, &'
             "10 cm slab n=1.4 μa=0.1/cm μs=10/cm g=0",
             Sample::slab(Layer::new(0.01, 1.0, 0.0, 1.4, 100.0)?, 1.0)?,
             200_000 / k,
-            "MCML ≈ 1.0e5 photons/s per core; target ≥ 2e5",
+            "MCML (C, gcc -O3) ≈ 1.0e5 photons/s per core on the reference machine",
         ),
         (
             "standard slab (van de Hulst) g=0.75 τ=2",
             Sample::slab(Layer::new(1.0, 9.0, 0.75, 1.0, 0.2)?, 1.0)?,
             4_000_000 / k,
-            "MCML ≈ 4e6 photons/s per core; target ≥ 8e6",
+            "MCML (C, gcc -O3) ≈ 4e6 photons/s per core on the reference machine",
         ),
     ])
 }

@@ -234,13 +234,13 @@ pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figu
             name: "dipole Rd(r) + derivatives, 300 radii".into(),
             value: profile_us,
             unit: "µs".into(),
-            note: "one thread; issue target < 5 µs".into(),
+            note: "one thread; BENCHMARKS.md has the figures of the reference machine".into(),
         },
         crate::bench::Figure {
             name: "α′ inversion (Rd = 0.01…0.99, η = 1.3)".into(),
             value: inversion_us,
             unit: "µs".into(),
-            note: "one thread, mean over Rd; issue target < 2 µs".into(),
+            note: "one thread, mean over Rd".into(),
         },
     ])
 }

@@ -68,7 +68,7 @@ fn simulate_refuses_bad_input() {
     let cases: [(&[&str], &str); 6] = [
         (
             &["--sigma-s-prime", "1", "--sigma-a", "-0.1", "--eta", "1.3"],
-            "sigma_a",
+            "--sigma-a",
         ),
         (
             &[
@@ -181,4 +181,123 @@ fn table_builds_then_reuses_cache() {
     let second = run();
     assert_eq!(second["status"], "loaded from cache");
     assert_eq!(first["rd_total"], second["rd_total"]);
+}
+
+/// Issue 10: runs that would never finish, or exhaust memory, are refused before any work with exit
+/// 2 and a message giving the estimate and the way out; counts accept `1e4`.
+#[test]
+fn simulate_refuses_unbounded_work_and_memory_up_front() {
+    let base = ["simulate", "--eta", "1.4"];
+    let cases: [(&[&str], &[&str]); 6] = [
+        (
+            &["--sigma-a", "0"],
+            &["never end", "--thickness-mm", "--sigma-a 1e-4"],
+        ),
+        (
+            &["--sigma-a", "0.01", "--g", "0.9999999"],
+            &["interactions", "days", "--max-interactions"],
+        ),
+        (
+            &["--sigma-a", "0.01", "--sigma-s-prime", "1e12"],
+            &["interactions", "--max-interactions"],
+        ),
+        (
+            &["--sigma-a", "0.01", "--bins", "1e11"],
+            &["TiB", "--max-memory-mib"],
+        ),
+        (
+            &["--sigma-a", "0.01", "--angle-bins", "1e9"],
+            &["GiB", "--max-memory-mib"],
+        ),
+        (
+            &["--sigma-a", "0.01", "--photons", "1.5"],
+            &["whole number"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let start = std::time::Instant::now();
+        let sp = if args.contains(&"--sigma-s-prime") {
+            &[][..]
+        } else {
+            &["--sigma-s-prime", "1"][..]
+        };
+        let out = scatterfit()
+            .args(base)
+            .args(sp)
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        for needle in needles {
+            assert!(err.contains(needle), "{args:?}: {needle} not in {err}");
+        }
+        assert!(
+            start.elapsed().as_secs() < 5,
+            "{args:?} took {:?}",
+            start.elapsed()
+        );
+    }
+    // A slab without absorption is fine, and counts take scientific notation.
+    let out = scatterfit()
+        .args(base)
+        .args([
+            "--sigma-s-prime",
+            "1",
+            "--sigma-a",
+            "0",
+            "--thickness-mm",
+            "1",
+        ])
+        .args(["--photons", "1e4", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["result"]["photons"], 10_000);
+    assert!(json["result"]["interactions"].as_u64().unwrap() > 10_000);
+    // The work budget can be lowered (and raised) explicitly.
+    let out = scatterfit()
+        .args(base)
+        .args([
+            "--sigma-s-prime",
+            "1",
+            "--sigma-a",
+            "0.01",
+            "--photons",
+            "1e4",
+        ])
+        .args(["--max-interactions", "1e5"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// Issue 10 for `table`: a g close to 1 is refused with its cost; absurd sizes are refused with
+/// their ranges; nothing is written to the cache.
+#[test]
+fn table_refuses_unbounded_work_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (&["--g", "0.99999"], "--max-interactions"),
+        (&["--albedos", "1e9"], "2 to 1000"),
+        (&["--photons-per-albedo", "0"], "at least one photon"),
+        (&["--g", "1"], "(−1, 1)"),
+    ];
+    for (args, needle) in cases {
+        let out = scatterfit()
+            .args(["table", "--eta", "1.4", "--cache-dir"])
+            .arg(dir.path())
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }

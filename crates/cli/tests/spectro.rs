@@ -1,5 +1,4 @@
-//! Integration tests of `scatterfit spectro` and `scatterfit demo`: the real binary in a temporary
-//! folder.
+//! Integration tests of `scatterfit spectro`: the real binary in a temporary folder.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -39,7 +38,7 @@ fn spectro_json_reports_eta_and_albedo() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!((v["eta"].as_f64().unwrap() - 1.5).abs() < 1e-6);
     // A flat 0.5 spectrum is a neutral grey: linear sRGB ≈ 0.5 in every channel.
-    for c in v["channels"].as_array().unwrap() {
+    for c in ["r", "g", "b"].map(|k| &v["channels"][k]) {
         assert!((c["rd_total"].as_f64().unwrap() - 0.5).abs() < 2e-4);
         assert!(c["albedo_prime"].as_f64().unwrap() > 0.9);
     }
@@ -61,7 +60,7 @@ fn given_eta_and_grey_match_inversion_vector() {
         String::from_utf8_lossy(&out.stderr)
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    for c in v["channels"].as_array().unwrap() {
+    for c in ["r", "g", "b"].map(|k| &v["channels"][k]) {
         assert!(
             (c["albedo_prime"].as_f64().unwrap() - 0.97258193).abs() < 3e-5,
             "{c}"
@@ -133,56 +132,4 @@ fn out_of_gamut_lab_is_a_failed_measurement() {
     );
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stdout).contains("channel R"));
-}
-
-/// The demo recovers the published η and α′ of the paper's seven materials from its synthetic
-/// readings (Choi, Lee & Chin 2014, Table 1: the truth is computed here from σ′s and σa, not read
-/// from the tool's output).
-#[test]
-fn demo_recovers_published_parameters() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = scatterfit(&["demo", "--out-dir", "d", "--json"], dir.path());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let table1 = [
-        (
-            "pink-plastic",
-            [1.979, 1.893, 1.992],
-            [0.000792, 0.049600, 0.022700],
-            1.2886,
-        ),
-        (
-            "red-aluminum",
-            [1.89, 1.171, 0.7498],
-            [0.018700, 0.768300, 0.558000],
-            2.4102,
-        ),
-    ];
-    for (name, sp, sa, eta) in table1 {
-        let row = rows
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|r| r["name"] == name)
-            .unwrap();
-        // Six decimals in the CSV limit η to ~1e-4 near η = 2.4.
-        assert!(
-            (row["eta_recovered"].as_f64().unwrap() - eta).abs() < 2e-4,
-            "{name}"
-        );
-        for c in 0..3 {
-            let truth = sp[c] / (sp[c] + sa[c]);
-            let got = row["albedo_prime_recovered"][c].as_f64().unwrap();
-            assert!(
-                (got - truth).abs() < 1e-3 * (1.0 - truth).max(0.05),
-                "{name} {c}: {got} vs {truth}"
-            );
-        }
-    }
-    assert!(dir.path().join("d/pink-plastic/spectro.csv").exists());
-    assert!(dir.path().join("d/demo-summary.json").exists());
 }

@@ -109,6 +109,82 @@ pub enum ImagingError {
         /// Pixels required.
         needed: usize,
     },
+    /// The number of sample pixels for response recovery is outside what the bracket needs and
+    /// what the solver can hold.
+    #[error(
+        "{samples} sample pixels per channel with {frames} frames: the response recovery takes \
+         {min} to {max} (at least ⌈256/(P − 1)⌉, so that N·(P − 1) ≥ 256 equations determine the 256 \
+         values of g, Debevec & Malik 1997 §2.1; more than {max} only cost time and memory)"
+    )]
+    SampleCount {
+        /// Samples asked for.
+        samples: usize,
+        /// Frames in the bracket.
+        frames: usize,
+        /// The least number for this bracket, ⌈256/(P − 1)⌉.
+        min: usize,
+        /// The most accepted, [`crate::MAX_RESPONSE_SAMPLES`].
+        max: usize,
+    },
+    /// The recovered response does not increase with the code value: a camera's does, so the
+    /// exposure times do not belong to their frames (reversed or shuffled) or the bracket carries
+    /// too little information.
+    #[error(
+        "channel {channel}: the recovered camera response falls by {drop:.3} (ln units) between code \
+         {z_from} and code {z_to}, over a rise of {span:.3} across the codes the samples use; a \
+         camera's response increases with exposure — are the exposure times in the right order, each \
+         with its own frame? (check the exposures CSV or the files' EXIF times, or give a known \
+         response)"
+    )]
+    ResponseNotIncreasing {
+        /// Channel index.
+        channel: usize,
+        /// Code where the fall starts (the running maximum).
+        z_from: usize,
+        /// Code where the fall is largest.
+        z_to: usize,
+        /// The fall g(z_from) − g(z_to) [ln exposure].
+        drop: f64,
+        /// g(z_hi) − g(z_lo) over the codes the samples use (negative for a curve that runs
+        /// downward).
+        span: f64,
+    },
+    /// The dark frame is at or above the signal: fewer than [`crate::MIN_VALID_FRACTION`] of a
+    /// channel's pixels rise above it even in the longest exposure.
+    #[error(
+        "dark frame, channel {channel}: only {above} of {total} pixels of the longest exposure are \
+         brighter than the dark frame; a dark frame is taken with the light blocked (lens capped) at \
+         the bracket's settings and must be darker than the scene — is it the right file, or taken \
+         with the light on?"
+    )]
+    DarkFrameAboveSignal {
+        /// Channel index.
+        channel: usize,
+        /// Pixels of the longest exposure above the dark frame.
+        above: usize,
+        /// Pixels in the image.
+        total: usize,
+    },
+    /// (Nearly) every pixel of a channel is clipped in every exposure: the merge has no radiance to
+    /// give.
+    #[error(
+        "channel {channel}: only {valid} of {total} pixels have a radiance ({saturated} saturated in \
+         every exposure, {dark} at or below the black level in every exposure); {advice}"
+    )]
+    NoValidRadiance {
+        /// Channel index.
+        channel: usize,
+        /// Pixels with an estimate.
+        valid: usize,
+        /// Pixels in the image.
+        total: usize,
+        /// Pixels saturated in every exposure.
+        saturated: usize,
+        /// Pixels at the low clip (or the dark level) in every exposure.
+        dark: usize,
+        /// What to do.
+        advice: &'static str,
+    },
     /// The least-squares system for the response is rank deficient or not finite.
     #[error("channel {channel}: response recovery failed: {reason}")]
     SolveFailed {
@@ -138,6 +214,24 @@ pub enum ImagingError {
     /// A buffer could not be built.
     #[error(transparent)]
     Shape(#[from] ShapeError),
+}
+
+impl ImagingError {
+    /// True when the error says that a measurement ran and failed (the CLI's exit code 1): the data
+    /// do not yield a result — a bracket with too few usable pixels, a response that does not
+    /// increase, a radiance map without valid pixels, no light spot. False for bad input or options
+    /// (exit code 2), which are found before any work: mismatched frames, times, shapes, an option
+    /// out of range, a dark frame at or above the signal.
+    pub fn is_failed_measurement(&self) -> bool {
+        matches!(
+            self,
+            Self::NotEnoughSamples { .. }
+                | Self::SolveFailed { .. }
+                | Self::ResponseNotIncreasing { .. }
+                | Self::NoValidRadiance { .. }
+                | Self::NoSpot { .. }
+        )
+    }
 }
 
 /// Result with [`ImagingError`].

@@ -24,11 +24,12 @@ pub use buffer::{ImageBuf, ShapeError};
 pub use center::{CenterOptions, SpotCenter, find_spot_center};
 pub use error::{ImagingError, Result};
 pub use merge::{
-    CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MergeOptions, Weighting,
-    merge, merge_linear_u16,
+    CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MIN_VALID_FRACTION,
+    MergeOptions, Weighting, merge, merge_linear_u16,
 };
-pub use profile::{ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
+pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{
-    CalibrateOptions, Calibration, ChannelSolution, LEVELS, ResponseCurve, SamplePixel, gsolve,
-    hat_weight, recover_response, select_samples,
+    CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,
+    MAX_RESPONSE_SAMPLES, ResponseCurve, SamplePixel, gsolve, hat_weight, min_response_samples,
+    recover_response, select_samples,
 };

@@ -23,6 +23,83 @@ pub const CLIPPED_LOW: u8 = 1;
 /// sample.
 pub const CLIPPED_HIGH: u8 = 2;
 
+/// The least fraction of a channel's pixels that must have a radiance estimate (and, with a dark
+/// frame, rise above it in the longest exposure) for a merge to count as a measurement: 0.1 %, a disc
+/// of 87 px radius in a 24-MP frame. Below it the merge is refused
+/// ([`ImagingError::NoValidRadiance`], [`ImagingError::DarkFrameAboveSignal`]) instead of returning
+/// a map of NaN that looks like a result.
+pub const MIN_VALID_FRACTION: f64 = 1e-3;
+
+/// The least number of pixels out of `total` that [`MIN_VALID_FRACTION`] asks for (at least 1).
+fn min_valid(total: usize) -> usize {
+    ((MIN_VALID_FRACTION * total as f64).ceil() as usize).max(1)
+}
+
+/// Refuses a dark frame at or above the signal: per channel, fewer than [`min_valid`] pixels of the
+/// longest exposure above the dark frame.
+fn check_dark<T: Copy + PartialOrd>(
+    frames: &[ImageBuf<T>],
+    times_s: &[f64],
+    dark: &ImageBuf<T>,
+) -> Result<()> {
+    let longest = (0..frames.len())
+        .max_by(|&a, &b| times_s[a].total_cmp(&times_s[b]))
+        .unwrap_or(0);
+    let (f, ch) = (&frames[longest], dark.channels());
+    let total = f.width() * f.height();
+    for channel in 0..ch {
+        let above = f
+            .data()
+            .iter()
+            .zip(dark.data())
+            .skip(channel)
+            .step_by(ch)
+            .filter(|(v, d)| v > d)
+            .count();
+        if above < min_valid(total) {
+            return Err(ImagingError::DarkFrameAboveSignal {
+                channel,
+                above,
+                total,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a merge in which (nearly) every pixel of a channel is clipped in every exposure.
+fn check_valid(mask: &ImageBuf<u8>) -> Result<()> {
+    let ch = mask.channels();
+    let total = mask.width() * mask.height();
+    for channel in 0..ch {
+        let (mut valid, mut saturated, mut dark) = (0usize, 0usize, 0usize);
+        for &m in mask.data().iter().skip(channel).step_by(ch) {
+            match m {
+                0 => valid += 1,
+                m if m & CLIPPED_HIGH != 0 => saturated += 1,
+                _ => dark += 1,
+            }
+        }
+        if valid < min_valid(total) {
+            return Err(ImagingError::NoValidRadiance {
+                channel,
+                valid,
+                total,
+                saturated,
+                dark,
+                advice: if saturated >= dark {
+                    "the bracket is overexposed: add shorter exposures (or dim the light) so that \
+                     every pixel is below saturation in at least one frame"
+                } else {
+                    "the bracket is too dark: add longer exposures (or more light), and check that \
+                     the dark frame is darker than the scene"
+                },
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The radiance given to a pixel-channel that is clipped in every exposure (always also flagged).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
@@ -123,7 +200,10 @@ impl HdrImage {
 ///
 /// # Errors
 /// Bracket errors (fewer than 2 frames, one time per frame, positive distinct times, equal shapes),
-/// a dark frame of another shape, [`ImagingError::ChannelMismatch`].
+/// a dark frame of another shape, [`ImagingError::ChannelMismatch`];
+/// [`ImagingError::DarkFrameAboveSignal`] (checked before merging) and
+/// [`ImagingError::NoValidRadiance`] when fewer than [`MIN_VALID_FRACTION`] of a channel's pixels
+/// have an estimate.
 pub fn merge(
     frames: &[ImageBuf<u8>],
     times_s: &[f64],
@@ -142,6 +222,7 @@ pub fn merge(
     }
     if let Some(d) = dark {
         check_shape(f0, d, || "dark frame".to_string())?;
+        check_dark(frames, times_s, d)?;
     }
     let g = |c: usize| &response.tables()[if response.channels() == 1 { 0 } else { c }];
     let lin: Vec<Vec<f64>> = (0..ch)
@@ -235,9 +316,11 @@ pub fn merge(
             },
         )
         .sum();
+    let clipped = ImageBuf::new(w, h, ch, mask)?;
+    check_valid(&clipped)?;
     Ok(HdrImage {
         radiance: ImageBuf::new(w, h, ch, radiance)?,
-        clipped: ImageBuf::new(w, h, ch, mask)?,
+        clipped,
         clipped_count,
     })
 }
@@ -433,7 +516,8 @@ fn merge_row_lut(rows: &[&[u8]], t: &Tables, out: &mut [f32], den: &mut [f32]) {
 /// value counts as clipped low; saturation is judged on the raw value.
 ///
 /// # Errors
-/// Bracket errors, a dark frame of another shape, [`ImagingError::InvalidOption`] for saturation < 2.
+/// Bracket errors, a dark frame of another shape, [`ImagingError::InvalidOption`] for saturation < 2,
+/// [`ImagingError::DarkFrameAboveSignal`], [`ImagingError::NoValidRadiance`] (as [`merge`]).
 pub fn merge_linear_u16(
     frames: &[ImageBuf<u16>],
     times_s: &[f64],
@@ -445,6 +529,7 @@ pub fn merge_linear_u16(
     let (w, h, ch) = (f0.width(), f0.height(), f0.channels());
     if let Some(d) = dark {
         check_shape(f0, d, || "dark frame".to_string())?;
+        check_dark(frames, times_s, d)?;
     }
     let sat = opts.saturation;
     if sat < 2 {
@@ -506,9 +591,11 @@ pub fn merge_linear_u16(
             count
         })
         .sum();
+    let clipped = ImageBuf::new(w, h, ch, mask)?;
+    check_valid(&clipped)?;
     Ok(HdrImage {
         radiance: ImageBuf::new(w, h, ch, radiance)?,
-        clipped: ImageBuf::new(w, h, ch, mask)?,
+        clipped,
         clipped_count,
     })
 }

@@ -7,6 +7,10 @@
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result, check_shape};
 
+/// Most rings a profile may have (r_max / ring width): 10⁶ rings hold about 100 MB of statistics
+/// for RGB, far more than a light spot's profile needs (the paper uses 300).
+pub const MAX_RINGS: usize = 1_000_000;
+
 /// Options of [`radial_profile`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProfileOptions {
@@ -85,7 +89,8 @@ impl RadialProfile {
 /// `mask` (e.g. [`crate::HdrImage::clipped`]; same shape as `img`) is non-zero there.
 ///
 /// # Errors
-/// [`ImagingError::InvalidOption`] for a non-positive ring width, r_max or mm per pixel;
+/// [`ImagingError::InvalidOption`] for a non-positive ring width, r_max or mm per pixel, or more
+/// than [`MAX_RINGS`] rings;
 /// [`ImagingError::CenterOutside`] for a non-finite centre; [`ImagingError::ShapeMismatch`] for a mask
 /// of another shape.
 pub fn radial_profile(
@@ -124,7 +129,15 @@ pub fn radial_profile(
     }
     let width = opts.ring_width_px;
     let r_max = opts.r_max_px;
-    let n_rings = (r_max / width).ceil() as usize;
+    let rings = (r_max / width).ceil();
+    if rings > MAX_RINGS as f64 {
+        return Err(ImagingError::InvalidOption {
+            name: "r_max_px / ring_width_px",
+            value: rings,
+            reason: "more than 1 000 000 rings (MAX_RINGS); widen the rings or reduce r_max",
+        });
+    }
+    let n_rings = rings as usize;
     // Per ring: pixel count and Σr over in-image pixels; per ring and channel: n, Σv, Σv², Σr.
     let mut geo = vec![(0usize, 0.0f64); n_rings];
     let mut acc = vec![[0.0f64; 4]; n_rings * ch];
@@ -208,4 +221,39 @@ pub fn radial_profile(
         options: *opts,
         rings,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 10: `--ring-width-px 1e-300` panicked with "capacity overflow" and `--r-max-px 1e13`
+    /// asked for 160 TB; both are now an `InvalidOption` before anything is allocated.
+    #[test]
+    fn ring_count_is_bounded() {
+        let img = ImageBuf::filled(8, 8, 1, 1.0f32).unwrap();
+        for (width, r_max) in [(1e-300, 300.0), (1.0, 1e13), (1e-3, 1001.0)] {
+            let opts = ProfileOptions {
+                ring_width_px: width,
+                r_max_px: r_max,
+            };
+            let err = radial_profile(&img, [4.0, 4.0], None, 0.1, &opts).unwrap_err();
+            assert!(
+                matches!(
+                    err,
+                    ImagingError::InvalidOption {
+                        name: "r_max_px / ring_width_px",
+                        ..
+                    }
+                ),
+                "{err:?}"
+            );
+        }
+        let opts = ProfileOptions {
+            ring_width_px: 1e-3,
+            r_max_px: 1000.0,
+        };
+        let p = radial_profile(&img, [4.0, 4.0], None, 0.1, &opts).unwrap();
+        assert_eq!(p.rings.len(), MAX_RINGS);
+    }
 }

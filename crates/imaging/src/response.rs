@@ -15,6 +15,23 @@ use crate::error::{ImagingError, Result, check_bracket};
 /// Number of code values of an 8-bit frame.
 pub const LEVELS: usize = 256;
 
+/// Most sample pixels per channel [`recover_response`] and [`gsolve`] accept: 10× the default. The
+/// dense system has N·P + 255 rows of 256 doubles (1000 samples × 13 frames: 27 MB, well under a
+/// second to solve); more samples add nothing that 1000 do not already give.
+pub const MAX_RESPONSE_SAMPLES: usize = 1000;
+
+/// Largest fall of a recovered response, as a fraction of its rise over the codes the samples use,
+/// that is taken for noise rather than a curve running the wrong way (see
+/// [`ImagingError::ResponseNotIncreasing`]).
+pub const MAX_RESPONSE_FALL: f64 = 0.05;
+
+/// The fewest sample pixels per channel for a bracket of `frames` exposures: N·(P − 1) ≥ 256, so that
+/// the data rows alone (once each pixel's ln E is eliminated) outnumber the 256 unknowns g(z)
+/// (Debevec & Malik 1997, §2.1: "N(P − 1) > (Z_max − Z_min)"). 256 for 2 frames, 22 for 13.
+pub fn min_response_samples(frames: usize) -> usize {
+    LEVELS.div_ceil(frames.saturating_sub(1).max(1))
+}
+
 /// The paper's hat weight, Debevec & Malik 1997, eq. (4) with Z_min = 0, Z_max = 255:
 /// w(z) = z − Z_min for z ≤ ½(Z_min + Z_max), Z_max − z otherwise. So w(0) = w(255) = 0 (clipped codes
 /// carry no weight) and w(127) = w(128) = 127.
@@ -130,7 +147,8 @@ impl ResponseCurve {
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrateOptions {
     /// Number of sample pixels N per channel (OpenCV's default is 70; Debevec & Malik ask for
-    /// N(P − 1) > 255 with P frames). Default 100.
+    /// N(P − 1) > 255 with P frames). Default 100; [`recover_response`] accepts
+    /// [`min_response_samples`]`(P)` to [`MAX_RESPONSE_SAMPLES`].
     pub samples: usize,
     /// Smoothness weight λ of the second-difference rows (Debevec & Malik 1997, eq. 3). Default 10,
     /// OpenCV's default.
@@ -213,6 +231,14 @@ pub fn gsolve(z: &[u8], ln_dt: &[f64], lambda: f64, channel: usize) -> Result<Ch
         });
     }
     let n = z.len() / p;
+    if n > MAX_RESPONSE_SAMPLES {
+        return Err(ImagingError::SampleCount {
+            samples: n,
+            frames: p,
+            min: 1,
+            max: MAX_RESPONSE_SAMPLES,
+        });
+    }
     let rows = n * p + 1 + (LEVELS - 2);
     let mut a = DMatrix::<f64>::zeros(rows, LEVELS);
     let mut b = DVector::<f64>::zeros(rows);
@@ -330,33 +356,56 @@ fn solve_least_squares(a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>>
 /// Recovers the camera response of each channel from an 8-bit bracket (Debevec & Malik 1997): picks
 /// [`CalibrateOptions::samples`] pixels per channel with [`select_samples`] and solves [`gsolve`].
 ///
+/// The recovered curve is checked: over the codes the samples use (1st to 99th percentile, codes 0
+/// and 255 left out) it must rise, and fall nowhere by more than [`MAX_RESPONSE_FALL`] of that rise
+/// (noise can make an estimate dip by a hair; exposure times in the wrong order make it run
+/// downward).
+///
 /// # Errors
 /// Bracket errors (fewer than 2 frames, times not one per frame, non-positive or duplicate times,
-/// frames of different shapes), [`ImagingError::InvalidOption`], [`ImagingError::NotEnoughSamples`],
-/// [`ImagingError::SolveFailed`].
+/// frames of different shapes), [`ImagingError::SampleCount`] for a sample count outside
+/// [`min_response_samples`]`(P)..=`[`MAX_RESPONSE_SAMPLES`], [`ImagingError::InvalidOption`],
+/// [`ImagingError::NotEnoughSamples`] when the bracket has fewer usable pixels than that minimum,
+/// [`ImagingError::SolveFailed`], [`ImagingError::ResponseNotIncreasing`].
 pub fn recover_response(
     frames: &[ImageBuf<u8>],
     times_s: &[f64],
     opts: &CalibrateOptions,
 ) -> Result<Calibration> {
     check_bracket(frames, times_s)?;
-    let ln_dt: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();
     let p = frames.len();
+    let min = min_response_samples(p);
+    if !(min..=MAX_RESPONSE_SAMPLES).contains(&opts.samples) {
+        return Err(ImagingError::SampleCount {
+            samples: opts.samples,
+            frames: p,
+            min,
+            max: MAX_RESPONSE_SAMPLES,
+        });
+    }
+    let ln_dt: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();
     let mut samples = Vec::new();
     let mut solutions = Vec::new();
     for c in 0..frames[0].channels() {
         let picked = select_samples(frames, times_s, c, opts.samples)?;
+        if picked.len() < min {
+            return Err(ImagingError::NotEnoughSamples {
+                channel: c,
+                found: picked.len(),
+                needed: min,
+            });
+        }
         let mut z = Vec::with_capacity(picked.len() * p);
         for s in &picked {
             for f in frames {
                 z.push(f.data()[(s.y * f.width() + s.x) * f.channels() + c]);
             }
         }
-        solutions.push(gsolve(&z, &ln_dt, opts.lambda, c)?);
+        let solution = gsolve(&z, &ln_dt, opts.lambda, c)?;
+        check_increasing(&solution.g, &z, c)?;
+        solutions.push(solution);
         samples.push(picked);
     }
-    // Not validated for monotonicity: noise can make an estimated curve dip by a hair, and that is the
-    // estimate's business, not an input error.
     let response = ResponseCurve {
         g: solutions.iter().map(|s| s.g).collect(),
     };
@@ -365,6 +414,54 @@ pub fn recover_response(
         samples,
         solutions,
     })
+}
+
+/// Refuses a recovered curve that does not rise over the codes the samples use (1st to 99th
+/// percentile of their codes, 0 and 255 left out), or falls anywhere there by more than
+/// [`MAX_RESPONSE_FALL`] of its rise.
+fn check_increasing(g: &[f64; LEVELS], z: &[u8], channel: usize) -> Result<()> {
+    let mut hist = [0usize; LEVELS];
+    for &v in z {
+        if v != 0 && v != u8::MAX {
+            hist[usize::from(v)] += 1;
+        }
+    }
+    let n: usize = hist.iter().sum();
+    let quantile = |q: f64| {
+        let target = ((q * n as f64).ceil() as usize).max(1);
+        let mut acc = 0;
+        for (code, count) in hist.iter().enumerate() {
+            acc += count;
+            if acc >= target {
+                return code;
+            }
+        }
+        LEVELS - 1
+    };
+    let (lo, hi) = (quantile(0.01), quantile(0.99));
+    if n == 0 || hi <= lo {
+        return Ok(());
+    }
+    let span = g[hi] - g[lo];
+    let (mut peak, mut drop, mut z_from, mut z_to) = (lo, 0.0f64, lo, lo);
+    for code in lo..=hi {
+        if g[code] > g[peak] {
+            peak = code;
+        }
+        if g[peak] - g[code] > drop {
+            (drop, z_from, z_to) = (g[peak] - g[code], peak, code);
+        }
+    }
+    if span <= 0.0 || drop > MAX_RESPONSE_FALL * span {
+        return Err(ImagingError::ResponseNotIncreasing {
+            channel,
+            z_from,
+            z_to,
+            drop,
+            span,
+        });
+    }
+    Ok(())
 }
 
 /// Chooses `n` sample pixels of channel `c` for response recovery, deterministically.
@@ -395,11 +492,12 @@ pub fn select_samples(
             reason: "no such channel",
         });
     }
-    if n == 0 {
-        return Err(ImagingError::InvalidOption {
-            name: "samples",
-            value: 0.0,
-            reason: "must be ≥ 1",
+    if n == 0 || n > MAX_RESPONSE_SAMPLES {
+        return Err(ImagingError::SampleCount {
+            samples: n,
+            frames: frames.len(),
+            min: 1,
+            max: MAX_RESPONSE_SAMPLES,
         });
     }
     // Candidate grid with a 1-pixel border (for central differences) where possible.

@@ -262,12 +262,111 @@ fn noise_aware_formula_by_hand() {
     let expected = (0.5 + 4.0 * u2 * 200.0 / 128.0) / (1.25 + 16.0 * u2);
     let got = f64::from(hdr.radiance.data()[0]);
     assert!((got / expected - 1.0).abs() < 1e-6, "{got} vs {expected}");
-    // Zero in every frame, or saturated in every frame: no estimate, flagged.
-    let hdr = merge(&[one(0), one(0)], &[1.0, 4.0], &resp, None, &opts).unwrap();
-    assert_eq!(hdr.clipped.data()[0], CLIPPED_LOW);
+    // Zero in every frame, or saturated in every frame: no estimate, flagged (beside a pixel that
+    // has one: a map with no estimate at all is refused, see `all_clipped_map_is_refused`).
+    let two = |z: u8| ImageBuf::new(2, 1, 1, vec![z, 100]).unwrap();
+    let hdr = merge(&[two(0), two(0)], &[1.0, 4.0], &resp, None, &opts).unwrap();
+    assert_eq!(hdr.clipped.data(), &[CLIPPED_LOW, 0]);
     assert!(hdr.radiance.data()[0].is_nan());
-    let hdr = merge(&[one(255), one(255)], &[1.0, 4.0], &resp, None, &opts).unwrap();
+    let hdr = merge(&[two(255), two(255)], &[1.0, 4.0], &resp, None, &opts).unwrap();
     assert_eq!(hdr.clipped.data()[0], CLIPPED_HIGH);
+}
+
+/// Issue 10: a bracket saturated (or black) everywhere gave an all-NaN map and exit 0. Now fewer
+/// than `MIN_VALID_FRACTION` of a channel's pixels with an estimate is a failed measurement naming
+/// the channel and what to change; 0.1 % valid pixels is still a map.
+#[test]
+fn all_clipped_map_is_refused() {
+    let resp = ResponseCurve::linear(3).unwrap();
+    let opts = MergeOptions::default();
+    let (w, h) = (50, 40);
+    let frame = |v: u8| ImageBuf::filled(w, h, 3, v).unwrap();
+    for (v, needle) in [(255u8, "overexposed"), (0, "too dark")] {
+        let err = merge(&[frame(v), frame(v)], &[1.0, 2.0], &resp, None, &opts).unwrap_err();
+        assert!(err.is_failed_measurement(), "{err:?}");
+        assert!(
+            matches!(
+                err,
+                ImagingError::NoValidRadiance {
+                    channel: 0,
+                    valid: 0,
+                    total: 2000,
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains(needle), "{err}");
+    }
+    // Two valid pixels of 2000 (0.1 %) in every channel: accepted.
+    let mut f = frame(255);
+    f.data_mut()[..6].fill(100);
+    assert!(merge(&[f.clone(), f], &[1.0, 2.0], &resp, None, &opts).is_ok());
+    // The 16-bit linear merge refuses the same way.
+    let u = |v: u16| ImageBuf::filled(w, h, 1, v).unwrap();
+    let err = merge_linear_u16(
+        &[u(65535), u(65535)],
+        &[1.0, 2.0],
+        None,
+        &LinearMergeOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, ImagingError::NoValidRadiance { .. }),
+        "{err:?}"
+    );
+}
+
+/// Issue 10: a dark frame brighter than the bracket wrote an all-NaN map. It is refused before the
+/// merge (bad input, not a failed measurement), for 8- and 16-bit data; a dark frame below the
+/// signal where the spot is, equal to it elsewhere, is accepted.
+#[test]
+fn dark_frame_at_or_above_the_signal_is_refused() {
+    let resp = ResponseCurve::linear(1).unwrap();
+    let opts = MergeOptions::default();
+    let (w, h) = (40, 30);
+    let frames: Vec<ImageBuf<u8>> = [30u8, 60]
+        .iter()
+        .map(|&v| ImageBuf::filled(w, h, 1, v).unwrap())
+        .collect();
+    let times = [1.0, 2.0];
+    for dark_level in [60u8, 200] {
+        let dark = ImageBuf::filled(w, h, 1, dark_level).unwrap();
+        let err = merge(&frames, &times, &resp, Some(&dark), &opts).unwrap_err();
+        assert!(!err.is_failed_measurement());
+        assert!(
+            matches!(
+                err,
+                ImagingError::DarkFrameAboveSignal {
+                    above: 0,
+                    total: 1200,
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains("light on"), "{err}");
+    }
+    // A background at the dark level with a small bright spot (4 px of 1200, above 0.1 %).
+    let mut spot = frames.clone();
+    for f in &mut spot {
+        f.data_mut().fill(20);
+        f.data_mut()[..4].fill(90);
+    }
+    let dark = ImageBuf::filled(w, h, 1, 20u8).unwrap();
+    assert!(merge(&spot, &times, &resp, Some(&dark), &opts).is_ok());
+    let u = |v: u16| ImageBuf::filled(w, h, 1, v).unwrap();
+    let err = merge_linear_u16(
+        &[u(100), u(200)],
+        &times,
+        Some(&u(200)),
+        &LinearMergeOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, ImagingError::DarkFrameAboveSignal { .. }),
+        "{err:?}"
+    );
 }
 
 /// With an 8-bit dark frame the hat is taken over the signal range above the dark code, like the

@@ -356,3 +356,60 @@ fn noise_aware_weighting_removes_dim_pixel_bias() {
         "hat {hat:?} vs {noise:?}"
     );
 }
+
+/// Issue 10: exposure times listed in reverse order gave a response running downward, accepted
+/// without a word. Now it is a failed measurement that asks whether the times are in the right
+/// order; two swapped neighbours in the middle of the bracket are refused as well.
+#[test]
+fn reversed_or_shuffled_times_are_refused() {
+    let s = scene();
+    let frames = bracket(&s, 1.0, 7);
+    let mut reversed = times();
+    reversed.reverse();
+    let err = recover_response(&frames, &reversed, &CalibrateOptions::default()).unwrap_err();
+    assert!(
+        matches!(err, ImagingError::ResponseNotIncreasing { channel: 0, span, .. } if span < 0.0),
+        "{err:?}"
+    );
+    assert!(err.is_failed_measurement());
+    assert!(err.to_string().contains("right order"), "{err}");
+    let mut shuffled = times();
+    shuffled.swap(3, 9);
+    let err = recover_response(&frames, &shuffled, &CalibrateOptions::default()).unwrap_err();
+    assert!(
+        matches!(err, ImagingError::ResponseNotIncreasing { .. }),
+        "{err:?}"
+    );
+}
+
+/// Issue 10: `--samples 1` gave a 35.6-stop dynamic range from a 13.5-stop bracket. The sample
+/// count must make N·(P − 1) ≥ 256 (Debevec & Malik 1997, §2.1): 22 for 13 frames, 256 for 2; and
+/// at most MAX_RESPONSE_SAMPLES. Refused before any work, as bad input.
+#[test]
+fn sample_count_is_bounded_by_the_unknowns() {
+    use scatterfit_imaging::{MAX_RESPONSE_SAMPLES, min_response_samples};
+    assert_eq!(min_response_samples(13), 22);
+    assert_eq!(min_response_samples(2), 256);
+    let s = scene();
+    let frames = bracket(&s, 1.0, 7);
+    let opts = |samples| CalibrateOptions {
+        samples,
+        ..Default::default()
+    };
+    for n in [0, 1, 21, MAX_RESPONSE_SAMPLES + 1, usize::MAX] {
+        let err = recover_response(&frames, &times(), &opts(n)).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                ImagingError::SampleCount {
+                    min: 22,
+                    max: 1000,
+                    ..
+                }
+            ),
+            "{n}: {err:?}"
+        );
+        assert!(!err.is_failed_measurement());
+    }
+    assert!(recover_response(&frames, &times(), &opts(22)).is_ok());
+}

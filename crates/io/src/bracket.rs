@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use crate::image_files::{CameraFrame, ImageFileError, decode_camera_frame, describe_shape};
+use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
 
 /// What can go wrong reading a bracket. Every variant names the file (and line) at fault.
 #[derive(Debug, thiserror::Error)]
@@ -32,6 +33,9 @@ pub enum BracketError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The exposures CSV is not text we read (UTF-16 without BOM, a workbook, binary, too large).
+    #[error(transparent)]
+    ExposuresText(TextError),
     /// The exposures CSV lacks the `file` or `time_s` column.
     #[error(
         "{}: the header must name the columns `file` and `time_s` (found: {found}); \
@@ -103,6 +107,24 @@ pub enum BracketError {
         /// How many were given.
         count: usize,
     },
+    /// The decoded bracket would not fit the memory budget ([`crate::budget`]).
+    #[error(
+        "the {frames} frames of this bracket ({shape}) need about {} once decoded, more than the \
+         memory budget of {}; {}",
+        crate::budget::describe_bytes(*needed),
+        crate::budget::describe_bytes(*budget),
+        crate::budget::how_to_raise()
+    )]
+    TooLarge {
+        /// Number of frames.
+        frames: usize,
+        /// The first frame's header, e.g. `6000×4000 Rgb8`.
+        shape: String,
+        /// Bytes needed.
+        needed: u64,
+        /// The budget.
+        budget: u64,
+    },
     /// A frame's size, channel count or bit depth differs from the first frame's.
     #[error(
         "{} is {found} but {} is {expected}; all frames of a bracket (and the dark frame) must have \
@@ -141,15 +163,43 @@ pub struct ExposureEntry {
 /// (empty file name, unparsable time, short line) and [`BracketError::NonPositiveTime`], each naming
 /// the CSV and the line.
 pub fn read_exposures_csv(path: &Path) -> Result<Vec<ExposureEntry>, BracketError> {
-    let text = std::fs::read_to_string(path).map_err(|source| BracketError::ExposuresRead {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = read_text_file(path).map_err(|e| exposures_text_error(e, path))?;
+    parse_exposures_csv(&text.text, path)
+}
+
+/// [`read_exposures_csv`] on the bytes of the file (any accepted encoding, [`crate::text`]); `path`
+/// names it in messages and relative image paths are resolved against its folder.
+///
+/// # Errors
+/// As [`read_exposures_csv`].
+pub fn parse_exposures_bytes(
+    bytes: &[u8],
+    path: &Path,
+) -> Result<Vec<ExposureEntry>, BracketError> {
+    let text = decode_text(bytes, path).map_err(|e| exposures_text_error(e, path))?;
+    parse_exposures_csv(&text.text, path)
+}
+
+fn exposures_text_error(e: TextError, path: &Path) -> BracketError {
+    match e {
+        TextError::Io { source, .. } => BracketError::ExposuresRead {
+            path: path.to_path_buf(),
+            source,
+        },
+        other => BracketError::ExposuresText(other),
+    }
+}
+
+/// [`read_exposures_csv`] on decoded text.
+///
+/// # Errors
+/// As [`read_exposures_csv`].
+pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>, BracketError> {
     let base = path.parent().unwrap_or(Path::new(""));
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
+    let dialect = CsvDialect::detect(text);
+    let mut reader = dialect
+        .reader_builder()
         .flexible(true)
-        .comment(Some(b'#'))
         .from_reader(text.as_bytes());
     let header_err = |found: String| BracketError::ExposuresHeader {
         path: path.to_path_buf(),
@@ -169,6 +219,7 @@ pub fn read_exposures_csv(path: &Path) -> Result<Vec<ExposureEntry>, BracketErro
         }));
     };
     let mut entries = Vec::new();
+    let mut lines = LineCounter::new(text);
     for record in reader.records() {
         let line_err = |line: u64, detail: String| BracketError::ExposuresLine {
             path: path.to_path_buf(),
@@ -176,12 +227,18 @@ pub fn read_exposures_csv(path: &Path) -> Result<Vec<ExposureEntry>, BracketErro
             detail,
         };
         let record = record.map_err(|e| {
-            let line = csv_line(&text, e.position());
+            let line = lines.line(e.position());
             line_err(line, format!("malformed CSV: {e}"))
         })?;
-        let line = csv_line(&text, record.position());
+        let line = lines.line(record.position());
         if record.iter().all(str::is_empty) {
             continue;
+        }
+        if record.len() > headers.len() {
+            return Err(line_err(
+                line,
+                dialect.extra_fields_hint(headers.len(), record.len()),
+            ));
         }
         let file = record.get(file_col).unwrap_or("");
         if file.is_empty() {
@@ -198,7 +255,7 @@ pub fn read_exposures_csv(path: &Path) -> Result<Vec<ExposureEntry>, BracketErro
                 ),
             ));
         };
-        let time_s = parse_time(time_text).ok_or_else(|| {
+        let time_s = parse_time(time_text, &dialect).ok_or_else(|| {
             line_err(
                 line,
                 format!(
@@ -222,41 +279,14 @@ pub fn read_exposures_csv(path: &Path) -> Result<Vec<ExposureEntry>, BracketErro
     Ok(entries)
 }
 
-/// The 1-based line of a CSV record, from its byte offset. The `csv` crate's own line counter skips
-/// blank and comment lines, and a record's offset can point at blank or `#` lines before it, so
-/// those are stepped over here.
-pub(crate) fn csv_line(text: &str, position: Option<&csv::Position>) -> u64 {
-    let Some(p) = position else { return 0 };
-    let mut start = usize::try_from(p.byte())
-        .unwrap_or(usize::MAX)
-        .min(text.len());
-    while start < text.len() {
-        let rest = &text[start..];
-        let end = rest.find('\n').map_or(rest.len(), |i| i + 1);
-        let line = rest[..end].trim();
-        if !(line.is_empty() || line.starts_with('#')) || end == rest.len() {
-            break;
-        }
-        start += end;
-    }
-    text.as_bytes()[..start]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count() as u64
-        + 1
-}
-
-/// Parses `0.01`, `1e-3` or `1/600` seconds.
-fn parse_time(text: &str) -> Option<f64> {
+/// Parses `0.01`, `1e-3` or `1/600` seconds (`0,01` where the dialect has decimal commas).
+fn parse_time(text: &str, dialect: &CsvDialect) -> Option<f64> {
     match text.split_once('/') {
         Some((num, den)) => {
-            let (num, den) = (
-                num.trim().parse::<f64>().ok()?,
-                den.trim().parse::<f64>().ok()?,
-            );
+            let (num, den) = (dialect.parse_f64(num)?, dialect.parse_f64(den)?);
             (den != 0.0).then(|| num / den)
         }
-        None => text.parse::<f64>().ok(),
+        None => dialect.parse_f64(text),
     }
 }
 
@@ -465,6 +495,7 @@ pub fn read_bracket(
         })
         .collect();
     check_distinct_times(&known)?;
+    check_bracket_budget(&plan, crate::budget::memory_budget_bytes())?;
 
     let decoded: Vec<Result<BracketFrame, BracketError>> = plan
         .par_iter()
@@ -500,6 +531,45 @@ pub fn read_bracket(
     Ok(Bracket { frames })
 }
 
+/// Reads the frames' headers (not their pixels) and refuses a bracket whose decoded frames would
+/// not fit `budget` bytes: all frames at once, plus one transient copy (alpha dropped) per decoding
+/// thread. A header that cannot be read is left for the decoder to report.
+fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), BracketError> {
+    use image::ImageDecoder;
+    let mut total = 0u64;
+    let mut largest = 0u64;
+    let mut shape = String::new();
+    for (path, _) in plan {
+        let Ok(reader) = image::ImageReader::open(path).and_then(|r| r.with_guessed_format())
+        else {
+            continue;
+        };
+        let Ok(decoder) = reader.into_decoder() else {
+            continue;
+        };
+        let (w, h) = decoder.dimensions();
+        let bytes = u64::from(w)
+            .saturating_mul(u64::from(h))
+            .saturating_mul(u64::from(decoder.color_type().bytes_per_pixel()));
+        if shape.is_empty() {
+            shape = format!("{w}×{h} {:?}", decoder.color_type());
+        }
+        total = total.saturating_add(bytes);
+        largest = largest.max(bytes);
+    }
+    let threads = rayon::current_num_threads() as u64;
+    let needed = total.saturating_add(largest.saturating_mul(threads));
+    if needed > budget {
+        return Err(BracketError::TooLarge {
+            frames: plan.len(),
+            shape,
+            needed,
+            budget,
+        });
+    }
+    Ok(())
+}
+
 /// Two times closer than one part in 10⁶ count as the same shutter speed.
 fn check_distinct_times(times: &[(PathBuf, f64)]) -> Result<(), BracketError> {
     let mut sorted: Vec<&(PathBuf, f64)> = times.iter().collect();
@@ -529,17 +599,36 @@ fn path_key(path: &Path) -> PathBuf {
     std::fs::canonicalize(path).unwrap_or_else(|_| path.components().collect())
 }
 
+/// Writes an `exposures.csv` (`file,time_s`; file names as given, relative to the CSV's folder)
+/// atomically. Times are written in Rust's shortest round-trip form, so they read back exactly.
+///
+/// # Errors
+/// The I/O error, with the path.
+pub fn write_exposures_csv(path: &Path, entries: &[(String, f64)]) -> std::io::Result<()> {
+    let mut text = String::from("file,time_s\n");
+    for (file, t) in entries {
+        text.push_str(&format!("{file},{t}\n"));
+    }
+    crate::atomic::write_atomic(path, text.as_bytes())
+        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn times_parse_as_decimals_and_fractions() {
-        assert_eq!(parse_time("0.5"), Some(0.5));
-        assert_eq!(parse_time("1/600"), Some(1.0 / 600.0));
-        assert_eq!(parse_time("2e-3"), Some(2e-3));
-        assert_eq!(parse_time("1/0"), None);
-        assert_eq!(parse_time("fast"), None);
+        let d = CsvDialect::detect("file,time_s");
+        assert_eq!(parse_time("0.5", &d), Some(0.5));
+        assert_eq!(parse_time("1/600", &d), Some(1.0 / 600.0));
+        assert_eq!(parse_time("2e-3", &d), Some(2e-3));
+        assert_eq!(parse_time("1/0", &d), None);
+        assert_eq!(parse_time("fast", &d), None);
+        assert_eq!(parse_time("0,5", &d), None);
+        let semicolon = CsvDialect::detect("file;time_s");
+        assert_eq!(parse_time("0,5", &semicolon), Some(0.5));
+        assert_eq!(parse_time("1/2,5", &semicolon), Some(0.4));
     }
 
     #[test]

@@ -51,6 +51,24 @@ pub enum ImageFileError {
         /// The OpenEXR library's error.
         source: exr::error::Error,
     },
+    /// Decoding the image would need more memory than the budget allows ([`crate::budget`]).
+    #[error(
+        "{}: {what} needs {} to decode, more than the memory budget of {}; {}",
+        path.display(),
+        crate::budget::describe_bytes(*needed),
+        crate::budget::describe_bytes(*budget),
+        crate::budget::how_to_raise()
+    )]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// What the header says, e.g. `a 60000×40000 RGB 16-bit image`.
+        what: String,
+        /// Bytes the decode would allocate.
+        needed: u64,
+        /// The budget.
+        budget: u64,
+    },
     /// The image decodes but its kind is not the one expected here (e.g. float data as a camera
     /// frame, 8-bit data as a radiance map, EXR channels that are neither `R,G,B` nor `Y`).
     #[error("{}: {detail}", path.display())]
@@ -144,13 +162,28 @@ pub fn read_camera_frame(path: &Path) -> Result<DecodedFrame, ImageFileError> {
     decode_camera_frame(&bytes, path)
 }
 
-/// Decodes a camera frame from the bytes of a file; `path` is only used in error messages.
+/// Decodes a camera frame from the bytes of a file within the memory budget
+/// ([`crate::budget::memory_budget_bytes`]); `path` is only used in error messages.
 ///
 /// # Errors
-/// As [`read_camera_frame`].
+/// As [`read_camera_frame`], and [`ImageFileError::TooLarge`] when the header announces an image
+/// larger than the budget.
 pub fn decode_camera_frame(bytes: &[u8], path: &Path) -> Result<DecodedFrame, ImageFileError> {
+    decode_camera_frame_within(bytes, path, crate::budget::memory_budget_bytes())
+}
+
+/// [`decode_camera_frame`] with an explicit memory budget [bytes]: the decoded image and the copy
+/// without alpha must fit in it, checked from the header before any pixel is decoded.
+///
+/// # Errors
+/// As [`decode_camera_frame`].
+pub fn decode_camera_frame_within(
+    bytes: &[u8],
+    path: &Path,
+    budget: u64,
+) -> Result<DecodedFrame, ImageFileError> {
     use image::DynamicImage as D;
-    let image = decode_any(bytes, path)?;
+    let image = decode_any(bytes, path, budget)?;
     let (w, h) = (image.width() as usize, image.height() as usize);
     let buf_err = |e: scatterfit_imaging::ShapeError| ImageFileError::Unsupported {
         path: path.to_path_buf(),
@@ -242,7 +275,21 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageFileError> {
     })
 }
 
-fn decode_any(bytes: &[u8], path: &Path) -> Result<image::DynamicImage, ImageFileError> {
+/// What decoding an image of this header allocates at most [bytes]: the decoded buffer, plus a
+/// copy without alpha (or a float conversion) of at most the same size.
+fn decode_cost(width: u32, height: u32, color: image::ColorType) -> u64 {
+    u64::from(width)
+        .saturating_mul(u64::from(height))
+        .saturating_mul(u64::from(color.bytes_per_pixel()))
+        .saturating_mul(2)
+}
+
+fn decode_any(
+    bytes: &[u8],
+    path: &Path,
+    budget: u64,
+) -> Result<image::DynamicImage, ImageFileError> {
+    use image::ImageDecoder;
     let decode_err = |source| ImageFileError::Decode {
         path: path.to_path_buf(),
         source,
@@ -258,12 +305,24 @@ fn decode_any(bytes: &[u8], path: &Path) -> Result<image::DynamicImage, ImageFil
     {
         reader.set_format(format);
     }
-    // A 24-MP RGBA float image is 384 MB, above the `image` crate's default 512 MiB cap only for
-    // larger sensors; a measurement rig's files are trusted input, so allow up to 8 GiB.
+    // The `image` crate checks every allocation of the decoders against `max_alloc`; the whole
+    // decode is checked against the budget from the header first.
     let mut limits = image::Limits::default();
-    limits.max_alloc = Some(8 << 30);
+    limits.max_alloc = Some(budget);
     reader.limits(limits);
-    reader.decode().map_err(decode_err)
+    let decoder = reader.into_decoder().map_err(decode_err)?;
+    let (w, h) = decoder.dimensions();
+    let color = decoder.color_type();
+    let needed = decode_cost(w, h, color);
+    if needed > budget {
+        return Err(ImageFileError::TooLarge {
+            path: path.to_path_buf(),
+            what: format!("a {w}×{h} {color:?} image"),
+            needed,
+            budget,
+        });
+    }
+    image::DynamicImage::from_decoder(decoder).map_err(decode_err)
 }
 
 /// Writes a camera frame atomically, in the format its extension names: `.png` (8 or 16-bit, fast
@@ -388,7 +447,8 @@ pub fn write_jpeg(path: &Path, frame: &ImageBuf<u8>, quality: u8) -> Result<(), 
 /// File formats for float radiance maps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RadianceFormat {
-    /// OpenEXR, 32-bit float samples, channels `R,G,B` or `Y`, lossless (RLE) compression.
+    /// OpenEXR, 32-bit float samples, channels `R,G,B` or `Y`, lossless PIZ compression, the same
+    /// bytes for the same image.
     Exr,
     /// Radiance RGBE (`.hdr`): RGB only (a grey map is written as three equal channels), about 1 %
     /// precision (8-bit mantissa, shared exponent).
@@ -414,11 +474,24 @@ impl RadianceFormat {
 /// [`ImageFileError`] naming the file: unreadable, not a float image, or unsupported EXR channels.
 pub fn read_radiance(path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
     let bytes = read_bytes(path)?;
+    decode_radiance(&bytes, path, crate::budget::memory_budget_bytes())
+}
+
+/// [`read_radiance`] on the bytes of a file, within a memory budget [bytes] checked from the header
+/// before any pixel is decoded; `path` is only used in error messages.
+///
+/// # Errors
+/// As [`read_radiance`], and [`ImageFileError::TooLarge`].
+pub fn decode_radiance(
+    bytes: &[u8],
+    path: &Path,
+    budget: u64,
+) -> Result<ImageBuf<f32>, ImageFileError> {
     if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        return read_exr(&bytes, path);
+        return read_exr(bytes, path, budget);
     }
     use image::DynamicImage as D;
-    let image = decode_any(&bytes, path)?;
+    let image = decode_any(bytes, path, budget)?;
     let (w, h) = (image.width() as usize, image.height() as usize);
     let buf_err = |e: scatterfit_imaging::ShapeError| ImageFileError::Unsupported {
         path: path.to_path_buf(),
@@ -438,12 +511,46 @@ pub fn read_radiance(path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
     }
 }
 
-fn read_exr(bytes: &[u8], path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
+fn read_exr(bytes: &[u8], path: &Path, budget: u64) -> Result<ImageBuf<f32>, ImageFileError> {
     use exr::prelude::*;
     let exr_err = |source| ImageFileError::Exr {
         path: path.to_path_buf(),
         source,
     };
+    // The headers first: every layer's samples (as stored) plus our f32 copy must fit the budget.
+    let meta =
+        exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_err)?;
+    let mut needed = 0u64;
+    let mut what = String::new();
+    for header in &meta.headers {
+        let size = header.layer_size;
+        let pixels = (size.width() as u64).saturating_mul(size.height() as u64);
+        let stored: u64 = header
+            .channels
+            .list
+            .iter()
+            .map(|c| pixels.saturating_mul(c.sample_type.bytes_per_sample() as u64))
+            .fold(0, u64::saturating_add);
+        needed = needed
+            .saturating_add(stored)
+            .saturating_add(pixels.saturating_mul(3 * 4));
+        if what.is_empty() {
+            what = format!(
+                "an OpenEXR image of {}×{} pixels and {} channels",
+                size.width(),
+                size.height(),
+                header.channels.list.len()
+            );
+        }
+    }
+    if needed > budget {
+        return Err(ImageFileError::TooLarge {
+            path: path.to_path_buf(),
+            what,
+            needed,
+            budget,
+        });
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -472,13 +579,14 @@ fn read_exr(bytes: &[u8], path: &Path) -> Result<ImageBuf<f32>, ImageFileError> 
         }
     };
     let channels = picked.len();
-    let planes: Vec<Vec<f32>> = picked
-        .iter()
-        .map(|c| c.sample_data.values_as_f32().collect())
-        .collect();
     let mut data = vec![0f32; w * h * channels];
-    for (c, plane) in planes.iter().enumerate() {
-        for (dst, &v) in data.iter_mut().skip(c).step_by(channels).zip(plane) {
+    for (c, channel) in picked.iter().enumerate() {
+        for (dst, v) in data
+            .iter_mut()
+            .skip(c)
+            .step_by(channels)
+            .zip(channel.sample_data.values_as_f32())
+        {
             *dst = v;
         }
     }
@@ -532,10 +640,20 @@ fn encode_exr(image: &ImageBuf<f32>, path: &Path) -> Result<Vec<u8>, ImageFileEr
         .enumerate()
         .map(|(c, name)| AnyChannel::new(*name, FlatSamples::F32(plane(c))))
         .collect();
+    // PIZ (lossless wavelet + Huffman, 32 scan lines per block) in increasing line order: the blocks
+    // are compressed in parallel but written in order, so the same image gives the same bytes (the
+    // former RLE tiles in `Unspecified` order came out in whatever order the threads finished). On a
+    // noisy 12-MP map PIZ gives 106 MB where RLE gave 144 MB and ZIP 135 MB, and writes faster than
+    // ZIP (BENCHMARKS.md, "EXR output").
+    let encoding = Encoding {
+        compression: Compression::PIZ,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
     let layer = Layer::new(
         (w, h),
         LayerAttributes::named("radiance"),
-        Encoding::FAST_LOSSLESS,
+        encoding,
         AnyChannels::sort(list),
     );
     let mut out = Cursor::new(Vec::new());

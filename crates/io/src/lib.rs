@@ -8,8 +8,15 @@
 
 pub mod atomic;
 pub mod bracket;
+pub mod budget;
+pub mod export;
 pub mod image_files;
+pub mod manifest;
+pub mod mesh;
 pub mod profile_csv;
 pub mod response_csv;
 pub mod result_json;
+pub mod result_table;
+pub mod sample_folder;
 pub mod spectro;
+pub mod text;

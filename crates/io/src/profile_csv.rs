@@ -7,11 +7,14 @@
 //! ```
 //! `value` is the mean radiance of the ring's valid pixels (relative units), `stderr` its standard
 //! error, `count` the number of pixels averaged. A grey map has the single channel `y`. A ring with no
-//! valid pixel has count 0 and empty value and stderr fields. Numbers are written in Rust's shortest
-//! round-trip form.
+//! valid pixel has count 0 and empty value and stderr fields. An optional `limit_<c>` column holds the
+//! bracket's detection limit (same units as `value`): a ring below it was not measured. Numbers are
+//! written in Rust's shortest round-trip form.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
 
 /// What can go wrong reading or writing a profile CSV.
 #[derive(Debug, thiserror::Error)]
@@ -33,6 +36,9 @@ pub enum ProfileCsvError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The file is not text we read (UTF-16 without BOM, a workbook, binary data, too large).
+    #[error(transparent)]
+    Text(TextError),
     /// The table is malformed (header, a line, or inconsistent column lengths on write).
     #[error("{}: {detail}", path.display())]
     Invalid {
@@ -54,6 +60,8 @@ pub struct ProfileColumn {
     pub stderr: Vec<f64>,
     /// Pixels averaged per ring.
     pub count: Vec<u64>,
+    /// Detection limit per ring (empty when unknown; then no `limit_<c>` column).
+    pub limit: Vec<f64>,
 }
 
 /// A radial profile: ring radii and per-channel columns.
@@ -82,10 +90,12 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
     let rings = table.r_mm.len();
     let consistent = !table.channels.is_empty()
         && table.r_px.len() == rings
-        && table
-            .channels
-            .iter()
-            .all(|c| c.value.len() == rings && c.stderr.len() == rings && c.count.len() == rings);
+        && table.channels.iter().all(|c| {
+            c.value.len() == rings
+                && c.stderr.len() == rings
+                && c.count.len() == rings
+                && (c.limit.is_empty() || c.limit.len() == rings)
+        });
     if !consistent {
         return Err(ProfileCsvError::Invalid {
             path: path.to_path_buf(),
@@ -96,6 +106,9 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
     text.push_str("r_mm,r_px");
     for c in &table.channels {
         let _ = write!(text, ",value_{0},stderr_{0},count_{0}", c.name);
+        if !c.limit.is_empty() {
+            let _ = write!(text, ",limit_{}", c.name);
+        }
     }
     text.push('\n');
     for i in 0..rings {
@@ -108,6 +121,10 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
             text.push(',');
             number(&mut text, c.stderr[i]);
             let _ = write!(text, ",{}", c.count[i]);
+            if !c.limit.is_empty() {
+                text.push(',');
+                number(&mut text, c.limit[i]);
+            }
         }
         text.push('\n');
     }
@@ -122,18 +139,37 @@ pub fn write_profile_csv(path: &Path, table: &ProfileTable) -> Result<(), Profil
 /// # Errors
 /// [`ProfileCsvError`] naming the file and line.
 pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ProfileCsvError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = read_text_file(path).map_err(text_error)?;
+    parse_profile_csv(&text.text, path)
+}
+
+/// [`read_profile_csv`] on the bytes of a file (any accepted encoding, [`crate::text`]).
+///
+/// # Errors
+/// As [`read_profile_csv`].
+pub fn parse_profile_bytes(bytes: &[u8], path: &Path) -> Result<ProfileTable, ProfileCsvError> {
+    let text = decode_text(bytes, path).map_err(text_error)?;
+    parse_profile_csv(&text.text, path)
+}
+
+fn text_error(e: TextError) -> ProfileCsvError {
+    match e {
+        TextError::Io { path, source } => ProfileCsvError::Read { path, source },
+        other => ProfileCsvError::Text(other),
+    }
+}
+
+/// [`read_profile_csv`] on decoded text; `path` names it in messages.
+///
+/// # Errors
+/// As [`read_profile_csv`].
+pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, ProfileCsvError> {
     let invalid = |detail: String| ProfileCsvError::Invalid {
         path: path.to_path_buf(),
         detail,
     };
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(text.as_bytes());
+    let dialect = CsvDialect::detect(text);
+    let mut reader = dialect.reader_builder().from_reader(text.as_bytes());
     let headers = reader
         .headers()
         .map_err(|e| invalid(format!("unreadable header ({e})")))?
@@ -159,7 +195,7 @@ pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
                     "channel `{name}` needs columns value_{name}, stderr_{name} and count_{name}"
                 )));
             };
-            channels.push((name.to_string(), v, s, n));
+            channels.push((name.to_string(), v, s, n, find(&format!("limit_{name}"))));
         }
     }
     if channels.is_empty() {
@@ -177,32 +213,47 @@ pub fn read_profile_csv(path: &Path) -> Result<ProfileTable, ProfileCsvError> {
                 value: vec![],
                 stderr: vec![],
                 count: vec![],
+                limit: vec![],
             })
             .collect(),
     };
+    let mut lines = LineCounter::new(text);
     for record in reader.records() {
-        let record = record.map_err(|e| invalid(format!("malformed CSV: {e}")))?;
-        let line = crate::bracket::csv_line(&text, record.position());
+        let record = record.map_err(|e| {
+            invalid(format!(
+                "line {}: malformed CSV: {}",
+                lines.line(e.position()),
+                crate::spectro::csv_message(&e, &dialect)
+            ))
+        })?;
+        let line = lines.line(record.position());
         let float = |col: usize, allow_empty: bool| -> Result<f64, ProfileCsvError> {
             let field = record.get(col).unwrap_or("");
             if field.is_empty() && allow_empty {
                 return Ok(f64::NAN);
             }
-            field.parse::<f64>().map_err(|_| {
-                invalid(format!(
-                    "line {line}: `{}` = {field:?} is not a number",
-                    names[col]
-                ))
-            })
+            // Non-finite values are written as empty fields, so `NaN` or `inf` text is refused.
+            dialect
+                .parse_f64(field)
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    invalid(format!(
+                        "line {line}: `{}` = {field:?} is not a finite number",
+                        names[col]
+                    ))
+                })
         };
         table.r_mm.push(float(r_mm_col, false)?);
         table.r_px.push(match r_px_col {
             Some(c) => float(c, true)?,
             None => f64::NAN,
         });
-        for (column, (_, v, s, n)) in table.channels.iter_mut().zip(&channels) {
+        for (column, (_, v, s, n, l)) in table.channels.iter_mut().zip(&channels) {
             column.value.push(float(*v, true)?);
             column.stderr.push(float(*s, true)?);
+            if let Some(l) = l {
+                column.limit.push(float(*l, true)?);
+            }
             let field = record.get(*n).unwrap_or("");
             column.count.push(field.parse::<u64>().map_err(|_| {
                 invalid(format!(

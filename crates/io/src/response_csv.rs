@@ -13,6 +13,11 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
+
+/// Most rows a response table may have: one per code value of a 16-bit camera.
+pub const MAX_LEVELS: usize = 1 << 16;
+
 /// What can go wrong reading or writing a response CSV.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -33,6 +38,9 @@ pub enum ResponseCsvError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The file is not text we read (UTF-16 without BOM, a workbook, binary data, too large).
+    #[error(transparent)]
+    Text(TextError),
     /// The header is not `z,g_r,g_g,g_b` or `z,g`.
     #[error(
         "{}: the header must be `z,g_r,g_g,g_b` (RGB) or `z,g` (grey), found `{found}`; \
@@ -149,13 +157,35 @@ pub fn write_response_csv(path: &Path, response: &ResponseTable) -> Result<(), R
 /// # Errors
 /// [`ResponseCsvError`] naming the file and line.
 pub fn read_response_csv(path: &Path) -> Result<ResponseTable, ResponseCsvError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ResponseCsvError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
+    let text = read_text_file(path).map_err(text_error)?;
+    parse_response_csv(&text.text, path)
+}
+
+/// [`read_response_csv`] on the bytes of a file (any accepted encoding, [`crate::text`]); `path`
+/// names it in messages.
+///
+/// # Errors
+/// As [`read_response_csv`].
+pub fn parse_response_bytes(bytes: &[u8], path: &Path) -> Result<ResponseTable, ResponseCsvError> {
+    let text = decode_text(bytes, path).map_err(text_error)?;
+    parse_response_csv(&text.text, path)
+}
+
+fn text_error(e: TextError) -> ResponseCsvError {
+    match e {
+        TextError::Io { path, source } => ResponseCsvError::Read { path, source },
+        other => ResponseCsvError::Text(other),
+    }
+}
+
+/// [`read_response_csv`] on decoded text.
+///
+/// # Errors
+/// As [`read_response_csv`].
+pub fn parse_response_csv(text: &str, path: &Path) -> Result<ResponseTable, ResponseCsvError> {
+    let dialect = CsvDialect::detect(text);
+    let mut reader = dialect
+        .reader_builder()
         .flexible(true)
         .from_reader(text.as_bytes());
     let header_err = |found: String| ResponseCsvError::Header {
@@ -180,20 +210,32 @@ pub fn read_response_csv(path: &Path) -> Result<ResponseTable, ResponseCsvError>
         _ => return Err(header_err(names.join(","))),
     };
     let mut g = vec![Vec::new(); value_cols.len()];
+    let mut lines = LineCounter::new(text);
     for record in reader.records() {
         let line_err = |line: u64, detail: String| ResponseCsvError::Line {
             path: path.to_path_buf(),
             line,
             detail,
         };
-        let record = record.map_err(|e| {
-            line_err(
-                crate::bracket::csv_line(&text, e.position()),
-                format!("malformed CSV: {e}"),
-            )
-        })?;
-        let line = crate::bracket::csv_line(&text, record.position());
+        let record = record
+            .map_err(|e| line_err(lines.line(e.position()), format!("malformed CSV: {e}")))?;
+        let line = lines.line(record.position());
+        if record.len() > headers.len() {
+            return Err(line_err(
+                line,
+                dialect.extra_fields_hint(headers.len(), record.len()),
+            ));
+        }
         let expected_z = g[0].len();
+        if expected_z >= MAX_LEVELS {
+            return Err(line_err(
+                line,
+                format!(
+                    "more than {MAX_LEVELS} rows; a response has one row per code value (256 for \
+                     8-bit, at most 65536 for 16-bit data)"
+                ),
+            ));
+        }
         let z = record.get(z_col).unwrap_or("");
         if z.parse::<usize>().ok() != Some(expected_z) {
             return Err(line_err(
@@ -205,9 +247,8 @@ pub fn read_response_csv(path: &Path) -> Result<ResponseTable, ResponseCsvError>
         }
         for (c, &col) in value_cols.iter().enumerate() {
             let field = record.get(col).unwrap_or("");
-            let value = field
-                .parse::<f64>()
-                .ok()
+            let value = dialect
+                .parse_f64(field)
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
                     line_err(

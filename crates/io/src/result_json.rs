@@ -41,6 +41,9 @@ pub enum ResultJsonError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The file is not text we read (UTF-16 without BOM, binary data, too large).
+    #[error(transparent)]
+    Text(crate::text::TextError),
     /// The file is not a scatterfit result, or a field is missing or out of range.
     #[error("{}: {detail}", path.display())]
     Invalid {
@@ -262,11 +265,27 @@ pub fn write_result_json(path: &Path, result: &MeasurementResult) -> Result<(), 
 /// # Errors
 /// [`ResultJsonError`] naming the file and the field.
 pub fn read_result_json(path: &Path) -> Result<MeasurementResult, ResultJsonError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ResultJsonError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_result_json(&text, path)
+    let text = crate::text::read_text_file(path).map_err(text_error)?;
+    parse_result_json(&text.text, path)
+}
+
+/// [`read_result_json`] on the bytes of a file (UTF-8 with or without BOM, UTF-16 with BOM).
+///
+/// # Errors
+/// As [`read_result_json`].
+pub fn parse_result_json_bytes(
+    bytes: &[u8],
+    path: &Path,
+) -> Result<MeasurementResult, ResultJsonError> {
+    let text = crate::text::decode_text(bytes, path).map_err(text_error)?;
+    parse_result_json(&text.text, path)
+}
+
+fn text_error(e: crate::text::TextError) -> ResultJsonError {
+    match e {
+        crate::text::TextError::Io { path, source } => ResultJsonError::Read { path, source },
+        other => ResultJsonError::Text(other),
+    }
 }
 
 /// [`read_result_json`] on text already read; `path` names it in errors.

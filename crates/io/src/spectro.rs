@@ -10,10 +10,15 @@
 //! must increase strictly and cover 400–700 nm with steps of at most 10 nm (360–780 nm and 5 nm steps
 //! are fine). SCI below SCE by more than [`SCI_BELOW_SCE_TOLERANCE`] is refused (swapped columns or a
 //! faulty reading); within it, it is noise and is kept.
+//!
+//! The file may be UTF-8 (with or without BOM), UTF-16 with a BOM or Windows-1252, `,`-, `;`- or
+//! tab-separated, with decimal commas where the separator is not a comma ([`crate::text`]).
 
 use std::path::{Path, PathBuf};
 
 use scatterfit_optics::spectro::SpectroReading;
+
+use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
 
 /// How far SCI may fall below SCE (absolute reflectance) before the reading is refused: about five
 /// times the repeatability of a d/8 instrument such as the CM-600d (≈ 0.1 % reflectance).
@@ -31,6 +36,9 @@ pub enum SpectroCsvError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The bytes are not text we read (UTF-16 without BOM, a workbook, binary data, too large).
+    #[error(transparent)]
+    Text(TextError),
     /// The CSV structure is broken (unbalanced quotes, a row with too few fields, …).
     #[error("{path}: line {line}: {message}")]
     Malformed {
@@ -118,11 +126,35 @@ pub enum SpectroCsvError {
 /// # Errors
 /// [`SpectroCsvError`] naming the file, line and column of the first problem.
 pub fn read_spectro_csv(path: &Path) -> Result<SpectroReading, SpectroCsvError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SpectroCsvError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
-    parse_spectro_csv(&text, path)
+    let text = read_text_file(path).map_err(text_error)?;
+    parse_spectro_csv(&text.text, path)
+}
+
+/// Parses the bytes of a spectrophotometer CSV (any accepted encoding, [`crate::text`]); `path` is
+/// used in messages only.
+///
+/// # Errors
+/// As [`read_spectro_csv`].
+pub fn parse_spectro_bytes(bytes: &[u8], path: &Path) -> Result<SpectroReading, SpectroCsvError> {
+    let text = decode_text(bytes, path).map_err(text_error)?;
+    parse_spectro_csv(&text.text, path)
+}
+
+fn text_error(e: TextError) -> SpectroCsvError {
+    match e {
+        TextError::Io { path, source } => SpectroCsvError::Io { path, source },
+        other => SpectroCsvError::Text(other),
+    }
+}
+
+/// The message of a CSV error, with a hint when a row has more fields than the header.
+pub(crate) fn csv_message(e: &csv::Error, dialect: &CsvDialect) -> String {
+    match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } if len > expected_len => dialect.extra_fields_hint(*expected_len as usize, *len as usize),
+        _ => e.to_string(),
+    }
 }
 
 /// Parses the text of a spectrophotometer CSV; `path` is used in messages only.
@@ -131,16 +163,14 @@ pub fn read_spectro_csv(path: &Path) -> Result<SpectroReading, SpectroCsvError> 
 /// As [`read_spectro_csv`].
 pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, SpectroCsvError> {
     let p = || path.to_owned();
-    let mut reader = csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
+    let dialect = CsvDialect::detect(text);
+    let mut reader = dialect.reader_builder().from_reader(text.as_bytes());
     let header: Vec<String> = reader
         .headers()
         .map_err(|e| SpectroCsvError::Malformed {
             path: p(),
             line: 1,
-            message: e.to_string(),
+            message: csv_message(&e, &dialect),
         })?
         .iter()
         .map(|h| h.to_ascii_lowercase())
@@ -175,13 +205,14 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
     let max = if scale == 1.0 { "1" } else { "100" };
 
     let (mut wavelengths, mut sci, mut sce) = (Vec::new(), Vec::new(), Vec::new());
+    let mut lines = LineCounter::new(text);
     for record in reader.records() {
         let record = record.map_err(|e| SpectroCsvError::Malformed {
             path: p(),
-            line: e.position().map_or(0, |pos| pos.line()),
-            message: e.to_string(),
+            line: lines.line(e.position()),
+            message: csv_message(&e, &dialect),
         })?;
-        let line = record.position().map_or(0, |pos| pos.line());
+        let line = lines.line(record.position());
         let cell = |col: usize, name: &str| -> Result<f64, SpectroCsvError> {
             let text = record.get(col).unwrap_or("");
             let bad = |reason: String| SpectroCsvError::BadValue {
@@ -191,7 +222,17 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 value: text.to_owned(),
                 reason,
             };
-            let v: f64 = text.parse().map_err(|_| bad("is not a number".into()))?;
+            let v: f64 = dialect.parse_f64(text).ok_or_else(|| {
+                bad(format!(
+                    "is not a number (columns separated by {}{})",
+                    dialect.delimiter_name(),
+                    if dialect.decimal_comma {
+                        ", decimal comma or point"
+                    } else {
+                        ", decimal point"
+                    }
+                ))
+            })?;
             if !v.is_finite() {
                 return Err(bad("is not a finite number".into()));
             }
@@ -288,6 +329,36 @@ fn check_coverage(wavelengths: &[f64]) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Writes a reading as a spectrophotometer CSV (`wavelength_nm,sci,sce`, fractions with 6
+/// decimals, as instruments export them) atomically, with `comment` as `#` lines on top.
+///
+/// # Errors
+/// [`SpectroCsvError::Io`] when the file cannot be written.
+pub fn write_spectro_csv(
+    path: &Path,
+    reading: &SpectroReading,
+    comment: &str,
+) -> Result<(), SpectroCsvError> {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    for line in comment.lines() {
+        let _ = writeln!(text, "# {line}");
+    }
+    text.push_str("wavelength_nm,sci,sce\n");
+    for ((w, sci), sce) in reading
+        .wavelengths_nm
+        .iter()
+        .zip(&reading.sci)
+        .zip(&reading.sce)
+    {
+        let _ = writeln!(text, "{w},{sci:.6},{sce:.6}");
+    }
+    crate::atomic::write_atomic(path, text.as_bytes()).map_err(|source| SpectroCsvError::Io {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 #[cfg(test)]

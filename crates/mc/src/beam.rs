@@ -25,10 +25,28 @@ pub enum BeamProfile {
 /// A collimated beam: profile, and polar angle of incidence in the outside medium (0 = normal). The
 /// beam axis hits the surface at the origin and is tilted in the x–z plane; an oblique beam's
 /// footprint is stretched by 1/cos θ along x.
+///
+/// Built only through [`Beam::pencil`], [`Beam::new`] and [`Beam::with_incidence`]; JSON is read
+/// through the same checks.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawBeam")]
 pub struct Beam {
     profile: BeamProfile,
     incidence: f64,
+}
+
+/// The unchecked shape of [`Beam`] in files.
+#[derive(Deserialize)]
+struct RawBeam {
+    profile: BeamProfile,
+    incidence: f64,
+}
+
+impl TryFrom<RawBeam> for Beam {
+    type Error = crate::McError;
+    fn try_from(raw: RawBeam) -> Result<Self> {
+        Self::new(raw.profile)?.with_incidence(raw.incidence)
+    }
 }
 
 impl Beam {
@@ -82,5 +100,28 @@ impl Beam {
     /// Polar angle of incidence [radians].
     pub fn incidence(&self) -> f64 {
         self.incidence
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// JSON goes through the checks: a beam round-trips; a negative radius or a grazing angle in a
+    /// file is refused.
+    #[test]
+    fn json_round_trip_goes_through_the_checks() {
+        let beam = Beam::new(BeamProfile::Gaussian { radius: 0.5 })
+            .unwrap()
+            .with_incidence(0.3)
+            .unwrap();
+        let json = serde_json::to_string(&beam).unwrap();
+        assert_eq!(serde_json::from_str::<Beam>(&json).unwrap(), beam);
+        for bad in [
+            r#"{"profile":{"Disk":{"radius":-1}},"incidence":0}"#,
+            r#"{"profile":"Pencil","incidence":2}"#,
+        ] {
+            assert!(serde_json::from_str::<Beam>(bad).is_err(), "{bad}");
+        }
     }
 }

@@ -22,9 +22,40 @@ pub const ROULETTE_CHANCE: f64 = 0.1;
 /// Photons per chunk: the unit of work with its own random stream. Fixed, so that results do not
 /// depend on the thread count; 2048 photons are 0.1–20 ms of work, large against rayon's overhead.
 pub const CHUNK_PHOTONS: u64 = 2048;
-/// Chunks traced in parallel before their tallies are summed (in chunk order). Bounds memory by
-/// `WAVE_CHUNKS` tallies whatever the photon count, and sets how often progress is reported.
+/// Most chunks traced in parallel before their tallies are summed (in chunk order). Bounds memory by
+/// `WAVE_CHUNKS` tallies whatever the photon count.
 const WAVE_CHUNKS: u64 = 64;
+/// Interactions a wave aims at, so that progress is reported every few seconds even when photons
+/// are expensive (a wave is never less than one chunk per thread). Waves only group chunks: the
+/// tallies are summed in chunk order whatever the wave size, so results do not depend on it.
+const WAVE_INTERACTIONS: f64 = 1e8;
+
+/// Bytes of one chunk tally per tally bin (radial or angular): a sum and a sum of squares, f64 each.
+const TALLY_BYTES_PER_BIN: u64 = 16;
+
+/// Steps (interactions) per second per thread on the project's standard machine (2-core AMD EPYC VM,
+/// shared: 1.6e7–2.2e7 on paths of hundreds of steps), measured with `cargo test --release -p
+/// scatterfit-mc --test cost -- --ignored --nocapture` (BENCHMARKS.md, "Monte Carlo cost model"):
+/// only for turning a step count into an expected run time in messages.
+pub const REFERENCE_INTERACTIONS_PER_SECOND: f64 = 2.0e7;
+
+/// What a simulation is expected to cost, before it runs ([`Simulation::cost_estimate`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CostEstimate {
+    /// Expected steps per photon: interactions (scattering events) plus the launch.
+    pub interactions_per_photon: f64,
+    /// Expected steps in all, photons × the above.
+    pub interactions: f64,
+    /// Memory the tallies take while running [bytes].
+    pub memory_bytes: u64,
+}
+
+impl CostEstimate {
+    /// The expected run time [s] on `threads` threads at [`REFERENCE_INTERACTIONS_PER_SECOND`].
+    pub fn seconds(&self, threads: usize) -> f64 {
+        self.interactions / (REFERENCE_INTERACTIONS_PER_SECOND * threads.max(1) as f64)
+    }
+}
 
 /// A Monte Carlo estimate: the mean over photons and its standard error.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -75,7 +106,10 @@ impl Simulation {
     /// A simulation of `photons` photons from `beam` into `sample`, tallying Rd(r) on `grid`.
     ///
     /// # Errors
-    /// `InvalidParameter` for zero photons.
+    /// `InvalidParameter` for zero photons; `NeverEnds` for a half-space whose infinite layer does
+    /// not absorb (σa = 0): a random walk in a half-space returns to the surface with probability 1
+    /// but after a time of infinite mean, and without absorption the photon's weight never falls to
+    /// the roulette, so the run has no finite expected length.
     pub fn new(
         sample: Sample,
         beam: Beam,
@@ -84,6 +118,18 @@ impl Simulation {
         seed: u64,
     ) -> Result<Self> {
         check(photons > 0, "photons", 0.0, "trace at least one photon")?;
+        if let Some(last) = sample.layers().last()
+            && !last.thickness().is_finite()
+            && last.sigma_a() == 0.0
+        {
+            return Err(crate::McError::NeverEnds {
+                what: "σa = 0 in a half-space: photons walk without absorption, and the mean length \
+                       of a path that must return to the surface is infinite, so the simulation \
+                       would never end",
+                hint: "give a thickness (a slab) or a small absorption σa > 0 (e.g. 1e-4 mm⁻¹; the \
+                       cost estimate tells how long it will take)",
+            });
+        }
         Ok(Self {
             sample,
             beam,
@@ -111,6 +157,50 @@ impl Simulation {
         self.photons
     }
 
+    /// Memory the tallies take while running [bytes]: a wave of [`WAVE_CHUNKS`] chunk tallies plus
+    /// the running total, each a sum and a sum of squares per radial and angular bin, and the
+    /// result. Independent of the photon count.
+    pub fn memory_bytes(&self) -> u64 {
+        Self::tally_memory_bytes(self.grid.bins(), self.angle_bins)
+    }
+
+    /// [`Simulation::memory_bytes`] for a grid of `bins` radial and `angle_bins` angular bins, before
+    /// either is allocated.
+    pub fn tally_memory_bytes(bins: usize, angle_bins: usize) -> u64 {
+        let per_bin = TALLY_BYTES_PER_BIN * (WAVE_CHUNKS + 2) + 8;
+        (bins as u64)
+            .saturating_add(angle_bins as u64)
+            .saturating_mul(per_bin)
+    }
+
+    /// The expected cost of [`Simulation::run`], from the sample's coefficients alone (no photon is
+    /// traced), in steps per photon (interactions plus the launch). It is the smallest of three
+    /// bounds, with η² (the largest layer index over the outside one, squared) for the light that
+    /// internal reflection keeps inside:
+    ///
+    /// - *absorption*: with implicit capture the weight falls by α = σs/σt per interaction, so the
+    ///   roulette (threshold W = 10⁻⁴, chance 0.1) ends a path after N_abs ≈ (ln(1/W) + 0.26)/(−ln α)
+    ///   interactions (0.26: the roulette's expected tail), α the stack's largest;
+    /// - *slab*: a non-absorbing slab of optical thickness τ = Σ σt·d is left after about 2η²τ
+    ///   interactions (the mean path length in a body under uniform illumination is 4V/S = 2d for a
+    ///   slab, whatever the scattering: Blanco & Fournier 2003, Europhys. Lett. 61, 168);
+    /// - *half-space*: a path that leaves through the surface it entered is a one-dimensional walk
+    ///   of transport steps, cut off after K = (1 − g)·N_abs of them; the expected length of such a
+    ///   walk until its first return, truncated at K, grows as 2√(2K/π) (Feller, vol. 1, §III.7),
+    ///   so η²(1 + 2√(2K/π))/(1 − g) interactions.
+    ///
+    /// An order-of-magnitude estimate for refusing runs that would not finish and for telling how
+    /// long a run will take, not a prediction: `tests/cost.rs` holds it within a factor 3 of measured
+    /// counts over slabs and half-spaces, g from 0 to 0.9, α′ from 0.5 to 0.999.
+    pub fn cost_estimate(&self) -> CostEstimate {
+        let per_photon = interactions_per_photon(&self.sample);
+        CostEstimate {
+            interactions_per_photon: per_photon,
+            interactions: per_photon * self.photons as f64,
+            memory_bytes: self.memory_bytes(),
+        }
+    }
+
     /// Runs on the current rayon thread pool.
     pub fn run(&self) -> SimulationResult {
         self.run_with_progress(&|_| {})
@@ -122,9 +212,13 @@ impl Simulation {
         let tracer = Tracer::new(self);
         let chunks = self.photons.div_ceil(CHUNK_PHOTONS);
         let mut total = Accum::new(self.grid.bins(), self.angle_bins);
+        let per_chunk = interactions_per_photon(&self.sample) * CHUNK_PHOTONS as f64;
+        let wave_chunks = ((WAVE_INTERACTIONS / per_chunk) as u64)
+            .max(rayon::current_num_threads() as u64)
+            .clamp(1, WAVE_CHUNKS);
         let mut first = 0;
         while first < chunks {
-            let last = (first + WAVE_CHUNKS).min(chunks);
+            let last = (first + wave_chunks).min(chunks);
             let wave: Vec<Accum> = (first..last)
                 .into_par_iter()
                 .map(|c| {
@@ -147,12 +241,59 @@ impl Simulation {
     }
 }
 
+/// Expected interactions per photon in `sample` (see [`Simulation::cost_estimate`]).
+fn interactions_per_photon(sample: &Sample) -> f64 {
+    let layers = sample.layers();
+    let outside = sample.n_above().min(sample.n_below());
+    let trap = layers
+        .iter()
+        .map(|l| (l.n() / outside).powi(2))
+        .fold(1.0f64, f64::max);
+    // Implicit capture + roulette: ln(1/W) to reach the threshold, plus the roulette's tail
+    // Σ_k 0.1^k ln(10) ≈ 0.26, each interaction multiplying the weight by α.
+    let roulette = (1.0 / ROULETTE_THRESHOLD).ln()
+        + ROULETTE_CHANCE * (1.0 / ROULETTE_CHANCE).ln() / (1.0 - ROULETTE_CHANCE);
+    let absorb_bound = |l: &crate::Layer| {
+        let sigma_t = l.sigma_a() + l.sigma_s();
+        let alpha = l.sigma_s() / sigma_t;
+        if alpha >= 1.0 {
+            f64::INFINITY
+        } else {
+            // −ln α, accurate for α near 1.
+            roulette / -(-l.sigma_a() / sigma_t).ln_1p()
+        }
+    };
+    let n_abs = layers.iter().map(absorb_bound).fold(0.0f64, f64::max);
+    // A walk from the surface into a half-space of this layer, cut off after K transport steps.
+    let half_space_bound = |l: &crate::Layer| {
+        let one_minus_g = 1.0 - l.g();
+        let k = one_minus_g * absorb_bound(l);
+        trap * (1.0 + 2.0 * (2.0 * k / std::f64::consts::PI).sqrt()) / one_minus_g
+    };
+    let n_half = layers.iter().map(half_space_bound).fold(0.0f64, f64::max);
+    let last = layers[layers.len() - 1];
+    let n_escape = if last.thickness().is_finite() {
+        let optical: f64 = layers
+            .iter()
+            .map(|l| (l.sigma_a() + l.sigma_s()) * l.thickness())
+            .sum();
+        (2.0 * trap * optical).min(n_half)
+    } else {
+        n_half
+    };
+    // Plus the launch step every photon takes.
+    n_abs.min(n_escape) + 1.0
+}
+
 /// What a simulation measured. All quantities are per incident photon weight (fractions), Rd(r) in
 /// mm⁻², the angular tally per steradian.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SimulationResult {
     /// Photons traced.
     pub photons: u64,
+    /// Interactions (scattering events) traced, all photons together.
+    #[serde(default)]
+    pub interactions: u64,
     /// Seed of the random streams.
     pub seed: u64,
     /// Specular reflectance at entry R_sp (exact, not sampled; not part of `rd_total`).
@@ -184,6 +325,8 @@ struct Accum {
     ang_w2: Vec<f64>,
     /// [R, R², T, T², A, A², R+T+A, (R+T+A)²]
     sums: [f64; 8],
+    /// Interactions traced.
+    interactions: u64,
 }
 
 impl Accum {
@@ -194,6 +337,7 @@ impl Accum {
             ang_w: vec![0.0; angle_bins],
             ang_w2: vec![0.0; angle_bins],
             sums: [0.0; 8],
+            interactions: 0,
         }
     }
 
@@ -213,6 +357,7 @@ impl Accum {
         for (a, b) in self.sums.iter_mut().zip(&o.sums) {
             *a += b;
         }
+        self.interactions += o.interactions;
     }
 
     fn finish(self, sim: &Simulation, specular: f64) -> SimulationResult {
@@ -240,6 +385,7 @@ impl Accum {
         conservation.value += specular;
         SimulationResult {
             photons: n,
+            interactions: self.interactions,
             seed: sim.seed,
             specular,
             rd_total: Estimate::from_moments(s[0], s[1], n),
@@ -385,6 +531,7 @@ impl<'a> Tracer<'a> {
         let last = self.layers.len() - 1;
         let mut l = self.layers[0];
         let mut cos_out = 0.0;
+        let mut interactions = 0u64;
         loop {
             // StepSizeInTissue: s = −ln ξ / σt (an Exp(1) variate / σt), or the leftover from a
             // boundary hit.
@@ -445,6 +592,7 @@ impl<'a> Tracer<'a> {
                 }
             } else {
                 // Hop.
+                interactions += 1;
                 x += s * ux;
                 y += s * uy;
                 z += s * uz;
@@ -463,6 +611,7 @@ impl<'a> Tracer<'a> {
                 w /= ROULETTE_CHANCE;
             }
         }
+        acc.interactions += interactions;
         let total = reflected + transmitted + absorbed;
         let s = &mut acc.sums;
         s[0] += reflected;

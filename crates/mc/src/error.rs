@@ -16,6 +16,14 @@ pub enum McError {
         /// What the domain is, and what to do.
         reason: &'static str,
     },
+    /// The simulation would never finish: photon paths without a finite mean length.
+    #[error("{what}; {hint}")]
+    NeverEnds {
+        /// What cannot terminate.
+        what: &'static str,
+        /// What to do instead.
+        hint: &'static str,
+    },
     /// A query falls outside what a profile table covers.
     #[error("{name} = {value} is outside the table's range [{min}, {max}]")]
     OutOfTable {

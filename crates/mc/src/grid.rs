@@ -6,7 +6,12 @@ use crate::error::{Result, check};
 
 /// Annuli [r_i, r_{i+1}) of the radial reflectance tally, in mm, starting at r = 0. Photons leaving
 /// beyond the last edge count in the totals only.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+///
+/// Built only through the checked constructors; JSON holds the edges and is read back through
+/// [`RadialGrid::from_edges`] (`#[serde(try_from)]`), which also recognises a uniform grid, so a grid
+/// read back equals the one written. Two grids are equal when their edges are.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "RawGrid")]
 pub struct RadialGrid {
     edges: Vec<f64>,
     /// Bin width when the grid is uniform (fast O(1) lookup), else 0.
@@ -15,6 +20,26 @@ pub struct RadialGrid {
     /// 1 / `uniform_dr` (0 when not uniform).
     #[serde(skip)]
     inv_dr: f64,
+}
+
+/// The unchecked shape of [`RadialGrid`] in files.
+#[derive(Deserialize)]
+struct RawGrid {
+    edges: Vec<f64>,
+}
+
+impl TryFrom<RawGrid> for RadialGrid {
+    type Error = crate::McError;
+    fn try_from(raw: RawGrid) -> Result<Self> {
+        Self::from_edges(raw.edges)
+    }
+}
+
+impl PartialEq for RadialGrid {
+    /// Equal edges (the lookup fields are derived from them).
+    fn eq(&self, other: &Self) -> bool {
+        self.edges == other.edges
+    }
 }
 
 impl RadialGrid {
@@ -35,14 +60,24 @@ impl RadialGrid {
             0.0,
             "the radial grid needs at least one bin",
         )?;
+        let mut edges = Vec::new();
+        edges
+            .try_reserve_exact(bins.saturating_add(1))
+            .map_err(|_| crate::McError::InvalidParameter {
+                name: "bins",
+                value: bins as f64,
+                reason: "too many radial bins to allocate; use fewer",
+            })?;
+        edges.extend((0..=bins).map(|i| i as f64 * dr));
         Ok(Self {
-            edges: (0..=bins).map(|i| i as f64 * dr).collect(),
+            edges,
             uniform_dr: dr,
             inv_dr: 1.0 / dr,
         })
     }
 
     /// Annuli between the given edges [mm]: the first must be 0, the rest strictly increasing and finite.
+    /// Edges that are exactly i·dr (as [`RadialGrid::uniform`] makes them) give a uniform grid.
     ///
     /// # Errors
     /// `InvalidParameter` when the edges break those rules or there are fewer than two.
@@ -67,10 +102,12 @@ impl RadialGrid {
                 "edges must be finite and strictly increasing",
             )?;
         }
+        let dr = edges[1];
+        let uniform = edges.iter().enumerate().all(|(i, &e)| e == i as f64 * dr);
         Ok(Self {
             edges,
-            uniform_dr: 0.0,
-            inv_dr: 0.0,
+            uniform_dr: if uniform { dr } else { 0.0 },
+            inv_dr: if uniform { 1.0 / dr } else { 0.0 },
         })
     }
 
@@ -130,13 +167,18 @@ impl RadialGrid {
         (i >= 1 && i <= nb).then(|| i - 1)
     }
 
-    /// Scaled copy: every edge times `factor` (> 0).
-    pub fn scaled(&self, factor: f64) -> Self {
-        Self {
-            edges: self.edges.iter().map(|e| e * factor).collect(),
-            uniform_dr: self.uniform_dr * factor,
-            inv_dr: self.inv_dr / factor,
-        }
+    /// Scaled copy: every edge times `factor`.
+    ///
+    /// # Errors
+    /// `InvalidParameter` unless `factor` is finite and > 0 (and the scaled edges stay finite).
+    pub fn scaled(&self, factor: f64) -> Result<Self> {
+        check(
+            factor.is_finite() && factor > 0.0,
+            "factor",
+            factor,
+            "a grid is scaled by a finite factor > 0",
+        )?;
+        Self::from_edges(self.edges.iter().map(|e| e * factor).collect())
     }
 }
 
@@ -163,6 +205,32 @@ mod tests {
         assert!(RadialGrid::from_edges(vec![0.0, 1.0, 1.0]).is_err());
         assert!(RadialGrid::from_edges(vec![0.1, 1.0]).is_err());
         assert!(RadialGrid::logarithmic(0.0, 1.0, 4).is_err());
+    }
+
+    /// A grid read back from JSON equals the one written and keeps its fast uniform lookup; bad
+    /// edges in a file are refused by the same checks as the constructor.
+    #[test]
+    fn json_round_trip_goes_through_the_checks() {
+        for grid in [
+            RadialGrid::uniform(0.1, 200).unwrap(),
+            RadialGrid::logarithmic(0.005, 200.0, 64).unwrap(),
+        ] {
+            let json = serde_json::to_string(&grid).unwrap();
+            let back: RadialGrid = serde_json::from_str(&json).unwrap();
+            assert_eq!(back, grid);
+            assert_eq!(
+                (back.uniform_dr, back.inv_dr),
+                (grid.uniform_dr, grid.inv_dr)
+            );
+        }
+        for bad in [
+            r#"{"edges":[0.1,1.0]}"#,
+            r#"{"edges":[0.0,1.0,1.0]}"#,
+            r#"{"edges":[0.0]}"#,
+            r#"{"edges":[0.0,-1.0]}"#,
+        ] {
+            assert!(serde_json::from_str::<RadialGrid>(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -43,7 +43,8 @@ pub mod white;
 
 pub use beam::{Beam, BeamProfile};
 pub use engine::{
-    CHUNK_PHOTONS, Estimate, ROULETTE_CHANCE, ROULETTE_THRESHOLD, Simulation, SimulationResult,
+    CHUNK_PHOTONS, CostEstimate, Estimate, REFERENCE_INTERACTIONS_PER_SECOND, ROULETTE_CHANCE,
+    ROULETTE_THRESHOLD, Simulation, SimulationResult,
 };
 pub use error::{McError, Result};
 pub use fresnel::{FresnelSample, fresnel_mcml};

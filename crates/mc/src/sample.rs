@@ -6,13 +6,52 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, check};
 
 /// One homogeneous layer. Coefficients in mm⁻¹, thickness in mm.
+///
+/// Built only through [`Layer::new`] or [`Layer::from_reduced`]; JSON is read through the same
+/// checks (`#[serde(try_from)]`). An infinite thickness is written as `null` (JSON has no infinity).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawLayer", into = "RawLayer")]
 pub struct Layer {
     sigma_a: f64,
     sigma_s: f64,
     g: f64,
     n: f64,
     thickness: f64,
+}
+
+/// The unchecked shape of [`Layer`] in files; `thickness: null` is a half-space.
+#[derive(Clone, Copy, Serialize, Deserialize)]
+struct RawLayer {
+    sigma_a: f64,
+    sigma_s: f64,
+    g: f64,
+    n: f64,
+    thickness: Option<f64>,
+}
+
+impl TryFrom<RawLayer> for Layer {
+    type Error = crate::McError;
+    fn try_from(raw: RawLayer) -> Result<Self> {
+        Self::new(
+            raw.sigma_a,
+            raw.sigma_s,
+            raw.g,
+            raw.n,
+            raw.thickness.unwrap_or(f64::INFINITY),
+        )
+    }
+}
+
+impl From<Layer> for RawLayer {
+    fn from(l: Layer) -> Self {
+        Self {
+            sigma_a: l.sigma_a,
+            sigma_s: l.sigma_s,
+            g: l.g,
+            n: l.n,
+            thickness: l.thickness.is_finite().then_some(l.thickness),
+        }
+    }
 }
 
 impl Layer {
@@ -122,12 +161,29 @@ impl Layer {
 }
 
 /// A stack of layers, top (z = 0, where light enters) to bottom, with the indices of the media above
-/// and below.
+/// and below. Built only through [`Sample::new`] or [`Sample::slab`]; JSON is read through the same
+/// checks.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawSample")]
 pub struct Sample {
     layers: Vec<Layer>,
     n_above: f64,
     n_below: f64,
+}
+
+/// The unchecked shape of [`Sample`] in files.
+#[derive(Deserialize)]
+struct RawSample {
+    layers: Vec<Layer>,
+    n_above: f64,
+    n_below: f64,
+}
+
+impl TryFrom<RawSample> for Sample {
+    type Error = crate::McError;
+    fn try_from(raw: RawSample) -> Result<Self> {
+        Self::new(raw.layers, raw.n_above, raw.n_below)
+    }
 }
 
 impl Sample {
@@ -193,6 +249,31 @@ impl Sample {
 mod tests {
     use super::*;
     use crate::error::McError;
+
+    /// JSON goes through the constructors: a stack round-trips (a half-space's infinite thickness
+    /// as `null`), and invalid layers or stacks in a file are refused.
+    #[test]
+    fn json_round_trip_goes_through_the_checks() {
+        let top = Layer::new(0.2, 5.0, 0.8, 1.5, 0.3).unwrap();
+        let bottom = Layer::new(0.05, 2.0, 0.0, 1.33, f64::INFINITY).unwrap();
+        let sample = Sample::new(vec![top, bottom], 1.0, 1.2).unwrap();
+        let json = serde_json::to_string(&sample).unwrap();
+        assert!(json.contains("\"thickness\":null"), "{json}");
+        assert_eq!(serde_json::from_str::<Sample>(&json).unwrap(), sample);
+        for bad in [
+            r#"{"sigma_a":-1,"sigma_s":1,"g":0,"n":1.4,"thickness":1}"#,
+            r#"{"sigma_a":0,"sigma_s":0,"g":0,"n":1.4,"thickness":1}"#,
+            r#"{"sigma_a":0.1,"sigma_s":1,"g":1,"n":1.4,"thickness":1}"#,
+            r#"{"sigma_a":0.1,"sigma_s":1,"g":0,"n":1.4,"thickness":0}"#,
+        ] {
+            assert!(serde_json::from_str::<Layer>(bad).is_err(), "{bad}");
+        }
+        let infinite_on_top = json.replace("\"thickness\":0.3", "\"thickness\":null");
+        assert!(serde_json::from_str::<Sample>(&infinite_on_top).is_err());
+        assert!(
+            serde_json::from_str::<Sample>(r#"{"layers":[],"n_above":1,"n_below":1}"#).is_err()
+        );
+    }
 
     /// A clear layer (σa = σs = 0, a glass slide) is refused with a typed error naming σt, not traced.
     #[test]

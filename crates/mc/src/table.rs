@@ -24,23 +24,124 @@ pub const FORMAT_VERSION: u32 = 1;
 pub const DEFAULT_MAX_ALBEDO: f64 = 0.999;
 
 /// What a table is made of. Two specs that compare equal give the same table bit for bit.
+///
+/// Built only through [`TableSpec::new`], [`TableSpec::coarse`] and [`TableSpec::from_parts`] (and
+/// the checked `with_*` variations); a cache file's spec is read through the same checks
+/// (`#[serde(try_from)]`), so every value of this type is valid.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawSpec")]
 pub struct TableSpec {
     /// Relative refractive index η of the half-space (outside index 1).
-    pub eta: f64,
+    eta: f64,
     /// Henyey–Greenstein asymmetry g (σs = σ′s/(1 − g)).
-    pub g: f64,
+    g: f64,
     /// Reduced albedos α′, strictly increasing, in [0, 1).
-    pub albedos: Vec<f64>,
+    albedos: Vec<f64>,
     /// Radial bin edges in units of the reduced mean free path 1/σ′t (the radii at σ′t = 1 mm⁻¹).
-    pub radial_edges: Vec<f64>,
+    radial_edges: Vec<f64>,
     /// Photons traced per albedo.
-    pub photons_per_albedo: u64,
+    photons_per_albedo: u64,
     /// Seed; albedo i uses seed + i.
-    pub seed: u64,
+    seed: u64,
+}
+
+/// The unchecked shape of [`TableSpec`] in files.
+#[derive(Deserialize)]
+struct RawSpec {
+    eta: f64,
+    g: f64,
+    albedos: Vec<f64>,
+    radial_edges: Vec<f64>,
+    photons_per_albedo: u64,
+    seed: u64,
+}
+
+impl TryFrom<RawSpec> for TableSpec {
+    type Error = McError;
+    fn try_from(raw: RawSpec) -> Result<Self> {
+        Self::from_parts(
+            raw.eta,
+            raw.g,
+            raw.albedos,
+            raw.radial_edges,
+            raw.photons_per_albedo,
+            raw.seed,
+        )
+    }
 }
 
 impl TableSpec {
+    /// A spec from all its parts, checked ([`TableSpec::validate`]'s rules).
+    ///
+    /// # Errors
+    /// `InvalidParameter` naming the first bad part.
+    pub fn from_parts(
+        eta: f64,
+        g: f64,
+        albedos: Vec<f64>,
+        radial_edges: Vec<f64>,
+        photons_per_albedo: u64,
+        seed: u64,
+    ) -> Result<Self> {
+        let spec = Self {
+            eta,
+            g,
+            albedos,
+            radial_edges,
+            photons_per_albedo,
+            seed,
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// The same spec with other albedos.
+    ///
+    /// # Errors
+    /// As [`TableSpec::from_parts`].
+    pub fn with_albedos(self, albedos: Vec<f64>) -> Result<Self> {
+        Self::from_parts(
+            self.eta,
+            self.g,
+            albedos,
+            self.radial_edges,
+            self.photons_per_albedo,
+            self.seed,
+        )
+    }
+
+    /// The same spec with another seed (always valid).
+    #[must_use]
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Relative refractive index η of the half-space (outside index 1).
+    pub fn eta(&self) -> f64 {
+        self.eta
+    }
+    /// Henyey–Greenstein asymmetry g.
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+    /// Reduced albedos α′, strictly increasing, in [0, 1).
+    pub fn albedos(&self) -> &[f64] {
+        &self.albedos
+    }
+    /// Radial bin edges in reduced mean free paths (the radii at σ′t = 1 mm⁻¹).
+    pub fn radial_edges(&self) -> &[f64] {
+        &self.radial_edges
+    }
+    /// Photons traced per albedo.
+    pub fn photons_per_albedo(&self) -> u64 {
+        self.photons_per_albedo
+    }
+    /// Seed; albedo i uses seed + i.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
     /// The default layout: `albedo_count` albedos equally spaced in √(1 − α′) from α′ = 0 to
     /// [`DEFAULT_MAX_ALBEDO`] (dense near 1, where profiles change fastest), 64 radial bins, the
     /// first [0, 0.005), then logarithmic to 200 mean free paths.
@@ -64,16 +165,7 @@ impl TableSpec {
             })
             .collect();
         let radial_edges = RadialGrid::logarithmic(0.005, 200.0, 64)?.edges().to_vec();
-        let spec = Self {
-            eta,
-            g,
-            albedos,
-            radial_edges,
-            photons_per_albedo,
-            seed: 1,
-        };
-        spec.validate()?;
-        Ok(spec)
+        Self::from_parts(eta, g, albedos, radial_edges, photons_per_albedo, 1)
     }
 
     /// A coarse table that builds in seconds: 16 albedos × 50 000 photons.
@@ -84,7 +176,8 @@ impl TableSpec {
         Self::new(eta, g, 16, 50_000)
     }
 
-    /// Checks every field.
+    /// Checks every field (every constructor does; kept public for callers that hold a spec from
+    /// elsewhere).
     ///
     /// # Errors
     /// `InvalidParameter` naming the first bad field.
@@ -133,6 +226,36 @@ impl TableSpec {
         Ok(())
     }
 
+    /// The expected cost of [`ProfileTable::build`]: the sum over albedos of each simulation's
+    /// [`Simulation::cost_estimate`] (memory: the largest, they run one after the other).
+    ///
+    /// # Errors
+    /// `InvalidParameter` if a simulation cannot be set up (not for a valid spec).
+    pub fn cost_estimate(&self) -> Result<crate::CostEstimate> {
+        let grid = RadialGrid::from_edges(self.radial_edges.clone())?;
+        let mut total = crate::CostEstimate {
+            interactions_per_photon: 0.0,
+            interactions: 0.0,
+            memory_bytes: 0,
+        };
+        for &albedo in &self.albedos {
+            let layer = Layer::from_reduced(albedo, 1.0 - albedo, self.g, self.eta, f64::INFINITY)?;
+            let sim = Simulation::new(
+                Sample::slab(layer, 1.0)?,
+                Beam::pencil(),
+                grid.clone(),
+                self.photons_per_albedo,
+                0,
+            )?;
+            let c = sim.cost_estimate();
+            total.interactions += c.interactions;
+            total.memory_bytes = total.memory_bytes.max(c.memory_bytes);
+        }
+        total.interactions_per_photon =
+            total.interactions / (self.photons_per_albedo as f64 * self.albedos.len() as f64);
+        Ok(total)
+    }
+
     /// A short stable hash of the spec (FNV-1a 64 of its JSON), used in the cache file name.
     pub fn fingerprint(&self) -> String {
         let json = serde_json::to_string(self).expect("a spec of numbers always serialises");
@@ -156,7 +279,9 @@ impl TableSpec {
 }
 
 /// A built table: R̂(ρ; α′) per albedo and radial bin at σ′t = 1, with standard errors, and totals.
+/// Read from JSON through the consistency checks of [`ProfileTable::load`] (`#[serde(try_from)]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawTable")]
 pub struct ProfileTable {
     format: String,
     version: u32,
@@ -168,6 +293,54 @@ pub struct ProfileTable {
     rd_total_stderr: Vec<f64>,
     /// Area-weighted bin centres (optical radii).
     centers: Vec<f64>,
+}
+
+/// The unchecked shape of [`ProfileTable`] in files.
+#[derive(Deserialize)]
+struct RawTable {
+    format: String,
+    version: u32,
+    spec: TableSpec,
+    rd: Vec<f64>,
+    rd_stderr: Vec<f64>,
+    rd_total: Vec<f64>,
+    rd_total_stderr: Vec<f64>,
+    centers: Vec<f64>,
+}
+
+impl TryFrom<RawTable> for ProfileTable {
+    type Error = String;
+    /// The format tag and version, and every array's length against the spec.
+    fn try_from(raw: RawTable) -> std::result::Result<Self, String> {
+        let bins = raw.spec.radial_edges.len() - 1;
+        let rows = raw.spec.albedos.len();
+        if raw.format != FORMAT_TAG || raw.version != FORMAT_VERSION {
+            return Err(format!(
+                "format {:?} version {}, expected {FORMAT_TAG:?} version {FORMAT_VERSION}",
+                raw.format, raw.version
+            ));
+        }
+        let sizes = [
+            ("centers", raw.centers.len(), bins),
+            ("rd", raw.rd.len(), bins * rows),
+            ("rd_stderr", raw.rd_stderr.len(), bins * rows),
+            ("rd_total", raw.rd_total.len(), rows),
+            ("rd_total_stderr", raw.rd_total_stderr.len(), rows),
+        ];
+        if let Some((name, got, want)) = sizes.iter().find(|(_, got, want)| got != want) {
+            return Err(format!("`{name}` has {got} values, the spec needs {want}"));
+        }
+        Ok(Self {
+            format: raw.format,
+            version: raw.version,
+            spec: raw.spec,
+            rd: raw.rd,
+            rd_stderr: raw.rd_stderr,
+            rd_total: raw.rd_total,
+            rd_total_stderr: raw.rd_total_stderr,
+            centers: raw.centers,
+        })
+    }
 }
 
 /// How [`ProfileTable::load_or_build`] obtained its table.
@@ -405,29 +578,10 @@ impl ProfileTable {
             path: path.to_owned(),
             source,
         })?;
-        let table: Self = serde_json::from_str(&text).map_err(|e| McError::Format {
+        serde_json::from_str(&text).map_err(|e| McError::Format {
             path: path.to_owned(),
             message: e.to_string(),
-        })?;
-        let bins = table.spec.radial_edges.len().saturating_sub(1);
-        let rows = table.spec.albedos.len();
-        if table.format != FORMAT_TAG
-            || table.version != FORMAT_VERSION
-            || table.spec.validate().is_err()
-            || table.centers.len() != bins
-            || table.rd.len() != bins * rows
-            || table.rd_stderr.len() != bins * rows
-            || table.rd_total.len() != rows
-            || table.rd_total_stderr.len() != rows
-        {
-            return Err(McError::Format {
-                path: path.to_owned(),
-                message: format!(
-                    "not a {FORMAT_TAG} of version {FORMAT_VERSION}, or inconsistent sizes"
-                ),
-            });
-        }
-        Ok(table)
+        })
     }
 
     /// Writes the table atomically: a temporary file in the same folder, synced, then renamed.
@@ -554,9 +708,39 @@ mod tests {
     use super::*;
 
     fn small_spec() -> TableSpec {
-        let mut spec = TableSpec::new(1.3, 0.0, 3, 2_000).unwrap();
-        spec.albedos = vec![0.3, 0.8, 0.95];
-        spec
+        TableSpec::new(1.3, 0.0, 3, 2_000)
+            .unwrap()
+            .with_albedos(vec![0.3, 0.8, 0.95])
+            .unwrap()
+    }
+
+    /// A spec or a table read back from JSON equals the one written; a spec or table that breaks
+    /// the constructor's rules or the sizes is refused on reading.
+    #[test]
+    fn json_goes_through_the_checks() {
+        let spec = small_spec();
+        let json = serde_json::to_string(&spec).unwrap();
+        assert_eq!(serde_json::from_str::<TableSpec>(&json).unwrap(), spec);
+        for (from, to) in [
+            ("\"eta\":1.3", "\"eta\":-1.3"),
+            ("\"g\":0.0", "\"g\":1.0"),
+            ("\"photons_per_albedo\":2000", "\"photons_per_albedo\":0"),
+            ("[0.3,0.8,0.95]", "[0.8,0.3,0.95]"),
+            ("[0.3,0.8,0.95]", "[0.3,0.8,1.0]"),
+        ] {
+            assert!(json.contains(from), "{from} in {json}");
+            let bad = json.replace(from, to);
+            assert!(serde_json::from_str::<TableSpec>(&bad).is_err(), "{bad}");
+        }
+        assert!(spec.clone().with_albedos(vec![0.5]).is_err());
+        let table = ProfileTable::build(&spec, &|_, _| {}).unwrap();
+        let json = serde_json::to_string(&table).unwrap();
+        assert_eq!(serde_json::from_str::<ProfileTable>(&json).unwrap(), table);
+        let short = json.replacen("\"rd_total\":[", "\"rd_total\":[0.5,", 1);
+        let err = serde_json::from_str::<ProfileTable>(&short)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("rd_total"), "{err}");
     }
 
     /// A cached table is reused when its spec matches, rebuilt when the spec differs or the file is
@@ -570,8 +754,7 @@ mod tests {
         let (b, s2, _) = ProfileTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();
         assert_eq!(s2, CacheStatus::Loaded);
         assert_eq!(a, b);
-        let mut other = spec.clone();
-        other.seed = 2;
+        let other = spec.clone().with_seed(2);
         assert_ne!(other.file_name(), spec.file_name());
         std::fs::write(&path, b"{ not json").unwrap();
         let (c, s3, _) = ProfileTable::load_or_build(&spec, dir.path(), &|_, _| {}).unwrap();

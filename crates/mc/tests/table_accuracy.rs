@@ -97,8 +97,8 @@ fn row_rel_se(i: usize, rho: f64) -> f64 {
 #[test]
 fn profile_between_albedos_matches_direct_simulation() {
     let t = table();
-    let a = &t.spec().albedos;
-    let grid = RadialGrid::from_edges(t.spec().radial_edges.clone()).unwrap();
+    let a = t.spec().albedos();
+    let grid = RadialGrid::from_edges(t.spec().radial_edges().to_vec()).unwrap();
     for (k, seed) in [(17usize, 71u64), (28, 72), (30, 73)] {
         let u = 0.5 * ((1.0 - a[k]).sqrt() + (1.0 - a[k + 1]).sqrt());
         let alpha = 1.0 - u * u;
@@ -121,12 +121,12 @@ fn profile_between_albedos_matches_direct_simulation() {
 fn profile_between_radii_matches_direct_simulation() {
     let t = table();
     let st = 2.0;
-    let e = &t.spec().radial_edges;
+    let e = t.spec().radial_edges();
     let mut edges = vec![0.0];
     edges.extend((1..e.len() - 1).map(|j| (e[j] * e[j + 1]).sqrt() / st));
     let grid = RadialGrid::from_edges(edges).unwrap();
     for (k, seed) in [(9usize, 81u64), (21, 82), (28, 83)] {
-        let alpha = t.spec().albedos[k];
+        let alpha = t.spec().albedos()[k];
         // σ′t = 2: σ′s = 2α′, σa = 2(1 − α′).
         let half = Sample::slab(
             Layer::from_reduced(2.0 * alpha, 2.0 * (1.0 - alpha), 0.0, ETA, f64::INFINITY).unwrap(),
@@ -156,7 +156,7 @@ fn profile_between_radii_matches_direct_simulation() {
 fn total_rd_and_inversion_match_adding_doubling() {
     let t = table();
     let (_, se) = t.totals();
-    let a = &t.spec().albedos;
+    let a = t.spec().albedos();
     for (alpha, reference) in [
         (0.5, 0.052305),
         (0.8, 0.153054),

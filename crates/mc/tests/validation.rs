@@ -332,12 +332,14 @@ fn far_field_approaches_dipole_near_field_does_not() {
 #[test]
 fn similarity_scaling_matches_direct_simulation() {
     let eta = 1.4;
-    let mut spec = TableSpec::new(eta, 0.0, 2, 100_000).unwrap();
-    spec.albedos = vec![0.5, 0.9];
+    let spec = TableSpec::new(eta, 0.0, 2, 100_000)
+        .unwrap()
+        .with_albedos(vec![0.5, 0.9])
+        .unwrap();
     let table = ProfileTable::build(&spec, &|_, _| {}).unwrap();
     let st = 2.5;
     let alpha = 0.9;
-    let g = RadialGrid::from_edges(spec.radial_edges.iter().map(|e| e / st).collect()).unwrap();
+    let g = RadialGrid::from_edges(spec.radial_edges().iter().map(|e| e / st).collect()).unwrap();
     let half = Sample::slab(
         Layer::from_reduced(alpha * st, (1.0 - alpha) * st, 0.0, eta, f64::INFINITY).unwrap(),
         1.0,

@@ -125,10 +125,25 @@ pub struct SpectroAnalysis {
     pub lab_10deg: Lab,
     /// Where Rd came from.
     pub colour_source: ColourSource,
-    /// Per channel R, G, B (linear sRGB).
+    /// Per channel R, G, B (linear sRGB); in JSON an object keyed `"r"`, `"g"`, `"b"` like every
+    /// other result file of scatterfit.
+    #[serde(serialize_with = "rgb_keyed")]
     pub channels: [ChannelResult; 3],
     /// Things the user should know (low specular, negative SCI − SCE at some wavelengths, …).
     pub warnings: Vec<String>,
+}
+
+/// Serialises three per-channel values as `{"r": …, "g": …, "b": …}`.
+fn rgb_keyed<S: serde::Serializer, T: Serialize>(
+    v: &[T; 3],
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut m = s.serialize_map(Some(3))?;
+    for (k, x) in ["r", "g", "b"].iter().zip(v) {
+        m.serialize_entry(k, x)?;
+    }
+    m.end()
 }
 
 impl SpectroAnalysis {

@@ -1,10 +1,12 @@
-//! Published optical parameters used by the demo and the end-to-end tests.
+//! Published optical parameters used by the demo, the rig twin and the end-to-end tests.
 
 /// A material's published parameters per linear-sRGB channel (R, G, B).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PublishedMaterial {
-    /// Short name.
+    /// Short name (lower case, hyphenated), as `scatterfit synth --material` takes it.
     pub name: &'static str,
+    /// Where the numbers come from.
+    pub source: &'static str,
     /// Reduced scattering coefficient σ′s per channel [mm⁻¹].
     pub sigma_s_prime: [f64; 3],
     /// Absorption coefficient σa per channel [mm⁻¹].
@@ -24,11 +26,55 @@ impl PublishedMaterial {
 /// material); also in `shared/reference/materials.csv`.
 #[rustfmt::skip]
 pub const CHOI_2014: [PublishedMaterial; 7] = [
-    PublishedMaterial { name: "pink-plastic", sigma_s_prime: [1.979, 1.893, 1.992], sigma_a: [0.000792, 0.049600, 0.022700], eta: 1.2886 },
-    PublishedMaterial { name: "blue-coating", sigma_s_prime: [1.189, 1.742, 1.865], sigma_a: [1.189000, 0.090597, 0.016372], eta: 1.9432 },
-    PublishedMaterial { name: "brown-leather", sigma_s_prime: [1.659, 1.383, 1.113], sigma_a: [0.116993, 0.272607, 0.428075], eta: 1.2391 },
-    PublishedMaterial { name: "nephrite", sigma_s_prime: [1.439, 1.565, 1.414], sigma_a: [0.066138, 0.053121, 0.046018], eta: 1.0777 },
-    PublishedMaterial { name: "wood-tile", sigma_s_prime: [2.35, 2.33, 1.461], sigma_a: [0.017508, 0.065100, 0.138360], eta: 1.3108 },
-    PublishedMaterial { name: "sulfur", sigma_s_prime: [1.896, 1.954, 1.622], sigma_a: [0.002359, 0.004151, 0.073041], eta: 1.1159 },
-    PublishedMaterial { name: "red-aluminum", sigma_s_prime: [1.89, 1.171, 0.7498], sigma_a: [0.018700, 0.768300, 0.558000], eta: 2.4102 },
+    PublishedMaterial { name: "pink-plastic", source: "choi2014", sigma_s_prime: [1.979, 1.893, 1.992], sigma_a: [0.000792, 0.049600, 0.022700], eta: 1.2886 },
+    PublishedMaterial { name: "blue-coating", source: "choi2014", sigma_s_prime: [1.189, 1.742, 1.865], sigma_a: [1.189000, 0.090597, 0.016372], eta: 1.9432 },
+    PublishedMaterial { name: "brown-leather", source: "choi2014", sigma_s_prime: [1.659, 1.383, 1.113], sigma_a: [0.116993, 0.272607, 0.428075], eta: 1.2391 },
+    PublishedMaterial { name: "nephrite", source: "choi2014", sigma_s_prime: [1.439, 1.565, 1.414], sigma_a: [0.066138, 0.053121, 0.046018], eta: 1.0777 },
+    PublishedMaterial { name: "wood-tile", source: "choi2014", sigma_s_prime: [2.35, 2.33, 1.461], sigma_a: [0.017508, 0.065100, 0.138360], eta: 1.3108 },
+    PublishedMaterial { name: "sulfur", source: "choi2014", sigma_s_prime: [1.896, 1.954, 1.622], sigma_a: [0.002359, 0.004151, 0.073041], eta: 1.1159 },
+    PublishedMaterial { name: "red-aluminum", source: "choi2014", sigma_s_prime: [1.89, 1.171, 0.7498], sigma_a: [0.018700, 0.768300, 0.558000], eta: 2.4102 },
 ];
+
+/// Jensen, Marschner, Levoy & Hanrahan (2001), measured materials as pbrt-v3/v4 carry them
+/// (physics.md §1.5; `shared/reference/materials.csv`). The paper gives no η; Jensen et al. used 1.3.
+#[rustfmt::skip]
+pub const JENSEN_2001: [PublishedMaterial; 11] = [
+    PublishedMaterial { name: "apple", source: "jensen2001", sigma_s_prime: [2.29, 2.39, 1.97], sigma_a: [0.0030, 0.0034, 0.046], eta: 1.3 },
+    PublishedMaterial { name: "chicken1", source: "jensen2001", sigma_s_prime: [0.15, 0.21, 0.38], sigma_a: [0.015, 0.077, 0.19], eta: 1.3 },
+    PublishedMaterial { name: "chicken2", source: "jensen2001", sigma_s_prime: [0.19, 0.25, 0.32], sigma_a: [0.018, 0.088, 0.20], eta: 1.3 },
+    PublishedMaterial { name: "cream", source: "jensen2001", sigma_s_prime: [7.38, 5.47, 3.15], sigma_a: [0.0002, 0.0028, 0.0163], eta: 1.3 },
+    PublishedMaterial { name: "ketchup", source: "jensen2001", sigma_s_prime: [0.18, 0.07, 0.03], sigma_a: [0.061, 0.97, 1.45], eta: 1.3 },
+    PublishedMaterial { name: "marble", source: "jensen2001", sigma_s_prime: [2.19, 2.62, 3.00], sigma_a: [0.0021, 0.0041, 0.0071], eta: 1.3 },
+    PublishedMaterial { name: "potato", source: "jensen2001", sigma_s_prime: [0.68, 0.70, 0.55], sigma_a: [0.0024, 0.0090, 0.12], eta: 1.3 },
+    PublishedMaterial { name: "skimmilk", source: "jensen2001", sigma_s_prime: [0.70, 1.22, 1.90], sigma_a: [0.0014, 0.0025, 0.0142], eta: 1.3 },
+    PublishedMaterial { name: "skin1", source: "jensen2001", sigma_s_prime: [0.74, 0.88, 1.01], sigma_a: [0.032, 0.17, 0.48], eta: 1.3 },
+    PublishedMaterial { name: "skin2", source: "jensen2001", sigma_s_prime: [1.09, 1.59, 1.79], sigma_a: [0.013, 0.070, 0.145], eta: 1.3 },
+    PublishedMaterial { name: "wholemilk", source: "jensen2001", sigma_s_prime: [2.55, 3.21, 3.77], sigma_a: [0.0011, 0.0024, 0.014], eta: 1.3 },
+];
+
+/// Every built-in material.
+pub fn all() -> impl Iterator<Item = &'static PublishedMaterial> {
+    CHOI_2014.iter().chain(JENSEN_2001.iter())
+}
+
+/// The built-in material of this name (case-insensitive; `_` and spaces count as `-`).
+pub fn by_name(name: &str) -> Option<&'static PublishedMaterial> {
+    let key = name.trim().to_ascii_lowercase().replace(['_', ' '], "-");
+    all().find(|m| m.name == key)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tables agree with the reference sheet `shared/reference/materials.csv` (copied values
+    /// checked here against the ones pbrt carries, physics.md §1.5, for three spot checks).
+    #[test]
+    fn lookup_and_spot_checks() {
+        assert_eq!(by_name("Pink Plastic").unwrap().eta, 1.2886);
+        assert_eq!(by_name("skin_1"), None);
+        assert_eq!(by_name("skin1").unwrap().sigma_a, [0.032, 0.17, 0.48]);
+        assert_eq!(by_name("marble").unwrap().sigma_s_prime, [2.19, 2.62, 3.00]);
+        assert_eq!(all().count(), 18);
+    }
+}

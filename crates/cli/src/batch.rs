@@ -1,0 +1,112 @@
+//! `scatterfit batch`: many sample folders, measured in parallel; every good sample's result files
+//! are written into its folder as soon as it is done, failures are listed at the end (exit 1 if
+//! any), and summary.csv / summary.md (Table 1's shape) gather the good ones.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Mutex;
+
+use scatterfit_io::result_json::MeasurementResult;
+use scatterfit_io::result_table::{table1_csv, table1_markdown};
+use scatterfit_pipeline::sample_dirs;
+
+use crate::common::FitArgs;
+
+/// Arguments of `scatterfit batch`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Sample folders (each with a sample.toml), or folders holding sample folders.
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Samples measured at the same time [1, 256] (default: one per core).
+    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+    pub jobs: Option<u16>,
+    /// Where to write summary.csv and summary.md (the command's own files, replaced).
+    #[arg(
+        short = 'o',
+        long = "output-dir",
+        value_name = "DIR",
+        default_value = "."
+    )]
+    pub output_dir: PathBuf,
+    #[command(flatten)]
+    pub fit: FitArgs,
+    /// Print the results as a JSON array.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Runs `scatterfit batch`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let overrides = args.fit.overrides()?;
+    let dirs = sample_dirs(&args.dirs);
+    let write_errors = Mutex::new(Vec::<(PathBuf, String)>::new());
+    let outcomes = crate::runner::measure_many(
+        &dirs,
+        &overrides,
+        args.jobs.map_or(0, usize::from),
+        args.quiet || args.json,
+        &|dir, r| {
+            if let Ok(m) = r
+                && let Err(e) = crate::report::write_measurement(dir, m)
+                && let Ok(mut w) = write_errors.lock()
+            {
+                w.push((dir.to_path_buf(), format!("{e:#}")));
+            }
+        },
+    )?;
+    let mut results: Vec<MeasurementResult> = Vec::new();
+    let mut failed: Vec<(PathBuf, String)> = write_errors.into_inner().unwrap_or_default();
+    for o in &outcomes {
+        match &o.result {
+            Ok(m) => {
+                let r = m.to_result(Some("profile.csv"));
+                if !m.complete() {
+                    let why: Vec<String> = r
+                        .channels
+                        .as_array()
+                        .iter()
+                        .filter_map(|c| c.problem.clone())
+                        .collect();
+                    failed.push((o.dir.clone(), why.join("; ")));
+                }
+                results.push(r);
+            }
+            Err(e) => failed.push((o.dir.clone(), format!("{e:#}"))),
+        }
+    }
+    std::fs::create_dir_all(&args.output_dir)?;
+    for (name, text) in [
+        ("summary.csv", table1_csv(&results)),
+        ("summary.md", table1_markdown(&results)),
+    ] {
+        let p = args.output_dir.join(name);
+        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
+            .map_err(|e| anyhow::anyhow!("writing {}: {e}", p.display()))?;
+    }
+    if args.json {
+        crate::output::print_json(&results)?;
+    } else {
+        for r in &results {
+            print!("{}", crate::report::summary_text(r));
+        }
+        println!(
+            "\n{} of {} samples measured completely; summary: {} and {}",
+            dirs.len() - failed.len(),
+            dirs.len(),
+            args.output_dir.join("summary.csv").display(),
+            args.output_dir.join("summary.md").display()
+        );
+    }
+    if !failed.is_empty() {
+        eprintln!("\n{} sample(s) failed or are incomplete:", failed.len());
+        for (dir, why) in &failed {
+            eprintln!("  {}: {why}", dir.display());
+        }
+        return Ok(ExitCode::from(1));
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,213 @@
+//! Helpers shared by the subcommands: value parsers, progress bars, output-folder safety and the
+//! exit-code classes.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+use scatterfit_io::manifest::{MethodName, ModelName};
+use scatterfit_pipeline::Overrides;
+
+/// A measurement that ran and failed (exit code 1), as opposed to bad input (2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct MeasurementFailed(pub String);
+
+/// True when `err` (or a cause) is a failed measurement: exit 1.
+pub fn is_measurement_failure(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| {
+        e.is::<MeasurementFailed>()
+            || e.downcast_ref::<scatterfit_pipeline::PipelineError>()
+                .is_some_and(scatterfit_pipeline::PipelineError::is_measurement_failure)
+    })
+}
+
+/// The error and its causes joined by ": ", skipping a cause whose text the message already holds
+/// (many library errors name their source in their own message, and `{:#}` would repeat it).
+pub fn error_text(err: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in err.chain() {
+        let c = cause.to_string();
+        if text.contains(&c) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&c);
+    }
+    text
+}
+
+/// Parses `R,G,B` (three numbers).
+pub fn parse_rgb(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
+    match (parts.len(), values.as_slice()) {
+        (3, &[r, g, b]) if [r, g, b].iter().all(|v| v.is_finite()) => Ok([r, g, b]),
+        _ => Err(format!(
+            "`{text}` is not three numbers R,G,B (e.g. 1.979,1.893,1.992)"
+        )),
+    }
+}
+
+/// A progress bar on stderr when it is a terminal and not `quiet`, else hidden.
+pub fn bar(len: u64, template: &str, quiet: bool) -> indicatif::ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Refuses to write into `dir` when any of `files` already exists there, unless `force`.
+///
+/// # Errors
+/// Names the first existing file and says how to proceed.
+pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::Result<()> {
+    if force {
+        return Ok(());
+    }
+    if let Some(f) = files.iter().find(|f| dir.join(f).exists()) {
+        bail!(
+            "{} already exists; nothing was written — choose another folder or pass --force to \
+             overwrite",
+            dir.join(f).display()
+        );
+    }
+    Ok(())
+}
+
+/// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default.
+pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
+    given
+        .map(Path::to_path_buf)
+        .or_else(scatterfit_mc::table::default_cache_dir)
+}
+
+/// `1/600` for short times that are whole fractions, else 4 significant digits.
+pub fn shutter(t: f64) -> String {
+    if t < 0.5 && t > 0.0 {
+        let inv = 1.0 / t;
+        if (inv - inv.round()).abs() < 1e-6 * inv {
+            return format!("1/{}", inv.round());
+        }
+    }
+    if (1e-3..1e4).contains(&t) {
+        let decimals = (3 - t.log10().floor() as i32).max(0) as usize;
+        format!("{t:.decimals$}")
+    } else {
+        format!("{t:.3e}")
+    }
+}
+
+/// The fitting method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Choi et al. 2014: α′ from the spectrophotometer, σ′s (and the profile's scale) fitted.
+    Proposed,
+    /// Jensen et al. 2001: σ′s, σa (and the scale) fitted.
+    Existing,
+}
+
+impl From<MethodArg> for MethodName {
+    fn from(m: MethodArg) -> Self {
+        match m {
+            MethodArg::Proposed => MethodName::Proposed,
+            MethodArg::Existing => MethodName::Existing,
+        }
+    }
+}
+
+/// The forward model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    /// The classical dipole, Jensen et al. 2001 (the paper's).
+    Dipole,
+    /// d'Eon 2012 (not available yet).
+    BetterDipole,
+    /// Photon beam diffusion (not available yet).
+    Pbd,
+    /// Monte Carlo tables (not available yet).
+    Mc,
+}
+
+impl From<ModelArg> for ModelName {
+    fn from(m: ModelArg) -> Self {
+        match m {
+            ModelArg::Dipole => ModelName::Dipole,
+            ModelArg::BetterDipole => ModelName::BetterDipole,
+            ModelArg::Pbd => ModelName::Pbd,
+            ModelArg::Mc => ModelName::Mc,
+        }
+    }
+}
+
+/// Options shared by `measure`, `batch` and `compare`: what overrides the manifests' `[fit]`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct FitArgs {
+    /// The fitting method (default: the manifest's `fit.method`, else proposed).
+    #[arg(long, value_enum)]
+    pub method: Option<MethodArg>,
+    /// The forward model (default: the manifest's `fit.model`, else dipole).
+    #[arg(long, value_enum)]
+    pub model: Option<ModelArg>,
+    /// A known η instead of the one measured from SCI − SCE [1, 3].
+    #[arg(long)]
+    pub eta: Option<f64>,
+    /// Proposed method: fix the profile's scale by the spectrophotometer's Rd instead of fitting it.
+    #[arg(long)]
+    pub normalise_with_spectro: bool,
+}
+
+impl FitArgs {
+    /// The pipeline's overrides.
+    ///
+    /// # Errors
+    /// An η outside [1, 3].
+    pub fn overrides(&self) -> anyhow::Result<Overrides> {
+        if let Some(e) = self.eta
+            && !(e.is_finite() && (1.0..=3.0).contains(&e))
+        {
+            anyhow::bail!("--eta {e}: the relative refractive index must lie in [1, 3]");
+        }
+        Ok(Overrides {
+            method: self.method.map(Into::into),
+            model: self.model.map(Into::into),
+            eta: self.eta,
+            normalise_with_spectro: self.normalise_with_spectro.then_some(true),
+        })
+    }
+}
+
+/// A path's identity for "is this output one of the inputs?": canonical folder + file name.
+pub fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let parent = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (std::fs::canonicalize(parent), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Refuses to write `output` over any of `inputs`.
+pub fn refuse_overwrite(output: &Path, what: &str, inputs: &[&Path]) -> anyhow::Result<()> {
+    let out = identity(output);
+    if let Some(input) = inputs.iter().find(|i| identity(i) == out) {
+        bail!(
+            "{what} {} is also an input ({}); inputs are never overwritten — choose another output file",
+            output.display(),
+            input.display()
+        );
+    }
+    Ok(())
+}

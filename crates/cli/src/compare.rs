@@ -1,0 +1,78 @@
+//! `scatterfit compare`: both methods on the same data — the proposed (α′ from the
+//! spectrophotometer, σ′s fitted) and the existing (σ′s and σa fitted) — per channel: parameters,
+//! fit time and MSE (the paper's Table 2 shape), and a plot per sample shaped like its Figure 6
+//! (compare.svg, compare.png in the sample folder).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use scatterfit_io::result_table::{table2_csv, table2_markdown};
+use scatterfit_pipeline::sample_dirs;
+
+use crate::common::FitArgs;
+
+/// Arguments of `scatterfit compare`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Sample folders (each with a sample.toml), or folders holding sample folders.
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Samples measured at the same time [1, 256] (default: one per core).
+    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+    pub jobs: Option<u16>,
+    /// Where to write compare.csv and compare.md (the command's own files, replaced).
+    #[arg(
+        short = 'o',
+        long = "output-dir",
+        value_name = "DIR",
+        default_value = "."
+    )]
+    pub output_dir: PathBuf,
+    #[command(flatten)]
+    pub fit: FitArgs,
+    /// Print the pairs of results as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Runs `scatterfit compare`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let dirs = sample_dirs(&args.dirs);
+    let (pairs, failed) = crate::runner::compare_dirs(
+        &dirs,
+        &args.fit,
+        args.jobs.map_or(0, usize::from),
+        args.quiet || args.json,
+        false,
+    )?;
+    std::fs::create_dir_all(&args.output_dir)?;
+    for (name, text) in [
+        ("compare.csv", table2_csv(&pairs)),
+        ("compare.md", table2_markdown(&pairs)),
+    ] {
+        let p = args.output_dir.join(name);
+        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
+            .map_err(|e| anyhow::anyhow!("writing {}: {e}", p.display()))?;
+    }
+    if args.json {
+        crate::output::print_json(&pairs)?;
+    } else {
+        print!("{}", table2_markdown(&pairs));
+        println!(
+            "\nplots: compare.svg / compare.png in each sample folder; tables: {} and {}",
+            args.output_dir.join("compare.csv").display(),
+            args.output_dir.join("compare.md").display()
+        );
+    }
+    if !failed.is_empty() {
+        eprintln!("\n{} sample(s) failed:", failed.len());
+        for (dir, why) in &failed {
+            eprintln!("  {}: {why}", dir.display());
+        }
+        return Ok(ExitCode::from(1));
+    }
+    Ok(ExitCode::SUCCESS)
+}

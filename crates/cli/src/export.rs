@@ -1,0 +1,173 @@
+//! `scatterfit export`: a measured result (`result.json`) as a material renderers read — pbrt-v4,
+//! Mitsuba 3, Blender (bpy script) or renderer-neutral JSON.
+//!
+//! The formats and their conventions are `scatterfit_io::export`'s (ARCHITECTURE.md, "io: exports");
+//! this file parses the arguments, checks the output path, writes atomically or prints to stdout.
+//! A result with a failed channel exports nothing (exit 1, the channel named); unconstrained channels
+//! are exported with a warning on stderr.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use scatterfit_io::export::{ExportError, Format, SceneUnit, export};
+use scatterfit_io::result_json::read_result_json;
+
+/// Arguments of `scatterfit export`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The result to export, as `scatterfit measure` writes it (result.json).
+    pub result: PathBuf,
+    /// Target format: pbrt (pbrt-v4 subsurface material + homogeneous medium, .pbrt), mitsuba
+    /// (Mitsuba 3 XML fragment: dielectric boundary + homogeneous medium, .xml), blender (bpy script
+    /// setting a Principled BSDF, Blender ≥ 4.0, .py), json (renderer-neutral, .json).
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub to: FormatArg,
+    /// Length unit of the target scene: coefficients are written per mm (mm⁻¹, as measured) or per
+    /// metre (m⁻¹ = 1000 × mm⁻¹), mean free paths in that unit.
+    #[arg(long, value_enum, default_value = "mm", value_name = "UNIT")]
+    pub scale: UnitArg,
+    /// Write to FILE (atomically; its extension must match the format: .pbrt, .xml, .py, .json)
+    /// instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    pub force: bool,
+    /// No warnings or confirmation on stderr/stdout (errors are still printed).
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `--to`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum FormatArg {
+    /// pbrt-v4 (.pbrt).
+    Pbrt,
+    /// Mitsuba 3 (.xml).
+    Mitsuba,
+    /// Blender ≥ 4.0 bpy script (.py).
+    Blender,
+    /// Renderer-neutral JSON (.json).
+    Json,
+}
+
+impl From<FormatArg> for Format {
+    fn from(f: FormatArg) -> Self {
+        match f {
+            FormatArg::Pbrt => Format::Pbrt,
+            FormatArg::Mitsuba => Format::Mitsuba,
+            FormatArg::Blender => Format::Blender,
+            FormatArg::Json => Format::Json,
+        }
+    }
+}
+
+/// `--scale`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum UnitArg {
+    /// One scene unit is one millimetre.
+    Mm,
+    /// One scene unit is one metre.
+    M,
+}
+
+impl From<UnitArg> for SceneUnit {
+    fn from(u: UnitArg) -> Self {
+        match u {
+            UnitArg::Mm => SceneUnit::Millimetre,
+            UnitArg::M => SceneUnit::Metre,
+        }
+    }
+}
+
+/// Runs `scatterfit export`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let format = Format::from(args.to);
+    let unit = SceneUnit::from(args.scale);
+    if let Some(out) = &args.output {
+        check_output(out, format, &args.result, args.force)?;
+    }
+    // The error's message already includes its cause; flatten it so `{:#}` does not repeat it.
+    let result = read_result_json(&args.result).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let exported = match export(&result, format, unit) {
+        Ok(e) => e,
+        Err(err @ ExportError::FailedChannel { .. }) => {
+            eprintln!("error: {}: {err}", args.result.display());
+            return Ok(ExitCode::from(1));
+        }
+        Err(err) => return Err(err).context(format!("exporting {}", args.result.display())),
+    };
+    if !args.quiet {
+        for w in &exported.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    match &args.output {
+        Some(out) => {
+            scatterfit_io::atomic::write_atomic(out, exported.text.as_bytes())
+                .with_context(|| format!("writing {}", out.display()))?;
+            if !args.quiet {
+                eprintln!(
+                    "wrote {} ({} material \"{}\", 1 scene unit = 1 {})",
+                    out.display(),
+                    format.name(),
+                    result.name,
+                    unit.symbol()
+                );
+            }
+        }
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            match stdout
+                .write_all(exported.text.as_bytes())
+                .and_then(|()| stdout.flush())
+            {
+                // A closed stdout (`| head`) ends the command quietly.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+                other => other.context("writing to stdout")?,
+            }
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses an output whose extension does not match the format, an existing file without `--force`,
+/// and the input itself (inputs are never overwritten).
+fn check_output(out: &Path, format: Format, input: &Path, force: bool) -> anyhow::Result<()> {
+    let want = format.extension();
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if ext.as_deref() != Some(want) {
+        bail!(
+            "output {}: a {} export is written to a .{want} file; name it e.g. `{}`",
+            out.display(),
+            format.name(),
+            out.with_extension(want).display()
+        );
+    }
+    if out.exists() {
+        let same = match (out.canonicalize(), input.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        if same {
+            bail!(
+                "output {} is the input result; write the export to another file",
+                out.display()
+            );
+        }
+        if !force {
+            bail!(
+                "output {} exists; pass --force to replace it, or choose another name",
+                out.display()
+            );
+        }
+        if out.is_dir() {
+            bail!("output {} is a folder; name a file", out.display());
+        }
+    }
+    Ok(())
+}

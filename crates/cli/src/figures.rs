@@ -1,0 +1,185 @@
+//! The figures of a measurement, built from its data for `crate::plot`: the fit (Figure 4 of Choi
+//! et al. 2014: measured profile and fitted model per channel, log scale) and the comparison of
+//! methods (their Figure 6: measured, existing, proposed).
+
+use scatterfit_fit::{FitReport, model_profile};
+use scatterfit_io::result_json::MeasurementResult;
+use scatterfit_io::result_table::sig4;
+use scatterfit_optics::OpticalProperties;
+use scatterfit_pipeline::Measurement;
+use scatterfit_pipeline::fit::{ChannelOutcome, model_for};
+
+use crate::plot::{Figure, Panel, Series, SeriesStyle};
+
+const NAMES: [&str; 3] = ["R", "G", "B"];
+const COLOURS: [(u8, u8, u8); 3] = [(200, 30, 30), (20, 140, 40), (30, 70, 200)];
+
+/// The measured rings of channel `c`: used ones with error bars, excluded ones apart.
+fn measured_series(m: &Measurement, c: usize, report: Option<&FitReport>) -> Vec<Series> {
+    let rings = &m.profile.profile.rings;
+    let used: std::collections::HashSet<usize> = report
+        .map(|r| r.fitted.iter().map(|f| f.index).collect())
+        .unwrap_or_default();
+    let (mut inc, mut err, mut exc) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, ring) in rings.iter().enumerate() {
+        let Some(r_mm) = m.profile.profile.r_mm(k) else {
+            continue;
+        };
+        let ch = &ring.channels[c];
+        if !(ch.mean.is_finite() && ch.mean > 0.0) {
+            continue;
+        }
+        if used.contains(&k) {
+            inc.push((r_mm, ch.mean));
+            err.push(if ch.std_err.is_finite() {
+                ch.std_err
+            } else {
+                0.0
+            });
+        } else {
+            exc.push((r_mm, ch.mean));
+        }
+    }
+    vec![
+        Series {
+            label: "measured (fitted rings)".into(),
+            points: inc,
+            errors: Some(err),
+            style: SeriesStyle::Measured,
+        },
+        Series {
+            label: "not fitted (spot, below detection)".into(),
+            points: exc,
+            errors: None,
+            style: SeriesStyle::Excluded,
+        },
+    ]
+}
+
+/// The model of a fitted channel × its scale over every ring radius (in the profile's units).
+fn model_series(
+    m: &Measurement,
+    report: &FitReport,
+    label: &str,
+    style: SeriesStyle,
+) -> Option<Series> {
+    let model = model_for(m.settings.model).ok()?;
+    let props =
+        OpticalProperties::new(report.sigma_s_prime.value, report.sigma_a.value, report.eta)
+            .ok()?;
+    let radii: Vec<f64> = (0..m.profile.profile.rings.len())
+        .filter_map(|k| m.profile.profile.r_mm(k))
+        .filter(|r| *r > 0.0)
+        .collect();
+    let spot = m.settings.options().spot;
+    let values = model_profile(model, &props, spot, &radii).ok()?;
+    Some(Series {
+        label: label.into(),
+        points: radii
+            .iter()
+            .zip(values)
+            .map(|(&r, v)| (r, v * report.scale.value))
+            .collect(),
+        errors: None,
+        style,
+    })
+}
+
+/// Figure 4's shape: per channel, the measured profile and the fitted model.
+pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
+    let panels = (0..3)
+        .map(|c| {
+            let report = m.fits.get(c).and_then(ChannelOutcome::report);
+            let mut series = measured_series(m, c, report);
+            if let Some(r) = report
+                && let Some(s) = model_series(
+                    m,
+                    r,
+                    &format!("{} fit ({})", result.model, result.method),
+                    SeriesStyle::Line,
+                )
+            {
+                series.push(s);
+            }
+            let ch = result.channels.as_array()[c];
+            let note = match (ch.sigma_s_prime, ch.sigma_a) {
+                (Some(sp), Some(sa)) => format!(
+                    "σ′s = {} mm⁻¹, σa = {} mm⁻¹, α′ = {}{}",
+                    sig4(sp),
+                    sig4(sa),
+                    ch.albedo_prime.map_or("—".into(), |a| format!("{a:.4}")),
+                    if ch.unconstrained.is_empty() {
+                        ""
+                    } else {
+                        " (unconstrained)"
+                    }
+                ),
+                _ => ch.problem.clone().unwrap_or_else(|| "not fitted".into()),
+            };
+            Panel {
+                title: format!("{} channel", NAMES[c]),
+                colour: COLOURS[c],
+                series,
+                note: Some(note),
+            }
+        })
+        .collect();
+    Figure {
+        title: format!(
+            "{} — radial profile and {} fit ({} method, η = {:.4})",
+            result.name, result.model, result.method, result.eta
+        ),
+        x_label: "r [mm]".into(),
+        y_label: "Rd(r) [relative]".into(),
+        panels,
+        log_y: true,
+        log_x: false,
+    }
+}
+
+/// Figure 6's shape: per channel, the measured profile with the existing and the proposed fits
+/// (both measurements are of the same sample; the profile is the proposed one's).
+pub fn compare_figure(existing: &Measurement, proposed: &Measurement, name: &str) -> Figure {
+    let panels = (0..3)
+        .map(|c| {
+            let rp = proposed.fits.get(c).and_then(ChannelOutcome::report);
+            let re = existing.fits.get(c).and_then(ChannelOutcome::report);
+            let mut series = measured_series(proposed, c, rp);
+            if let Some(r) = re
+                && let Some(s) = model_series(
+                    existing,
+                    r,
+                    "existing (σ′s, σa fitted)",
+                    SeriesStyle::DashedLine,
+                )
+            {
+                series.push(s);
+            }
+            if let Some(r) = rp
+                && let Some(s) =
+                    model_series(proposed, r, "proposed (α′ from spectro)", SeriesStyle::Line)
+            {
+                series.push(s);
+            }
+            let mse = |r: Option<&FitReport>| r.map_or("—".into(), |r| sig4(r.mse));
+            Panel {
+                title: format!("{} channel", NAMES[c]),
+                colour: COLOURS[c],
+                series,
+                note: Some(format!(
+                    "MSE existing {}, proposed {} mm⁻⁴",
+                    mse(re),
+                    mse(rp)
+                )),
+            }
+        })
+        .collect();
+    Figure {
+        title: format!("{name} — measured profile, existing and proposed methods"),
+        x_label: "r [mm]".into(),
+        y_label: "Rd(r) [relative]".into(),
+        panels,
+        log_y: true,
+        log_x: false,
+    }
+}

@@ -1,0 +1,165 @@
+//! `scatterfit fit`: fits a profile a user already has — the profile command's CSV, or any table
+//! with `r_mm` and `value_<c>`, `stderr_<c>`, `count_<c>` columns per channel (optionally
+//! `limit_<c>`) — given η and, for the proposed method, α′ per channel.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use scatterfit_fit::ProfileData;
+use scatterfit_io::manifest::{MethodName, ModelName};
+use scatterfit_io::profile_csv::read_profile_csv;
+use scatterfit_io::result_json::{Channels, Inputs, MeasurementResult, write_result_json};
+use scatterfit_pipeline::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage, model_for};
+use scatterfit_pipeline::profile::channel_from_table;
+use scatterfit_pipeline::spectro::SpectroStage;
+
+use crate::common::parse_rgb;
+use crate::common::{MethodArg, ModelArg};
+
+/// Arguments of `scatterfit fit`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The profile CSV (channels r, g, b).
+    pub profile: PathBuf,
+    /// Relative refractive index η [1, 3].
+    #[arg(long)]
+    pub eta: f64,
+    /// Reduced albedo α′ per channel R,G,B, each in (0, 1] (the proposed method needs it).
+    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
+    pub albedo: Option<[f64; 3]>,
+    /// The spectrophotometer's diffuse reflectance Rd per channel R,G,B (for
+    /// --normalise-with-spectro; default: the model's Rd of the given α′).
+    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
+    pub rd: Option<[f64; 3]>,
+    /// The fitting method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Proposed)]
+    pub method: MethodArg,
+    /// The forward model.
+    #[arg(long, value_enum, default_value_t = ModelArg::Dipole)]
+    pub model: ModelArg,
+    /// Diameter of the light spot [mm] (0, 20]; the model is convolved with it.
+    #[arg(long, default_value_t = 1.0, value_name = "MM")]
+    pub spot_diameter_mm: f64,
+    /// Innermost fitted radius [mm] (default: the spot diameter).
+    #[arg(long, value_name = "MM")]
+    pub r_min_mm: Option<f64>,
+    /// Proposed method: fix the profile's scale by the spectrophotometer's Rd.
+    #[arg(long)]
+    pub normalise_with_spectro: bool,
+    /// Also write the result (result.json's shape) to this file.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Print the result as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `scatterfit fit`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    if !(args.eta.is_finite() && (1.0..=3.0).contains(&args.eta)) {
+        bail!(
+            "--eta {}: the relative refractive index must lie in [1, 3]",
+            args.eta
+        );
+    }
+    if !(args.spot_diameter_mm > 0.0 && args.spot_diameter_mm <= 20.0) {
+        bail!(
+            "--spot-diameter-mm {}: must lie in (0, 20] mm",
+            args.spot_diameter_mm
+        );
+    }
+    let method: MethodName = args.method.into();
+    if method == MethodName::Proposed && args.albedo.is_none() {
+        bail!(
+            "the proposed method needs the reduced albedo per channel: --albedo R,G,B (from \
+             `scatterfit spectro`), or use --method existing"
+        );
+    }
+    if let Some(a) = args.albedo
+        && let Some(bad) = a.iter().find(|v| !(**v > 0.0 && **v <= 1.0))
+    {
+        bail!("--albedo: {bad} is outside (0, 1]");
+    }
+    if let Some(out) = &args.output {
+        crate::common::refuse_overwrite(out, "-o", &[args.profile.as_path()])?;
+        if out
+            .extension()
+            .is_none_or(|e| !e.eq_ignore_ascii_case("json"))
+        {
+            bail!(
+                "-o {}: the result is JSON; name the file *.json",
+                out.display()
+            );
+        }
+    }
+    let model_name: ModelName = args.model.into();
+    let model = model_for(model_name)?;
+    let table = read_profile_csv(&args.profile)?;
+    let data: Vec<ProfileData> = ["r", "g", "b"]
+        .iter()
+        .map(|c| channel_from_table(&table, c))
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{}", args.profile.display()))?;
+    let albedo = args.albedo.map_or([None; 3], |a| a.map(Some));
+    let rd = args
+        .rd
+        .unwrap_or_else(|| albedo.map(|a| a.map_or(f64::NAN, |a| model.rd_total(a, args.eta))));
+    let spectro = SpectroStage {
+        file: None,
+        analysis: None,
+        eta: args.eta,
+        eta_source: "given",
+        rd,
+        albedo_prime: albedo,
+        problems: Default::default(),
+        warnings: Vec::new(),
+    };
+    let settings = FitSettings {
+        method,
+        model: model_name,
+        spot_radius_mm: 0.5 * args.spot_diameter_mm,
+        r_min_mm: args.r_min_mm,
+        normalise_with_spectro: args.normalise_with_spectro,
+    };
+    let fits = fit_stage(&data, &spectro, &settings, model);
+    let result = MeasurementResult {
+        name: args
+            .profile
+            .file_stem()
+            .map_or_else(|| "profile".into(), |s| s.to_string_lossy().into_owned()),
+        eta: args.eta,
+        eta_source: "given".into(),
+        method: method.as_str().into(),
+        model: model_name.as_str().into(),
+        albedo_model: "given".into(),
+        channels: Channels::from_array(std::array::from_fn(|c| {
+            channel_result(&fits[c], &spectro, c)
+        })),
+        inputs: Inputs {
+            profile: Some(args.profile.to_string_lossy().into_owned()),
+            spot_radius_mm: Some(settings.spot_radius_mm),
+            options: serde_json::json!({
+                "method": method.as_str(),
+                "model": model_name.as_str(),
+                "normalise_with_spectro": args.normalise_with_spectro,
+                "r_min_mm": settings.options().selection.r_min_mm,
+            }),
+            ..Inputs::default()
+        },
+        version: env!("CARGO_PKG_VERSION").into(),
+    };
+    if let Some(out) = &args.output {
+        write_result_json(out, &result)?;
+    }
+    if args.json {
+        crate::output::print_json(&result)?;
+    } else {
+        print!("{}", crate::report::summary_text(&result));
+    }
+    Ok(if fits.iter().all(ChannelOutcome::is_measurement) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}

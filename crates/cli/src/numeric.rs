@@ -1,0 +1,138 @@
+//! Numeric flags shared by the subcommands: counts written as people write them (`1e6`), and the
+//! budgets (memory, Monte Carlo work) that sizes derived from the flags are checked against before
+//! anything is allocated or traced.
+
+use scatterfit_io::budget::{DEFAULT_MEMORY_BUDGET_MIB, MEMORY_BUDGET_ENV, describe_bytes};
+
+/// Help text of `--max-memory-mib`.
+pub const MAX_MEMORY_HELP: &str = "Memory budget [MiB] for the tallies and tables sized by the \
+     other flags; checked before anything is allocated. Default: $SCATTERFIT_MAX_MEMORY_MIB, else \
+     8192 (8 GiB). Raise it if this machine has the memory";
+
+/// Help text of `--max-interactions`.
+pub const MAX_INTERACTIONS_HELP: &str = "Work budget: the most photon interactions (scattering \
+     events, all photons together) the run may be expected to take, estimated before it starts from \
+     σs, σa, g, η and the thickness; a count (default 1e12: about 7 h on 2 cores at 2e7 \
+     interactions/s per thread). Raise it to allow longer runs";
+
+/// Parses a count: `1000000`, `1e6`, `2.5e5` or `1_000_000`; a whole number ≥ 0 that fits in u64
+/// (decimal notation must be exact: at most 2⁵³ when written with an exponent or a point).
+///
+/// # Errors
+/// A message for clap naming what was wrong.
+pub fn parse_count(text: &str) -> Result<u64, String> {
+    let t = text.trim().replace('_', "");
+    if let Ok(n) = t.parse::<u64>() {
+        return Ok(n);
+    }
+    let v: f64 = t
+        .parse()
+        .map_err(|_| format!("`{text}` is not a count (write e.g. 1000000 or 1e6)"))?;
+    if !v.is_finite() || v < 0.0 {
+        return Err(format!("`{text}` is not a count ≥ 0"));
+    }
+    if v.fract() != 0.0 {
+        return Err(format!("`{text}` is not a whole number"));
+    }
+    const EXACT: f64 = 9_007_199_254_740_992.0; // 2⁵³
+    if v > EXACT {
+        return Err(format!(
+            "`{text}` is too large for a count in floating-point notation (at most 2⁵³ ≈ 9.0e15); \
+             write the digits"
+        ));
+    }
+    Ok(v as u64)
+}
+
+/// [`parse_count`] for sizes held in `usize`.
+///
+/// # Errors
+/// As [`parse_count`], or a count that does not fit this machine's `usize`.
+pub fn parse_size(text: &str) -> Result<usize, String> {
+    let n = parse_count(text)?;
+    usize::try_from(n).map_err(|_| format!("`{text}` is too large"))
+}
+
+/// Parses a decimal number (for clap), refusing NaN and infinities up front.
+///
+/// # Errors
+/// A message for clap.
+pub fn parse_finite(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("`{text}` is not a finite number"))
+    }
+}
+
+/// The memory budget [bytes]: the flag's MiB, else [`MEMORY_BUDGET_ENV`], else
+/// [`DEFAULT_MEMORY_BUDGET_MIB`].
+pub fn memory_budget(flag_mib: Option<u64>) -> u64 {
+    flag_mib.map_or_else(scatterfit_io::budget::memory_budget_bytes, |m| {
+        m.saturating_mul(1 << 20)
+    })
+}
+
+/// Refuses `needed` bytes above `budget`, saying what needs them and how to raise the budget.
+///
+/// # Errors
+/// The refusal.
+pub fn check_memory(what: &str, needed: u64, budget: u64) -> anyhow::Result<()> {
+    if needed > budget {
+        anyhow::bail!(
+            "{what} needs {} of memory, more than the budget of {}; use fewer, or raise the budget \
+             with --max-memory-mib (or {MEMORY_BUDGET_ENV}; default {DEFAULT_MEMORY_BUDGET_MIB} MiB) \
+             if this machine has the memory",
+            describe_bytes(needed),
+            describe_bytes(budget)
+        );
+    }
+    Ok(())
+}
+
+/// A duration for messages: `45 s`, `12 min`, `3.5 h`, `40 days`, `3e4 years`.
+pub fn describe_seconds(s: f64) -> String {
+    if !s.is_finite() {
+        "forever".into()
+    } else if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else if s < 3.0 * 86_400.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else if s < 1000.0 * 86_400.0 {
+        format!("{:.0} days", s / 86_400.0)
+    } else {
+        format!("{:.1e} years", s / (365.25 * 86_400.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_accept_scientific_notation() {
+        assert_eq!(parse_count("1e6"), Ok(1_000_000));
+        assert_eq!(parse_count("2.5e5"), Ok(250_000));
+        assert_eq!(parse_count("1_000_000"), Ok(1_000_000));
+        assert_eq!(parse_count("18446744073709551615"), Ok(u64::MAX));
+        assert!(parse_count("1.5").unwrap_err().contains("whole"));
+        assert!(parse_count("-3").is_err());
+        assert!(parse_count("1e300").unwrap_err().contains("too large"));
+        assert!(parse_count("NaN").is_err());
+        assert!(parse_count("many").unwrap_err().contains("1e6"));
+    }
+
+    #[test]
+    fn durations_read_well() {
+        assert_eq!(describe_seconds(45.0), "45 s");
+        assert_eq!(describe_seconds(720.0), "12 min");
+        assert_eq!(describe_seconds(12_600.0), "3.5 h");
+        assert_eq!(describe_seconds(f64::INFINITY), "forever");
+    }
+}

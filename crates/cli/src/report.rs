@@ -1,0 +1,92 @@
+//! Writing and printing a measurement: result.json, result.csv and result.md (Table 1's shape),
+//! profile.csv, and the fit plot (fit.svg, fit.png; Figure 4's shape). Shared by `measure`,
+//! `batch` and `demo`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use scatterfit_io::result_json::{ChannelStatus, MeasurementResult, write_result_json};
+use scatterfit_io::result_table::{sig4, table1_csv, table1_markdown};
+use scatterfit_pipeline::Measurement;
+
+/// Writes every result file of `m` into `dir` (created if missing); returns the result and the
+/// paths written.
+///
+/// # Errors
+/// The first file that cannot be written.
+pub fn write_measurement(
+    dir: &Path,
+    m: &Measurement,
+) -> anyhow::Result<(MeasurementResult, Vec<PathBuf>)> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut written = Vec::new();
+    let profile = dir.join("profile.csv");
+    scatterfit_io::profile_csv::write_profile_csv(&profile, &m.profile.to_table())?;
+    written.push(profile);
+    let result = m.to_result(Some("profile.csv"));
+    let json = dir.join("result.json");
+    write_result_json(&json, &result)?;
+    written.push(json);
+    for (name, text) in [
+        ("result.csv", table1_csv(std::slice::from_ref(&result))),
+        ("result.md", table1_markdown(std::slice::from_ref(&result))),
+    ] {
+        let p = dir.join(name);
+        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
+            .with_context(|| format!("writing {}", p.display()))?;
+        written.push(p);
+    }
+    let (svg, png) = (dir.join("fit.svg"), dir.join("fit.png"));
+    crate::plot::write_figure(
+        &crate::figures::fit_figure(m, &result),
+        Some(&svg),
+        Some(&png),
+    )?;
+    written.extend([svg, png]);
+    Ok((result, written))
+}
+
+/// A human summary of one result: η and, per channel, σ′s ± error, σa ± error, α′, MSE, time.
+pub fn summary_text(r: &MeasurementResult) -> String {
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "{}: η = {:.4} ({}), method {}, model {}",
+        r.name, r.eta, r.eta_source, r.method, r.model
+    );
+    let _ = writeln!(
+        t,
+        "  ch  {:<22} {:<24} {:<8} {:<10} {:>9} {:>6}",
+        "σ′s [mm⁻¹]", "σa [mm⁻¹]", "α′", "MSE", "fit [µs]", "rings"
+    );
+    for (name, c) in ["R", "G", "B"].iter().zip(r.channels.as_array()) {
+        let pm = |v: Option<f64>, e: Option<f64>, key: &str| -> String {
+            if c.status == ChannelStatus::Failed {
+                "failed".into()
+            } else if c.unconstrained.iter().any(|u| u == key) {
+                "unconstrained".into()
+            } else {
+                match (v, e) {
+                    (Some(v), Some(e)) => format!("{} ± {}", sig4(v), sig4(e)),
+                    (Some(v), None) => sig4(v),
+                    _ => "—".into(),
+                }
+            }
+        };
+        let _ = writeln!(
+            t,
+            "  {name}   {:<22} {:<24} {:<8} {:<10} {:>9.1} {:>6}",
+            pm(c.sigma_s_prime, c.sigma_s_prime_stderr, "sigma_s_prime"),
+            pm(c.sigma_a, c.sigma_a_stderr, "sigma_a"),
+            c.albedo_prime.map_or("—".into(), |a| format!("{a:.5}")),
+            c.mse.map_or("—".into(), sig4),
+            c.fit_time_s * 1e6,
+            c.rings_used
+        );
+        if let Some(p) = &c.problem {
+            let _ = writeln!(t, "      note: {p}");
+        }
+    }
+    t
+}

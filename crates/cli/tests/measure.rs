@@ -1,0 +1,294 @@
+//! Integration tests of the measurement commands — `synth`, `measure`, `fit`, `batch`, `compare`
+//! and `demo` — with the real binary in a temporary folder, on quick rig-twin samples. Each exit-code
+//! class is pinned: 0 success, 1 a measurement that ran and failed, 2 bad usage or input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+struct Run {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn scatterfit(cwd: &Path, args: &[&str]) -> Run {
+    let out: Output = Command::new(env!("CARGO_BIN_EXE_scatterfit"))
+        .args(args)
+        .current_dir(cwd)
+        .env("SCATTERFIT_CACHE", cache())
+        .output()
+        .unwrap();
+    Run {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// One Monte Carlo cache for the whole test binary, so each material is simulated once.
+fn cache() -> &'static Path {
+    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
+    DIR.get_or_init(|| tempfile::tempdir().unwrap()).path()
+}
+
+/// A quick twin sample of `material` in `cwd/dir`.
+fn synth(cwd: &Path, material: &str, dir: &str) {
+    let out = scatterfit(
+        cwd,
+        &[
+            "synth",
+            "--material",
+            material,
+            "--quick",
+            "-o",
+            dir,
+            "--quiet",
+        ],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
+
+/// synth → measure: the folder has every file the manifest names, measure writes its six files,
+/// result.json has the documented shape with channels keyed r, g, b, and σ′s is near the truth in
+/// truth.json (the fit issue's 5 % target on a channel well inside its range).
+#[test]
+fn synth_then_measure() {
+    let dir = tempfile::tempdir().unwrap();
+    synth(dir.path(), "wood-tile", "wood");
+    for f in [
+        "sample.toml",
+        "spectro.csv",
+        "exposures.csv",
+        "frame_00.png",
+        "frame_12.png",
+        "truth.json",
+    ] {
+        assert!(dir.path().join("wood").join(f).exists(), "{f}");
+    }
+    let out = scatterfit(dir.path(), &["measure", "wood", "--quiet"]);
+    assert_eq!(out.code, 0, "{}\n{}", out.stdout, out.stderr);
+    assert!(out.stdout.contains("σ′s"), "{}", out.stdout);
+    for f in [
+        "result.json",
+        "result.csv",
+        "result.md",
+        "profile.csv",
+        "fit.svg",
+        "fit.png",
+    ] {
+        assert!(dir.path().join("wood").join(f).exists(), "{f}");
+    }
+    let r: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("wood/result.json")).unwrap(),
+    )
+    .unwrap();
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("wood/truth.json")).unwrap())
+            .unwrap();
+    assert_eq!(r["method"], "proposed");
+    assert_eq!(r["model"], "dipole");
+    let got = r["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
+    let want = truth["channels"][0]["sigma_s_prime"].as_f64().unwrap();
+    assert!((got / want - 1.0).abs() < 0.05, "{got} vs {want}");
+    assert!((r["eta"].as_f64().unwrap() - truth["eta"].as_f64().unwrap()).abs() < 0.005);
+    for k in [
+        "sigma_s_prime_stderr",
+        "sigma_a",
+        "sigma_a_stderr",
+        "albedo_prime",
+        "rd_total",
+        "fit_time_s",
+        "iterations",
+        "mse",
+    ] {
+        assert!(!r["channels"]["g"][k].is_null(), "{k}");
+    }
+    assert_eq!(r["inputs"]["profile"], "profile.csv");
+    // Measuring again replaces the command's own files; --output-dir writes elsewhere.
+    let out = scatterfit(
+        dir.path(),
+        &["measure", "wood", "-o", "out", "--json", "--quiet"],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(v["name"], "wood-tile");
+    assert!(dir.path().join("out/fit.png").exists());
+
+    // `fit` on the profile the measurement wrote, with the α′ it found, gives the same σ′s.
+    let a: Vec<String> = ["r", "g", "b"]
+        .iter()
+        .map(|c| {
+            r["channels"][c]["albedo_prime"]
+                .as_f64()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    let eta = r["eta"].as_f64().unwrap().to_string();
+    let out = scatterfit(
+        dir.path(),
+        &[
+            "fit",
+            "wood/profile.csv",
+            "--eta",
+            &eta,
+            "--albedo",
+            &a.join(","),
+            "--json",
+        ],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let f: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let refit = f["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
+    assert!((refit / got - 1.0).abs() < 1e-6, "{refit} vs {got}");
+    // The proposed method without α′ is bad usage.
+    let out = scatterfit(dir.path(), &["fit", "wood/profile.csv", "--eta", &eta]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("--albedo"), "{}", out.stderr);
+}
+
+/// Bad input anywhere in a sample folder gets exit 2 and a message naming the file and the key.
+#[test]
+fn bad_sample_folders_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = scatterfit(d, &["measure", "nowhere", "--quiet"]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("sample.toml"), "{}", out.stderr);
+    std::fs::create_dir(d.join("s")).unwrap();
+    let cases = [
+        ("name = 1\n", "name"),
+        (
+            "[spectro]\nfile = \"spectro.csv\"\n[camera]\nexposures = \"e.csv\"\nmm_per_pixel = -2\n",
+            "camera.mm_per_pixel",
+        ),
+        (
+            "[spectro]\nfile = \"spectro.csv\"\n[camera]\nexposures = \"e.csv\"\nmm_per_pixel = 0.1\n[fit]\nmethod = \"best\"\n",
+            "best",
+        ),
+        (
+            "[spectro]\nfile = \"spectro.csv\"\n[camera]\nexposures = \"e.csv\"\nmm_per_pixel = 0.1\n",
+            "spectro.csv",
+        ),
+    ];
+    for (manifest, key) in cases {
+        std::fs::write(d.join("s/sample.toml"), manifest).unwrap();
+        let out = scatterfit(d, &["measure", "s", "--quiet"]);
+        assert_eq!(out.code, 2, "{manifest}: {}", out.stderr);
+        assert!(out.stderr.contains(key), "{key}: {}", out.stderr);
+        assert!(!d.join("s/result.json").exists());
+    }
+    let out = scatterfit(d, &["measure", "s", "--method", "best"]);
+    assert_eq!(out.code, 2);
+    let out = scatterfit(d, &["measure", "s", "--model", "pbd", "--quiet"]);
+    assert_eq!(out.code, 2);
+}
+
+/// A batch goes on past a broken sample, keeps the good one's results, lists the bad one with its
+/// error and exits 1; a matte sample (no specular reflection) is a failed measurement, exit 1.
+#[test]
+fn batch_survives_a_bad_sample_and_failures_exit_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    synth(d, "sulfur", "samples/sulfur");
+    std::fs::create_dir_all(d.join("samples/broken")).unwrap();
+    std::fs::write(
+        d.join("samples/broken/sample.toml"),
+        "[camera]\nmm_per_pixel = 0.1\n",
+    )
+    .unwrap();
+    let out = scatterfit(
+        d,
+        &["batch", "samples", "-j", "2", "-o", "report", "--quiet"],
+    );
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("broken") && out.stderr.contains("spectro.file"),
+        "{}",
+        out.stderr
+    );
+    let summary = std::fs::read_to_string(d.join("report/summary.csv")).unwrap();
+    assert!(summary.contains("sulfur,R,ok"), "{summary}");
+    assert!(d.join("samples/sulfur/result.json").exists());
+    assert!(d.join("report/summary.md").exists());
+
+    // Matte: SCI = SCE, so η cannot be measured: exit 1 and the reason.
+    let spectro = std::fs::read_to_string(d.join("samples/sulfur/spectro.csv")).unwrap();
+    let matte: String = spectro
+        .lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            if l.starts_with('#') || f.len() != 3 || f[0] == "wavelength_nm" {
+                l.to_string()
+            } else {
+                format!("{},{},{}", f[0], f[2], f[2])
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(d.join("samples/sulfur/spectro.csv"), matte).unwrap();
+    let out = scatterfit(d, &["measure", "samples/sulfur", "--quiet"]);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(out.stderr.contains("specular"), "{}", out.stderr);
+    // …and with η given the same sample measures.
+    let out = scatterfit(
+        d,
+        &["measure", "samples/sulfur", "--eta", "1.1159", "--quiet"],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
+
+/// compare writes Table 2 and a Figure 6 per sample; synth refuses to overwrite; the demo refuses a
+/// folder it did not make; the quick demo runs and recovers the truth it prints.
+#[test]
+fn compare_synth_safety_and_quick_demo() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    synth(d, "nephrite", "n");
+    let out = scatterfit(d, &["compare", "n", "-o", "cmp", "--quiet"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let table = std::fs::read_to_string(d.join("cmp/compare.md")).unwrap();
+    assert!(
+        table.contains("nephrite") && table.contains("MSE"),
+        "{table}"
+    );
+    assert!(d.join("n/compare.png").exists());
+
+    let out = scatterfit(
+        d,
+        &["synth", "--material", "nephrite", "--quick", "-o", "n"],
+    );
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("--force"), "{}", out.stderr);
+    let out = scatterfit(d, &["synth", "--material", "unobtainium", "-o", "x"]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("pink-plastic"), "{}", out.stderr);
+
+    std::fs::create_dir(d.join("mine")).unwrap();
+    std::fs::write(d.join("mine/thesis.tex"), "precious").unwrap();
+    let out = scatterfit(d, &["demo", "--quick", "-o", "mine", "--quiet"]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("thesis.tex"), "{}", out.stderr);
+    assert_eq!(
+        std::fs::read_to_string(d.join("mine/thesis.tex")).unwrap(),
+        "precious"
+    );
+
+    let out = scatterfit(d, &["demo", "--quick", "-o", "demo", "--json", "--quiet"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let rows: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(rows.as_array().unwrap().len(), 7);
+    for r in rows.as_array().unwrap() {
+        assert!((r["eta_found"].as_f64().unwrap() - r["eta_true"].as_f64().unwrap()).abs() < 0.005);
+    }
+    for f in [
+        "summary.md",
+        "compare.md",
+        "accuracy.md",
+        "pink-plastic/fit.png",
+        "pink-plastic/compare.png",
+    ] {
+        assert!(d.join("demo").join(f).exists(), "{f}");
+    }
+}

@@ -1,0 +1,194 @@
+//! A measured radial profile of one channel, and the choice of rings a fit may use.
+//!
+//! The HDR profile is in relative units (radiance per ring, unknown gain); each ring carries its
+//! standard error and, when the bracket knows it, a detection limit: the radiance below which the
+//! longest exposure cannot tell signal from its noise floor. Far rings of an absorbing channel sit
+//! there; their mean is dominated by quantisation and noise, not by the sample, so they are
+//! excluded and counted rather than fitted (fitting them as values biases σa).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{FitError, Result, check};
+
+/// One ring of a measured profile.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Ring {
+    /// Ring radius [mm] (mean distance of its pixels from the spot centre).
+    pub r_mm: f64,
+    /// Mean value of the ring's pixels [relative radiance]; NaN when there is none.
+    pub value: f64,
+    /// Standard error of `value` [same units]; NaN when undefined.
+    pub stderr: f64,
+    /// Pixels averaged.
+    pub count: u64,
+    /// Detection limit [same units as `value`]: below it the ring is not measured. NaN or 0 when
+    /// unknown (then only non-positive values are excluded).
+    pub detection_limit: f64,
+}
+
+/// A measured radial profile of one channel, rings from the centre out.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ProfileData {
+    rings: Vec<Ring>,
+}
+
+impl ProfileData {
+    /// A profile from its rings.
+    ///
+    /// # Errors
+    /// [`FitError::Profile`] if a radius is negative, not finite, or not increasing.
+    pub fn new(rings: Vec<Ring>) -> Result<Self> {
+        for (i, w) in rings.windows(2).enumerate() {
+            if w[1].r_mm <= w[0].r_mm || w[1].r_mm.is_nan() {
+                return Err(FitError::Profile(format!(
+                    "ring radii must increase: ring {} at {} mm follows {} mm",
+                    i + 1,
+                    w[1].r_mm,
+                    w[0].r_mm
+                )));
+            }
+        }
+        if let Some(r) = rings
+            .iter()
+            .find(|r| !(r.r_mm.is_finite() && r.r_mm >= 0.0))
+        {
+            return Err(FitError::Profile(format!(
+                "ring radius {} mm is not a finite number ≥ 0",
+                r.r_mm
+            )));
+        }
+        Ok(Self { rings })
+    }
+
+    /// The rings.
+    pub fn rings(&self) -> &[Ring] {
+        &self.rings
+    }
+}
+
+/// Which rings a fit may use.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RingSelection {
+    /// Innermost radius fitted [mm]; rings inside are counted as "inside the spot". Default: the
+    /// spot's diameter (twice its radius), see [`RingSelection::for_spot`].
+    pub r_min_mm: f64,
+    /// Outermost radius fitted [mm] (∞: every ring of the profile).
+    pub r_max_mm: f64,
+    /// A ring is fitted only if its value is at least this multiple of its detection limit.
+    pub detection_factor: f64,
+    /// Relative standard error floor of a ring (calibration and merge accuracy): a ring's weight
+    /// never exceeds 1/floor² in the log residual.
+    pub relative_error_floor: f64,
+}
+
+impl RingSelection {
+    /// The defaults for a uniform light spot of radius `spot_radius_mm`: fit from one spot diameter
+    /// out, every ring above its detection limit, 0.5 % error floor.
+    pub fn for_spot(spot_radius_mm: f64) -> Self {
+        Self {
+            r_min_mm: 2.0 * spot_radius_mm,
+            r_max_mm: f64::INFINITY,
+            detection_factor: 1.0,
+            relative_error_floor: 5e-3,
+        }
+    }
+
+    pub(crate) fn validate(&self) -> Result<()> {
+        check(
+            self.r_min_mm.is_finite() && self.r_min_mm >= 0.0,
+            "r_min_mm",
+            self.r_min_mm,
+            "the innermost fitted radius must be a finite number ≥ 0 mm",
+        )?;
+        check(
+            self.r_max_mm > self.r_min_mm,
+            "r_max_mm",
+            self.r_max_mm,
+            "the outermost fitted radius must exceed the innermost",
+        )?;
+        check(
+            self.detection_factor.is_finite() && self.detection_factor >= 0.0,
+            "detection_factor",
+            self.detection_factor,
+            "must be a finite number ≥ 0",
+        )?;
+        check(
+            self.relative_error_floor.is_finite() && self.relative_error_floor > 0.0,
+            "relative_error_floor",
+            self.relative_error_floor,
+            "must be a finite number > 0",
+        )
+    }
+}
+
+/// The rings a fit uses, with the counts of those it left out and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Selected {
+    /// Radii of the fitted rings [mm].
+    pub r_mm: Vec<f64>,
+    /// Their values [relative].
+    pub value: Vec<f64>,
+    /// Standard deviation of ln(value) per ring (relative error, floored).
+    pub sigma_ln: Vec<f64>,
+    /// Indices of the fitted rings in the profile.
+    pub index: Vec<usize>,
+    /// Rings left out because r < r_min (inside the spot).
+    pub inside_spot: usize,
+    /// Rings left out because their value is below the detection limit.
+    pub below_detection: usize,
+    /// Rings left out for having no finite positive value (no valid pixel) or lying beyond r_max.
+    pub invalid: usize,
+}
+
+/// Applies `sel` to `profile`.
+///
+/// # Errors
+/// [`FitError::InvalidInput`] for bad options.
+pub fn select_rings(profile: &ProfileData, sel: &RingSelection) -> Result<Selected> {
+    sel.validate()?;
+    let mut s = Selected {
+        r_mm: Vec::new(),
+        value: Vec::new(),
+        sigma_ln: Vec::new(),
+        index: Vec::new(),
+        inside_spot: 0,
+        below_detection: 0,
+        invalid: 0,
+    };
+    for (i, ring) in profile.rings.iter().enumerate() {
+        if ring.r_mm < sel.r_min_mm {
+            s.inside_spot += 1;
+            continue;
+        }
+        if ring.r_mm > sel.r_max_mm || !(ring.value.is_finite()) || ring.count == 0 {
+            s.invalid += 1;
+            continue;
+        }
+        let limit = if ring.detection_limit.is_finite() {
+            ring.detection_limit.max(0.0)
+        } else {
+            0.0
+        };
+        if ring.value <= 0.0 || ring.value < sel.detection_factor * limit {
+            s.below_detection += 1;
+            continue;
+        }
+        let rel = if ring.stderr.is_finite() && ring.stderr >= 0.0 {
+            ring.stderr / ring.value
+        } else {
+            // One pixel (or an unknown error): as uncertain as the error floor allows, no better.
+            f64::INFINITY
+        };
+        let rel = if rel.is_finite() {
+            rel.max(sel.relative_error_floor)
+        } else {
+            // Unknown error: weight like a ring at ten times the floor.
+            10.0 * sel.relative_error_floor
+        };
+        s.r_mm.push(ring.r_mm);
+        s.value.push(ring.value);
+        s.sigma_ln.push(rel);
+        s.index.push(i);
+    }
+    Ok(s)
+}

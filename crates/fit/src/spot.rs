@@ -1,0 +1,352 @@
+//! The light spot: a uniform disk of radius a instead of the point of incidence the diffusion
+//! models assume. The measured profile is the model convolved with the disk,
+//!
+//! ```text
+//! m(r) = (1/πa²) ∫_{|y|<a} Rd(|x − y|) dy,   |x| = r
+//!      = (2/πa²) ∫ Rd(s) · s θ(s; r) ds,     θ = arccos((s² + r² − a²)/(2sr)) ∈ [0, π]
+//! ```
+//!
+//! (the second line counts, for each distance s from the point of incidence, the arc 2sθ of the
+//! circle |u| = s that lies inside the disk of radius a around x). The model is evaluated on a
+//! uniform grid of nodes sₖ = k·h and interpolated between them by Catmull-Rom cubics (exact for
+//! quadratics; an even extension at s = 0, where a radial profile has zero slope), so the
+//! convolution is a fixed linear map from node values to ring values: a banded matrix computed once
+//! per profile geometry. A fit then costs one model evaluation at the nodes and one sparse product
+//! per iteration, derivatives included (the map is linear).
+//!
+//! The integral per matrix entry is done by Gauss–Legendre quadrature on each node interval; where
+//! θ has a square-root end point (s = |r − a| and s = r + a) the interval is mapped by s = s₀ ± Δv²,
+//! which makes the integrand smooth.
+
+use crate::error::{Result, check};
+
+/// Gauss–Legendre nodes and weights on [0, 1], 8 points (Abramowitz & Stegun, Table 25.4).
+const GL8: [(f64, f64); 8] = {
+    const X: [f64; 4] = [
+        0.183_434_642_495_649_8,
+        0.525_532_409_916_329,
+        0.796_666_477_413_626_7,
+        0.960_289_856_497_536_3,
+    ];
+    const W: [f64; 4] = [
+        0.362_683_783_378_362,
+        0.313_706_645_877_887_3,
+        0.222_381_034_453_374_5,
+        0.101_228_536_290_376_3,
+    ];
+    let mut out = [(0.0, 0.0); 8];
+    let mut i = 0;
+    while i < 4 {
+        out[2 * i] = (0.5 - 0.5 * X[i], 0.5 * W[i]);
+        out[2 * i + 1] = (0.5 + 0.5 * X[i], 0.5 * W[i]);
+        i += 1;
+    }
+    out
+};
+
+/// Catmull-Rom cardinal weights at t ∈ [0, 1] for the nodes k−1, k, k+1, k+2 (uniform spacing).
+#[inline]
+fn catmull_rom(t: f64) -> [f64; 4] {
+    let (t2, t3) = (t * t, t * t * t);
+    [
+        0.5 * (-t3 + 2.0 * t2 - t),
+        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+        0.5 * (t3 - t2),
+    ]
+}
+
+/// One row of the convolution map: ring value = Σ weights[j] · f(node first + j).
+#[derive(Debug, Clone, PartialEq)]
+struct Row {
+    first: usize,
+    weights: Vec<f64>,
+}
+
+/// The linear map from model values at uniform nodes to spot-convolved values at ring radii.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpotKernel {
+    radius_mm: f64,
+    nodes: Vec<f64>,
+    rows: Vec<Row>,
+}
+
+impl SpotKernel {
+    /// The map for a uniform disk of radius `radius_mm` and the ring radii `r_mm`, with node
+    /// spacing `h_mm` (the model must vary little over h; a/8 or the ring spacing, whichever is
+    /// smaller, is plenty).
+    ///
+    /// # Errors
+    /// `InvalidInput` for a radius or spacing that is not finite and > 0, or a ring radius < 0.
+    pub fn new(radius_mm: f64, r_mm: &[f64], h_mm: f64) -> Result<Self> {
+        check(
+            radius_mm.is_finite() && radius_mm > 0.0,
+            "spot radius [mm]",
+            radius_mm,
+            "must be finite and > 0",
+        )?;
+        check(
+            h_mm.is_finite() && h_mm > 0.0,
+            "node spacing [mm]",
+            h_mm,
+            "must be finite and > 0",
+        )?;
+        if let Some(&r) = r_mm.iter().find(|r| !(r.is_finite() && **r >= 0.0)) {
+            check(false, "ring radius [mm]", r, "must be finite and ≥ 0")?;
+        }
+        let a = radius_mm;
+        let r_hi = r_mm.iter().fold(0.0f64, |m, &r| m.max(r)) + a;
+        // Nodes up to two past r_hi so every Catmull-Rom stencil exists.
+        let n = (r_hi / h_mm).ceil() as usize + 3;
+        let nodes: Vec<f64> = (0..n).map(|k| k as f64 * h_mm).collect();
+        let rows = r_mm.iter().map(|&r| row(r, a, h_mm, n)).collect();
+        Ok(Self {
+            radius_mm,
+            nodes,
+            rows,
+        })
+    }
+
+    /// Spot radius [mm].
+    pub fn radius_mm(&self) -> f64 {
+        self.radius_mm
+    }
+
+    /// The radii [mm] at which the model must be evaluated.
+    pub fn nodes(&self) -> &[f64] {
+        &self.nodes
+    }
+
+    /// Number of rings (rows).
+    pub fn rings(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The convolved value at ring `i` from node values `f` (one per node): Σⱼ Kᵢⱼ f(sⱼ).
+    #[inline]
+    pub fn apply_row(&self, i: usize, f: &[f64]) -> f64 {
+        let row = &self.rows[i];
+        row.weights
+            .iter()
+            .zip(&f[row.first..])
+            .map(|(&w, &v)| w * v)
+            .sum()
+    }
+
+    /// Every row: `out[i]` = Σⱼ Kᵢⱼ f(sⱼ) (the hot path of a fit: one contiguous dot product
+    /// per ring).
+    pub fn apply(&self, f: &[f64], out: &mut [f64]) {
+        for (row, o) in self.rows.iter().zip(out.iter_mut()) {
+            *o = dot(&row.weights, &f[row.first..row.first + row.weights.len()]);
+        }
+    }
+
+    /// Keeps only the rows whose index is in `keep` (ascending), in that order.
+    pub fn select_rows(&self, keep: &[usize]) -> Self {
+        Self {
+            radius_mm: self.radius_mm,
+            nodes: self.nodes.clone(),
+            rows: keep.iter().map(|&i| self.rows[i].clone()).collect(),
+        }
+    }
+}
+
+/// Σ aᵢbᵢ with four independent partial sums (a sequential sum cannot be reordered by the
+/// compiler, so it neither vectorises nor pipelines; measured 2× faster on the fit's rows).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+/// The weights of the ring at radius r: K_j = (2/πa²) ∫ B_j(s) s θ(s) ds.
+fn row(r: f64, a: f64, h: f64, n: usize) -> Row {
+    let s_lo = (r - a).max(0.0);
+    let s_hi = r + a;
+    let theta = |s: f64| -> f64 {
+        if r <= 0.0 || s <= 0.0 {
+            return if s < a { std::f64::consts::PI } else { 0.0 };
+        }
+        let c = (s * s + r * r - a * a) / (2.0 * s * r);
+        c.clamp(-1.0, 1.0).acos()
+    };
+    // Break points: node boundaries inside (s_lo, s_hi), the ends, and a − r (θ's kink inside the
+    // spot).
+    let mut breaks = vec![s_lo, s_hi];
+    if r > 0.0 && r < a {
+        breaks.push(a - r);
+    }
+    let k0 = (s_lo / h).floor() as usize + 1;
+    let k1 = (s_hi / h).ceil() as usize;
+    for k in k0..k1 {
+        let s = k as f64 * h;
+        if s > s_lo && s < s_hi {
+            breaks.push(s);
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup_by(|x, y| (*x - *y).abs() <= 1e-14 * (1.0 + y.abs()));
+    let first = ((s_lo / h).floor() as usize).saturating_sub(1);
+    let last = ((s_hi / h).floor() as usize + 2).min(n - 1);
+    let mut w = vec![0.0; last + 1 - first];
+    let norm = 2.0 / (std::f64::consts::PI * a * a);
+    // Points where θ(s) behaves like a square root: r + a always, |r − a| when r > 0.
+    let mut singular = vec![s_hi];
+    if r > 0.0 {
+        singular.push((r - a).abs());
+    }
+    let mut add = |s: f64, weight: f64| {
+        if weight == 0.0 {
+            return;
+        }
+        let k = ((s / h).floor() as usize).min(n - 2);
+        let t = (s / h - k as f64).clamp(0.0, 1.0);
+        for (q, c) in catmull_rom(t).iter().enumerate() {
+            // Node k − 1 + q; node −1 reflects to node 1 (even extension at s = 0).
+            let j = (k + q) as isize - 1;
+            let j = if j < 0 { 1 } else { j as usize }.min(n - 1);
+            w[j - first] += weight * c;
+        }
+    };
+    for seg in breaks.windows(2) {
+        let (u0, u1) = (seg[0], seg[1]);
+        let len = u1 - u0;
+        if len <= 0.0 {
+            continue;
+        }
+        // A square-root point at or just beyond an end (closer than the segment's length) makes
+        // plain Gauss–Legendre inaccurate: substitute s = p ± w² around it, smooth in w.
+        let left = singular.iter().copied().find(|&p| p <= u0 && u0 - p < len);
+        let right = singular.iter().copied().find(|&p| p >= u1 && p - u1 < len);
+        let parts: Vec<(f64, f64, Option<f64>, Option<f64>)> = match (left, right) {
+            (Some(p), Some(q)) => {
+                let m = 0.5 * (u0 + u1);
+                vec![(u0, m, Some(p), None), (m, u1, None, Some(q))]
+            }
+            (l, r) => vec![(u0, u1, l, r)],
+        };
+        for (p0, p1, l, r) in parts {
+            match (l, r) {
+                (Some(p), _) => {
+                    let (w0, w1) = ((p0 - p).max(0.0).sqrt(), (p1 - p).sqrt());
+                    for &(v, gw) in &GL8 {
+                        let x = w0 + (w1 - w0) * v;
+                        let s = p + x * x;
+                        add(s, norm * gw * (w1 - w0) * 2.0 * x * s * theta(s));
+                    }
+                }
+                (None, Some(q)) => {
+                    let (w0, w1) = ((q - p1).max(0.0).sqrt(), (q - p0).sqrt());
+                    for &(v, gw) in &GL8 {
+                        let x = w0 + (w1 - w0) * v;
+                        let s = q - x * x;
+                        add(s, norm * gw * (w1 - w0) * 2.0 * x * s * theta(s));
+                    }
+                }
+                (None, None) => {
+                    for &(v, gw) in &GL8 {
+                        let s = p0 + (p1 - p0) * v;
+                        add(s, norm * gw * (p1 - p0) * s * theta(s));
+                    }
+                }
+            }
+        }
+    }
+    // Trim zero weights at both ends.
+    let lead = w.iter().take_while(|&&x| x == 0.0).count();
+    let trail = w.iter().rev().take_while(|&&x| x == 0.0).count();
+    let weights = w[lead..w.len() - trail.min(w.len() - lead)].to_vec();
+    Row {
+        first: first + lead,
+        weights,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Disk average of f(|x − y|) over |y| < a by brute-force polar quadrature (midpoint rule on a
+    /// fine grid): an independent check of the arc-length formula and the node interpolation.
+    fn brute_force(f: impl Fn(f64) -> f64, r: f64, a: f64) -> f64 {
+        let (nr, nphi) = (400, 800);
+        let mut sum = 0.0;
+        for i in 0..nr {
+            let rho = a * (i as f64 + 0.5) / nr as f64;
+            for j in 0..nphi {
+                let phi = std::f64::consts::PI * (j as f64 + 0.5) / nphi as f64;
+                let d = (r * r + rho * rho - 2.0 * r * rho * phi.cos())
+                    .max(0.0)
+                    .sqrt();
+                sum += f(d) * rho;
+            }
+        }
+        // ∫ρ dρ dφ over half the disk, times 2, over πa².
+        2.0 * sum * (a / nr as f64) * (std::f64::consts::PI / nphi as f64)
+            / (std::f64::consts::PI * a * a)
+    }
+
+    fn apply(k: &SpotKernel, f: impl Fn(f64) -> f64) -> Vec<f64> {
+        let values: Vec<f64> = k.nodes().iter().map(|&s| f(s)).collect();
+        (0..k.rings()).map(|i| k.apply_row(i, &values)).collect()
+    }
+
+    /// Constants and quadratics are reproduced exactly (Catmull-Rom is exact for quadratics):
+    /// the disk average of 1 is 1 and of |x − y|² is r² + a²/2.
+    #[test]
+    fn exact_for_constants_and_quadratics() {
+        let a = 0.5;
+        let radii = [0.0, 0.1, 0.3, 0.5, 0.5001, 0.7, 1.0, 2.37, 10.0];
+        let k = SpotKernel::new(a, &radii, 0.05).unwrap();
+        for (i, m) in apply(&k, |_| 1.0).iter().enumerate() {
+            assert!((m - 1.0).abs() < 1e-9, "r = {}: {m}", radii[i]);
+        }
+        for (i, m) in apply(&k, |s| s * s).iter().enumerate() {
+            let r = radii[i];
+            let want = r * r + 0.5 * a * a;
+            assert!(
+                (m - want).abs() < 1e-9 * (1.0 + want),
+                "r = {r}: {m} vs {want}"
+            );
+        }
+    }
+
+    /// A profile with structure on the node scale (a dipole-like e^{−σd}/d³ shape) against brute
+    /// force 2-D quadrature, inside and outside the spot.
+    #[test]
+    fn matches_brute_force_on_a_peaked_profile() {
+        let a = 0.5;
+        let f = |s: f64| {
+            let z: f64 = 0.4;
+            let d = (s * s + z * z).sqrt();
+            z * (1.5 * d + 1.0) * (-1.5 * d).exp() / (d * d * d)
+        };
+        let radii = [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 3.0, 8.0];
+        let k = SpotKernel::new(a, &radii, 0.025).unwrap();
+        for (i, m) in apply(&k, f).iter().enumerate() {
+            let want = brute_force(f, radii[i], a);
+            assert!(
+                ((m - want) / want).abs() < 2e-4,
+                "r = {}: {m} vs {want}",
+                radii[i]
+            );
+        }
+    }
+
+    #[test]
+    fn refuses_bad_geometry() {
+        assert!(SpotKernel::new(0.0, &[1.0], 0.1).is_err());
+        assert!(SpotKernel::new(0.5, &[1.0], f64::NAN).is_err());
+        assert!(SpotKernel::new(0.5, &[-1.0], 0.1).is_err());
+    }
+}

@@ -1,0 +1,62 @@
+//! The memory budget: how much memory one command may allocate for the data it reads or makes.
+//!
+//! Sizes that follow from the input (an image's width × height, a bracket's frames) are checked
+//! against it *before* anything is allocated, so that a corrupt header or a typo in a flag is a clear
+//! error instead of an abort or a machine that starts to swap. The default,
+//! [`DEFAULT_MEMORY_BUDGET_MIB`], holds a 13-frame bracket of 100-MP 16-bit RGB frames; raise it with
+//! the environment variable [`MEMORY_BUDGET_ENV`] (MiB), or with a command's `--max-memory-mib`.
+
+/// The default budget [MiB]: 8 GiB, a third of the project's 24-GiB standard machine.
+pub const DEFAULT_MEMORY_BUDGET_MIB: u64 = 8192;
+
+/// Environment variable that sets the budget in MiB, e.g. `SCATTERFIT_MAX_MEMORY_MIB=32768`.
+pub const MEMORY_BUDGET_ENV: &str = "SCATTERFIT_MAX_MEMORY_MIB";
+
+/// The budget in bytes: [`MEMORY_BUDGET_ENV`] when it holds a positive whole number of MiB, else
+/// [`DEFAULT_MEMORY_BUDGET_MIB`].
+pub fn memory_budget_bytes() -> u64 {
+    std::env::var(MEMORY_BUDGET_ENV)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .filter(|&mib| mib > 0)
+        .unwrap_or(DEFAULT_MEMORY_BUDGET_MIB)
+        .saturating_mul(1 << 20)
+}
+
+/// A byte count for messages: `512 MiB`, `3.2 GiB`, `1.5 TiB`.
+pub fn describe_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = bytes as f64;
+    let mut unit = 0;
+    while v >= 1024.0 && unit + 1 < UNITS.len() {
+        v /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{bytes} bytes")
+    } else if v < 10.0 {
+        format!("{v:.1} {}", UNITS[unit])
+    } else {
+        format!("{v:.0} {}", UNITS[unit])
+    }
+}
+
+/// How to raise the budget, for messages.
+pub fn how_to_raise() -> String {
+    format!(
+        "raise the memory budget with {MEMORY_BUDGET_ENV}=<MiB> (default {DEFAULT_MEMORY_BUDGET_MIB}) \
+         if this machine has the memory"
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bytes_are_described_in_binary_units() {
+        assert_eq!(describe_bytes(512), "512 bytes");
+        assert_eq!(describe_bytes(3 << 29), "1.5 GiB");
+        assert_eq!(describe_bytes(144 << 20), "144 MiB");
+    }
+}

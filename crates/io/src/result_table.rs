@@ -1,0 +1,233 @@
+//! Results as tables shaped like Choi, Lee & Chin (2014): Table 1 (optical properties per material
+//! and channel, with fitting time) and Table 2 (mean squared errors, existing vs proposed), as CSV
+//! and Markdown.
+
+use std::fmt::Write as _;
+
+use crate::result_json::{ChannelResult, ChannelStatus, MeasurementResult};
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+fn num(v: Option<f64>, digits: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.digits$}"),
+        _ => String::new(),
+    }
+}
+
+/// A coefficient for people: 4 significant figures, scientific below 10⁻³.
+pub fn sig4(v: f64) -> String {
+    if !v.is_finite() {
+        return "—".into();
+    }
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e4).contains(&a) {
+        format!("{v:.3e}")
+    } else {
+        let decimals = if a == 0.0 {
+            3
+        } else {
+            (3 - a.log10().floor() as i32).max(0) as usize
+        };
+        format!("{v:.decimals$}")
+    }
+}
+
+/// "value ± stderr", or the reason there is none.
+fn with_error(c: &ChannelResult, v: Option<f64>, e: Option<f64>, name: &str) -> String {
+    if c.status == ChannelStatus::Failed {
+        return "failed".into();
+    }
+    if c.unconstrained.iter().any(|u| u == name) {
+        return "unconstrained".into();
+    }
+    match (v, e) {
+        (Some(v), Some(e)) => format!("{} ± {}", sig4(v), sig4(e)),
+        (Some(v), None) => sig4(v),
+        _ => "—".into(),
+    }
+}
+
+/// Table 1 as CSV: one row per material and channel.
+pub fn table1_csv(results: &[MeasurementResult]) -> String {
+    let mut t = String::from(
+        "material,channel,status,sigma_s_prime_mm-1,sigma_s_prime_stderr,sigma_a_mm-1,sigma_a_stderr,\
+         albedo_prime,rd_total,eta,method,model,fit_time_s,iterations,mse_mm-4,rms_log_residual,\
+         chi2_reduced,rings_used,rings_inside_spot,rings_below_detection,problem\n",
+    );
+    for r in results {
+        for (name, c) in CHANNELS.iter().zip(r.channels.as_array()) {
+            let status = match c.status {
+                ChannelStatus::Ok => "ok",
+                ChannelStatus::Unconstrained => "unconstrained",
+                ChannelStatus::Failed => "failed",
+            };
+            let _ = writeln!(
+                t,
+                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                csv_text(&r.name),
+                num(c.sigma_s_prime, 6),
+                num(c.sigma_s_prime_stderr, 6),
+                num(c.sigma_a, 8),
+                num(c.sigma_a_stderr, 8),
+                num(c.albedo_prime, 6),
+                num(c.rd_total, 6),
+                num(Some(r.eta), 4),
+                r.method,
+                r.model,
+                num(Some(c.fit_time_s), 7),
+                c.iterations,
+                num(c.mse, 8),
+                num(c.rms_log_residual, 5),
+                num(c.chi2_reduced, 3),
+                c.rings_used,
+                c.rings_inside_spot,
+                c.rings_below_detection,
+                csv_text(c.problem.as_deref().unwrap_or("")),
+            );
+        }
+    }
+    t
+}
+
+fn csv_text(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\"").replace('\n', " "))
+    } else {
+        s.to_string()
+    }
+}
+
+/// Table 1 as Markdown: Material | Color | σ′s | σa | η | fitting time, as the paper prints it,
+/// with standard errors.
+pub fn table1_markdown(results: &[MeasurementResult]) -> String {
+    let mut t = String::from(
+        "| Material | Color | σ′s [mm⁻¹] | σa [mm⁻¹] | η | α′ | Fitting time [µs] | MSE [mm⁻⁴] |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for r in results {
+        for (k, (name, c)) in CHANNELS.iter().zip(r.channels.as_array()).enumerate() {
+            let material = if k == 0 { r.name.as_str() } else { "" };
+            let eta = if k == 1 {
+                format!("{:.4}", r.eta)
+            } else {
+                String::new()
+            };
+            let time = if c.status == ChannelStatus::Failed && c.iterations == 0 {
+                "—".into()
+            } else {
+                format!("{:.0}", c.fit_time_s * 1e6)
+            };
+            let _ = writeln!(
+                t,
+                "| {material} | {name} | {} | {} | {eta} | {} | {time} | {} |",
+                with_error(c, c.sigma_s_prime, c.sigma_s_prime_stderr, "sigma_s_prime"),
+                with_error(c, c.sigma_a, c.sigma_a_stderr, "sigma_a"),
+                c.albedo_prime.map_or("—".into(), |a| format!("{a:.5}")),
+                c.mse.map_or("—".into(), sig4),
+            );
+        }
+    }
+    let notes: Vec<String> = results
+        .iter()
+        .flat_map(|r| {
+            CHANNELS
+                .iter()
+                .zip(r.channels.as_array())
+                .filter_map(move |(n, c)| {
+                    c.problem.as_ref().map(|p| format!("- {} {n}: {p}", r.name))
+                })
+        })
+        .collect();
+    if !notes.is_empty() {
+        t.push('\n');
+        t.push_str(&notes.join("\n"));
+        t.push('\n');
+    }
+    t
+}
+
+/// Table 2 as Markdown: per material, MSE of the existing and the proposed method per channel, with
+/// fit times and parameters beside (pairs of results of the same sample).
+pub fn table2_markdown(pairs: &[(MeasurementResult, MeasurementResult)]) -> String {
+    let mut t = String::from(
+        "| Material | Color | σ′s existing | σa existing | MSE existing | fit µs | σ′s proposed | σa proposed | MSE proposed | fit µs |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for (existing, proposed) in pairs {
+        for (k, name) in CHANNELS.iter().enumerate() {
+            let (e, p) = (
+                existing.channels.as_array()[k],
+                proposed.channels.as_array()[k],
+            );
+            let material = if k == 0 { existing.name.as_str() } else { "" };
+            let _ = writeln!(
+                t,
+                "| {material} | {name} | {} | {} | {} | {:.0} | {} | {} | {} | {:.0} |",
+                with_error(e, e.sigma_s_prime, e.sigma_s_prime_stderr, "sigma_s_prime"),
+                with_error(e, e.sigma_a, e.sigma_a_stderr, "sigma_a"),
+                e.mse.map_or("—".into(), sig4),
+                e.fit_time_s * 1e6,
+                with_error(p, p.sigma_s_prime, p.sigma_s_prime_stderr, "sigma_s_prime"),
+                with_error(p, p.sigma_a, p.sigma_a_stderr, "sigma_a"),
+                p.mse.map_or("—".into(), sig4),
+                p.fit_time_s * 1e6,
+            );
+        }
+    }
+    t
+}
+
+/// Table 2 as CSV.
+pub fn table2_csv(pairs: &[(MeasurementResult, MeasurementResult)]) -> String {
+    let mut t = String::from(
+        "material,channel,sigma_s_prime_existing,sigma_a_existing,mse_existing,fit_time_s_existing,\
+         status_existing,sigma_s_prime_proposed,sigma_a_proposed,mse_proposed,fit_time_s_proposed,status_proposed\n",
+    );
+    let status = |c: &ChannelResult| match c.status {
+        ChannelStatus::Ok => "ok",
+        ChannelStatus::Unconstrained => "unconstrained",
+        ChannelStatus::Failed => "failed",
+    };
+    for (e, p) in pairs {
+        for (k, name) in CHANNELS.iter().enumerate() {
+            let (ce, cp) = (e.channels.as_array()[k], p.channels.as_array()[k]);
+            let _ = writeln!(
+                t,
+                "{},{name},{},{},{},{},{},{},{},{},{},{}",
+                csv_text(&e.name),
+                num(ce.sigma_s_prime, 6),
+                num(ce.sigma_a, 8),
+                num(ce.mse, 8),
+                num(Some(ce.fit_time_s), 7),
+                status(ce),
+                num(cp.sigma_s_prime, 6),
+                num(cp.sigma_a, 8),
+                num(cp.mse, 8),
+                num(Some(cp.fit_time_s), 7),
+                status(cp),
+            );
+        }
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn significant_figures() {
+        assert_eq!(sig4(1.979), "1.979");
+        assert_eq!(sig4(0.0496), "0.04960");
+        assert_eq!(sig4(0.000792), "7.920e-4");
+        assert_eq!(sig4(12.5), "12.50");
+        assert_eq!(sig4(f64::NAN), "—");
+    }
+
+    #[test]
+    fn csv_quotes_problems() {
+        assert_eq!(csv_text("a, b"), "\"a, b\"");
+        assert_eq!(csv_text("plain"), "plain");
+    }
+}

@@ -1,0 +1,211 @@
+//! Stage 4: the fit per channel, and its conversion into the result file's shape.
+
+use scatterfit_fit::{
+    ChannelInput, DipoleModel, FitOptions, FitReport, Method, ProfileData, ProfileModel, Spot,
+};
+use scatterfit_io::manifest::{MethodName, ModelName};
+use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
+use serde::Serialize;
+
+use crate::error::{PipelineError, Result};
+use crate::spectro::SpectroStage;
+
+/// How to fit a sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitSettings {
+    /// proposed | existing.
+    pub method: MethodName,
+    /// The forward model.
+    pub model: ModelName,
+    /// Radius of the light spot [mm]; the model is convolved with it.
+    pub spot_radius_mm: f64,
+    /// Innermost fitted radius [mm] (default: the spot's diameter).
+    pub r_min_mm: Option<f64>,
+    /// Fix the profile's scale by the spectrophotometer (proposed only).
+    pub normalise_with_spectro: bool,
+}
+
+impl FitSettings {
+    /// The options of `scatterfit_fit` for these settings.
+    pub fn options(&self) -> FitOptions {
+        let mut o = FitOptions::new(match self.method {
+            MethodName::Proposed => Method::Proposed,
+            MethodName::Existing => Method::Existing,
+        });
+        o.spot = Spot::Disk {
+            radius_mm: self.spot_radius_mm,
+        };
+        o.selection = scatterfit_fit::RingSelection::for_spot(self.spot_radius_mm);
+        if let Some(r) = self.r_min_mm {
+            o.selection.r_min_mm = r;
+        }
+        o.normalise_with_spectro = self.normalise_with_spectro;
+        o
+    }
+}
+
+/// The forward model for `name`.
+///
+/// # Errors
+/// [`PipelineError::Input`] for a model not available in this build.
+pub fn model_for(name: ModelName) -> Result<&'static dyn ProfileModel> {
+    match name {
+        ModelName::Dipole => Ok(&DipoleModel),
+        other => Err(PipelineError::Input(format!(
+            "the forward model `{}` is not available yet; use `dipole` (Jensen et al. 2001)",
+            other.as_str()
+        ))),
+    }
+}
+
+/// One channel's outcome: a report, or why there is none.
+#[derive(Debug, Clone, Serialize)]
+#[serde(tag = "outcome", rename_all = "snake_case")]
+pub enum ChannelOutcome {
+    /// The fit ran.
+    Fitted(Box<FitReport>),
+    /// No fit: the spectrophotometer gave no α′, or too few rings.
+    NotFitted {
+        /// Why.
+        problem: String,
+    },
+}
+
+impl ChannelOutcome {
+    /// The report, if the fit ran.
+    pub fn report(&self) -> Option<&FitReport> {
+        match self {
+            ChannelOutcome::Fitted(r) => Some(r),
+            ChannelOutcome::NotFitted { .. } => None,
+        }
+    }
+
+    /// True when the channel gave parameters the data constrain.
+    pub fn is_measurement(&self) -> bool {
+        self.report().is_some_and(FitReport::is_measurement)
+    }
+}
+
+/// Fits the three channels of a profile (one [`ProfileData`] per channel) with the
+/// spectrophotometer's η and α′, in parallel is not worth it (microseconds each).
+pub fn fit_stage(
+    profiles: &[ProfileData],
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    model: &dyn ProfileModel,
+) -> Vec<ChannelOutcome> {
+    let opts = settings.options();
+    let names = ["R", "G", "B"];
+    profiles
+        .iter()
+        .enumerate()
+        .map(|(c, data)| {
+            let albedo = spectro.albedo_prime.get(c).copied().flatten();
+            if settings.method == MethodName::Proposed && albedo.is_none() {
+                return ChannelOutcome::NotFitted {
+                    problem: spectro
+                        .problems
+                        .get(c)
+                        .cloned()
+                        .flatten()
+                        .unwrap_or_else(|| format!("channel {}: no reduced albedo", names[c])),
+                };
+            }
+            let input = ChannelInput {
+                eta: spectro.eta,
+                albedo_prime: albedo,
+                rd_total: spectro.rd.get(c).copied(),
+            };
+            match scatterfit_fit::fit_channel(data, &input, model, &opts) {
+                Ok(r) => ChannelOutcome::Fitted(Box::new(r)),
+                Err(e) => ChannelOutcome::NotFitted {
+                    problem: format!("channel {}: {e}", names.get(c).unwrap_or(&"?")),
+                },
+            }
+        })
+        .collect()
+}
+
+/// A channel's row of `result.json`.
+pub fn channel_result(outcome: &ChannelOutcome, spectro: &SpectroStage, c: usize) -> ChannelResult {
+    let rd_total = spectro.rd.get(c).copied();
+    match outcome {
+        ChannelOutcome::NotFitted { problem } => ChannelResult {
+            status: ChannelStatus::Failed,
+            sigma_s_prime: None,
+            sigma_s_prime_stderr: None,
+            sigma_a: None,
+            sigma_a_stderr: None,
+            albedo_prime: spectro.albedo_prime.get(c).copied().flatten(),
+            rd_total,
+            scale: None,
+            correlation: None,
+            unconstrained: Vec::new(),
+            fit_time_s: 0.0,
+            iterations: 0,
+            termination: String::new(),
+            mse: None,
+            rms_log_residual: None,
+            chi2_reduced: None,
+            rings_used: 0,
+            rings_inside_spot: 0,
+            rings_below_detection: 0,
+            rings_invalid: 0,
+            problem: Some(problem.clone()),
+        },
+        ChannelOutcome::Fitted(r) => {
+            let status = if !r.converged {
+                ChannelStatus::Failed
+            } else if r.unconstrained.is_empty() {
+                ChannelStatus::Ok
+            } else {
+                ChannelStatus::Unconstrained
+            };
+            let finite = |v: f64| v.is_finite().then_some(v);
+            let problem = if !r.converged {
+                Some(format!("the fit did not converge: {}", r.termination))
+            } else if !r.unconstrained.is_empty() {
+                Some(format!(
+                    "the profile does not constrain {} (standard error of its logarithm above {}): \
+                     the values are the solver's end point, not a measurement",
+                    r.unconstrained.join(" and "),
+                    scatterfit_fit::UNCONSTRAINED_SD_LN
+                ))
+            } else {
+                None
+            };
+            ChannelResult {
+                status,
+                sigma_s_prime: finite(r.sigma_s_prime.value),
+                sigma_s_prime_stderr: finite(r.sigma_s_prime.stderr),
+                sigma_a: finite(r.sigma_a.value),
+                sigma_a_stderr: finite(r.sigma_a.stderr),
+                albedo_prime: finite(r.albedo_prime),
+                rd_total,
+                scale: finite(r.scale.value),
+                // JSON has no NaN: a singular fit has no correlation matrix.
+                correlation: r
+                    .correlation
+                    .iter()
+                    .flatten()
+                    .all(|v| v.is_finite())
+                    .then(|| Correlation {
+                        parameters: r.parameters.clone(),
+                        matrix: r.correlation.clone(),
+                    }),
+                unconstrained: r.unconstrained.clone(),
+                fit_time_s: r.fit_time_s,
+                iterations: r.evaluations,
+                termination: r.termination.clone(),
+                mse: finite(r.mse),
+                rms_log_residual: finite(r.rms_log_residual),
+                chi2_reduced: finite(r.chi2_reduced),
+                rings_used: r.rings_used,
+                rings_inside_spot: r.rings_inside_spot,
+                rings_below_detection: r.rings_below_detection,
+                rings_invalid: r.rings_invalid,
+                problem,
+            }
+        }
+    }
+}

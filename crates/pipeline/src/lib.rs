@@ -1,0 +1,22 @@
+//! scatterfit-pipeline: the measurement, one function per stage.
+//!
+//! 1. [`spectro::spectro_stage`] — η from SCI − SCE, Rd and α′ per channel;
+//! 2. [`hdr::read_and_merge`] — the exposure bracket → a radiance map and its detection limits;
+//! 3. [`profile::profile_stage`] — spot centre and radial profile Rd(r);
+//! 4. [`fit::fit_stage`] — σ′s and σa per channel.
+//!
+//! [`measure_sample`] runs them on a sample folder (its `sample.toml`). The command-line tool's
+//! commands parse their arguments, call these functions and print; no command calls another's file.
+//! Inputs are typed (paths, options); results are typed; nothing here prints or writes files.
+
+#![forbid(unsafe_code)]
+
+mod error;
+pub mod fit;
+pub mod hdr;
+pub mod measure;
+pub mod profile;
+pub mod spectro;
+
+pub use error::{PipelineError, Result};
+pub use measure::{Measurement, Overrides, Stage, Timings, measure_sample, sample_dirs};
