@@ -1,7 +1,8 @@
 //! The `mc` model's tables shipped inside the crate, so that a measurement never waits for a
-//! simulation: g = 0, η ∈ {1.0, 1.05, 1.1, 1.2, 1.4, 1.6, 1.8, 2.0, 2.2, 2.4} (dense near 1, where
-//! total internal reflection sets in; Catmull-Rom in η on this grid stays within 0.2 % of exact
-//! adding-doubling totals, BENCHMARKS.md), each the default layout of [`McTableSpec::new`] with
+//! simulation: g = 0, η ∈ {1.0, 1.05, 1.1, 1.2, 1.3, …, 2.4} (16 tables, 0.1 apart and 0.05 near 1,
+//! where total internal reflection sets in; with 0.2 spacing Catmull-Rom in η was measured up to
+//! 0.7 % off a table built at η = 1.33 itself, BENCHMARKS.md), each the default layout of
+//! [`McTableSpec::new`] with
 //! 2·10⁶ full-length photons (and 8·10⁶ / 3.2·10⁷ in the shorter strata), in compact form
 //! ([`McTable::compact`]). Made by
 //! `cargo run --release -p scatterfit-mc --example build_mc_tables -- crates/mc/tables 2e6 <η…>`.
@@ -12,18 +13,26 @@ use crate::error::{McError, Result};
 use crate::model::{McTable, McTableSet};
 
 /// The η of the shipped tables.
-pub const BUNDLED_ETAS: [f64; 10] = [1.0, 1.05, 1.1, 1.2, 1.4, 1.6, 1.8, 2.0, 2.2, 2.4];
+pub const BUNDLED_ETAS: [f64; 16] = [
+    1.0, 1.05, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0, 2.1, 2.2, 2.3, 2.4,
+];
 
-const BUNDLED_JSON: [&str; 10] = [
+const BUNDLED_JSON: [&str; 16] = [
     include_str!("../tables/mc-white-eta1.00.json"),
     include_str!("../tables/mc-white-eta1.05.json"),
     include_str!("../tables/mc-white-eta1.10.json"),
     include_str!("../tables/mc-white-eta1.20.json"),
+    include_str!("../tables/mc-white-eta1.30.json"),
     include_str!("../tables/mc-white-eta1.40.json"),
+    include_str!("../tables/mc-white-eta1.50.json"),
     include_str!("../tables/mc-white-eta1.60.json"),
+    include_str!("../tables/mc-white-eta1.70.json"),
     include_str!("../tables/mc-white-eta1.80.json"),
+    include_str!("../tables/mc-white-eta1.90.json"),
     include_str!("../tables/mc-white-eta2.00.json"),
+    include_str!("../tables/mc-white-eta2.10.json"),
     include_str!("../tables/mc-white-eta2.20.json"),
+    include_str!("../tables/mc-white-eta2.30.json"),
     include_str!("../tables/mc-white-eta2.40.json"),
 ];
 

@@ -195,7 +195,11 @@ pub struct RawProfiles {
 }
 
 /// A smoothed Monte Carlo profile table for one η and g (module docs).
+///
+/// Read from JSON only through the same checks as [`McTable::from_json`] (`#[serde(try_from)]`), so
+/// every value of this type is consistent.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawTable")]
 pub struct McTable {
     format: String,
     version: u32,
@@ -212,6 +216,96 @@ pub struct McTable {
     /// χ² per degree of freedom of each row's smoothing fit.
     chi2_per_bin: Vec<f64>,
     raw: Option<RawProfiles>,
+}
+
+/// The unchecked shape of [`McTable`] in files.
+#[derive(Deserialize)]
+struct RawTable {
+    format: String,
+    version: u32,
+    spec: McTableSpec,
+    albedos: Vec<f64>,
+    knots: Knots,
+    coefs: Vec<f64>,
+    rho_data_min: Vec<f64>,
+    rho_data_max: Vec<f64>,
+    rd_total: Vec<f64>,
+    rd_total_stderr: Vec<f64>,
+    chi2_per_bin: Vec<f64>,
+    raw: Option<RawProfiles>,
+}
+
+impl TryFrom<RawTable> for McTable {
+    type Error = String;
+    fn try_from(t: RawTable) -> std::result::Result<Self, String> {
+        let k = t.spec.albedo_count;
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let checks: [(bool, &str); 10] = [
+            (
+                t.format == MC_TABLE_TAG && t.version == MC_TABLE_VERSION,
+                "not a table of this format version",
+            ),
+            (t.spec.white().is_ok(), "invalid spec"),
+            (
+                t.albedos == t.spec.albedos(),
+                "albedos do not match the spec",
+            ),
+            (
+                t.knots.intervals >= 1
+                    && t.knots.intervals <= 100_000
+                    && t.knots.h.is_finite()
+                    && t.knots.h > 0.0
+                    && t.knots.u0.is_finite(),
+                "bad knots",
+            ),
+            (
+                t.coefs.len() == k.saturating_mul(t.knots.len()) && finite(&t.coefs),
+                "coefficients missing or not finite",
+            ),
+            (
+                [
+                    &t.rho_data_min,
+                    &t.rho_data_max,
+                    &t.rd_total,
+                    &t.rd_total_stderr,
+                    &t.chi2_per_bin,
+                ]
+                .iter()
+                .all(|v| v.len() == k && finite(v)),
+                "per-albedo vectors of the wrong length or not finite",
+            ),
+            (
+                t.rd_total.windows(2).all(|w| w[1] > w[0]) && t.rd_total.iter().all(|&r| r > 0.0),
+                "totals must be positive and increase with the albedo",
+            ),
+            (
+                t.raw.as_ref().is_none_or(|r| {
+                    let n = k.saturating_mul(r.edges.len().saturating_sub(1));
+                    r.rd.len() == n && r.rd_stderr.len() == n
+                }),
+                "raw profiles of the wrong size",
+            ),
+            (t.spec.albedo_count >= 4, "need at least 4 albedos"),
+            (t.rd_total.iter().all(|&r| r <= 1.5), "totals above 1.5"),
+        ];
+        if let Some((_, why)) = checks.iter().find(|(ok, _)| !ok) {
+            return Err(format!("{MC_TABLE_TAG} v{MC_TABLE_VERSION}: {why}"));
+        }
+        Ok(Self {
+            format: t.format,
+            version: t.version,
+            spec: t.spec,
+            albedos: t.albedos,
+            knots: t.knots,
+            coefs: t.coefs,
+            rho_data_min: t.rho_data_min,
+            rho_data_max: t.rho_data_max,
+            rd_total: t.rd_total,
+            rd_total_stderr: t.rd_total_stderr,
+            chi2_per_bin: t.chi2_per_bin,
+            raw: t.raw,
+        })
+    }
 }
 
 impl McTable {
@@ -621,25 +715,7 @@ impl McTable {
     /// # Errors
     /// A message when the text is not a consistent table of this format version.
     pub fn from_json(text: &str) -> std::result::Result<Self, String> {
-        let t: Self = serde_json::from_str(text).map_err(|e| e.to_string())?;
-        let k = t.spec.albedo_count;
-        let ok = t.format == MC_TABLE_TAG
-            && t.version == MC_TABLE_VERSION
-            && t.spec.white().is_ok()
-            && t.albedos == t.spec.albedos()
-            && t.coefs.len() == k * t.knots.len()
-            && t.rho_data_max.len() == k
-            && t.rho_data_min.len() == k
-            && t.rd_total.len() == k
-            && t.rd_total_stderr.len() == k
-            && t.coefs.iter().all(|c| c.is_finite());
-        if ok {
-            Ok(t)
-        } else {
-            Err(format!(
-                "not a {MC_TABLE_TAG} of version {MC_TABLE_VERSION}, or inconsistent sizes"
-            ))
-        }
+        serde_json::from_str(text).map_err(|e| e.to_string())
     }
 
     /// Writes the table atomically (temporary file, sync, rename).
@@ -985,5 +1061,20 @@ mod tests {
         );
         assert_eq!(m1.rd(2.0), m2.rd(2.0));
         assert!(McTable::from_json("{}").is_err());
+        // A table with broken knots or non-increasing totals is refused by the checks, not used.
+        let mut bad: serde_json::Value = serde_json::from_str(&json).unwrap();
+        bad["knots"]["intervals"] = 0.into();
+        assert!(
+            McTable::from_json(&bad.to_string())
+                .unwrap_err()
+                .contains("bad knots")
+        );
+        let mut bad: serde_json::Value = serde_json::from_str(&json).unwrap();
+        bad["rd_total"][3] = 0.0.into();
+        assert!(
+            McTable::from_json(&bad.to_string())
+                .unwrap_err()
+                .contains("increase")
+        );
     }
 }
