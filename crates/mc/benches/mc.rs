@@ -90,3 +90,19 @@ fn mc_model_profile_with_derivatives_300_radii(b: divan::Bencher) {
         divan::black_box(&out);
     });
 }
+
+/// Parsing the 16 shipped `mc` tables (`McTableSet::bundled`), done once per process.
+#[divan::bench(sample_count = 20)]
+fn mc_bundled_set_parse() -> scatterfit_mc::McTableSet {
+    scatterfit_mc::McTableSet::bundled().unwrap()
+}
+
+/// α′ from a total Rd by Monte Carlo between tables (η = 1.33): bisection on the interpolated totals.
+#[divan::bench(sample_count = 100)]
+fn mc_albedo_from_rd_total(b: divan::Bencher) {
+    let set = scatterfit_mc::McTableSet::bundled().unwrap();
+    b.bench_local(|| {
+        set.albedo_from_rd_total(divan::black_box(0.5), divan::black_box(1.33))
+            .unwrap()
+    });
+}

@@ -908,9 +908,14 @@ mod tests {
     /// A table that builds in a fraction of a second: 8 albedos 0.3–0.99, 120 bins to 60 mean free
     /// paths, 30 000 + 6 000 photons.
     fn small_spec(eta: f64) -> McTableSpec {
-        let mut spec = McTableSpec::with_strata(eta, 0.0, vec![30_000, 6_000], vec![64]).unwrap();
+        small_spec_g(eta, 0.0)
+    }
+
+    fn small_spec_g(eta: f64, g: f64) -> McTableSpec {
+        let mut spec = McTableSpec::with_strata(eta, g, vec![30_000, 6_000], vec![64]).unwrap();
         spec.albedo_count = 8;
-        spec.albedo_min = 0.3;
+        // Forward scattering (g > 0) sends low-albedo photons deep: start higher there.
+        spec.albedo_min = if g == 0.0 { 0.3 } else { 0.7 };
         spec.albedo_max = 0.99;
         spec.radial_bins = 120;
         spec.rho_max = 60.0;
@@ -951,14 +956,22 @@ mod tests {
     #[test]
     fn derivatives_match_finite_differences() {
         let set = small_set(&[1.0, 1.2, 1.5]);
-        for (sp, sa, eta) in [
-            (1.0, 0.05, 1.0),
-            (2.0, 0.4, 1.33),
-            (0.7, 0.02, 1.5),
-            (1.3, 0.3, 1.2),
+        let set_g = McTableSet::new(
+            [1.2, 1.5]
+                .iter()
+                .map(|&e| McTable::build(&small_spec_g(e, 0.5), &|_, _| {}).unwrap())
+                .collect(),
+        )
+        .unwrap();
+        for (sp, sa, eta, set) in [
+            (1.0, 0.05, 1.0, &set),
+            (2.0, 0.4, 1.33, &set),
+            (0.7, 0.02, 1.5, &set),
+            (1.3, 0.3, 1.2, &set),
+            (1.0, 0.1, 1.4, &set_g),
         ] {
             let model = |sp: f64, sa: f64| {
-                McProfile::new(&set, &OpticalProperties::new(sp, sa, eta).unwrap()).unwrap()
+                McProfile::new(set, &OpticalProperties::new(sp, sa, eta).unwrap()).unwrap()
             };
             let m = model(sp, sa);
             for r in [0.02, 0.3, 1.0, 4.0, 12.0] {
@@ -1016,6 +1029,37 @@ mod tests {
         let e = McProfile::new(&set, &OpticalProperties::new(1.0, 0.1, 1.6).unwrap());
         assert!(matches!(e, Err(McError::OutOfTable { name: "eta", .. })));
         assert!(McProfile::new(&only, &OpticalProperties::new(1.0, 0.1, 1.41).unwrap()).is_err());
+    }
+
+    /// g ≠ 0: the white table is in the single-scattering albedo a at σt = 1, and McProfile maps
+    /// (σ′s, σa, g) onto it; its total agrees with the MCML engine run on the same layer
+    /// (`Layer::from_reduced`, σs = σ′s/(1 − g)) within 4 combined standard errors + 0.003 (the small
+    /// table's interpolation).
+    #[test]
+    fn anisotropic_total_matches_engine() {
+        let (g, eta, sp, sa) = (0.5, 1.3, 1.0, 0.05);
+        let t = McTable::build(&small_spec_g(eta, g), &|_, _| {}).unwrap();
+        let set = McTableSet::new(vec![t]).unwrap();
+        let m = McProfile::new(&set, &OpticalProperties::new(sp, sa, eta).unwrap()).unwrap();
+        let half = crate::Sample::slab(
+            crate::Layer::from_reduced(sp, sa, g, eta, f64::INFINITY).unwrap(),
+            1.0,
+        )
+        .unwrap();
+        let grid = crate::RadialGrid::uniform(1.0, 10).unwrap();
+        let d = crate::Simulation::new(half, crate::Beam::pencil(), grid, 40_000, 9)
+            .unwrap()
+            .run();
+        let a = (sp / (1.0 - g)) / (sa + sp / (1.0 - g));
+        let (_, se) = set.tables()[0].totals();
+        let k = set.tables()[0].albedos().partition_point(|&x| x < a);
+        let tol = 4.0 * (d.rd_total.stderr.powi(2) + se[k].powi(2)).sqrt() + 0.003;
+        assert!(
+            (m.rd_total() - d.rd_total.value).abs() <= tol,
+            "{} vs engine {:?}",
+            m.rd_total(),
+            d.rd_total
+        );
     }
 
     /// α′ from the Monte Carlo total inverts the total at any η of the set (round trip 1e-12), and an
