@@ -54,7 +54,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 && let Err(e) = crate::report::write_measurement(dir, m)
                 && let Ok(mut w) = write_errors.lock()
             {
-                w.push((dir.to_path_buf(), format!("{e:#}")));
+                w.push((dir.to_path_buf(), crate::common::error_text(&e)));
             }
         },
     )?;
@@ -75,7 +75,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 }
                 results.push(r);
             }
-            Err(e) => failed.push((o.dir.clone(), format!("{e:#}"))),
+            Err(e) => failed.push((o.dir.clone(), crate::common::error_text(e))),
         }
     }
     std::fs::create_dir_all(&args.output_dir)?;

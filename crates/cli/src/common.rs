@@ -5,7 +5,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
-use scatterfit_io::manifest::{MethodName, ModelName};
+use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
 use scatterfit_pipeline::Overrides;
 
 /// A measurement that ran and failed (exit code 1), as opposed to bad input (2).
@@ -128,12 +128,32 @@ impl From<MethodArg> for MethodName {
 pub enum ModelArg {
     /// The classical dipole, Jensen et al. 2001 (the paper's).
     Dipole,
-    /// d'Eon 2012 (not available yet).
+    /// d'Eon 2012, "A better dipole".
     BetterDipole,
-    /// Photon beam diffusion (not available yet).
+    /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (slow: ~2 ms per
+    /// evaluation).
     Pbd,
-    /// Monte Carlo tables (not available yet).
+    /// Monte Carlo tables shipped with scatterfit (exact transport; g = 0, η 1.0–2.4, α′ up to
+    /// 0.9999).
     Mc,
+}
+
+/// How α′ comes from the spectrophotometer's Rd.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum AlbedoModelArg {
+    /// The diffusion model's own total Rd(α′, η) inverted (the dipole's closed form: the paper).
+    Diffusion,
+    /// The Monte Carlo tables' total inverted (exact transport).
+    Mc,
+}
+
+impl From<AlbedoModelArg> for AlbedoModelName {
+    fn from(m: AlbedoModelArg) -> Self {
+        match m {
+            AlbedoModelArg::Diffusion => AlbedoModelName::Diffusion,
+            AlbedoModelArg::Mc => AlbedoModelName::Mc,
+        }
+    }
 }
 
 impl From<ModelArg> for ModelName {
@@ -156,6 +176,10 @@ pub struct FitArgs {
     /// The forward model (default: the manifest's `fit.model`, else dipole).
     #[arg(long, value_enum)]
     pub model: Option<ModelArg>,
+    /// How α′ comes from the spectrophotometer's Rd (default: the manifest's `fit.albedo_model`,
+    /// else mc for the mc model and diffusion otherwise).
+    #[arg(long, value_enum)]
+    pub albedo_model: Option<AlbedoModelArg>,
     /// A known η instead of the one measured from SCI − SCE [1, 3].
     #[arg(long)]
     pub eta: Option<f64>,
@@ -178,6 +202,7 @@ impl FitArgs {
         Ok(Overrides {
             method: self.method.map(Into::into),
             model: self.model.map(Into::into),
+            albedo_model: self.albedo_model.map(Into::into),
             eta: self.eta,
             normalise_with_spectro: self.normalise_with_spectro.then_some(true),
         })

@@ -150,6 +150,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let fit = FitArgs {
         method: None,
         model: None,
+        albedo_model: None,
         eta: None,
         normalise_with_spectro: false,
     };

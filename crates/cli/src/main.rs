@@ -23,6 +23,7 @@ mod report;
 mod runner;
 mod simulate;
 mod spectro;
+mod study;
 mod synth;
 mod table;
 mod twin;
@@ -65,6 +66,8 @@ enum Command {
     Profile(profile::Args),
     /// The rig twin: write a synthetic sample folder (Monte Carlo spectro reading and bracket).
     Synth(synth::Args),
+    /// The bias study: rig-twin samples over α′ and η fitted with every model and method.
+    Study(study::Args),
     /// Export a measured result as a pbrt-v4, Mitsuba 3, Blender or JSON material.
     Export(export::Args),
     /// Render measured parameters on a mesh by the paper's two methods; validate against the profile.
@@ -109,6 +112,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Merge(args) => merge::run(args),
         Command::Profile(args) => profile::run(args),
         Command::Synth(args) => synth::run(args),
+        Command::Study(args) => study::run(args),
         Command::Export(args) => export::run(args),
         Command::Render(args) => render::run(args),
         Command::Bench(args) => bench::run(args),

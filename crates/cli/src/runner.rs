@@ -88,7 +88,7 @@ pub fn compare_dirs(
         let proposed = match o.result {
             Ok(m) => m,
             Err(e) => {
-                failed.push((o.dir, format!("{e:#}")));
+                failed.push((o.dir, crate::common::error_text(&e)));
                 continue;
             }
         };

@@ -53,7 +53,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 pub use error::{FitError, Result};
-pub use model::{DipoleModel, ProfileModel, Spot, model_profile, node_spacing};
+pub use model::{Diffusion, DipoleModel, McModel, ProfileModel, Spot, model_profile, node_spacing};
 pub use profile::{ProfileData, Ring, RingSelection, Selected, select_rings};
 pub use spot::SpotKernel;
 
@@ -368,6 +368,11 @@ impl<'a> PreparedFit<'a> {
         }
         if starts.is_empty() || self.unknowns == Unknowns::Existing {
             starts.extend(problem::start(&data, &forward, self.unknowns));
+        }
+        if starts.is_empty() {
+            // The search found no shape the model can evaluate (the model's range does not meet
+            // the data): start from σ′s = 1 mm⁻¹, α′ = 0.99; the solver then reports why it fails.
+            starts.push(problem::solver_x(self.unknowns, 1.0, 1.0 / 0.99 - 1.0));
         }
         let lm = LevenbergMarquardt::new()
             .with_ftol(1e-10)

@@ -23,6 +23,7 @@
 //! [fit]                         # every key optional, defaults shown
 //! method = "proposed"           # proposed | existing
 //! model = "dipole"              # dipole | better-dipole | pbd | mc
+//! # albedo_model = "diffusion"  # diffusion | mc (default: mc for the mc model, else diffusion)
 //! r_max_px = 300                # the paper's cut-off
 //! ```
 //!
@@ -101,6 +102,26 @@ pub enum ModelName {
     Mc,
 }
 
+/// How α′ is obtained from the spectrophotometer's diffuse reflectance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AlbedoModelName {
+    /// The diffusion model's own total Rd(α′, η) inverted (the dipole's closed form for the paper).
+    Diffusion,
+    /// The Monte Carlo tables' total Rd(α′, η) inverted ("by the Monte Carlo method", exactly).
+    Mc,
+}
+
+impl AlbedoModelName {
+    /// The name as written.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AlbedoModelName::Diffusion => "diffusion",
+            AlbedoModelName::Mc => "mc",
+        }
+    }
+}
+
 impl MethodName {
     /// The name as written.
     pub fn as_str(self) -> &'static str {
@@ -167,8 +188,9 @@ pub struct FitSection {
     pub method: Option<MethodName>,
     /// dipole | better-dipole | pbd | mc.
     pub model: Option<ModelName>,
-    /// diffusion | mc: how α′ is obtained from the spectrophotometer's Rd.
-    pub albedo_model: Option<String>,
+    /// diffusion | mc: how α′ is obtained from the spectrophotometer's Rd (default: the physics of
+    /// `model`: mc for the mc model, else diffusion).
+    pub albedo_model: Option<AlbedoModelName>,
     /// Outermost profile radius [px] (default 300, the paper's).
     pub r_max_px: Option<f64>,
     /// Innermost fitted radius [mm] (default: the spot diameter).
@@ -369,15 +391,6 @@ pub fn parse_manifest(
     {
         return Err(invalid("fit.r_min_mm", format!("= {r}: must be ≥ 0 mm")));
     }
-    if let Some(a) = &m.fit.albedo_model
-        && a != "diffusion"
-        && a != "mc"
-    {
-        return Err(invalid(
-            "fit.albedo_model",
-            format!("= {a:?}: use \"diffusion\" or \"mc\""),
-        ));
-    }
     if m.fit.normalise_with_spectro == Some(true) && m.fit.method == Some(MethodName::Existing) {
         return Err(invalid(
             "fit.normalise_with_spectro",
@@ -471,8 +484,8 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     if let Some(r) = m.fit.r_min_mm {
         t.push_str(&format!("r_min_mm = {r}\n"));
     }
-    if let Some(a) = &m.fit.albedo_model {
-        t.push_str(&format!("albedo_model = {}\n", toml_string(a)));
+    if let Some(a) = m.fit.albedo_model {
+        t.push_str(&format!("albedo_model = \"{}\"\n", a.as_str()));
     }
     if let Some(b) = m.fit.normalise_with_spectro {
         t.push_str(&format!("normalise_with_spectro = {b}\n"));

@@ -1,10 +1,12 @@
 //! Stage 4: the fit per channel, and its conversion into the result file's shape.
 
 use scatterfit_fit::{
-    ChannelInput, DipoleModel, FitOptions, FitReport, Method, ProfileData, ProfileModel, Spot,
+    ChannelInput, Diffusion, DipoleModel, FitOptions, FitReport, McModel, Method, ProfileData,
+    ProfileModel, Spot,
 };
-use scatterfit_io::manifest::{MethodName, ModelName};
+use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
 use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
+use scatterfit_optics::model::DiffusionModel;
 use serde::Serialize;
 
 use crate::error::{PipelineError, Result};
@@ -17,6 +19,8 @@ pub struct FitSettings {
     pub method: MethodName,
     /// The forward model.
     pub model: ModelName,
+    /// How α′ comes from the spectrophotometer's Rd.
+    pub albedo_model: AlbedoModelName,
     /// Radius of the light spot [mm]; the model is convolved with it.
     pub spot_radius_mm: f64,
     /// Innermost fitted radius [mm] (default: the spot's diameter).
@@ -44,17 +48,37 @@ impl FitSettings {
     }
 }
 
-/// The forward model for `name`.
+/// The forward model for `name`: the dipole (Jensen et al. 2001), the better dipole (d'Eon 2012),
+/// photon beam diffusion (Habel et al. 2013) or the Monte Carlo tables shipped with scatterfit.
 ///
 /// # Errors
-/// [`PipelineError::Input`] for a model not available in this build.
+/// [`PipelineError::Input`] when the Monte Carlo tables cannot be loaded.
 pub fn model_for(name: ModelName) -> Result<&'static dyn ProfileModel> {
-    match name {
-        ModelName::Dipole => Ok(&DipoleModel),
-        other => Err(PipelineError::Input(format!(
-            "the forward model `{}` is not available yet; use `dipole` (Jensen et al. 2001)",
-            other.as_str()
-        ))),
+    static BETTER: Diffusion = Diffusion(DiffusionModel::BetterDipole);
+    static PBD: Diffusion = Diffusion(DiffusionModel::Pbd);
+    Ok(match name {
+        ModelName::Dipole => &DipoleModel,
+        ModelName::BetterDipole => &BETTER,
+        ModelName::Pbd => &PBD,
+        ModelName::Mc => McModel::bundled()
+            .map_err(|e| PipelineError::Input(format!("the Monte Carlo tables: {e}")))?,
+    })
+}
+
+/// The model whose total Rd(α′, η) is inverted for α′: the profile model's own for `diffusion`
+/// (the dipole's closed form — the paper's eq. 1 — when the profile model is `mc`), the Monte Carlo
+/// tables' for `mc`.
+///
+/// # Errors
+/// As [`model_for`].
+pub fn albedo_model_for(
+    albedo: AlbedoModelName,
+    model: ModelName,
+) -> Result<&'static dyn ProfileModel> {
+    match (albedo, model) {
+        (AlbedoModelName::Mc, _) => model_for(ModelName::Mc),
+        (AlbedoModelName::Diffusion, ModelName::Mc) => model_for(ModelName::Dipole),
+        (AlbedoModelName::Diffusion, m) => model_for(m),
     }
 }
 

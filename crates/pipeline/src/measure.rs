@@ -5,13 +5,17 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use scatterfit_fit::ProfileData;
-use scatterfit_io::manifest::{MethodName, ModelName, SampleManifest, read_manifest};
+use scatterfit_io::manifest::{
+    AlbedoModelName, MethodName, ModelName, SampleManifest, read_manifest,
+};
 use scatterfit_io::result_json::{Channels, FileRef, Inputs, MeasurementResult};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
-use crate::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage, model_for};
+use crate::fit::{
+    ChannelOutcome, FitSettings, albedo_model_for, channel_result, fit_stage, model_for,
+};
 use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
 use crate::profile::{ProfileSettings, ProfileStage, profile_stage};
 use crate::spectro::{SpectroStage, spectro_stage};
@@ -23,6 +27,8 @@ pub struct Overrides {
     pub method: Option<MethodName>,
     /// The forward model.
     pub model: Option<ModelName>,
+    /// How α′ comes from the spectrophotometer.
+    pub albedo_model: Option<AlbedoModelName>,
     /// η instead of the measured one.
     pub eta: Option<f64>,
     /// Fix the scale by the spectrophotometer.
@@ -90,6 +96,14 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
     let method = o.method.or(manifest.fit.method).unwrap_or_default();
     let model = o.model.or(manifest.fit.model).unwrap_or_default();
     model_for(model)?;
+    let albedo_model =
+        o.albedo_model
+            .or(manifest.fit.albedo_model)
+            .unwrap_or(if model == ModelName::Mc {
+                AlbedoModelName::Mc
+            } else {
+                AlbedoModelName::Diffusion
+            });
     let normalise = o
         .normalise_with_spectro
         .or(manifest.fit.normalise_with_spectro)
@@ -102,6 +116,7 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
     Ok(FitSettings {
         method,
         model,
+        albedo_model,
         spot_radius_mm: 0.5 * manifest.camera.spot_diameter_mm.unwrap_or(1.0),
         r_min_mm: manifest.fit.r_min_mm,
         normalise_with_spectro: normalise,
@@ -124,7 +139,8 @@ pub fn measure_sample(
     let settings = fit_settings(&manifest, overrides)?;
     let model = model_for(settings.model)?;
     progress(Stage::Spectro);
-    let spectro = spectro_stage(&manifest, overrides.eta)?;
+    let albedo = albedo_model_for(settings.albedo_model, settings.model)?;
+    let spectro = spectro_stage(&manifest, overrides.eta, albedo)?;
     let spectro_s = t0.elapsed().as_secs_f64();
     let hdr = match &manifest.camera.hdr {
         Some(p) => read_radiance_map(&manifest.resolve(p))?,
@@ -216,18 +232,30 @@ impl Measurement {
         if method == MethodName::Existing {
             settings.normalise_with_spectro = false;
         }
+        self.refit_with(settings)
+    }
+
+    /// The same sample with other fit settings — model, albedo model, method — reusing the merge
+    /// and the profile; α′ is recomputed from the spectrophotometer's Rd by the albedo model (what
+    /// the bias study needs).
+    ///
+    /// # Errors
+    /// [`PipelineError::Input`] when a model cannot be loaded.
+    pub fn refit_with(&self, settings: FitSettings) -> Result<Measurement> {
         let model = model_for(settings.model)?;
+        let albedo = albedo_model_for(settings.albedo_model, settings.model)?;
+        let spectro = self.spectro.with_albedo_model(albedo);
         let t = Instant::now();
         let data: Vec<ProfileData> = (0..3)
             .map(|c| self.profile.channel_data(c))
             .collect::<Result<_>>()?;
-        let fits = fit_stage(&data, &self.spectro, &settings, model);
+        let fits = fit_stage(&data, &spectro, &settings, model);
         let mut timings = self.timings;
         timings.fit_s = t.elapsed().as_secs_f64();
         Ok(Measurement {
             manifest: self.manifest.clone(),
             settings,
-            spectro: self.spectro.clone(),
+            spectro,
             hdr: self.hdr.clone(),
             profile: self.profile.clone(),
             fits,
@@ -275,7 +303,7 @@ impl Measurement {
             eta_source: self.spectro.eta_source.into(),
             method: self.settings.method.as_str().into(),
             model: self.settings.model.as_str().into(),
-            albedo_model: "diffusion".into(),
+            albedo_model: self.settings.albedo_model.as_str().into(),
             channels,
             inputs: Inputs {
                 sample_dir: m.dir.to_string_lossy().into_owned(),
@@ -290,6 +318,7 @@ impl Measurement {
                 options: serde_json::json!({
                     "method": self.settings.method.as_str(),
                     "model": self.settings.model.as_str(),
+                    "albedo_model": self.settings.albedo_model.as_str(),
                     "normalise_with_spectro": self.settings.normalise_with_spectro,
                     "r_min_mm": self.settings.options().selection.r_min_mm,
                     "r_max_px": m.fit.r_max_px.unwrap_or(300.0),

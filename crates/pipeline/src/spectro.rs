@@ -4,9 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
+use scatterfit_fit::ProfileModel;
 use scatterfit_io::manifest::SampleManifest;
 use scatterfit_optics::colour::{Lab, Observer};
-use scatterfit_optics::dipole;
 use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
 use serde::Serialize;
 
@@ -33,14 +33,34 @@ pub struct SpectroStage {
     pub warnings: Vec<String>,
 }
 
+impl SpectroStage {
+    /// The same reading with α′ from another model's total Rd(α′, η).
+    pub fn with_albedo_model(&self, albedo: &dyn ProfileModel) -> SpectroStage {
+        from_rd(
+            self.file.clone(),
+            self.analysis.clone(),
+            self.rd,
+            self.eta,
+            self.eta_source,
+            self.warnings.clone(),
+            albedo,
+        )
+    }
+}
+
 /// Reads and analyses the reading of `manifest` (or its L\*a\*b\* with a given η). `eta` overrides
-/// the measured η.
+/// the measured η; `albedo` is the model whose total Rd(α′, η) is inverted for α′ (the paper: the
+/// dipole's closed form, eq. 1).
 ///
 /// # Errors
 /// [`PipelineError::SpectroCsv`] for an unreadable or malformed CSV; [`PipelineError::Spectro`] when
 /// the reading gives no η (no specular reflection: a failed measurement) or does not cover
 /// 400–700 nm; [`PipelineError::Input`] for a bad η.
-pub fn spectro_stage(manifest: &SampleManifest, eta: Option<f64>) -> Result<SpectroStage> {
+pub fn spectro_stage(
+    manifest: &SampleManifest,
+    eta: Option<f64>,
+    albedo: &dyn ProfileModel,
+) -> Result<SpectroStage> {
     let eta = eta.or(manifest.spectro.eta);
     let lab = manifest.spectro.lab.map(|[l, a, b]| {
         let observer = match manifest.spectro.lab_observer {
@@ -53,7 +73,7 @@ pub fn spectro_stage(manifest: &SampleManifest, eta: Option<f64>) -> Result<Spec
         Some(file) => {
             let path = manifest.resolve(file);
             let reading = scatterfit_io::spectro::read_spectro_csv(&path)?;
-            from_reading(&reading, &path, lab, eta)
+            from_reading(&reading, &path, lab, eta, albedo)
         }
         None => {
             let eta = eta.ok_or_else(|| {
@@ -63,7 +83,7 @@ pub fn spectro_stage(manifest: &SampleManifest, eta: Option<f64>) -> Result<Spec
                 PipelineError::Input("without a spectro file, give spectro.lab".into())
             })?;
             let rd = scatterfit_optics::colour::lab_to_linear_srgb(lab, observer);
-            Ok(from_rd(None, None, rd, eta, "given", Vec::new()))
+            Ok(from_rd(None, None, rd, eta, "given", Vec::new(), albedo))
         }
     }
 }
@@ -77,6 +97,7 @@ pub fn from_reading(
     path: &Path,
     lab: Option<(Lab, Observer)>,
     eta: Option<f64>,
+    albedo: &dyn ProfileModel,
 ) -> Result<SpectroStage> {
     if let Some(e) = eta
         && !(e.is_finite() && e >= 1.0)
@@ -105,6 +126,7 @@ pub fn from_reading(
         eta,
         source,
         warnings,
+        albedo,
     ))
 }
 
@@ -115,15 +137,24 @@ fn from_rd(
     eta: f64,
     eta_source: &'static str,
     warnings: Vec<String>,
+    albedo: &dyn ProfileModel,
 ) -> SpectroStage {
     let names = ["R", "G", "B"];
     let mut albedo_prime = [None; 3];
     let mut problems: [Option<String>; 3] = Default::default();
     for c in 0..3 {
-        // The paper's eq. (1): the dipole's total diffuse reflectance, inverted.
-        match dipole::albedo_from_rd(rd[c], eta) {
+        // The paper's eq. (1) (the dipole's total diffuse reflectance, inverted) or the same
+        // inversion with another model's total.
+        match albedo.albedo_from_rd(rd[c], eta) {
             Ok(a) => albedo_prime[c] = Some(a),
-            Err(e) => problems[c] = Some(format!("channel {}: {e}", names[c])),
+            Err(e) => {
+                problems[c] = Some(format!(
+                    "channel {}: α′ from Rd = {:.4} by the {} total: {e}",
+                    names[c],
+                    rd[c],
+                    albedo.name()
+                ));
+            }
         }
     }
     SpectroStage {
