@@ -11,6 +11,7 @@ use scatterfit_io::result_table::{table1_csv, table1_markdown};
 use scatterfit_pipeline::sample_dirs;
 
 use crate::common::FitArgs;
+use crate::output::{errln, out, outln};
 
 /// Arguments of `scatterfit batch`.
 #[derive(Debug, clap::Args)]
@@ -91,20 +92,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         crate::output::print_json(&results)?;
     } else {
         for r in &results {
-            print!("{}", crate::report::summary_text(r));
+            out!("{}", crate::report::summary_text(r))?;
         }
-        println!(
+        outln!(
             "\n{} of {} samples measured completely; summary: {} and {}",
             dirs.len() - failed.len(),
             dirs.len(),
             args.output_dir.join("summary.csv").display(),
             args.output_dir.join("summary.md").display()
-        );
+        )?;
     }
     if !failed.is_empty() {
-        eprintln!("\n{} sample(s) failed or are incomplete:", failed.len());
+        errln!("\n{} sample(s) failed or are incomplete:", failed.len());
         for (dir, why) in &failed {
-            eprintln!("  {}: {why}", dir.display());
+            errln!("  {}: {why}", dir.display());
         }
         return Ok(ExitCode::from(1));
     }

@@ -10,6 +10,7 @@ use scatterfit_io::result_table::{table2_csv, table2_markdown};
 use scatterfit_pipeline::sample_dirs;
 
 use crate::common::FitArgs;
+use crate::output::{errln, out, outln};
 
 /// Arguments of `scatterfit compare`.
 #[derive(Debug, clap::Args)]
@@ -60,17 +61,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&pairs)?;
     } else {
-        print!("{}", table2_markdown(&pairs));
-        println!(
+        out!("{}", table2_markdown(&pairs))?;
+        outln!(
             "\nplots: compare.svg / compare.png in each sample folder; tables: {} and {}",
             args.output_dir.join("compare.csv").display(),
             args.output_dir.join("compare.md").display()
-        );
+        )?;
     }
     if !failed.is_empty() {
-        eprintln!("\n{} sample(s) failed:", failed.len());
+        errln!("\n{} sample(s) failed:", failed.len());
         for (dir, why) in &failed {
-            eprintln!("  {}: {why}", dir.display());
+            errln!("  {}: {why}", dir.display());
         }
         return Ok(ExitCode::from(1));
     }

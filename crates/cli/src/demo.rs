@@ -22,6 +22,7 @@ use serde::Serialize;
 
 use crate::common::{FitArgs, cache_dir};
 use crate::twin::{Material, synthesize, write_sample};
+use crate::output::{errln, out, outln};
 
 /// Arguments of `scatterfit demo`.
 #[derive(Debug, clap::Args)]
@@ -123,7 +124,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let quiet = args.quiet || args.json;
     let cache = cache_dir(args.cache_dir.as_deref());
     if !quiet {
-        eprintln!(
+        errln!(
             "synthesising the 7 materials of Choi et al. 2014 with the Monte Carlo rig twin (cached in {})",
             cache
                 .as_deref()
@@ -178,28 +179,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&rows)?;
     } else {
-        println!(
+        outln!(
             "The method of Choi, Lee & Chin (2014) on Monte Carlo rig-twin samples of their seven materials"
-        );
-        println!(
+        )?;
+        outln!(
             "(samples in {}; the fitted model never made these data; truth in each truth.json)\n",
             out.display()
-        );
-        print!("{accuracy}");
-        println!(
+        )?;
+        out!("{accuracy}")?;
+        outln!(
             "\ntime: {synth_s:.1} s synthesising (Monte Carlo, cached for the next run), {measure_s:.1} s measuring 7 \
              samples with both methods"
-        );
-        println!(
+        )?;
+        outln!(
             "files: {0}/<material>/result.json, fit.png, compare.png; {0}/summary.md (Table 1), \
              compare.md (Table 2), accuracy.md",
             out.display()
-        );
+        )?;
     }
     if !failed.is_empty() {
-        eprintln!("\n{} sample(s) failed:", failed.len());
+        errln!("\n{} sample(s) failed:", failed.len());
         for (dir, why) in &failed {
-            eprintln!("  {}: {why}", dir.display());
+            errln!("  {}: {why}", dir.display());
         }
         return Ok(ExitCode::from(1));
     }

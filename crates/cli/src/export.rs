@@ -13,6 +13,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use scatterfit_io::export::{ExportError, Format, SceneUnit, export};
 use scatterfit_io::result_json::read_result_json;
+use crate::output::errln;
 
 /// Arguments of `scatterfit export`.
 #[derive(Debug, clap::Args)]
@@ -94,14 +95,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let exported = match export(&result, format, unit) {
         Ok(e) => e,
         Err(err @ ExportError::FailedChannel { .. }) => {
-            eprintln!("error: {}: {err}", args.result.display());
+            errln!("error: {}: {err}", args.result.display());
             return Ok(ExitCode::from(1));
         }
         Err(err) => return Err(err).context(format!("exporting {}", args.result.display())),
     };
     if !args.quiet {
         for w in &exported.warnings {
-            eprintln!("warning: {w}");
+            errln!("warning: {w}");
         }
     }
     match &args.output {
@@ -109,7 +110,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             scatterfit_io::atomic::write_atomic(out, exported.text.as_bytes())
                 .with_context(|| format!("writing {}", out.display()))?;
             if !args.quiet {
-                eprintln!(
+                errln!(
                     "wrote {} ({} material \"{}\", 1 scene unit = 1 {})",
                     out.display(),
                     format.name(),

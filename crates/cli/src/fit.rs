@@ -16,6 +16,7 @@ use scatterfit_pipeline::spectro::SpectroStage;
 
 use crate::common::parse_rgb;
 use crate::common::{MethodArg, ModelArg};
+use crate::output::out;
 
 /// Arguments of `scatterfit fit`.
 #[derive(Debug, clap::Args)]
@@ -143,7 +144,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 "method": method.as_str(),
                 "model": model_name.as_str(),
                 "normalise_with_spectro": args.normalise_with_spectro,
-                "r_min_mm": settings.options().selection.r_min_mm,
+                "r_min_mm": settings.r_min_mm(),
             }),
             ..Inputs::default()
         },
@@ -155,7 +156,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&result)?;
     } else {
-        print!("{}", crate::report::summary_text(&result));
+        out!("{}", crate::report::summary_text(&result))?;
     }
     Ok(if fits.iter().all(ChannelOutcome::is_measurement) {
         ExitCode::SUCCESS

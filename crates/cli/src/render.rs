@@ -32,6 +32,7 @@ use scatterfit_render::{
     studio, studio_lights,
 };
 use serde::Serialize;
+use crate::output::{errln, outln};
 
 /// DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`) for captions.
 const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
@@ -518,7 +519,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             let r = data.report;
             if !args.quiet {
                 if r.boundary_edges > 0 {
-                    eprintln!(
+                    errln!(
                         "warning: {}: the surface is open ({} border edges); thickness through it \
                          is measured to the far side where there is one",
                         path.display(),
@@ -526,7 +527,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     );
                 }
                 if r.inconsistent_edges > 0 {
-                    eprintln!(
+                    errln!(
                         "warning: {}: {} edges join triangles wound inconsistently; computed \
                          normals may be wrong there",
                         path.display(),
@@ -534,7 +535,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     );
                 }
                 if r.degenerate_dropped > 0 {
-                    eprintln!(
+                    errln!(
                         "note: {}: dropped {} degenerate triangles",
                         path.display(),
                         r.degenerate_dropped
@@ -706,7 +707,7 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
     if args.json {
         return crate::output::print_json(s);
     }
-    println!(
+    outln!(
         "mesh     {} ({} triangles, {:.1} × {:.1} × {:.1} mm), BVH {:.3} s",
         s.mesh.source,
         s.mesh.triangles,
@@ -714,7 +715,7 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
         s.mesh.size_mm[1],
         s.mesh.size_mm[2],
         s.mesh.bvh_build_s
-    );
+    )?;
     for r in &s.renders {
         let extra = if r.method == "dipole" {
             format!(
@@ -725,43 +726,43 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
         } else {
             String::new()
         };
-        println!(
+        outln!(
             "render   {:<6} {} ({}): {}x{}, {} spp, shading {:.3} s{extra}",
             r.method, r.material, r.parameters, r.width, r.height, r.spp, r.shading_s
-        );
+        )?;
         if r.invalid_samples > 0 {
-            println!(
+            outln!(
                 "warning  {} samples were non-finite or negative and were set to 0",
                 r.invalid_samples
-            );
+            )?;
         }
     }
     if let Some(p) = &s.profile {
-        println!(
+        outln!(
             "profile  {} : {:.4} mm/px, spot radius {:.3} mm, out to {:.2} mm; render {:.2} s",
             p.measured.display(),
             p.mm_per_pixel,
             p.spot_radius_mm,
             p.r_max_mm,
             p.render_s
-        );
-        println!(
+        )?;
+        outln!(
             "         {:<8} {:>6} {:>14} {:>10} {:>14}",
             "channel", "rings", "MSE [mm⁻⁴]", "rms ln", "fit MSE"
-        );
+        )?;
         for c in &p.channels {
-            println!(
+            outln!(
                 "         {:<8} {:>6} {:>14.4e} {:>10.4} {:>14}",
                 c.channel,
                 c.rings,
                 c.mse,
                 c.rms_log,
                 c.fit_mse.map_or("—".into(), |m| format!("{m:.4e}"))
-            );
+            )?;
         }
     }
     for o in &s.outputs {
-        println!("wrote    {}", o.display());
+        outln!("wrote    {}", o.display())?;
     }
     Ok(())
 }

@@ -9,6 +9,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationResult};
 use serde::Serialize;
+use crate::output::{errln, outln};
 
 /// Arguments of `scatterfit simulate`. Every number is checked before any work (exit 2 when out of
 /// range); the run's memory and expected work are checked against `--max-memory-mib` and
@@ -63,7 +64,7 @@ pub struct Args {
     #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
           help = crate::numeric::MAX_INTERACTIONS_HELP)]
     pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_count, help = crate::numeric::MAX_MEMORY_HELP)]
+    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
     pub max_memory_mib: Option<u64>,
     /// Write the profile as CSV (r_inner_mm, r_outer_mm, r_mm, rd_per_mm2, rd_stderr_per_mm2).
     #[arg(long)]
@@ -247,7 +248,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let cost = sim.cost_estimate();
     let expected_s = cost.seconds(rayon::current_num_threads());
     if !args.quiet && expected_s > 10.0 {
-        eprintln!(
+        errln!(
             "expected work: {:.1e} interactions ({:.3e} per photon), about {} on {} threads",
             cost.interactions,
             cost.interactions_per_photon,
@@ -310,23 +311,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         })?;
     } else {
         let e = |x: scatterfit_mc::Estimate| format!("{:.6} ± {:.6}", x.value, x.stderr);
-        println!("photons            {}", result.photons);
-        println!(
+        outln!("photons            {}", result.photons)?;
+        outln!(
             "interactions       {} ({:.1} per photon)",
             result.interactions,
             result.interactions as f64 / result.photons as f64
-        );
-        println!("specular R_sp      {:.6}", result.specular);
-        println!("diffuse Rd         {}", e(result.rd_total));
-        println!("transmitted Tt     {}", e(result.transmittance));
-        println!("absorbed A         {}", e(result.absorbed));
-        println!("sum (should be 1)  {}", e(result.conservation));
-        println!(
+        )?;
+        outln!("specular R_sp      {:.6}", result.specular)?;
+        outln!("diffuse Rd         {}", e(result.rd_total))?;
+        outln!("transmitted Tt     {}", e(result.transmittance))?;
+        outln!("absorbed A         {}", e(result.absorbed))?;
+        outln!("sum (should be 1)  {}", e(result.conservation))?;
+        outln!(
             "speed              {rate:.3e} photons/s on {} threads ({elapsed:.2} s)",
             rayon::current_num_threads()
-        );
+        )?;
         if let Some(p) = &args.out {
-            println!("profile            {}", p.display());
+            outln!("profile            {}", p.display())?;
         }
     }
     Ok(ExitCode::SUCCESS)

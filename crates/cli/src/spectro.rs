@@ -8,6 +8,7 @@ use anyhow::{Context, bail};
 use scatterfit_optics::colour::{Lab, Observer};
 use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
 use serde::Serialize;
+use crate::output::outln;
 
 /// Arguments of `scatterfit spectro`.
 #[derive(Debug, clap::Args)]
@@ -65,7 +66,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&report(&args, &analysis))?;
     } else {
-        print_summary(&args.file, &reading, &analysis);
+        print_summary(&args.file, &reading, &analysis)?;
     }
     Ok(if analysis.complete() {
         ExitCode::SUCCESS
@@ -130,31 +131,31 @@ pub fn refuse_overwriting_input(out: &Path, input: &Path) -> anyhow::Result<()> 
     Ok(())
 }
 
-fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) {
-    let wl = &reading.wavelengths_nm;
-    println!(
+fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) -> anyhow::Result<()> {
+    let wl = reading.wavelengths_nm();
+    outln!(
         "{}: {} wavelengths, {}–{} nm",
         file.display(),
         wl.len(),
         wl.first().copied().unwrap_or(0.0),
         wl.last().copied().unwrap_or(0.0)
-    );
+    )?;
     match a.eta_source {
-        scatterfit_optics::spectro::EtaSource::Given => println!("η = {:.4} (given)", a.eta),
-        scatterfit_optics::spectro::EtaSource::SchlickSciMinusSce => println!(
+        scatterfit_optics::spectro::EtaSource::Given => outln!("η = {:.4} (given)", a.eta)?,
+        scatterfit_optics::spectro::EtaSource::SchlickSciMinusSce => outln!(
             "η = {:.4}  (Schlick at 8° from SCI − SCE = {:.5}, luminance-weighted; exact Fresnel: {})",
             a.eta,
             a.specular_mean,
             a.eta_exact_fresnel
                 .map_or("—".into(), |e| format!("{e:.4}"))
-        ),
+        )?,
     }
     let ch = |c: usize| {
         a.channels[c]
             .eta_channel
             .map_or("—".into(), |e| format!("{e:.4}"))
     };
-    println!(
+    outln!(
         "η per channel: R {}  G {}  B {}  (dispersion {})",
         ch(0),
         ch(1),
@@ -164,36 +165,37 @@ fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) {
         } else {
             "not significant"
         }
-    );
-    println!(
+    )?;
+    outln!(
         "SCE colour: L*a*b* D65/2° {:.3} {:.3} {:.3}   D65/10° {:.3} {:.3} {:.3}",
         a.lab_2deg.l, a.lab_2deg.a, a.lab_2deg.b, a.lab_10deg.l, a.lab_10deg.a, a.lab_10deg.b
-    );
-    println!(
+    )?;
+    outln!(
         "            XYZ 2° {:.4} {:.4} {:.4}   10° {:.4} {:.4} {:.4}",
         a.xyz_2deg.x, a.xyz_2deg.y, a.xyz_2deg.z, a.xyz_10deg.x, a.xyz_10deg.y, a.xyz_10deg.z
-    );
+    )?;
     let source = match a.colour_source {
         scatterfit_optics::spectro::ColourSource::SceSpectrum => "SCE spectrum",
         scatterfit_optics::spectro::ColourSource::Lab2 => "given L*a*b* (2°)",
         scatterfit_optics::spectro::ColourSource::Lab10 => "given L*a*b* (10°, Bradford to 2°)",
     };
-    println!(
+    outln!(
         "\nchannel  Rd (linear sRGB, from {source})   α′ (dipole, η = {:.4})",
         a.eta
-    );
+    )?;
     for (name, c) in ["R", "G", "B"].iter().zip(&a.channels) {
         let albedo = c.albedo_prime.map_or("—".to_owned(), |v| format!("{v:.6}"));
-        println!("{name:<8} {:<38.6} {albedo}", c.rd_total);
+        outln!("{name:<8} {:<38.6} {albedo}", c.rd_total)?;
     }
     for c in &a.channels {
         if let Some(p) = &c.problem {
-            println!("problem: {p}");
+            outln!("problem: {p}")?;
         }
     }
     for w in &a.warnings {
-        println!("warning: {w}");
+        outln!("warning: {w}")?;
     }
+    Ok(())
 }
 
 /// Contributes this area's figures to `scatterfit bench`: the dipole profile with derivatives (300

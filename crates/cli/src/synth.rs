@@ -12,6 +12,7 @@ use serde::Serialize;
 
 use crate::common::{cache_dir, check_output_files, parse_rgb, shutter};
 use crate::twin::{Material, synthesize, write_sample};
+use crate::output::outln;
 
 /// Arguments of `scatterfit synth`.
 #[derive(Debug, clap::Args)]
@@ -135,7 +136,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             truth: &sample.truth,
         })?;
     } else {
-        println!(
+        outln!(
             "wrote {} ({} exposures {}–{} s, {}×{} px at {} mm/px, spot ⌀ {} mm)",
             args.output_dir.display(),
             sample.bracket.times_s.len(),
@@ -145,10 +146,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             rig.height,
             rig.mm_per_pixel,
             2.0 * rig.spot_radius_mm
-        );
-        println!("truth    η = {:.4}", sample.truth.eta);
+        )?;
+        outln!("truth    η = {:.4}", sample.truth.eta)?;
         for (name, c) in ["R", "G", "B"].iter().zip(&sample.truth.channels) {
-            println!(
+            outln!(
                 "  {name}  σ′s = {:<8} σa = {:<10} α′ = {:.5}  Rd(MC) = {:.4} ± {:.4}  ({} photons)",
                 c.sigma_s_prime,
                 c.sigma_a,
@@ -156,12 +157,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 c.rd_total,
                 c.rd_total_stderr,
                 c.photons
-            );
+            )?;
         }
-        println!(
+        outln!(
             "measure it with: scatterfit measure {}",
             args.output_dir.display()
-        );
+        )?;
     }
     Ok(ExitCode::SUCCESS)
 }

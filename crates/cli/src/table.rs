@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use scatterfit_mc::table::{CacheStatus, ProfileTable, TableSpec, default_cache_dir};
 use serde::Serialize;
+use crate::output::{errln, outln};
 
 /// Arguments of `scatterfit table`. Every number is checked before any work (exit 2 when out of
 /// range); the build's expected work and memory are checked against `--max-interactions` and
@@ -38,7 +39,7 @@ pub struct Args {
     #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
           help = crate::numeric::MAX_INTERACTIONS_HELP)]
     pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_count, help = crate::numeric::MAX_MEMORY_HELP)]
+    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
     pub max_memory_mib: Option<u64>,
     /// Print the table summary as JSON.
     #[arg(long)]
@@ -140,7 +141,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let cost = spec.cost_estimate()?;
     let expected_s = cost.seconds(rayon::current_num_threads());
     if !args.quiet && !cached && expected_s > 10.0 {
-        eprintln!(
+        errln!(
             "expected work: {:.1e} interactions, about {} on {} threads",
             cost.interactions,
             crate::numeric::describe_seconds(expected_s),
@@ -185,17 +186,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&summary)?;
     } else {
-        println!("table   {} ({})", summary.path.display(), summary.status);
-        println!(
+        outln!("table   {} ({})", summary.path.display(), summary.status)?;
+        outln!(
             "eta {}  g {}  {} radial bins  {} photons/albedo",
             spec.eta(),
             spec.g(),
             summary.radial_bins,
             spec.photons_per_albedo()
-        );
-        println!("{:>10} {:>12} {:>10}", "albedo'", "Rd total", "s.e.");
+        )?;
+        outln!("{:>10} {:>12} {:>10}", "albedo'", "Rd total", "s.e.")?;
         for ((a, r), s) in spec.albedos().iter().zip(tot).zip(se) {
-            println!("{a:>10.6} {r:>12.6} {s:>10.6}");
+            outln!("{a:>10.6} {r:>12.6} {s:>10.6}")?;
         }
     }
     Ok(ExitCode::SUCCESS)

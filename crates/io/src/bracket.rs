@@ -346,14 +346,54 @@ pub struct BracketFrame {
 }
 
 /// A validated exposure bracket: at least two frames of one shape and bit depth, with distinct
-/// positive times, sorted by time (shortest first).
+/// positive times, sorted by time (shortest first). Made by [`read_bracket`] or [`Bracket::new`],
+/// which check all that; the frames are read through [`Bracket::frames`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bracket {
-    /// The frames, shortest exposure first.
-    pub frames: Vec<BracketFrame>,
+    frames: Vec<BracketFrame>,
 }
 
 impl Bracket {
+    /// A bracket from decoded frames, sorted by time.
+    ///
+    /// # Errors
+    /// [`BracketError::TooFewImages`] for fewer than two frames, [`BracketError::NonPositiveTime`]
+    /// for a time that is not finite and > 0, [`BracketError::ShapeMismatch`] for frames of
+    /// different size, channels or bit depth, [`BracketError::DuplicateTime`] for two equal times.
+    pub fn new(mut frames: Vec<BracketFrame>) -> Result<Self, BracketError> {
+        if frames.len() < 2 {
+            return Err(BracketError::TooFewImages {
+                count: frames.len(),
+            });
+        }
+        if let Some(f) = frames
+            .iter()
+            .find(|f| !(f.time_s.is_finite() && f.time_s > 0.0))
+        {
+            return Err(BracketError::NonPositiveTime {
+                where_: f.path.display().to_string(),
+                time_s: f.time_s,
+            });
+        }
+        for f in &frames[1..] {
+            check_shape(&frames[0].frame, &frames[0].path, &f.frame, &f.path)?;
+        }
+        let times: Vec<(PathBuf, f64)> = frames.iter().map(|f| (f.path.clone(), f.time_s)).collect();
+        check_distinct_times(&times)?;
+        frames.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        Ok(Self { frames })
+    }
+
+    /// The frames, shortest exposure first.
+    pub fn frames(&self) -> &[BracketFrame] {
+        &self.frames
+    }
+
+    /// The frames, shortest exposure first, taken out of the bracket.
+    pub fn into_frames(self) -> Vec<BracketFrame> {
+        self.frames
+    }
+
     /// Shutter times Δt [s], in frame order.
     pub fn times_s(&self) -> Vec<f64> {
         self.frames.iter().map(|f| f.time_s).collect()
@@ -423,6 +463,26 @@ enum TimeOf {
 pub fn read_bracket(
     images: &[PathBuf],
     exposures: Option<&Path>,
+    on_frame_read: &(dyn Fn(&Path) + Sync),
+) -> Result<Bracket, BracketError> {
+    read_bracket_within(
+        images,
+        exposures,
+        crate::budget::memory_budget_bytes(),
+        on_frame_read,
+    )
+}
+
+/// [`read_bracket`] within a memory budget [bytes] (a command's `--max-memory-mib`) instead of the
+/// environment's: the frames' decoded size, read from their headers, is checked against it before
+/// any frame is decoded.
+///
+/// # Errors
+/// As [`read_bracket`].
+pub fn read_bracket_within(
+    images: &[PathBuf],
+    exposures: Option<&Path>,
+    budget: u64,
     on_frame_read: &(dyn Fn(&Path) + Sync),
 ) -> Result<Bracket, BracketError> {
     let plan: Vec<(PathBuf, TimeOf)> = match exposures {
@@ -495,7 +555,7 @@ pub fn read_bracket(
         })
         .collect();
     check_distinct_times(&known)?;
-    check_bracket_budget(&plan, crate::budget::memory_budget_bytes())?;
+    check_bracket_budget(&plan, budget)?;
 
     let decoded: Vec<Result<BracketFrame, BracketError>> = plan
         .par_iter()
@@ -520,15 +580,7 @@ pub fn read_bracket(
         })
         .collect();
     let frames: Vec<BracketFrame> = decoded.into_iter().collect::<Result<_, _>>()?;
-
-    for f in &frames[1..] {
-        check_shape(&frames[0].frame, &frames[0].path, &f.frame, &f.path)?;
-    }
-    let times: Vec<(PathBuf, f64)> = frames.iter().map(|f| (f.path.clone(), f.time_s)).collect();
-    check_distinct_times(&times)?;
-    let mut frames = frames;
-    frames.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-    Ok(Bracket { frames })
+    Bracket::new(frames)
 }
 
 /// Reads the frames' headers (not their pixels) and refuses a bracket whose decoded frames would

@@ -103,7 +103,7 @@ pub fn synthesize(
     let bracket = rig::render_bracket(&profiles, rig, seed)?;
     let rd: [f64; 3] = std::array::from_fn(|c| profiles[c].rd_total.value);
     let reading = spectro::reading_for(rd, eta)?;
-    let xyz10 = colour::spectrum_to_xyz(&reading.wavelengths_nm, &reading.sce, Observer::TenDegree)
+    let xyz10 = colour::spectrum_to_xyz(reading.wavelengths_nm(), reading.sce(), Observer::TenDegree)
         .map_err(|_| SynthError::InvalidParameter {
             name: "spectrum",
             value: 0.0,
