@@ -19,10 +19,12 @@ pub struct Args {
     /// Sample folders (each with a sample.toml), or folders holding sample folders.
     #[arg(required = true)]
     pub dirs: Vec<PathBuf>,
-    /// Samples measured at the same time [1, 256] (default: one per core).
-    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
-    pub jobs: Option<u16>,
-    /// Where to write summary.csv and summary.md (the command's own files, replaced).
+    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
+          help = crate::runner::JOBS_HELP)]
+    pub jobs: Option<usize>,
+    /// Where to write summary.csv and summary.md (the command's own files, replaced on each run;
+    /// checked before any sample is measured). Each sample's result files (result.json, .csv, .md,
+    /// profile.csv, fit.svg, fit.png) go into its own folder and are replaced, as with `measure`.
     #[arg(
         short = 'o',
         long = "output-dir",
@@ -43,12 +45,13 @@ pub struct Args {
 /// Runs `scatterfit batch`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
+    crate::common::check_output_dir(&args.output_dir, "-o")?;
     let dirs = sample_dirs(&args.dirs);
     let write_errors = Mutex::new(Vec::<(PathBuf, String)>::new());
     let outcomes = crate::runner::measure_many(
         &dirs,
         &overrides,
-        args.jobs.map_or(0, usize::from),
+        args.jobs.unwrap_or(0),
         args.quiet || args.json,
         &|dir, r| {
             if let Ok(m) = r

@@ -167,8 +167,8 @@ pub struct FitArgs {
     /// The forward model (default: the manifest's `fit.model`, else dipole).
     #[arg(long, value_enum)]
     pub model: Option<ModelArg>,
-    /// A known η instead of the one measured from SCI − SCE [1, 3].
-    #[arg(long)]
+    /// A known η instead of the one measured from SCI − SCE, in [1, 3].
+    #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: Option<f64>,
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd instead of fitting it.
     #[arg(long)]
@@ -274,6 +274,15 @@ pub fn check_output_file(
             path.display()
         );
     }
+    check_output_folder(path, flag)
+}
+
+/// Checks that the folder of the output file `path` exists and is writable (a probe file is
+/// created and removed there).
+///
+/// # Errors
+/// The problem, naming `flag` and the path.
+pub fn check_output_folder(path: &Path, flag: &str) -> anyhow::Result<()> {
     let folder = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())

@@ -18,10 +18,12 @@ pub struct Args {
     /// Sample folders (each with a sample.toml), or folders holding sample folders.
     #[arg(required = true)]
     pub dirs: Vec<PathBuf>,
-    /// Samples measured at the same time [1, 256] (default: one per core).
-    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
-    pub jobs: Option<u16>,
-    /// Where to write compare.csv and compare.md (the command's own files, replaced).
+    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
+          help = crate::runner::JOBS_HELP)]
+    pub jobs: Option<usize>,
+    /// Where to write compare.csv and compare.md (the command's own files, replaced on each run;
+    /// checked before any sample is measured). Each sample's plot (compare.svg, compare.png) goes
+    /// into its own folder and is replaced.
     #[arg(
         short = 'o',
         long = "output-dir",
@@ -41,11 +43,13 @@ pub struct Args {
 
 /// Runs `scatterfit compare`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    args.fit.overrides()?;
+    crate::common::check_output_dir(&args.output_dir, "-o")?;
     let dirs = sample_dirs(&args.dirs);
     let (pairs, failed) = crate::runner::compare_dirs(
         &dirs,
         &args.fit,
-        args.jobs.map_or(0, usize::from),
+        args.jobs.unwrap_or(0),
         args.quiet || args.json,
         false,
     )?;

@@ -40,6 +40,8 @@ struct Timing {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     let out = args.output_dir.clone().unwrap_or_else(|| args.dir.clone());
+    // Where the result files go is checked before the measurement (milliseconds, not minutes).
+    crate::common::check_output_dir(&out, "-o")?;
     let bar = bar(5, "{msg} {bar:30} {elapsed}", args.quiet || args.json);
     let m = measure_sample(&args.dir, &overrides, &|stage| {
         let msg = match stage {

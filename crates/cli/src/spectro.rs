@@ -15,26 +15,27 @@ use crate::output::outln;
 pub struct Args {
     /// Spectrophotometer CSV: `wavelength_nm,sci,sce` (fractions) or `…,sci_pct,sce_pct` (percent).
     pub file: PathBuf,
-    /// Measured L*a*b* (D65) to use for the colour instead of the SCE spectrum.
+    /// Measured L*a*b* (D65) to use for the colour instead of the SCE spectrum: L* in [0, 100], a*
+    /// and b* finite.
     #[arg(long, num_args = 3, value_names = ["L", "A", "B"], allow_negative_numbers = true)]
     pub lab: Option<Vec<f64>>,
     /// Observer of --lab: 10 (the instrument default) or 2.
     #[arg(long, default_value_t = 10, value_name = "2|10")]
     pub observer: u32,
-    /// A known η to use instead of the one measured from SCI − SCE (e.g. for matte samples).
-    #[arg(long)]
+    /// A known η to use instead of the one measured from SCI − SCE (e.g. for matte samples), in
+    /// [1, 3].
+    #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: Option<f64>,
     /// Print the full result as JSON on stdout instead of the summary.
     #[arg(long)]
     pub json: bool,
-    /// Also write the full result as JSON to this file (atomically).
-    #[arg(
-        short = 'o',
-        long = "output",
-        visible_alias = "out",
-        value_name = "FILE"
-    )]
+    /// Also write the full result as JSON to this file (`.json`, atomically; checked before any work;
+    /// an existing file only with --force).
+    #[arg(short = 'o', long = "output", alias = "out", value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The JSON document `scatterfit spectro` writes.
@@ -55,12 +56,23 @@ pub struct SpectroReport<'a> {
 
 /// Runs `scatterfit spectro`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let reading = scatterfit_io::spectro::read_spectro_csv(&args.file)?;
     let options = options_from(&args)?;
+    if let Some(out) = &args.out {
+        crate::common::check_output_file(
+            out,
+            "-o",
+            crate::common::Format {
+                extensions: &["json"],
+                what: "the result is written as JSON",
+            },
+            &[args.file.as_path()],
+            args.force,
+        )?;
+    }
+    let reading = scatterfit_io::spectro::read_spectro_csv(&args.file)?;
     let analysis =
         analyse(&reading, &options).with_context(|| format!("{}", args.file.display()))?;
     if let Some(out) = &args.out {
-        refuse_overwriting_input(out, &args.file)?;
         crate::output::write_json_file(out, &report(&args, &analysis))?;
     }
     if args.json {
@@ -91,9 +103,9 @@ fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
         }
     };
     if let Some(eta) = args.eta
-        && !(eta.is_finite() && eta >= 1.0)
+        && !(1.0..=3.0).contains(&eta)
     {
-        bail!("--eta {eta}: the relative refractive index must be a number ≥ 1");
+        bail!("--eta {eta}: the relative refractive index must lie in [1, 3]");
     }
     Ok(SpectroOptions { lab, eta: args.eta })
 }
@@ -114,21 +126,6 @@ fn analysis_lab(args: &Args) -> Option<Lab> {
         a: v[1],
         b: v[2],
     })
-}
-
-/// Refuses an output path that is the input file.
-pub fn refuse_overwriting_input(out: &Path, input: &Path) -> anyhow::Result<()> {
-    let same = match (out.canonicalize(), input.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => out == input,
-    };
-    if same {
-        bail!(
-            "refusing to write {} over the input; choose another --out",
-            out.display()
-        );
-    }
-    Ok(())
 }
 
 fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) -> anyhow::Result<()> {

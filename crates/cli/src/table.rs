@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use scatterfit_mc::table::{CacheStatus, ProfileTable, TableSpec, default_cache_dir};
+use scatterfit_mc::table::{CacheStatus, ProfileTable, TableSpec};
 use serde::Serialize;
 use crate::output::{errln, outln};
 
@@ -133,11 +133,15 @@ struct Summary {
 /// Runs `scatterfit table`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let spec = spec_from(&args)?;
-    let dir = match args.cache_dir.clone().or_else(default_cache_dir) {
+    let dir = match crate::common::cache_dir(args.cache_dir.as_deref()) {
         Some(d) => d,
         None => bail!("no cache folder: pass --cache-dir or set SCATTERFIT_CACHE"),
     };
     let cached = dir.join(spec.file_name()).is_file();
+    if !cached {
+        // The table is written there once built: find out now, not after the build.
+        crate::common::check_output_dir(&dir, "--cache-dir")?;
+    }
     let cost = spec.cost_estimate()?;
     let expected_s = cost.seconds(rayon::current_num_threads());
     if !args.quiet && !cached && expected_s > 10.0 {

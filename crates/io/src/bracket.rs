@@ -583,15 +583,15 @@ pub fn read_bracket_within(
     Bracket::new(frames)
 }
 
-/// Reads the frames' headers (not their pixels) and refuses a bracket whose decoded frames would
-/// not fit `budget` bytes: all frames at once, plus one transient copy (alpha dropped) per decoding
-/// thread. A header that cannot be read is left for the decoder to report.
-fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), BracketError> {
+/// The decoded size [bytes] of the frames `paths`, from their headers (not their pixels): the sum,
+/// the largest frame and the first frame's shape. Headers that cannot be read count 0 (the decoder
+/// reports them).
+pub fn decoded_size<'a>(paths: impl IntoIterator<Item = &'a Path>) -> (u64, u64, String) {
     use image::ImageDecoder;
     let mut total = 0u64;
     let mut largest = 0u64;
     let mut shape = String::new();
-    for (path, _) in plan {
+    for path in paths {
         let Ok(reader) = image::ImageReader::open(path).and_then(|r| r.with_guessed_format())
         else {
             continue;
@@ -609,6 +609,31 @@ fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), B
         total = total.saturating_add(bytes);
         largest = largest.max(bytes);
     }
+    (total, largest, shape)
+}
+
+/// The frames a bracket would read: the `images` given, else those listed in `exposures`.
+///
+/// # Errors
+/// The exposures CSV's errors.
+pub fn planned_frames(
+    images: &[PathBuf],
+    exposures: Option<&Path>,
+) -> Result<Vec<PathBuf>, BracketError> {
+    match exposures {
+        Some(csv) if images.is_empty() => Ok(read_exposures_csv(csv)?
+            .into_iter()
+            .map(|e| e.path)
+            .collect()),
+        _ => Ok(images.to_vec()),
+    }
+}
+
+/// Reads the frames' headers (not their pixels) and refuses a bracket whose decoded frames would
+/// not fit `budget` bytes: all frames at once, plus one transient copy (alpha dropped) per decoding
+/// thread. A header that cannot be read is left for the decoder to report.
+fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), BracketError> {
+    let (total, largest, shape) = decoded_size(plan.iter().map(|(p, _)| p.as_path()));
     let threads = rayon::current_num_threads() as u64;
     let needed = total.saturating_add(largest.saturating_mul(threads));
     if needed > budget {
