@@ -3,8 +3,8 @@
 
 use std::process::ExitCode;
 
-use serde::Serialize;
 use crate::output::outln;
+use serde::Serialize;
 
 /// Which part of the pipeline to measure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

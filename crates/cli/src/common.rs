@@ -246,14 +246,11 @@ pub fn check_output_file(
     inputs: &[&Path],
     force: bool,
 ) -> anyhow::Result<()> {
+    refuse_overwrite(path, flag, inputs)?;
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    if !format
-        .extensions
-        .iter()
-        .any(|e| ext.as_deref() == Some(*e))
-    {
+    if !format.extensions.iter().any(|e| ext.as_deref() == Some(*e)) {
         let list: Vec<String> = format.extensions.iter().map(|e| format!(".{e}")).collect();
         bail!(
             "{flag} {}: {}; name the file {} (e.g. `{}`)",
@@ -263,7 +260,6 @@ pub fn check_output_file(
             path.with_extension(format.extensions[0]).display()
         );
     }
-    refuse_overwrite(path, flag, inputs)?;
     if path.is_dir() {
         bail!("{flag} {}: is a folder; name a file", path.display());
     }
@@ -287,6 +283,13 @@ pub fn check_output_folder(path: &Path, flag: &str) -> anyhow::Result<()> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
+    if folder.exists() && !folder.is_dir() {
+        bail!(
+            "{flag} {}: {} is not a folder; choose another output file",
+            path.display(),
+            folder.display()
+        );
+    }
     if !folder.is_dir() {
         bail!(
             "{flag} {}: the folder {} does not exist; create it first",

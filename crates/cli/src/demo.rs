@@ -21,8 +21,8 @@ use scatterfit_synth::materials::CHOI_2014;
 use serde::Serialize;
 
 use crate::common::{FitArgs, cache_dir};
-use crate::twin::{Material, synthesize, write_sample};
 use crate::output::{errln, out, outln};
+use crate::twin::{Material, synthesize, write_sample};
 
 /// Arguments of `scatterfit demo`.
 #[derive(Debug, clap::Args)]

@@ -9,10 +9,10 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use crate::output::errln;
 use anyhow::{Context, bail};
 use scatterfit_io::export::{ExportError, Format, SceneUnit, export};
 use scatterfit_io::result_json::read_result_json;
-use crate::output::errln;
 
 /// Arguments of `scatterfit export`.
 #[derive(Debug, clap::Args)]

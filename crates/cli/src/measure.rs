@@ -9,8 +9,8 @@ use scatterfit_pipeline::{Stage, measure_sample};
 use serde::Serialize;
 
 use crate::common::{FitArgs, bar};
-use scatterfit_io::manifest::MethodName;
 use crate::output::{errln, out, outln};
+use scatterfit_io::manifest::MethodName;
 
 /// Arguments of `scatterfit measure`.
 #[derive(Debug, clap::Args)]
@@ -71,7 +71,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let t = &m.timings;
         outln!(
             "  time: {:.3} s (spectro {:.3}, read {:.3}, merge {:.3}, profile {:.3}, fits {:.4})",
-            t.total_s, t.spectro_s, t.read_s, t.merge_s, t.profile_s, t.fit_s
+            t.total_s,
+            t.spectro_s,
+            t.read_s,
+            t.merge_s,
+            t.profile_s,
+            t.fit_s
         )?;
         outln!(
             "  wrote {} files in {}: {}",

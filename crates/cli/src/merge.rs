@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
 use scatterfit_imaging::{
     CalibrateOptions, ClippedFill, HdrImage, ImageBuf, LEVELS, LinearMergeOptions, MergeOptions,
@@ -18,7 +19,6 @@ use scatterfit_io::bracket::{Bracket, read_bracket_within};
 use scatterfit_io::image_files::{CameraFrame, read_camera_frame, write_radiance};
 use scatterfit_io::response_csv::{ResponseTable, read_response_csv, write_response_csv};
 use serde::Serialize;
-use crate::output::{errln, outln};
 
 /// What to store for a pixel-channel clipped in every exposure (it is always counted and reported).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -199,13 +199,11 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
         indicatif::ProgressBar::hidden()
     };
     let budget = crate::numeric::memory_budget(args.max_memory_mib);
-    let bracket: Bracket = read_bracket_within(
-        &args.images,
-        args.exposures.as_deref(),
-        budget,
-        &|_| bar.inc(1),
-    )
-    .context("reading the exposure bracket")?;
+    let bracket: Bracket =
+        read_bracket_within(&args.images, args.exposures.as_deref(), budget, &|_| {
+            bar.inc(1)
+        })
+        .context("reading the exposure bracket")?;
     bar.finish_and_clear();
     for f in bracket.frames().iter().filter(|f| f.dropped_alpha) {
         errln!("note: {}: alpha channel ignored", f.path.display());
@@ -253,9 +251,9 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
         let (response, kind, rms) = match &args.response {
             Some(path) => (load_response(path)?, "given", Vec::new()),
             None => {
-                let samples = args
-                    .samples
-                    .unwrap_or_else(|| 100.max(scatterfit_imaging::min_response_samples(bufs.len())));
+                let samples = args.samples.unwrap_or_else(|| {
+                    100.max(scatterfit_imaging::min_response_samples(bufs.len()))
+                });
                 let opts = CalibrateOptions::new(samples, args.lambda)
                     .context("response recovery options")?;
                 let cal = scatterfit_imaging::recover_response(&bufs, &times, &opts).context(

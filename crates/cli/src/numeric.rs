@@ -20,11 +20,29 @@ pub const MAX_INTERACTIONS_HELP: &str = "Work budget: the most photon interactio
 ///
 /// # Errors
 /// The refusal (exit 2).
-pub fn ensure(ok: bool, flag: &str, value: impl std::fmt::Display, rule: &str) -> anyhow::Result<()> {
+pub fn ensure(
+    ok: bool,
+    flag: &str,
+    value: impl std::fmt::Display,
+    rule: &str,
+) -> anyhow::Result<()> {
     if ok {
         Ok(())
     } else {
+        let text = value.to_string();
+        let value = text.parse::<f64>().map_or(text, show);
         anyhow::bail!("{flag} {value}: {rule}")
+    }
+}
+
+/// A number for messages: as written for ordinary magnitudes, in scientific notation otherwise
+/// (`1e-300`, not three hundred zeros).
+pub fn show(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (1e-4..1e7).contains(&a) || !a.is_finite() {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
     }
 }
 
@@ -150,6 +168,16 @@ mod tests {
         assert!(parse_count("1e300").unwrap_err().contains("too large"));
         assert!(parse_count("NaN").is_err());
         assert!(parse_count("many").unwrap_err().contains("1e6"));
+    }
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        assert_eq!(show(1e-300), "1e-300");
+        assert_eq!(show(1e13), "1e13");
+        assert_eq!(show(300.0), "300");
+        assert_eq!(show(0.5), "0.5");
+        let err = ensure(false, "--ring-width-px", 1e-300, "rule").unwrap_err();
+        assert_eq!(err.to_string(), "--ring-width-px 1e-300: rule");
     }
 
     #[test]

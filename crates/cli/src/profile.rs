@@ -8,12 +8,12 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use crate::output::outln;
 use anyhow::Context;
 use scatterfit_io::image_files::read_radiance_within;
 use scatterfit_io::profile_csv::write_profile_csv;
 use scatterfit_pipeline::profile::{CenterSource, ProfileSettings, profile_stage};
 use serde::Serialize;
-use crate::output::outln;
 
 /// Arguments of `scatterfit profile`. Every number is checked before the radiance map is read
 /// (exit 2 with the range); the rings' memory (r_max / ring width of them) is checked against the
@@ -93,7 +93,8 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
         &format!(
             "--r-max-px {} / --ring-width-px {} makes {rings:.3e} rings, more than 10⁶ — a light \
              spot's profile needs hundreds; widen the rings or reduce r_max",
-            args.r_max_px, args.ring_width_px
+            crate::numeric::show(args.r_max_px),
+            crate::numeric::show(args.ring_width_px)
         ),
     )?;
     if let Some(l) = args.detection_limit
@@ -215,7 +216,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
         outln!(
             "rings    {} × {} px, out to {:.3} mm ({} with an empty channel)",
-            summary.rings, args.ring_width_px, summary.r_max_mm, summary.empty_rings
+            summary.rings,
+            args.ring_width_px,
+            summary.r_max_mm,
+            summary.empty_rings
         )?;
         outln!("wrote    {}", summary.output.display())?;
     }

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
 use glam::DVec3;
 use scatterfit_imaging::ImageBuf;
@@ -32,7 +33,6 @@ use scatterfit_render::{
     studio, studio_lights,
 };
 use serde::Serialize;
-use crate::output::{errln, outln};
 
 /// DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`) for captions.
 const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
@@ -797,7 +797,13 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
         };
         outln!(
             "render   {:<6} {} ({}): {}x{}, {} spp, shading {:.3} s{extra}",
-            r.method, r.material, r.parameters, r.width, r.height, r.spp, r.shading_s
+            r.method,
+            r.material,
+            r.parameters,
+            r.width,
+            r.height,
+            r.spp,
+            r.shading_s
         )?;
         if r.invalid_samples > 0 {
             outln!(
@@ -817,7 +823,11 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
         )?;
         outln!(
             "         {:<8} {:>6} {:>14} {:>10} {:>14}",
-            "channel", "rings", "MSE [mm⁻⁴]", "rms ln", "fit MSE"
+            "channel",
+            "rings",
+            "MSE [mm⁻⁴]",
+            "rms ln",
+            "fit MSE"
         )?;
         for c in &p.channels {
             outln!(

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
 use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationResult};
 use serde::Serialize;
-use crate::output::{errln, outln};
 
 /// Arguments of `scatterfit simulate`. Every number is checked before any work (exit 2 when out of
 /// range); the run's memory and expected work are checked against `--max-memory-mib` and
@@ -133,7 +133,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
         if ok {
             Ok(())
         } else {
-            bail!("{flag} {value}: {rule}")
+            bail!("{flag} {}: {rule}", crate::numeric::show(value))
         }
     };
     range(
@@ -324,8 +324,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if is_json {
             crate::output::write_json_file(path, &report)?;
         } else {
-            let mut csv =
-                String::from("r_inner_mm,r_outer_mm,r_mm,rd_per_mm2,rd_stderr_per_mm2\n");
+            let mut csv = String::from("r_inner_mm,r_outer_mm,r_mm,rd_per_mm2,rd_stderr_per_mm2\n");
             let g = &result.grid;
             for (i, e) in result.rd_profile.iter().enumerate() {
                 csv.push_str(&format!(

@@ -4,11 +4,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::outln;
 use anyhow::{Context, bail};
 use scatterfit_optics::colour::{Lab, Observer};
 use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
 use serde::Serialize;
-use crate::output::outln;
 
 /// Arguments of `scatterfit spectro`.
 #[derive(Debug, clap::Args)]
@@ -165,11 +165,21 @@ fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) -> 
     )?;
     outln!(
         "SCE colour: L*a*b* D65/2° {:.3} {:.3} {:.3}   D65/10° {:.3} {:.3} {:.3}",
-        a.lab_2deg.l, a.lab_2deg.a, a.lab_2deg.b, a.lab_10deg.l, a.lab_10deg.a, a.lab_10deg.b
+        a.lab_2deg.l,
+        a.lab_2deg.a,
+        a.lab_2deg.b,
+        a.lab_10deg.l,
+        a.lab_10deg.a,
+        a.lab_10deg.b
     )?;
     outln!(
         "            XYZ 2° {:.4} {:.4} {:.4}   10° {:.4} {:.4} {:.4}",
-        a.xyz_2deg.x, a.xyz_2deg.y, a.xyz_2deg.z, a.xyz_10deg.x, a.xyz_10deg.y, a.xyz_10deg.z
+        a.xyz_2deg.x,
+        a.xyz_2deg.y,
+        a.xyz_2deg.z,
+        a.xyz_10deg.x,
+        a.xyz_10deg.y,
+        a.xyz_10deg.z
     )?;
     let source = match a.colour_source {
         scatterfit_optics::spectro::ColourSource::SceSpectrum => "SCE spectrum",

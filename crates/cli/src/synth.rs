@@ -11,8 +11,8 @@ use scatterfit_synth::{RigSpec, materials};
 use serde::Serialize;
 
 use crate::common::{cache_dir, check_output_files, parse_rgb, shutter};
-use crate::twin::{Material, synthesize, write_sample};
 use crate::output::outln;
+use crate::twin::{Material, synthesize, write_sample};
 
 /// Arguments of `scatterfit synth`.
 #[derive(Debug, clap::Args)]

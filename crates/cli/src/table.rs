@@ -4,10 +4,10 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
 use scatterfit_mc::table::{CacheStatus, ProfileTable, TableSpec};
 use serde::Serialize;
-use crate::output::{errln, outln};
 
 /// Arguments of `scatterfit table`. Every number is checked before any work (exit 2 when out of
 /// range); the build's expected work and memory are checked against `--max-interactions` and
@@ -57,7 +57,7 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
     if !(args.eta > 0.0 && args.eta <= 10.0) {
         bail!(
             "--eta {}: the relative refractive index must lie in (0, 10]",
-            args.eta
+            crate::numeric::show(args.eta)
         );
     }
     if args.eta < 1.0 && !args.allow_eta_below_one {
@@ -69,7 +69,7 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
     if !(args.g > -1.0 && args.g < 1.0) {
         bail!(
             "--g {}: the Henyey–Greenstein asymmetry must lie in (−1, 1)",
-            args.g
+            crate::numeric::show(args.g)
         );
     }
     if !args.coarse {

@@ -3,9 +3,8 @@
 //! directions, and the proposed method on MCML's independent profiles.
 
 use scatterfit_fit::{
-    RingSelection,
-    ChannelInput, DipoleModel, FitError, FitOptions, Method, ProfileData, Ring, Spot, Start,
-    fit_channel,
+    ChannelInput, DipoleModel, FitError, FitOptions, Method, ProfileData, Ring, RingSelection,
+    Spot, Start, fit_channel,
 };
 use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
@@ -418,7 +417,8 @@ fn proposed_method_on_mcml_profiles() {
             .collect();
         let mut opts = FitOptions::new(Method::Proposed);
         opts.spot = Spot::Point;
-        opts.selection = RingSelection::new(1.0, 15.0, 1.0, RingSelection::DEFAULT_ERROR_FLOOR).unwrap();
+        opts.selection =
+            RingSelection::new(1.0, 15.0, 1.0, RingSelection::DEFAULT_ERROR_FLOOR).unwrap();
         let rep = fit_channel(
             &ProfileData::new(rings).unwrap(),
             &ChannelInput {

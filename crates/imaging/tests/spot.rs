@@ -73,7 +73,10 @@ fn center_within_005_px_on_noisy_clipped_spot_with_speck() {
         let img = noisy_spot(cx, cy, seed);
         let c = find_spot_center(&img, &CenterOptions::default()).unwrap();
         let err = ((c.x() - cx).powi(2) + (c.y() - cy).powi(2)).sqrt();
-        eprintln!("seed {seed}: error {err:.4} px, {} spot px", c.spot_pixels());
+        eprintln!(
+            "seed {seed}: error {err:.4} px, {} spot px",
+            c.spot_pixels()
+        );
         assert!(
             err < 0.05,
             "seed {seed}: found ({:.3}, {:.3}), true ({cx}, {cy}), error {err:.4} px",

@@ -33,7 +33,9 @@ static REGISTRY: Mutex<Registry> = Mutex::new(Registry {
 
 fn registry() -> MutexGuard<'static, Registry> {
     // A panic while the lock was held leaves the list as it was: still usable.
-    REGISTRY.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    REGISTRY
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 fn interrupted_error() -> io::Error {
@@ -104,7 +106,9 @@ where
     let result = (|| {
         let mut writer = BufWriter::new(file);
         write(&mut writer)?;
-        let file = writer.into_inner().map_err(io::IntoInnerError::into_error)?;
+        let file = writer
+            .into_inner()
+            .map_err(io::IntoInnerError::into_error)?;
         file.sync_all()?;
         drop(file);
         rename_registered(&tmp, path)
@@ -217,7 +221,11 @@ mod tests {
         fs::write(&target, b"old").unwrap();
         write_atomic(&target, b"new contents").unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"new contents");
-        assert_eq!(entries(dir.path()), ["result.json"], "only the target remains");
+        assert_eq!(
+            entries(dir.path()),
+            ["result.json"],
+            "only the target remains"
+        );
     }
 
     #[test]

@@ -378,7 +378,8 @@ impl Bracket {
         for f in &frames[1..] {
             check_shape(&frames[0].frame, &frames[0].path, &f.frame, &f.path)?;
         }
-        let times: Vec<(PathBuf, f64)> = frames.iter().map(|f| (f.path.clone(), f.time_s)).collect();
+        let times: Vec<(PathBuf, f64)> =
+            frames.iter().map(|f| (f.path.clone(), f.time_s)).collect();
         check_distinct_times(&times)?;
         frames.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
         Ok(Self { frames })

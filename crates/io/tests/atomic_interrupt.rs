@@ -48,7 +48,10 @@ fn interruption_removes_temporaries_and_stops_writes() {
     assert!(removed.contains(&tmp), "{removed:?}");
     assert!(removed.contains(&ours), "{removed:?}");
     assert!(!tmp.exists() && !ours.exists());
-    assert!(theirs.exists(), "another process's temporary is not ours to remove");
+    assert!(
+        theirs.exists(),
+        "another process's temporary is not ours to remove"
+    );
 
     resume.send(()).unwrap();
     let result = writer.join().unwrap();

@@ -61,7 +61,10 @@ impl SpectroReading {
                 wavelengths_nm.len()
             )));
         }
-        if let Some(w) = wavelengths_nm.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
+        if let Some(w) = wavelengths_nm
+            .iter()
+            .find(|w| !(w.is_finite() && **w > 0.0))
+        {
             return Err(OpticsError::Spectrum(format!(
                 "wavelength {w} nm is not a positive number"
             )));
@@ -387,8 +390,7 @@ mod tests {
 
     /// A spectrally flat reading at 400–700 nm.
     fn flat(sci: f64, sce: f64) -> SpectroReading {
-        SpectroReading::new(grid(), vec![sci; 31], vec![sce; 31])
-        .unwrap()
+        SpectroReading::new(grid(), vec![sci; 31], vec![sce; 31]).unwrap()
     }
 
     /// A sample of η = 1.5 (flat R₀ = 0.04 at 8°) with a flat SCE of 0.5: η comes back, and α′ per
@@ -397,8 +399,7 @@ mod tests {
     fn flat_specular_gives_eta_and_grey_albedo() {
         let wl = grid();
         let r0 = fresnel::fresnel_dielectric(8f64.to_radians().cos(), 1.5);
-        let reading = SpectroReading::new(wl, vec![0.5 + r0; 31], vec![0.5; 31])
-        .unwrap();
+        let reading = SpectroReading::new(wl, vec![0.5 + r0; 31], vec![0.5; 31]).unwrap();
         let a = analyse(&reading, &SpectroOptions::default()).unwrap();
         // Schlick inversion of an exact-Fresnel specular: 1.5 to within Schlick's error at 8°.
         assert!((a.eta - 1.5).abs() < 2e-4, "{}", a.eta);
