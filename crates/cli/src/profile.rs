@@ -98,7 +98,7 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
         ),
     )?;
     if let Some(l) = args.detection_limit
-        && let Some(bad) = l.iter().find(|v| !(**v >= 0.0))
+        && let Some(bad) = l.iter().find(|v| !(v.is_finite() && **v >= 0.0))
     {
         anyhow::bail!(
             "--detection-limit: {bad} is not a radiance ≥ 0 (relative units, as `scatterfit merge` \

@@ -38,7 +38,7 @@ impl ProfileOptions {
             }
         }
         let rings = (r_max_px / ring_width_px).ceil();
-        if !(rings <= MAX_RINGS as f64) {
+        if rings > MAX_RINGS as f64 {
             return Err(ImagingError::InvalidOption {
                 name: "r_max_px / ring_width_px",
                 value: rings,
