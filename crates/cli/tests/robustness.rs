@@ -151,6 +151,13 @@ fn a_closed_stdout_ends_every_command_quietly() {
             out("fit.json"),
         ],
         vec!["batch".into(), w(""), "-o".into(), out("b")],
+        vec![
+            "demo".into(),
+            "--quick".into(),
+            "-o".into(),
+            out("demo"),
+            "--quiet".into(),
+        ],
         vec!["compare".into(), w(""), "-o".into(), out("c")],
         vec![
             "export".into(),

@@ -269,12 +269,13 @@ mod tests {
     #[test]
     fn ring_count_is_bounded() {
         let img = ImageBuf::filled(8, 8, 1, 1.0f32).unwrap();
-        for (width, r_max) in [(1e-300, 300.0), (1.0, 1e13), (1e-3, 1001.0)] {
-            let opts = ProfileOptions {
-                ring_width_px: width,
-                r_max_px: r_max,
-            };
-            let err = radial_profile(&img, [4.0, 4.0], None, 0.1, &opts).unwrap_err();
+        for (width, r_max) in [
+            (1e-300, 300.0),
+            (1.0, 1e13),
+            (1e-3, 1001.0),
+            (1e-300, 1e300),
+        ] {
+            let err = ProfileOptions::new(width, r_max).unwrap_err();
             assert!(
                 matches!(
                     err,
@@ -286,10 +287,7 @@ mod tests {
                 "{err:?}"
             );
         }
-        let opts = ProfileOptions {
-            ring_width_px: 1e-3,
-            r_max_px: 1000.0,
-        };
+        let opts = ProfileOptions::new(1e-3, 1000.0).unwrap();
         let p = radial_profile(&img, [4.0, 4.0], None, 0.1, &opts).unwrap();
         assert_eq!(p.rings.len(), MAX_RINGS);
     }
