@@ -11,6 +11,7 @@ use scatterfit_io::result_table::{table1_csv, table1_markdown};
 use scatterfit_pipeline::sample_dirs;
 
 use crate::common::FitArgs;
+use crate::output::{errln, out, outln};
 
 /// Arguments of `scatterfit batch`.
 #[derive(Debug, clap::Args)]
@@ -18,10 +19,12 @@ pub struct Args {
     /// Sample folders (each with a sample.toml), or folders holding sample folders.
     #[arg(required = true)]
     pub dirs: Vec<PathBuf>,
-    /// Samples measured at the same time [1, 256] (default: one per core).
-    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
-    pub jobs: Option<u16>,
-    /// Where to write summary.csv and summary.md (the command's own files, replaced).
+    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
+          help = crate::runner::JOBS_HELP)]
+    pub jobs: Option<usize>,
+    /// Where to write summary.csv and summary.md (the command's own files, replaced on each run;
+    /// checked before any sample is measured). Each sample's result files (result.json, .csv, .md,
+    /// profile.csv, fit.svg, fit.png) go into its own folder and are replaced, as with `measure`.
     #[arg(
         short = 'o',
         long = "output-dir",
@@ -42,12 +45,13 @@ pub struct Args {
 /// Runs `scatterfit batch`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
+    crate::common::check_output_dir(&args.output_dir, "-o")?;
     let dirs = sample_dirs(&args.dirs);
     let write_errors = Mutex::new(Vec::<(PathBuf, String)>::new());
     let outcomes = crate::runner::measure_many(
         &dirs,
         &overrides,
-        args.jobs.map_or(0, usize::from),
+        args.jobs.unwrap_or(0),
         args.quiet || args.json,
         &|dir, r| {
             if let Ok(m) = r
@@ -91,20 +95,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         crate::output::print_json(&results)?;
     } else {
         for r in &results {
-            print!("{}", crate::report::summary_text(r));
+            out!("{}", crate::report::summary_text(r))?;
         }
-        println!(
+        outln!(
             "\n{} of {} samples measured completely; summary: {} and {}",
             dirs.len() - failed.len(),
             dirs.len(),
             args.output_dir.join("summary.csv").display(),
             args.output_dir.join("summary.md").display()
-        );
+        )?;
     }
     if !failed.is_empty() {
-        eprintln!("\n{} sample(s) failed or are incomplete:", failed.len());
+        errln!("\n{} sample(s) failed or are incomplete:", failed.len());
         for (dir, why) in &failed {
-            eprintln!("  {}: {why}", dir.display());
+            errln!("  {}: {why}", dir.display());
         }
         return Ok(ExitCode::from(1));
     }

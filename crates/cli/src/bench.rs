@@ -3,6 +3,7 @@
 
 use std::process::ExitCode;
 
+use crate::output::outln;
 use serde::Serialize;
 
 /// Which part of the pipeline to measure.
@@ -71,9 +72,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&figures)?;
     } else {
-        println!("{:<64} {:>14} {:<10} note", "benchmark", "value", "unit");
+        outln!("{:<64} {:>14} {:<10} note", "benchmark", "value", "unit")?;
         for f in &figures {
-            println!("{:<64} {:>14.4} {:<10} {}", f.name, f.value, f.unit, f.note);
+            outln!("{:<64} {:>14.4} {:<10} {}", f.name, f.value, f.unit, f.note)?;
         }
     }
     Ok(ExitCode::SUCCESS)

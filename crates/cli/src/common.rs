@@ -13,12 +13,18 @@ use scatterfit_pipeline::Overrides;
 #[error("{0}")]
 pub struct MeasurementFailed(pub String);
 
-/// True when `err` (or a cause) is a failed measurement: exit 1.
+/// True when `err` (or a cause) is a failed measurement: exit 1. The classes: the CLI's
+/// [`MeasurementFailed`], [`scatterfit_pipeline::PipelineError::is_measurement_failure`] (every
+/// command that runs a pipeline stage) and [`scatterfit_imaging::ImagingError::is_failed_measurement`]
+/// (`merge`, which calls the imaging crate itself: an all-saturated bracket, exposure times in the
+/// wrong order). Everything else is bad usage or input (exit 2).
 pub fn is_measurement_failure(err: &anyhow::Error) -> bool {
     err.chain().any(|e| {
         e.is::<MeasurementFailed>()
             || e.downcast_ref::<scatterfit_pipeline::PipelineError>()
                 .is_some_and(scatterfit_pipeline::PipelineError::is_measurement_failure)
+            || e.downcast_ref::<scatterfit_imaging::ImagingError>()
+                .is_some_and(scatterfit_imaging::ImagingError::is_failed_measurement)
     })
 }
 
@@ -82,11 +88,16 @@ pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::
     Ok(())
 }
 
-/// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default.
+/// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default. Its
+/// temporary files are swept on Ctrl-C (the mc and synth crates write them without `io::atomic`).
 pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
-    given
+    let dir = given
         .map(Path::to_path_buf)
-        .or_else(scatterfit_mc::table::default_cache_dir)
+        .or_else(scatterfit_mc::table::default_cache_dir);
+    if let Some(d) = &dir {
+        scatterfit_io::atomic::sweep_on_interrupt(d);
+    }
+    dir
 }
 
 /// `1/600` for short times that are whole fractions, else 4 significant digits.
@@ -180,8 +191,8 @@ pub struct FitArgs {
     /// else mc for the mc model and diffusion otherwise).
     #[arg(long, value_enum)]
     pub albedo_model: Option<AlbedoModelArg>,
-    /// A known η instead of the one measured from SCI − SCE [1, 3].
-    #[arg(long)]
+    /// A known η instead of the one measured from SCI − SCE, in [1, 3].
+    #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: Option<f64>,
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd instead of fitting it.
     #[arg(long)]
@@ -235,4 +246,126 @@ pub fn refuse_overwrite(output: &Path, what: &str, inputs: &[&Path]) -> anyhow::
         );
     }
     Ok(())
+}
+
+/// What an output file must be: its extensions and, for messages, what is written into it.
+#[derive(Debug, Clone, Copy)]
+pub struct Format {
+    /// Accepted extensions, lower case without the dot; the first is suggested.
+    pub extensions: &'static [&'static str],
+    /// What the command writes, e.g. "the profile is CSV".
+    pub what: &'static str,
+}
+
+/// Checks an output file before any work is done, so that a mistake costs milliseconds, not a
+/// computation: the extension matches what is written, the path is not one of the `inputs`, not a
+/// folder, not an existing file unless `force`, and its folder exists and is writable (a probe file
+/// is created and removed there).
+///
+/// # Errors
+/// The first problem, naming `flag` and the path and saying what to do.
+pub fn check_output_file(
+    path: &Path,
+    flag: &str,
+    format: Format,
+    inputs: &[&Path],
+    force: bool,
+) -> anyhow::Result<()> {
+    refuse_overwrite(path, flag, inputs)?;
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if !format.extensions.iter().any(|e| ext.as_deref() == Some(*e)) {
+        let list: Vec<String> = format.extensions.iter().map(|e| format!(".{e}")).collect();
+        bail!(
+            "{flag} {}: {}; name the file {} (e.g. `{}`)",
+            path.display(),
+            format.what,
+            list.join(" or "),
+            path.with_extension(format.extensions[0]).display()
+        );
+    }
+    if path.is_dir() {
+        bail!("{flag} {}: is a folder; name a file", path.display());
+    }
+    if path.exists() && !force {
+        bail!(
+            "{flag} {}: the file exists; nothing was done — pass --force to replace it, or choose \
+             another name",
+            path.display()
+        );
+    }
+    check_output_folder(path, flag)
+}
+
+/// Checks that the folder of the output file `path` exists and is writable (a probe file is
+/// created and removed there).
+///
+/// # Errors
+/// The problem, naming `flag` and the path.
+pub fn check_output_folder(path: &Path, flag: &str) -> anyhow::Result<()> {
+    let folder = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if folder.exists() && !folder.is_dir() {
+        bail!(
+            "{flag} {}: {} is not a folder; choose another output file",
+            path.display(),
+            folder.display()
+        );
+    }
+    if !folder.is_dir() {
+        bail!(
+            "{flag} {}: the folder {} does not exist; create it first",
+            path.display(),
+            folder.display()
+        );
+    }
+    scatterfit_io::atomic::check_can_write_in(folder).map_err(|e| {
+        anyhow::anyhow!(
+            "{flag} {}: cannot write in {} ({e}); choose a writable folder",
+            path.display(),
+            folder.display()
+        )
+    })
+}
+
+/// Checks an output folder before any work: an existing one must be a writable folder; a new one
+/// is created later, so the nearest folder above it that exists must be writable.
+///
+/// # Errors
+/// The problem, naming `flag` and the folder.
+pub fn check_output_dir(dir: &Path, flag: &str) -> anyhow::Result<()> {
+    let mut probe = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    loop {
+        if probe.exists() {
+            break;
+        }
+        match probe.parent() {
+            Some(p) if !p.as_os_str().is_empty() => probe = p,
+            _ => {
+                probe = Path::new(".");
+                break;
+            }
+        }
+    }
+    if !probe.is_dir() {
+        bail!(
+            "{flag} {}: {} is not a folder; choose another output folder",
+            dir.display(),
+            probe.display()
+        );
+    }
+    scatterfit_io::atomic::check_can_write_in(probe).map_err(|e| {
+        anyhow::anyhow!(
+            "{flag} {}: cannot write in {} ({e}); choose a writable folder",
+            dir.display(),
+            probe.display()
+        )
+    })
 }

@@ -10,6 +10,7 @@ use scatterfit_io::result_table::{table2_csv, table2_markdown};
 use scatterfit_pipeline::sample_dirs;
 
 use crate::common::FitArgs;
+use crate::output::{errln, out, outln};
 
 /// Arguments of `scatterfit compare`.
 #[derive(Debug, clap::Args)]
@@ -17,10 +18,12 @@ pub struct Args {
     /// Sample folders (each with a sample.toml), or folders holding sample folders.
     #[arg(required = true)]
     pub dirs: Vec<PathBuf>,
-    /// Samples measured at the same time [1, 256] (default: one per core).
-    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
-    pub jobs: Option<u16>,
-    /// Where to write compare.csv and compare.md (the command's own files, replaced).
+    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
+          help = crate::runner::JOBS_HELP)]
+    pub jobs: Option<usize>,
+    /// Where to write compare.csv and compare.md (the command's own files, replaced on each run;
+    /// checked before any sample is measured). Each sample's plot (compare.svg, compare.png) goes
+    /// into its own folder and is replaced.
     #[arg(
         short = 'o',
         long = "output-dir",
@@ -40,11 +43,13 @@ pub struct Args {
 
 /// Runs `scatterfit compare`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    args.fit.overrides()?;
+    crate::common::check_output_dir(&args.output_dir, "-o")?;
     let dirs = sample_dirs(&args.dirs);
     let (pairs, failed) = crate::runner::compare_dirs(
         &dirs,
         &args.fit,
-        args.jobs.map_or(0, usize::from),
+        args.jobs.unwrap_or(0),
         args.quiet || args.json,
         false,
     )?;
@@ -60,17 +65,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&pairs)?;
     } else {
-        print!("{}", table2_markdown(&pairs));
-        println!(
+        out!("{}", table2_markdown(&pairs))?;
+        outln!(
             "\nplots: compare.svg / compare.png in each sample folder; tables: {} and {}",
             args.output_dir.join("compare.csv").display(),
             args.output_dir.join("compare.md").display()
-        );
+        )?;
     }
     if !failed.is_empty() {
-        eprintln!("\n{} sample(s) failed:", failed.len());
+        errln!("\n{} sample(s) failed:", failed.len());
         for (dir, why) in &failed {
-            eprintln!("  {}: {why}", dir.display());
+            errln!("  {}: {why}", dir.display());
         }
         return Ok(ExitCode::from(1));
     }

@@ -21,12 +21,15 @@ use scatterfit_synth::materials::CHOI_2014;
 use serde::Serialize;
 
 use crate::common::{FitArgs, cache_dir};
+use crate::output::{errln, out, outln};
 use crate::twin::{Material, synthesize, write_sample};
 
 /// Arguments of `scatterfit demo`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Folder for the synthetic samples and the summaries (created; the demo's own).
+    /// Folder for the synthetic samples and the summaries (created; the demo's own: a
+    /// `.scatterfit-demo` marker is written there, and a folder holding anything else is refused
+    /// unless --force; a previous demo's files are replaced).
     #[arg(
         short = 'o',
         long = "output-dir",
@@ -35,12 +38,12 @@ pub struct Args {
         value_name = "DIR"
     )]
     pub output_dir: PathBuf,
-    /// Seed of the rig twin.
+    /// Seed of the rig twin, 0 to 2⁶⁴ − 1.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Samples measured at the same time [1, 256] (default: one per core).
-    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
-    pub jobs: Option<u16>,
+    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
+          help = crate::runner::JOBS_HELP)]
+    pub jobs: Option<usize>,
     /// Small fast samples (256 × 256 px at 0.1 mm/px, a tenth of the photons): a quick look, not the
     /// accuracy of the full rig.
     #[arg(long)]
@@ -113,6 +116,7 @@ fn check_folder(dir: &Path, force: bool) -> anyhow::Result<()> {
 /// Runs `scatterfit demo`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let t0 = Instant::now();
+    crate::common::check_output_dir(&args.output_dir, "-o")?;
     check_folder(&args.output_dir, args.force)?;
     std::fs::create_dir_all(&args.output_dir)
         .with_context(|| format!("creating {}", args.output_dir.display()))?;
@@ -123,7 +127,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let quiet = args.quiet || args.json;
     let cache = cache_dir(args.cache_dir.as_deref());
     if !quiet {
-        eprintln!(
+        errln!(
             "synthesising the 7 materials of Choi et al. 2014 with the Monte Carlo rig twin (cached in {})",
             cache
                 .as_deref()
@@ -155,7 +159,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         normalise_with_spectro: false,
     };
     let (pairs, failed) =
-        crate::runner::compare_dirs(&dirs, &fit, args.jobs.map_or(0, usize::from), quiet, true)?;
+        crate::runner::compare_dirs(&dirs, &fit, args.jobs.unwrap_or(0), quiet, true)?;
     let measure_s = t1.elapsed().as_secs_f64();
     let rows = accuracy_rows(&pairs, &truths);
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
@@ -179,28 +183,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&rows)?;
     } else {
-        println!(
+        outln!(
             "The method of Choi, Lee & Chin (2014) on Monte Carlo rig-twin samples of their seven materials"
-        );
-        println!(
+        )?;
+        outln!(
             "(samples in {}; the fitted model never made these data; truth in each truth.json)\n",
             out.display()
-        );
-        print!("{accuracy}");
-        println!(
+        )?;
+        out!("{accuracy}")?;
+        outln!(
             "\ntime: {synth_s:.1} s synthesising (Monte Carlo, cached for the next run), {measure_s:.1} s measuring 7 \
              samples with both methods"
-        );
-        println!(
+        )?;
+        outln!(
             "files: {0}/<material>/result.json, fit.png, compare.png; {0}/summary.md (Table 1), \
              compare.md (Table 2), accuracy.md",
             out.display()
-        );
+        )?;
     }
     if !failed.is_empty() {
-        eprintln!("\n{} sample(s) failed:", failed.len());
+        errln!("\n{} sample(s) failed:", failed.len());
         for (dir, why) in &failed {
-            eprintln!("  {}: {why}", dir.display());
+            errln!("  {}: {why}", dir.display());
         }
         return Ok(ExitCode::from(1));
     }

@@ -6,10 +6,10 @@
 //! A result with a failed channel exports nothing (exit 1, the channel named); unconstrained channels
 //! are exported with a warning on stderr.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use crate::output::errln;
 use anyhow::{Context, bail};
 use scatterfit_io::export::{ExportError, Format, SceneUnit, export};
 use scatterfit_io::result_json::read_result_json;
@@ -88,20 +88,24 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let unit = SceneUnit::from(args.scale);
     if let Some(out) = &args.output {
         check_output(out, format, &args.result, args.force)?;
+        crate::common::check_output_folder(out, "-o")?;
     }
     // The error's message already includes its cause; flatten it so `{:#}` does not repeat it.
     let result = read_result_json(&args.result).map_err(|e| anyhow::anyhow!("{e}"))?;
     let exported = match export(&result, format, unit) {
         Ok(e) => e,
         Err(err @ ExportError::FailedChannel { .. }) => {
-            eprintln!("error: {}: {err}", args.result.display());
-            return Ok(ExitCode::from(1));
+            return Err(crate::common::MeasurementFailed(format!(
+                "{}: {err}",
+                args.result.display()
+            ))
+            .into());
         }
         Err(err) => return Err(err).context(format!("exporting {}", args.result.display())),
     };
     if !args.quiet {
         for w in &exported.warnings {
-            eprintln!("warning: {w}");
+            errln!("warning: {w}");
         }
     }
     match &args.output {
@@ -109,7 +113,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             scatterfit_io::atomic::write_atomic(out, exported.text.as_bytes())
                 .with_context(|| format!("writing {}", out.display()))?;
             if !args.quiet {
-                eprintln!(
+                errln!(
                     "wrote {} ({} material \"{}\", 1 scene unit = 1 {})",
                     out.display(),
                     format.name(),
@@ -118,17 +122,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 );
             }
         }
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            match stdout
-                .write_all(exported.text.as_bytes())
-                .and_then(|()| stdout.flush())
-            {
-                // A closed stdout (`| head`) ends the command quietly.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-                other => other.context("writing to stdout")?,
-            }
-        }
+        // A closed stdout (`| head`) ends the output quietly (crate::output).
+        None => crate::output::write_stdout_bytes(exported.text.as_bytes())?,
     }
     Ok(ExitCode::SUCCESS)
 }

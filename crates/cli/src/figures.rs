@@ -71,7 +71,7 @@ fn model_series(
         .filter_map(|k| m.profile.profile.r_mm(k))
         .filter(|r| *r > 0.0)
         .collect();
-    let spot = m.settings.options().spot;
+    let spot = m.settings.options().ok()?.spot;
     let values = model_profile(model, &props, spot, &radii).ok()?;
     Some(Series {
         label: label.into(),

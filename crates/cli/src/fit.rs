@@ -16,19 +16,20 @@ use scatterfit_pipeline::spectro::SpectroStage;
 
 use crate::common::parse_rgb;
 use crate::common::{MethodArg, ModelArg};
+use crate::output::out;
 
 /// Arguments of `scatterfit fit`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The profile CSV (channels r, g, b).
     pub profile: PathBuf,
-    /// Relative refractive index η [1, 3].
-    #[arg(long)]
+    /// Relative refractive index η, in [1, 3].
+    #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: f64,
     /// Reduced albedo α′ per channel R,G,B, each in (0, 1] (the proposed method needs it).
     #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
     pub albedo: Option<[f64; 3]>,
-    /// The spectrophotometer's diffuse reflectance Rd per channel R,G,B (for
+    /// The spectrophotometer's diffuse reflectance Rd per channel R,G,B, each in (0, 1] (for
     /// --normalise-with-spectro; default: the model's Rd of the given α′).
     #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
     pub rd: Option<[f64; 3]>,
@@ -38,18 +39,22 @@ pub struct Args {
     /// The forward model.
     #[arg(long, value_enum, default_value_t = ModelArg::Dipole)]
     pub model: ModelArg,
-    /// Diameter of the light spot [mm] (0, 20]; the model is convolved with it.
-    #[arg(long, default_value_t = 1.0, value_name = "MM")]
+    /// Diameter of the light spot [mm], in (0, 20]; the model is convolved with it.
+    #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub spot_diameter_mm: f64,
-    /// Innermost fitted radius [mm] (default: the spot diameter).
-    #[arg(long, value_name = "MM")]
+    /// Innermost fitted radius [mm], in [0, 1000) (default: the spot diameter).
+    #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub r_min_mm: Option<f64>,
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd.
     #[arg(long)]
     pub normalise_with_spectro: bool,
-    /// Also write the result (result.json's shape) to this file.
+    /// Also write the result (result.json's shape) to this file (`.json`; checked before the fit;
+    /// an existing file only with --force).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    pub force: bool,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -79,19 +84,32 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(a) = args.albedo
         && let Some(bad) = a.iter().find(|v| !(**v > 0.0 && **v <= 1.0))
     {
-        bail!("--albedo: {bad} is outside (0, 1]");
+        bail!("--albedo: {bad} is outside (0, 1] (a reduced albedo σ′s/σ′t)");
+    }
+    if let Some(rd) = args.rd
+        && let Some(bad) = rd.iter().find(|v| !(**v > 0.0 && **v <= 1.0))
+    {
+        bail!("--rd: {bad} is outside (0, 1] (a diffuse reflectance, a fraction)");
+    }
+    if let Some(r) = args.r_min_mm {
+        crate::numeric::ensure(
+            (0.0..1000.0).contains(&r),
+            "--r-min-mm",
+            r,
+            "the innermost fitted radius must lie in [0, 1000) mm",
+        )?;
     }
     if let Some(out) = &args.output {
-        crate::common::refuse_overwrite(out, "-o", &[args.profile.as_path()])?;
-        if out
-            .extension()
-            .is_none_or(|e| !e.eq_ignore_ascii_case("json"))
-        {
-            bail!(
-                "-o {}: the result is JSON; name the file *.json",
-                out.display()
-            );
-        }
+        crate::common::check_output_file(
+            out,
+            "-o",
+            crate::common::Format {
+                extensions: &["json"],
+                what: "the result is written as JSON (result.json's shape)",
+            },
+            &[args.profile.as_path()],
+            args.force,
+        )?;
     }
     let model_name: ModelName = args.model.into();
     let model = model_for(model_name)?;
@@ -144,7 +162,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 "method": method.as_str(),
                 "model": model_name.as_str(),
                 "normalise_with_spectro": args.normalise_with_spectro,
-                "r_min_mm": settings.options().selection.r_min_mm,
+                "r_min_mm": settings.r_min_mm(),
             }),
             ..Inputs::default()
         },
@@ -156,7 +174,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&result)?;
     } else {
-        print!("{}", crate::report::summary_text(&result));
+        out!("{}", crate::report::summary_text(&result))?;
     }
     Ok(if fits.iter().all(ChannelOutcome::is_measurement) {
         ExitCode::SUCCESS

@@ -2,7 +2,12 @@
 //!
 //! `main` is glue: parse the arguments, run one subcommand, print errors with their causes, and map
 //! the outcome to the exit code documented in `ARCHITECTURE.md`: 0 success, 1 a measurement that
-//! failed (the tool ran, the sample did not yield parameters), 2 bad usage or bad input.
+//! failed (the tool ran, the sample did not yield parameters), 2 bad usage or bad input; 130 after
+//! Ctrl-C (temporary files removed first). A closed stdout (`| head`) drops what was still to be
+//! printed and keeps the command's own exit code (`output`).
+
+// Every print goes through `output`'s fallible writers: `println!` panics on a closed pipe.
+#![deny(clippy::print_stdout, clippy::print_stderr)]
 
 mod batch;
 mod bench;
@@ -12,6 +17,7 @@ mod demo;
 mod export;
 mod figures;
 mod fit;
+mod interrupt;
 mod measure;
 mod merge;
 mod numeric;
@@ -77,6 +83,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    interrupt::install();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(err) => {
@@ -86,10 +93,10 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
-    match run(cli) {
+    match run(cli).and_then(|code| output::flush_stdout().map(|()| code)) {
         Ok(code) => code,
         Err(err) => {
-            eprintln!("error: {}", common::error_text(&err));
+            output::errln!("error: {}", common::error_text(&err));
             ExitCode::from(if common::is_measurement_failure(&err) {
                 1
             } else {

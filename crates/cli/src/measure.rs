@@ -9,6 +9,7 @@ use scatterfit_pipeline::{Stage, measure_sample};
 use serde::Serialize;
 
 use crate::common::{FitArgs, bar};
+use crate::output::{errln, out, outln};
 use scatterfit_io::manifest::MethodName;
 
 /// Arguments of `scatterfit measure`.
@@ -39,6 +40,8 @@ struct Timing {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     let out = args.output_dir.clone().unwrap_or_else(|| args.dir.clone());
+    // Where the result files go is checked before the measurement (milliseconds, not minutes).
+    crate::common::check_output_dir(&out, "-o")?;
     let bar = bar(5, "{msg} {bar:30} {elapsed}", args.quiet || args.json);
     let m = measure_sample(&args.dir, &overrides, &|stage| {
         let msg = match stage {
@@ -55,22 +58,27 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     .with_context(|| format!("measuring {}", args.dir.display()))?;
     bar.finish_and_clear();
     for w in &m.spectro.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}");
     }
     for p in &m.hdr.dropped_alpha {
-        eprintln!("note: {}: alpha channel ignored", p.display());
+        errln!("note: {}: alpha channel ignored", p.display());
     }
     let (result, written) = crate::report::write_measurement(&out, &m)?;
     if args.json {
         crate::output::print_json(&result)?;
     } else {
-        print!("{}", crate::report::summary_text(&result));
+        out!("{}", crate::report::summary_text(&result))?;
         let t = &m.timings;
-        println!(
+        outln!(
             "  time: {:.3} s (spectro {:.3}, read {:.3}, merge {:.3}, profile {:.3}, fits {:.4})",
-            t.total_s, t.spectro_s, t.read_s, t.merge_s, t.profile_s, t.fit_s
-        );
-        println!(
+            t.total_s,
+            t.spectro_s,
+            t.read_s,
+            t.merge_s,
+            t.profile_s,
+            t.fit_s
+        )?;
+        outln!(
             "  wrote {} files in {}: {}",
             written.len(),
             out.display(),
@@ -79,7 +87,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
                 .collect::<Vec<_>>()
                 .join(", ")
-        );
+        )?;
     }
     let _ = Timing { timings: m.timings };
     Ok(if m.complete() {

@@ -9,12 +9,13 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
 use scatterfit_imaging::{
     CalibrateOptions, ClippedFill, HdrImage, ImageBuf, LEVELS, LinearMergeOptions, MergeOptions,
     ResponseCurve,
 };
-use scatterfit_io::bracket::{Bracket, read_bracket};
+use scatterfit_io::bracket::{Bracket, read_bracket_within};
 use scatterfit_io::image_files::{CameraFrame, read_camera_frame, write_radiance};
 use scatterfit_io::response_csv::{ResponseTable, read_response_csv, write_response_csv};
 use serde::Serialize;
@@ -55,14 +56,17 @@ pub struct Args {
     /// A dark frame (lens capped, same settings), subtracted before merging.
     #[arg(long, value_name = "IMAGE")]
     pub dark: Option<PathBuf>,
-    /// Smoothness weight λ of the response recovery (Debevec & Malik 1997, eq. 3).
-    #[arg(long, default_value_t = 10.0)]
+    /// Smoothness weight λ of the response recovery (Debevec & Malik 1997, eq. 3), in [0, 10⁶]
+    /// (dimensionless; OpenCV's default 10).
+    #[arg(long, default_value_t = 10.0, value_parser = crate::numeric::parse_finite)]
     pub lambda: f64,
-    /// Sample pixels per channel for the response recovery.
-    #[arg(long, default_value_t = 100)]
-    pub samples: usize,
-    /// 16-bit frames: raw value at and above which a sample counts as saturated.
-    #[arg(long, default_value_t = u16::MAX)]
+    /// Sample pixels per channel for the response recovery: a count from ⌈256/(P − 1)⌉ for P frames
+    /// (22 for 13; Debevec & Malik's N(P − 1) ≥ 256, fewer leave the curve undetermined) to 1000
+    /// (more only cost time: the solve grows as N·P). Default 100, or that minimum when larger.
+    #[arg(long, value_parser = crate::numeric::parse_size)]
+    pub samples: Option<usize>,
+    /// 16-bit frames: raw value at and above which a sample counts as saturated, 2 to 65535.
+    #[arg(long, default_value_t = u16::MAX, value_parser = clap::value_parser!(u16).range(2..))]
     pub saturation: u16,
     /// Value stored for pixels clipped in every exposure.
     #[arg(long, value_enum, default_value_t = Fill::Nan)]
@@ -70,12 +74,19 @@ pub struct Args {
     /// Sample weighting of 8-bit brackets.
     #[arg(long, value_enum, default_value_t = WeightingArg::NoiseOptimal)]
     pub weighting: WeightingArg,
-    /// The radiance map to write (.exr: 32-bit float, lossless; .hdr: Radiance RGBE).
+    /// The radiance map to write (.exr: 32-bit float, PIZ lossless; .hdr: Radiance RGBE); checked
+    /// with --response-out before any work; existing files only with --force.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
-    /// Where to save the camera response (default: beside the output, `<name>.response.csv`).
+    /// Where to save the camera response (.csv; default: beside the output, `<name>.response.csv`).
+    /// Written after the radiance map, so a map that cannot be written leaves no response behind.
     #[arg(long, value_name = "CSV")]
     pub response_out: Option<PathBuf>,
+    /// Replace existing output files.
+    #[arg(long)]
+    pub force: bool,
+    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
+    pub max_memory_mib: Option<u64>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -187,11 +198,15 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let bracket: Bracket = read_bracket(&args.images, args.exposures.as_deref(), &|_| bar.inc(1))
+    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    let bracket: Bracket =
+        read_bracket_within(&args.images, args.exposures.as_deref(), budget, &|_| {
+            bar.inc(1)
+        })
         .context("reading the exposure bracket")?;
     bar.finish_and_clear();
-    for f in bracket.frames.iter().filter(|f| f.dropped_alpha) {
-        eprintln!("note: {}: alpha channel ignored", f.path.display());
+    for f in bracket.frames().iter().filter(|f| f.dropped_alpha) {
+        errln!("note: {}: alpha channel ignored", f.path.display());
     }
     let dark = match &args.dark {
         Some(path) => {
@@ -203,7 +218,7 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
     };
     let read_s = t0.elapsed().as_secs_f64();
     let frames: Vec<FrameSummary> = bracket
-        .frames
+        .frames()
         .iter()
         .map(|f| FrameSummary {
             file: f.path.clone(),
@@ -212,11 +227,21 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
         .collect();
     let image = bracket.describe();
     let times = bracket.times_s();
+    // The merge's own allocations (radiance f32 + clipping mask + the encoded file), beside the
+    // frames already read, before any is made.
+    let first = &bracket.frames()[0].frame;
+    let samples = (first.width() * first.height() * first.channels()) as u64;
+    let frames_bytes = samples * u64::from(first.bit_depth() / 8) * bracket.frames().len() as u64;
+    crate::numeric::check_memory(
+        &format!("merging {} frames of {image}", bracket.frames().len()),
+        frames_bytes + samples * (4 + 1 + 4),
+        budget,
+    )?;
     let t1 = Instant::now();
-    let first = bracket.frames[0].frame.bit_depth();
+    let first = first.bit_depth();
     let merged = if first == 8 {
         let bufs: Vec<ImageBuf<u8>> = bracket
-            .frames
+            .into_frames()
             .into_iter()
             .filter_map(|f| match f.frame {
                 CameraFrame::U8(b) => Some(b),
@@ -226,10 +251,11 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
         let (response, kind, rms) = match &args.response {
             Some(path) => (load_response(path)?, "given", Vec::new()),
             None => {
-                let opts = CalibrateOptions {
-                    samples: args.samples,
-                    lambda: args.lambda,
-                };
+                let samples = args.samples.unwrap_or_else(|| {
+                    100.max(scatterfit_imaging::min_response_samples(bufs.len()))
+                });
+                let opts = CalibrateOptions::new(samples, args.lambda)
+                    .context("response recovery options")?;
                 let cal = scatterfit_imaging::recover_response(&bufs, &times, &opts).context(
                     "recovering the camera response (or give a known one with --response)",
                 )?;
@@ -270,7 +296,7 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
             );
         }
         let bufs: Vec<ImageBuf<u16>> = bracket
-            .frames
+            .into_frames()
             .into_iter()
             .filter_map(|f| match f.frame {
                 CameraFrame::U16(b) => Some(b),
@@ -281,10 +307,8 @@ pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merg
             CameraFrame::U16(b) => Some(b),
             _ => None,
         });
-        let opts = LinearMergeOptions {
-            saturation: args.saturation,
-            clipped_fill: fill(args.clipped_fill),
-        };
+        let opts = LinearMergeOptions::new(args.saturation, fill(args.clipped_fill))
+            .context("--saturation")?;
         let hdr = scatterfit_imaging::merge_linear_u16(&bufs, &times, dark.as_ref(), &opts)
             .context("merging the 16-bit bracket")?;
         Merged {
@@ -311,36 +335,85 @@ fn fill(f: Fill) -> ClippedFill {
     }
 }
 
+/// Checks every number before any file is read: λ and the sample count (its lower bound follows
+/// from the number of frames, known from the list or the exposures CSV).
+fn check_numbers(args: &Args, frames: usize) -> anyhow::Result<()> {
+    use crate::numeric::ensure;
+    ensure(
+        (0.0..=1e6).contains(&args.lambda),
+        "--lambda",
+        args.lambda,
+        "the smoothness weight must lie in [0, 1e6] (Debevec & Malik 1997, eq. 3; default 10)",
+    )?;
+    let Some(samples) = args.samples else {
+        return Ok(());
+    };
+    let min = scatterfit_imaging::min_response_samples(frames.max(2));
+    let max = scatterfit_imaging::MAX_RESPONSE_SAMPLES;
+    ensure(
+        (min..=max).contains(&samples),
+        "--samples",
+        samples,
+        &format!(
+            "the response recovery takes {min} to {max} sample pixels per channel for {frames} \
+             frames: with N samples and P frames Debevec & Malik's N(P − 1) ≥ 256 must hold, or \
+             the curve is undetermined; more than {max} only cost time"
+        ),
+    )
+}
+
 /// Runs `scatterfit merge`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut inputs: Vec<&Path> = args.images.iter().map(PathBuf::as_path).collect();
     inputs.extend(args.exposures.as_deref());
     inputs.extend(args.response.as_deref());
     inputs.extend(args.dark.as_deref());
-    if scatterfit_io::image_files::RadianceFormat::from_path(&args.output).is_none() {
-        bail!(
-            "-o {}: the radiance map must end in .exr or .hdr",
-            args.output.display()
-        );
+    // Frame paths listed in the CSV are inputs too.
+    let listed = match &args.exposures {
+        Some(csv) => scatterfit_io::bracket::read_exposures_csv(csv)?,
+        None => Vec::new(),
+    };
+    inputs.extend(listed.iter().map(|e| e.path.as_path()));
+    let frames = if args.images.is_empty() {
+        listed.len()
+    } else {
+        args.images.len()
+    };
+    if args.response.is_none() {
+        check_numbers(&args, frames)?;
     }
-    crate::common::refuse_overwrite(&args.output, "output", &inputs)?;
+    crate::common::check_output_file(
+        &args.output,
+        "-o",
+        crate::common::Format {
+            extensions: &["exr", "hdr"],
+            what: "the radiance map is written as OpenEXR or Radiance HDR",
+        },
+        &inputs,
+        args.force,
+    )?;
     let response_out = args
         .response_out
         .clone()
         .unwrap_or_else(|| default_response_out(&args.output));
-    crate::common::refuse_overwrite(&response_out, "--response-out", &inputs)?;
     if crate::common::identity(&response_out) == crate::common::identity(&args.output) {
         bail!(
             "--response-out and -o are the same file {}; choose two files",
             args.output.display()
         );
     }
-    // Frame paths listed in the CSV are inputs too.
-    if let Some(csv) = &args.exposures {
-        let listed = scatterfit_io::bracket::read_exposures_csv(csv)?;
-        let listed: Vec<&Path> = listed.iter().map(|e| e.path.as_path()).collect();
-        crate::common::refuse_overwrite(&args.output, "output", &listed)?;
-        crate::common::refuse_overwrite(&response_out, "--response-out", &listed)?;
+    let writes_response = args.response.is_none() || args.response_out.is_some();
+    if writes_response {
+        crate::common::check_output_file(
+            &response_out,
+            "--response-out",
+            crate::common::Format {
+                extensions: &["csv"],
+                what: "the camera response is written as CSV",
+            },
+            &inputs,
+            args.force,
+        )?;
     }
 
     let merged = read_and_merge(&args, !args.json)?;
@@ -370,8 +443,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .chunks_exact(ch)
         .filter(|p| p.iter().any(|&m| m != 0))
         .count();
+    // The radiance map first: if it cannot be written, no response CSV is left without it.
+    write_radiance(&args.output, &hdr.radiance).context("saving the radiance map")?;
     let response_written = match &response {
-        Some(curve) if response_kind != "given" || args.response_out.is_some() => {
+        Some(curve) if writes_response => {
             let table = ResponseTable {
                 g: curve.tables().iter().map(|t| t.to_vec()).collect(),
             };
@@ -380,7 +455,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
         _ => None,
     };
-    write_radiance(&args.output, &hdr.radiance).context("saving the radiance map")?;
 
     let summary = Summary {
         frames,
@@ -406,31 +480,31 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&summary)?;
     } else {
-        print_summary(&summary);
+        print_summary(&summary)?;
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_summary(s: &Summary) {
+fn print_summary(s: &Summary) -> anyhow::Result<()> {
     let t_min = s.frames.first().map_or(f64::NAN, |f| f.time_s);
     let t_max = s.frames.last().map_or(f64::NAN, |f| f.time_s);
-    println!(
+    outln!(
         "frames        {} × {} ({:.3} s read)",
         s.frames.len(),
         s.image,
         s.read_s
-    );
-    println!(
+    )?;
+    outln!(
         "times         {} s … {} s",
         crate::common::shutter(t_min),
         crate::common::shutter(t_max)
-    );
+    )?;
     for f in &s.frames {
-        println!(
+        outln!(
             "  {:>10} s  {}",
             crate::common::shutter(f.time_s),
             f.file.display()
-        );
+        )?;
     }
     let rms = if s.response_rms_residual.is_empty() {
         String::new()
@@ -442,16 +516,16 @@ fn print_summary(s: &Summary) {
             .collect();
         format!(" (weighted RMS residual {})", v.join(", "))
     };
-    println!("response      {}{rms}", s.response);
-    println!("merge         {:.3} s", s.merge_s);
-    println!(
+    outln!("response      {}{rms}", s.response)?;
+    outln!("merge         {:.3} s", s.merge_s)?;
+    outln!(
         "radiance      {:.4e} … {:.4e} (relative), dynamic range {:.1} stops ({:.1} decades)",
         s.radiance_min,
         s.radiance_max,
         s.dynamic_range_stops,
         s.dynamic_range_stops * std::f64::consts::LOG10_2
-    );
-    println!(
+    )?;
+    outln!(
         "clipped       {} pixels ({} pixel-channels) clipped in every exposure{}",
         s.clipped_everywhere_pixels,
         s.clipped_everywhere_samples,
@@ -460,11 +534,12 @@ fn print_summary(s: &Summary) {
         } else {
             ""
         }
-    );
-    println!("wrote         {}", s.output.display());
+    )?;
+    outln!("wrote         {}", s.output.display())?;
     if let Some(r) = &s.response_out {
-        println!("wrote         {}", r.display());
+        outln!("wrote         {}", r.display())?;
     }
+    Ok(())
 }
 
 /// A synthetic spot bracket: a radially decaying radiance (a light spot on a translucent sample)
@@ -594,12 +669,14 @@ pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figu
         response: None,
         dark: None,
         lambda: 10.0,
-        samples: 100,
+        samples: None,
         saturation: u16::MAX,
         clipped_fill: Fill::Nan,
         weighting: WeightingArg::NoiseOptimal,
         output: dir.join("radiance.exr"),
         response_out: None,
+        force: true,
+        max_memory_mib: None,
         json: true,
     };
     let t0 = Instant::now();

@@ -5,15 +5,46 @@
 use scatterfit_io::budget::{DEFAULT_MEMORY_BUDGET_MIB, MEMORY_BUDGET_ENV, describe_bytes};
 
 /// Help text of `--max-memory-mib`.
-pub const MAX_MEMORY_HELP: &str = "Memory budget [MiB] for the tallies and tables sized by the \
-     other flags; checked before anything is allocated. Default: $SCATTERFIT_MAX_MEMORY_MIB, else \
-     8192 (8 GiB). Raise it if this machine has the memory";
+pub const MAX_MEMORY_HELP: &str = "Memory budget [MiB, ≥ 1] for what the other flags and the \
+     inputs size (tallies, tables, rings, images); checked before anything is allocated. Default: \
+     $SCATTERFIT_MAX_MEMORY_MIB, else 8192 (8 GiB). Raise it if this machine has the memory";
 
 /// Help text of `--max-interactions`.
 pub const MAX_INTERACTIONS_HELP: &str = "Work budget: the most photon interactions (scattering \
      events, all photons together) the run may be expected to take, estimated before it starts from \
      σs, σa, g, η and the thickness; a count (default 1e12: about 7 h on 2 cores at 2e7 \
      interactions/s per thread). Raise it to allow longer runs";
+
+/// Refuses a flag's value unless `ok`, with the flag, the value and `rule` (the valid range, its
+/// unit and why), e.g. `--ring-width-px 0: must be > 0 px …`.
+///
+/// # Errors
+/// The refusal (exit 2).
+pub fn ensure(
+    ok: bool,
+    flag: &str,
+    value: impl std::fmt::Display,
+    rule: &str,
+) -> anyhow::Result<()> {
+    if ok {
+        Ok(())
+    } else {
+        let text = value.to_string();
+        let value = text.parse::<f64>().map_or(text, show);
+        anyhow::bail!("{flag} {value}: {rule}")
+    }
+}
+
+/// A number for messages: as written for ordinary magnitudes, in scientific notation otherwise
+/// (`1e-300`, not three hundred zeros).
+pub fn show(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (1e-4..1e7).contains(&a) || !a.is_finite() {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
 
 /// Parses a count: `1000000`, `1e6`, `2.5e5` or `1_000_000`; a whole number ≥ 0 that fits in u64
 /// (decimal notation must be exact: at most 2⁵³ when written with an exponent or a point).
@@ -42,6 +73,17 @@ pub fn parse_count(text: &str) -> Result<u64, String> {
         ));
     }
     Ok(v as u64)
+}
+
+/// A memory budget in MiB (`--max-memory-mib`): a count ≥ 1.
+///
+/// # Errors
+/// As [`parse_count`], or 0.
+pub fn parse_mib(text: &str) -> Result<u64, String> {
+    match parse_count(text)? {
+        0 => Err("a memory budget of 0 MiB allows nothing; give at least 1".into()),
+        n => Ok(n),
+    }
 }
 
 /// [`parse_count`] for sizes held in `usize`.
@@ -126,6 +168,16 @@ mod tests {
         assert!(parse_count("1e300").unwrap_err().contains("too large"));
         assert!(parse_count("NaN").is_err());
         assert!(parse_count("many").unwrap_err().contains("1e6"));
+    }
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        assert_eq!(show(1e-300), "1e-300");
+        assert_eq!(show(1e13), "1e13");
+        assert_eq!(show(300.0), "300");
+        assert_eq!(show(0.5), "0.5");
+        let err = ensure(false, "--ring-width-px", 1e-300, "rule").unwrap_err();
+        assert_eq!(err.to_string(), "--ring-width-px 1e-300: rule");
     }
 
     #[test]

@@ -1503,7 +1503,7 @@ mod tests {
             Some(&out.join("fig6.png")),
         )
         .unwrap();
-        eprintln!("fig4 (SVG + PNG, 3 × 300 rings): {elapsed:?}");
+        crate::output::errln!("fig4 (SVG + PNG, 3 × 300 rings): {elapsed:?}");
         let img = decode(&std::fs::read(out.join("fig4.png")).unwrap());
         // Rd spans ~10⁰ down to ~10⁻⁸ at 15 mm (blue, σtr = 0.74 mm⁻¹): the axis covers it all.
         let (_, y) = figure_axes(&fig4);

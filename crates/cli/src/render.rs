@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
 use glam::DVec3;
 use scatterfit_imaging::ImageBuf;
@@ -89,14 +90,14 @@ pub struct Args {
     /// A mesh file (.obj or .ply); its units are mm unless --mesh-scale says otherwise.
     #[arg(long, value_name = "FILE", conflicts_with = "shape")]
     pub mesh: Option<PathBuf>,
-    /// mm per mesh-file unit (e.g. 10 for a file in cm).
-    #[arg(long, default_value_t = 1.0, value_name = "MM")]
+    /// mm per mesh-file unit (e.g. 10 for a file in cm), in (0, 10⁶].
+    #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub mesh_scale: f64,
     /// A built-in model (used when no --mesh is given).
     #[arg(long, value_enum, default_value_t = ShapeArg::Statue)]
     pub shape: ShapeArg,
-    /// Triangles of the built-in sphere or statue (about; 1000–1e7).
-    #[arg(long, default_value = "100000", value_parser = parse_count, value_name = "N")]
+    /// Triangles of the built-in sphere or statue (about): a count, 1000 to 1e7.
+    #[arg(long, default_value = "100000", value_parser = crate::numeric::parse_size, value_name = "N")]
     pub triangles: usize,
     /// Which of the paper's rendering methods.
     #[arg(long, value_enum, default_value_t = MethodArg::Both)]
@@ -108,24 +109,26 @@ pub struct Args {
     /// Write the luminance (grey) instead of colour, like the paper's Figure 5.
     #[arg(long)]
     pub gray: bool,
-    /// Image size in pixels, WxH (each 16–8192).
+    /// Image size in pixels, WxH (each 16–8192; with every panel within the memory budget).
     #[arg(long, default_value = "512x512", value_parser = parse_size, value_name = "WxH")]
     pub size: (usize, usize),
-    /// Camera samples per pixel (1 = pixel centres; a square number is stratified; 1–4096).
-    #[arg(long, default_value = "4", value_parser = parse_count, value_name = "N")]
+    /// Camera samples per pixel: a count, 1 to 4096 (1 = pixel centres; a square number is
+    /// stratified); the time grows in proportion.
+    #[arg(long, default_value = "4", value_parser = crate::numeric::parse_size, value_name = "N")]
     pub spp: usize,
-    /// Seed of every random stream (the image is identical for a seed on any thread count).
+    /// Seed of every random stream, 0 to 2⁶⁴ − 1 (the image is identical for a seed on any thread
+    /// count).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Lighting.
     #[arg(long, value_enum, default_value_t = LightArg::Studio)]
     pub light: LightArg,
-    /// Rays each light shoots to sample the irradiance (texture-space method; 1e3–1e8; default:
-    /// a spacing of a third of the profile's half-width over the model, 65 536–2 097 152).
-    #[arg(long, value_parser = parse_count, value_name = "N")]
+    /// Rays each light shoots to sample the irradiance (texture-space method): a count, 1e3 to 1e8
+    /// (default: a spacing of a third of the profile's half-width over the model, 65 536–2 097 152).
+    #[arg(long, value_parser = crate::numeric::parse_size, value_name = "N")]
     pub light_rays: Option<usize>,
-    /// Hierarchy threshold: a node is used whole below this angular size [rad, (0, 1)].
-    #[arg(long, default_value_t = 0.5, value_name = "RAD")]
+    /// Hierarchy threshold: a node is used whole below this angular size [rad], in (0, 1).
+    #[arg(long, default_value_t = 0.5, value_name = "RAD", value_parser = crate::numeric::parse_finite)]
     pub max_angle: f64,
     /// Evaluate eq. 6 as a direct sum over every irradiance point (exact, slow).
     #[arg(long)]
@@ -162,13 +165,14 @@ pub struct Args {
     /// Henyey–Greenstein g of P(g) in eqs. 3–4, in (−1, 1).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub g: f64,
-    /// Exposure [EV]; at 0 a white diffuser facing a light of irradiance 1 is the reference white.
+    /// Exposure [EV], in [−60, 60]; at 0 a white diffuser facing a light of irradiance 1 is the
+    /// reference white.
     /// Default 0, except with --profile, where the slab image is exposed so that the glow at twice
     /// the spot radius shows as white.
-    #[arg(long, allow_hyphen_values = true, value_name = "EV")]
+    #[arg(long, allow_hyphen_values = true, value_name = "EV", value_parser = crate::numeric::parse_finite)]
     pub exposure: Option<f64>,
-    /// Tone-curve white: the exposed luminance shown as display white (≥ 1).
-    #[arg(long, default_value_t = 4.0)]
+    /// Tone-curve white: the exposed luminance shown as display white, in [1, 10⁶].
+    #[arg(long, default_value_t = 4.0, value_parser = crate::numeric::parse_finite)]
     pub white: f64,
     /// Validate against the measured profile (Table 2): render the measurement's slab and spot
     /// by the texture-space method, and report the MSE per channel against the result's
@@ -178,16 +182,20 @@ pub struct Args {
     /// The measured profile CSV for --profile, instead of the result's `inputs.profile`.
     #[arg(long, value_name = "CSV", requires = "profile")]
     pub measured_profile: Option<PathBuf>,
-    /// Light-spot radius for --profile [mm] (default: the result's `inputs.spot_radius_mm`).
-    #[arg(long, value_name = "MM")]
+    /// Light-spot radius for --profile [mm], in (0, 10] (default: the result's
+    /// `inputs.spot_radius_mm`).
+    #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub spot_radius_mm: Option<f64>,
     /// Output files, repeatable: .png (tone-mapped sRGB, with captions when there are several
-    /// panels), .exr (linear radiance), and with --profile .csv (rendered vs measured).
+    /// panels), .exr (linear radiance, PIZ lossless), and with --profile .csv (rendered vs
+    /// measured). Checked before rendering; existing files only with --force.
     #[arg(short, long = "output", value_name = "FILE", required = true)]
     pub output: Vec<PathBuf>,
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
+    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
+    pub max_memory_mib: Option<u64>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -196,17 +204,62 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// A count: an integer, or a float such as 1e6 that is an integer.
-fn parse_count(text: &str) -> Result<usize, String> {
-    if let Ok(n) = text.parse::<usize>() {
-        return Ok(n);
+/// Memory per pixel and panel [bytes], an upper bound: the linear image (3 × f32), its grey or
+/// composed copy and the figure grid (3 × f32 each), the tone-mapped bytes and the PNG encoder's.
+const BYTES_PER_PIXEL_PANEL: u64 = 48;
+/// Memory per triangle [bytes], an upper bound: positions, normals, indices, the BVH.
+const BYTES_PER_TRIANGLE: u64 = 256;
+/// Memory per light ray of the texture-space method [bytes]: its irradiance point and tree share.
+const BYTES_PER_LIGHT_RAY: u64 = 160;
+
+/// Checks the numbers that no library checks, then the memory the flags size, before any work.
+fn check_numbers(args: &Args, panels: usize) -> anyhow::Result<()> {
+    use crate::numeric::ensure;
+    ensure(
+        (1..=4096).contains(&args.spp),
+        "--spp",
+        args.spp,
+        "the samples per pixel must lie in 1–4096",
+    )?;
+    ensure(
+        args.mesh_scale > 0.0 && args.mesh_scale <= 1e6,
+        "--mesh-scale",
+        args.mesh_scale,
+        "the mesh scale must lie in (0, 1e6] mm per file unit",
+    )?;
+    if let Some(ev) = args.exposure {
+        ensure(
+            (-60.0..=60.0).contains(&ev),
+            "--exposure",
+            ev,
+            "the exposure must lie in [−60, 60] EV",
+        )?;
     }
-    match text.parse::<f64>() {
-        Ok(v) if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v < 1e15 => Ok(v as usize),
-        _ => Err(format!(
-            "`{text}` is not a count (write e.g. 4, 262144 or 1e6)"
-        )),
+    ensure(
+        (1.0..=1e6).contains(&args.white),
+        "--white",
+        args.white,
+        "the tone-curve white must lie in [1, 1e6]",
+    )?;
+    if let Some(r) = args.spot_radius_mm {
+        ensure(
+            r > 0.0 && r <= 10.0,
+            "--spot-radius-mm",
+            r,
+            "the light spot's radius must lie in (0, 10] mm",
+        )?;
     }
+    let (w, h) = args.size;
+    let pixels = (w * h) as u64;
+    let rays = args.light_rays.unwrap_or(1 << 21) as u64 * 2;
+    let needed = pixels * BYTES_PER_PIXEL_PANEL * panels as u64
+        + args.triangles as u64 * BYTES_PER_TRIANGLE
+        + rays * BYTES_PER_LIGHT_RAY;
+    crate::numeric::check_memory(
+        &format!("rendering {panels} panel(s) of {w}×{h} px"),
+        needed,
+        crate::numeric::memory_budget(args.max_memory_mib),
+    )
 }
 
 fn parse_size(text: &str) -> Result<(usize, usize), String> {
@@ -312,13 +365,14 @@ fn load_params(spec: &str, model: Option<&str>) -> anyhow::Result<Params> {
             result.model
         );
     }
-    let coefficients = result.coefficients().map_err(|ch| {
+    let coefficients = result.coefficients().map_err(|ch| -> anyhow::Error {
         let c = match ch {
             "r" => &result.channels.r,
             "g" => &result.channels.g,
             _ => &result.channels.b,
         };
-        anyhow::anyhow!(
+        // A measurement that failed (exit 1), as `export` says of the same result.
+        crate::common::MeasurementFailed(format!(
             "{spec}: channel {ch} has no σ′s/σa (status {:?}{}); render needs all three channels — \
              re-run the measurement or fix that channel",
             c.status,
@@ -326,7 +380,8 @@ fn load_params(spec: &str, model: Option<&str>) -> anyhow::Result<Params> {
                 .as_deref()
                 .map(|p| format!(": {p}"))
                 .unwrap_or_default()
-        )
+        ))
+        .into()
     })?;
     let folder = path
         .parent()
@@ -446,13 +501,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
         if out.exists() && !args.force {
             bail!(
-                "{} exists; pass --force to overwrite it or choose another file",
+                "-o {}: the file exists; nothing was done — pass --force to replace it, or choose \
+                 another name",
                 out.display()
             );
         }
         let refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-        crate::common::refuse_overwrite(out, "output", &refs)?;
+        crate::common::refuse_overwrite(out, "-o", &refs)?;
+        if out.is_dir() {
+            bail!("-o {}: is a folder; name a file", out.display());
+        }
+        crate::common::check_output_folder(out, "-o")?;
     }
+    let panels = if args.profile {
+        1
+    } else {
+        specs.len()
+            * match args.method {
+                MethodArg::Both => 2,
+                _ => 1,
+            }
+    };
+    check_numbers(&args, panels)?;
     if !(args.mesh_scale.is_finite() && args.mesh_scale > 0.0) {
         bail!(
             "--mesh-scale {} must be a positive number (mm per file unit)",
@@ -518,7 +588,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             let r = data.report;
             if !args.quiet {
                 if r.boundary_edges > 0 {
-                    eprintln!(
+                    errln!(
                         "warning: {}: the surface is open ({} border edges); thickness through it \
                          is measured to the far side where there is one",
                         path.display(),
@@ -526,7 +596,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     );
                 }
                 if r.inconsistent_edges > 0 {
-                    eprintln!(
+                    errln!(
                         "warning: {}: {} edges join triangles wound inconsistently; computed \
                          normals may be wrong there",
                         path.display(),
@@ -534,7 +604,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     );
                 }
                 if r.degenerate_dropped > 0 {
-                    eprintln!(
+                    errln!(
                         "note: {}: dropped {} degenerate triangles",
                         path.display(),
                         r.degenerate_dropped
@@ -706,7 +776,7 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
     if args.json {
         return crate::output::print_json(s);
     }
-    println!(
+    outln!(
         "mesh     {} ({} triangles, {:.1} × {:.1} × {:.1} mm), BVH {:.3} s",
         s.mesh.source,
         s.mesh.triangles,
@@ -714,7 +784,7 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
         s.mesh.size_mm[1],
         s.mesh.size_mm[2],
         s.mesh.bvh_build_s
-    );
+    )?;
     for r in &s.renders {
         let extra = if r.method == "dipole" {
             format!(
@@ -725,43 +795,53 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
         } else {
             String::new()
         };
-        println!(
+        outln!(
             "render   {:<6} {} ({}): {}x{}, {} spp, shading {:.3} s{extra}",
-            r.method, r.material, r.parameters, r.width, r.height, r.spp, r.shading_s
-        );
+            r.method,
+            r.material,
+            r.parameters,
+            r.width,
+            r.height,
+            r.spp,
+            r.shading_s
+        )?;
         if r.invalid_samples > 0 {
-            println!(
+            outln!(
                 "warning  {} samples were non-finite or negative and were set to 0",
                 r.invalid_samples
-            );
+            )?;
         }
     }
     if let Some(p) = &s.profile {
-        println!(
+        outln!(
             "profile  {} : {:.4} mm/px, spot radius {:.3} mm, out to {:.2} mm; render {:.2} s",
             p.measured.display(),
             p.mm_per_pixel,
             p.spot_radius_mm,
             p.r_max_mm,
             p.render_s
-        );
-        println!(
+        )?;
+        outln!(
             "         {:<8} {:>6} {:>14} {:>10} {:>14}",
-            "channel", "rings", "MSE [mm⁻⁴]", "rms ln", "fit MSE"
-        );
+            "channel",
+            "rings",
+            "MSE [mm⁻⁴]",
+            "rms ln",
+            "fit MSE"
+        )?;
         for c in &p.channels {
-            println!(
+            outln!(
                 "         {:<8} {:>6} {:>14.4e} {:>10.4} {:>14}",
                 c.channel,
                 c.rings,
                 c.mse,
                 c.rms_log,
                 c.fit_mse.map_or("—".into(), |m| format!("{m:.4e}"))
-            );
+            )?;
         }
     }
     for o in &s.outputs {
-        println!("wrote    {}", o.display());
+        outln!("wrote    {}", o.display())?;
     }
     Ok(())
 }

@@ -17,6 +17,83 @@ pub struct Outcome {
     pub result: anyhow::Result<Measurement>,
 }
 
+/// Samples measured at once [1, 256] (`-j`): the help text shared by `batch`, `compare`, `demo`.
+pub const JOBS_HELP: &str = "Samples measured at the same time: a count, 1 to 256 (default: one \
+     per core). Fewer are run at once when that many would not fit the memory budget \
+     ($SCATTERFIT_MAX_MEMORY_MIB, default 8192 MiB; each sample holds its decoded bracket and \
+     radiance map); a note on stderr says so";
+
+/// Parses `-j`: a count in 1..=256.
+///
+/// # Errors
+/// A message for clap.
+pub fn parse_jobs(text: &str) -> Result<usize, String> {
+    match crate::numeric::parse_size(text)? {
+        n @ 1..=256 => Ok(n),
+        n => Err(format!(
+            "{n} samples at once: give 1 to 256 (each holds a whole bracket in memory)"
+        )),
+    }
+}
+
+/// A sample's peak memory [bytes], estimated from its frames' headers: the decoded bracket, and as
+/// much again for the radiance map, its mask and the decoders' copies. 0 when unknown (the sample's
+/// own reading reports what is wrong with it).
+fn sample_memory(dir: &Path) -> u64 {
+    let Ok(m) = scatterfit_io::manifest::read_manifest(dir) else {
+        return 0;
+    };
+    let images: Vec<PathBuf> = m
+        .camera
+        .images
+        .iter()
+        .flatten()
+        .map(|p| m.resolve(p))
+        .collect();
+    let exposures = m.camera.exposures.as_ref().map(|p| m.resolve(p));
+    if let Some(hdr) = &m.camera.hdr {
+        // A float map: decoded ≈ 3 × the file (PIZ) at most; with the copy made on reading.
+        return std::fs::metadata(m.resolve(hdr)).map_or(0, |md| md.len().saturating_mul(6));
+    }
+    match scatterfit_io::bracket::planned_frames(&images, exposures.as_deref()) {
+        Ok(frames) => {
+            let (total, _, _) =
+                scatterfit_io::bracket::decoded_size(frames.iter().map(PathBuf::as_path));
+            total.saturating_mul(2)
+        }
+        Err(_) => 0,
+    }
+}
+
+/// How many of `dirs` to measure at once: `requested` (0: one per core), fewer when that many of
+/// the largest samples would not fit the memory budget (checked from the frames' headers before
+/// any is read), never below one.
+pub fn jobs_within_budget(dirs: &[PathBuf], requested: usize, quiet: bool) -> usize {
+    let want = if requested == 0 {
+        rayon::current_num_threads()
+    } else {
+        requested
+    }
+    .clamp(1, dirs.len().max(1));
+    let mut sizes: Vec<u64> = dirs.iter().map(|d| sample_memory(d)).collect();
+    sizes.sort_unstable_by(|a, b| b.cmp(a));
+    let budget = scatterfit_io::budget::memory_budget_bytes();
+    let mut jobs = want;
+    while jobs > 1 && sizes.iter().take(jobs).sum::<u64>() > budget {
+        jobs -= 1;
+    }
+    if jobs < want && !quiet {
+        crate::output::errln!(
+            "note: measuring {jobs} sample(s) at a time instead of {want}: {want} of these samples \
+             would need about {} of memory, more than the budget of {} ({}=<MiB> raises it)",
+            scatterfit_io::budget::describe_bytes(sizes.iter().take(want).sum()),
+            scatterfit_io::budget::describe_bytes(budget),
+            scatterfit_io::budget::MEMORY_BUDGET_ENV
+        );
+    }
+    jobs
+}
+
 /// Measures every folder of `dirs` with `jobs` samples at a time (0: one per core), calling
 /// `done` for each as soon as it is finished (from a worker thread) so results can be written
 /// before the others end.
@@ -30,6 +107,7 @@ pub fn measure_many(
     quiet: bool,
     done: &(dyn Fn(&Path, &anyhow::Result<Measurement>) + Sync),
 ) -> anyhow::Result<Vec<Outcome>> {
+    let jobs = jobs_within_budget(dirs, jobs, quiet);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()

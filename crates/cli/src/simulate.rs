@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
 use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationResult};
 use serde::Serialize;
@@ -39,14 +40,14 @@ pub struct Args {
     /// Seed of the random streams, 0 to 2⁶⁴ − 1 (the result is identical for any thread count).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Beam: `pencil`, `disk:R` (uniform disk of radius R mm, R > 0) or `gauss:R` (Gaussian, 1/e²
-    /// radius R mm, R > 0).
+    /// Beam: `pencil`, `disk:R` (uniform disk of radius R mm, R in (0, 1000]) or `gauss:R`
+    /// (Gaussian, 1/e² radius R mm, R in (0, 1000]).
     #[arg(long, default_value = "pencil")]
     pub beam: String,
     /// Angle of incidence [degrees] in air, in [0, 90) (0 = normal).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub incidence_deg: f64,
-    /// Outer radius of the Rd(r) grid [mm]: finite, > 0.
+    /// Outer radius of the Rd(r) grid [mm]: in (0, 10⁶].
     #[arg(long, default_value_t = 10.0, value_parser = crate::numeric::parse_finite)]
     pub r_max_mm: f64,
     /// Number of radial bins (uniform width r_max/bins): a count ≥ 1, within the memory budget
@@ -63,11 +64,16 @@ pub struct Args {
     #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
           help = crate::numeric::MAX_INTERACTIONS_HELP)]
     pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_count, help = crate::numeric::MAX_MEMORY_HELP)]
+    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
     pub max_memory_mib: Option<u64>,
-    /// Write the profile as CSV (r_inner_mm, r_outer_mm, r_mm, rd_per_mm2, rd_stderr_per_mm2).
+    /// Write the result to FILE: `.csv` the profile (r_inner_mm, r_outer_mm, r_mm, rd_per_mm2,
+    /// rd_stderr_per_mm2), `.json` the whole result as --json prints it. Checked before the run; an
+    /// existing file only with --force.
+    #[arg(short = 'o', long = "output", alias = "out", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Replace an existing output file.
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub force: bool,
     /// Print the whole result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -95,9 +101,17 @@ struct Report<'a> {
 /// Parses `pencil`, `disk:R`, `gauss:R` (R in mm).
 fn parse_beam(text: &str) -> anyhow::Result<BeamProfile> {
     let radius = |r: &str| -> anyhow::Result<f64> {
-        r.trim()
+        let v = r
+            .trim()
             .parse::<f64>()
-            .with_context(|| format!("--beam {text}: `{r}` is not a radius in mm"))
+            .with_context(|| format!("--beam {text}: `{r}` is not a radius in mm"))?;
+        crate::numeric::ensure(
+            v > 0.0 && v <= 1000.0,
+            "--beam",
+            text,
+            "the beam radius must lie in (0, 1000] mm",
+        )?;
+        Ok(v)
     };
     match text.split_once(':') {
         None if text == "pencil" => Ok(BeamProfile::Pencil),
@@ -119,7 +133,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
         if ok {
             Ok(())
         } else {
-            bail!("{flag} {value}: {rule}")
+            bail!("{flag} {}: {rule}", crate::numeric::show(value))
         }
     };
     range(
@@ -168,10 +182,10 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
         "the angle of incidence must lie in [0, 90) degrees",
     )?;
     range(
-        args.r_max_mm > 0.0,
+        args.r_max_mm > 0.0 && args.r_max_mm <= 1e6,
         "--r-max-mm",
         args.r_max_mm,
-        "the outer radius must be > 0 mm",
+        "the outer radius must lie in (0, 1e6] mm",
     )?;
     if args.photons == 0 {
         bail!("--photons 0: trace at least one photon");
@@ -243,11 +257,23 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
 /// Runs `scatterfit simulate`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let sim = configure(&args)?;
+    if let Some(path) = &args.output {
+        crate::common::check_output_file(
+            path,
+            "-o",
+            crate::common::Format {
+                extensions: &["csv", "json"],
+                what: "simulate writes the profile as CSV (.csv) or the whole result as JSON (.json)",
+            },
+            &[],
+            args.force,
+        )?;
+    }
     let show = !args.quiet && std::io::stderr().is_terminal();
     let cost = sim.cost_estimate();
     let expected_s = cost.seconds(rayon::current_num_threads());
     if !args.quiet && expected_s > 10.0 {
-        eprintln!(
+        errln!(
             "expected work: {:.1e} interactions ({:.3e} per photon), about {} on {} threads",
             cost.interactions,
             cost.interactions_per_photon,
@@ -277,56 +303,64 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    if let Some(path) = &args.out {
-        let mut csv = String::from("r_inner_mm,r_outer_mm,r_mm,rd_per_mm2,rd_stderr_per_mm2\n");
-        let g = &result.grid;
-        for (i, e) in result.rd_profile.iter().enumerate() {
-            csv.push_str(&format!(
-                "{},{},{},{:e},{:e}\n",
-                g.edges()[i],
-                g.edges()[i + 1],
-                g.center(i),
-                e.value,
-                e.stderr
-            ));
-        }
-        scatterfit_io::atomic::write_atomic(path, csv.as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
     let rate = args.photons as f64 / elapsed.max(1e-9);
+    let report = Report {
+        sigma_s_prime: args.sigma_s_prime,
+        sigma_a: args.sigma_a,
+        eta: args.eta,
+        g: args.g,
+        thickness_mm: args.thickness_mm,
+        beam: &args.beam,
+        incidence_deg: args.incidence_deg,
+        elapsed_s: elapsed,
+        photons_per_s: rate,
+        threads: rayon::current_num_threads(),
+        result: &result,
+    };
+    if let Some(path) = &args.output {
+        let is_json = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        if is_json {
+            crate::output::write_json_file(path, &report)?;
+        } else {
+            let mut csv = String::from("r_inner_mm,r_outer_mm,r_mm,rd_per_mm2,rd_stderr_per_mm2\n");
+            let g = &result.grid;
+            for (i, e) in result.rd_profile.iter().enumerate() {
+                csv.push_str(&format!(
+                    "{},{},{},{:e},{:e}\n",
+                    g.edges()[i],
+                    g.edges()[i + 1],
+                    g.center(i),
+                    e.value,
+                    e.stderr
+                ));
+            }
+            scatterfit_io::atomic::write_atomic(path, csv.as_bytes())
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+    }
     if args.json {
-        crate::output::print_json(&Report {
-            sigma_s_prime: args.sigma_s_prime,
-            sigma_a: args.sigma_a,
-            eta: args.eta,
-            g: args.g,
-            thickness_mm: args.thickness_mm,
-            beam: &args.beam,
-            incidence_deg: args.incidence_deg,
-            elapsed_s: elapsed,
-            photons_per_s: rate,
-            threads: rayon::current_num_threads(),
-            result: &result,
-        })?;
+        crate::output::print_json(&report)?;
     } else {
         let e = |x: scatterfit_mc::Estimate| format!("{:.6} ± {:.6}", x.value, x.stderr);
-        println!("photons            {}", result.photons);
-        println!(
+        outln!("photons            {}", result.photons)?;
+        outln!(
             "interactions       {} ({:.1} per photon)",
             result.interactions,
             result.interactions as f64 / result.photons as f64
-        );
-        println!("specular R_sp      {:.6}", result.specular);
-        println!("diffuse Rd         {}", e(result.rd_total));
-        println!("transmitted Tt     {}", e(result.transmittance));
-        println!("absorbed A         {}", e(result.absorbed));
-        println!("sum (should be 1)  {}", e(result.conservation));
-        println!(
+        )?;
+        outln!("specular R_sp      {:.6}", result.specular)?;
+        outln!("diffuse Rd         {}", e(result.rd_total))?;
+        outln!("transmitted Tt     {}", e(result.transmittance))?;
+        outln!("absorbed A         {}", e(result.absorbed))?;
+        outln!("sum (should be 1)  {}", e(result.conservation))?;
+        outln!(
             "speed              {rate:.3e} photons/s on {} threads ({elapsed:.2} s)",
             rayon::current_num_threads()
-        );
-        if let Some(p) = &args.out {
-            println!("profile            {}", p.display());
+        )?;
+        if let Some(p) = &args.output {
+            outln!("wrote              {}", p.display())?;
         }
     }
     Ok(ExitCode::SUCCESS)

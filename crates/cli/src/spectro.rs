@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::output::outln;
 use anyhow::{Context, bail};
 use scatterfit_optics::colour::{Lab, Observer};
 use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
@@ -14,26 +15,27 @@ use serde::Serialize;
 pub struct Args {
     /// Spectrophotometer CSV: `wavelength_nm,sci,sce` (fractions) or `…,sci_pct,sce_pct` (percent).
     pub file: PathBuf,
-    /// Measured L*a*b* (D65) to use for the colour instead of the SCE spectrum.
+    /// Measured L*a*b* (D65) to use for the colour instead of the SCE spectrum: L* in [0, 100], a*
+    /// and b* finite.
     #[arg(long, num_args = 3, value_names = ["L", "A", "B"], allow_negative_numbers = true)]
     pub lab: Option<Vec<f64>>,
     /// Observer of --lab: 10 (the instrument default) or 2.
     #[arg(long, default_value_t = 10, value_name = "2|10")]
     pub observer: u32,
-    /// A known η to use instead of the one measured from SCI − SCE (e.g. for matte samples).
-    #[arg(long)]
+    /// A known η to use instead of the one measured from SCI − SCE (e.g. for matte samples), in
+    /// [1, 3].
+    #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: Option<f64>,
     /// Print the full result as JSON on stdout instead of the summary.
     #[arg(long)]
     pub json: bool,
-    /// Also write the full result as JSON to this file (atomically).
-    #[arg(
-        short = 'o',
-        long = "output",
-        visible_alias = "out",
-        value_name = "FILE"
-    )]
+    /// Also write the full result as JSON to this file (`.json`, atomically; checked before any work;
+    /// an existing file only with --force).
+    #[arg(short = 'o', long = "output", alias = "out", value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The JSON document `scatterfit spectro` writes.
@@ -54,18 +56,29 @@ pub struct SpectroReport<'a> {
 
 /// Runs `scatterfit spectro`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let reading = scatterfit_io::spectro::read_spectro_csv(&args.file)?;
     let options = options_from(&args)?;
+    if let Some(out) = &args.out {
+        crate::common::check_output_file(
+            out,
+            "-o",
+            crate::common::Format {
+                extensions: &["json"],
+                what: "the result is written as JSON",
+            },
+            &[args.file.as_path()],
+            args.force,
+        )?;
+    }
+    let reading = scatterfit_io::spectro::read_spectro_csv(&args.file)?;
     let analysis =
         analyse(&reading, &options).with_context(|| format!("{}", args.file.display()))?;
     if let Some(out) = &args.out {
-        refuse_overwriting_input(out, &args.file)?;
         crate::output::write_json_file(out, &report(&args, &analysis))?;
     }
     if args.json {
         crate::output::print_json(&report(&args, &analysis))?;
     } else {
-        print_summary(&args.file, &reading, &analysis);
+        print_summary(&args.file, &reading, &analysis)?;
     }
     Ok(if analysis.complete() {
         ExitCode::SUCCESS
@@ -90,9 +103,9 @@ fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
         }
     };
     if let Some(eta) = args.eta
-        && !(eta.is_finite() && eta >= 1.0)
+        && !(1.0..=3.0).contains(&eta)
     {
-        bail!("--eta {eta}: the relative refractive index must be a number ≥ 1");
+        bail!("--eta {eta}: the relative refractive index must lie in [1, 3]");
     }
     Ok(SpectroOptions { lab, eta: args.eta })
 }
@@ -115,46 +128,31 @@ fn analysis_lab(args: &Args) -> Option<Lab> {
     })
 }
 
-/// Refuses an output path that is the input file.
-pub fn refuse_overwriting_input(out: &Path, input: &Path) -> anyhow::Result<()> {
-    let same = match (out.canonicalize(), input.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => out == input,
-    };
-    if same {
-        bail!(
-            "refusing to write {} over the input; choose another --out",
-            out.display()
-        );
-    }
-    Ok(())
-}
-
-fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) {
-    let wl = &reading.wavelengths_nm;
-    println!(
+fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) -> anyhow::Result<()> {
+    let wl = reading.wavelengths_nm();
+    outln!(
         "{}: {} wavelengths, {}–{} nm",
         file.display(),
         wl.len(),
         wl.first().copied().unwrap_or(0.0),
         wl.last().copied().unwrap_or(0.0)
-    );
+    )?;
     match a.eta_source {
-        scatterfit_optics::spectro::EtaSource::Given => println!("η = {:.4} (given)", a.eta),
-        scatterfit_optics::spectro::EtaSource::SchlickSciMinusSce => println!(
+        scatterfit_optics::spectro::EtaSource::Given => outln!("η = {:.4} (given)", a.eta)?,
+        scatterfit_optics::spectro::EtaSource::SchlickSciMinusSce => outln!(
             "η = {:.4}  (Schlick at 8° from SCI − SCE = {:.5}, luminance-weighted; exact Fresnel: {})",
             a.eta,
             a.specular_mean,
             a.eta_exact_fresnel
                 .map_or("—".into(), |e| format!("{e:.4}"))
-        ),
+        )?,
     }
     let ch = |c: usize| {
         a.channels[c]
             .eta_channel
             .map_or("—".into(), |e| format!("{e:.4}"))
     };
-    println!(
+    outln!(
         "η per channel: R {}  G {}  B {}  (dispersion {})",
         ch(0),
         ch(1),
@@ -164,36 +162,47 @@ fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) {
         } else {
             "not significant"
         }
-    );
-    println!(
+    )?;
+    outln!(
         "SCE colour: L*a*b* D65/2° {:.3} {:.3} {:.3}   D65/10° {:.3} {:.3} {:.3}",
-        a.lab_2deg.l, a.lab_2deg.a, a.lab_2deg.b, a.lab_10deg.l, a.lab_10deg.a, a.lab_10deg.b
-    );
-    println!(
+        a.lab_2deg.l,
+        a.lab_2deg.a,
+        a.lab_2deg.b,
+        a.lab_10deg.l,
+        a.lab_10deg.a,
+        a.lab_10deg.b
+    )?;
+    outln!(
         "            XYZ 2° {:.4} {:.4} {:.4}   10° {:.4} {:.4} {:.4}",
-        a.xyz_2deg.x, a.xyz_2deg.y, a.xyz_2deg.z, a.xyz_10deg.x, a.xyz_10deg.y, a.xyz_10deg.z
-    );
+        a.xyz_2deg.x,
+        a.xyz_2deg.y,
+        a.xyz_2deg.z,
+        a.xyz_10deg.x,
+        a.xyz_10deg.y,
+        a.xyz_10deg.z
+    )?;
     let source = match a.colour_source {
         scatterfit_optics::spectro::ColourSource::SceSpectrum => "SCE spectrum",
         scatterfit_optics::spectro::ColourSource::Lab2 => "given L*a*b* (2°)",
         scatterfit_optics::spectro::ColourSource::Lab10 => "given L*a*b* (10°, Bradford to 2°)",
     };
-    println!(
+    outln!(
         "\nchannel  Rd (linear sRGB, from {source})   α′ (dipole, η = {:.4})",
         a.eta
-    );
+    )?;
     for (name, c) in ["R", "G", "B"].iter().zip(&a.channels) {
         let albedo = c.albedo_prime.map_or("—".to_owned(), |v| format!("{v:.6}"));
-        println!("{name:<8} {:<38.6} {albedo}", c.rd_total);
+        outln!("{name:<8} {:<38.6} {albedo}", c.rd_total)?;
     }
     for c in &a.channels {
         if let Some(p) = &c.problem {
-            println!("problem: {p}");
+            outln!("problem: {p}")?;
         }
     }
     for w in &a.warnings {
-        println!("warning: {w}");
+        outln!("warning: {w}")?;
     }
+    Ok(())
 }
 
 /// Contributes this area's figures to `scatterfit bench`: the dipole profile with derivatives (300

@@ -20,6 +20,7 @@ use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
 use serde::Serialize;
 
 use crate::common::cache_dir;
+use crate::output::{errln, out, outln};
 use crate::plot::{Figure, Panel, Series, SeriesStyle};
 use crate::twin::{Material, synthesize, write_sample};
 
@@ -204,7 +205,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     if !quiet {
-        eprintln!(
+        errln!(
             "study: {} samples ({} η × {} α′) on the {} rig, Monte Carlo cached in {}",
             samples.len(),
             args.etas.len(),
@@ -284,17 +285,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&rows)?;
     } else {
-        print!("{summary}");
-        println!(
+        out!("{summary}")?;
+        outln!(
             "\ntime: {synth_s:.0} s synthesising, {:.0} s fitting; files: {}/study.md, study.csv, study.png",
             t0.elapsed().as_secs_f64() - synth_s,
             out.display()
-        );
+        )?;
     }
     if !failed.is_empty() {
-        eprintln!("\n{} sample(s) failed:", failed.len());
+        errln!("\n{} sample(s) failed:", failed.len());
         for f in &failed {
-            eprintln!("  {f}");
+            errln!("  {f}");
         }
         return Ok(ExitCode::from(1));
     }

@@ -11,6 +11,7 @@ use scatterfit_synth::{RigSpec, materials};
 use serde::Serialize;
 
 use crate::common::{cache_dir, check_output_files, parse_rgb, shutter};
+use crate::output::outln;
 use crate::twin::{Material, synthesize, write_sample};
 
 /// Arguments of `scatterfit synth`.
@@ -27,16 +28,18 @@ pub struct Args {
     /// Absorption coefficient per channel R,G,B [mm⁻¹, each in (0, 100]].
     #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, requires = "sigma_s_prime")]
     pub sigma_a: Option<[f64; 3]>,
-    /// Relative refractive index η [1, 3] (overrides the material's).
-    #[arg(long)]
+    /// Relative refractive index η, in [1, 3] (overrides the material's).
+    #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: Option<f64>,
     /// Sample name (default: the material's, or "synthetic").
     #[arg(long)]
     pub name: Option<String>,
-    /// Folder to write (created; existing files are not overwritten without --force).
+    /// Folder to write (created; checked before the Monte Carlo runs; existing files are not
+    /// overwritten without --force).
     #[arg(short = 'o', long = "output-dir", value_name = "DIR")]
     pub output_dir: PathBuf,
-    /// Seed of the Monte Carlo runs, the spot position, the gains and the camera noise.
+    /// Seed of the Monte Carlo runs, the spot position, the gains and the camera noise, 0 to
+    /// 2⁶⁴ − 1.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// A small fast sample (256 × 256 px at 0.1 mm/px, a tenth of the photons) for trying the tool
@@ -110,6 +113,7 @@ struct Summary<'a> {
 /// Runs `scatterfit synth`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let m = material_from(&args)?;
+    crate::common::check_output_dir(&args.output_dir, "-o")?;
     let rig = if args.quick {
         RigSpec::quick()
     } else {
@@ -135,7 +139,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             truth: &sample.truth,
         })?;
     } else {
-        println!(
+        outln!(
             "wrote {} ({} exposures {}–{} s, {}×{} px at {} mm/px, spot ⌀ {} mm)",
             args.output_dir.display(),
             sample.bracket.times_s.len(),
@@ -145,10 +149,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             rig.height,
             rig.mm_per_pixel,
             2.0 * rig.spot_radius_mm
-        );
-        println!("truth    η = {:.4}", sample.truth.eta);
+        )?;
+        outln!("truth    η = {:.4}", sample.truth.eta)?;
         for (name, c) in ["R", "G", "B"].iter().zip(&sample.truth.channels) {
-            println!(
+            outln!(
                 "  {name}  σ′s = {:<8} σa = {:<10} α′ = {:.5}  Rd(MC) = {:.4} ± {:.4}  ({} photons)",
                 c.sigma_s_prime,
                 c.sigma_a,
@@ -156,12 +160,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 c.rd_total,
                 c.rd_total_stderr,
                 c.photons
-            );
+            )?;
         }
-        println!(
+        outln!(
             "measure it with: scatterfit measure {}",
             args.output_dir.display()
-        );
+        )?;
     }
     Ok(ExitCode::SUCCESS)
 }

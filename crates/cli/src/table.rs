@@ -4,8 +4,9 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use crate::output::{errln, outln};
 use anyhow::{Context, bail};
-use scatterfit_mc::table::{CacheStatus, ProfileTable, TableSpec, default_cache_dir};
+use scatterfit_mc::table::{CacheStatus, ProfileTable, TableSpec};
 use serde::Serialize;
 
 /// Arguments of `scatterfit table`. Every number is checked before any work (exit 2 when out of
@@ -38,7 +39,7 @@ pub struct Args {
     #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
           help = crate::numeric::MAX_INTERACTIONS_HELP)]
     pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_count, help = crate::numeric::MAX_MEMORY_HELP)]
+    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
     pub max_memory_mib: Option<u64>,
     /// Print the table summary as JSON.
     #[arg(long)]
@@ -56,7 +57,7 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
     if !(args.eta > 0.0 && args.eta <= 10.0) {
         bail!(
             "--eta {}: the relative refractive index must lie in (0, 10]",
-            args.eta
+            crate::numeric::show(args.eta)
         );
     }
     if args.eta < 1.0 && !args.allow_eta_below_one {
@@ -68,7 +69,7 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
     if !(args.g > -1.0 && args.g < 1.0) {
         bail!(
             "--g {}: the Henyey–Greenstein asymmetry must lie in (−1, 1)",
-            args.g
+            crate::numeric::show(args.g)
         );
     }
     if !args.coarse {
@@ -132,15 +133,19 @@ struct Summary {
 /// Runs `scatterfit table`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let spec = spec_from(&args)?;
-    let dir = match args.cache_dir.clone().or_else(default_cache_dir) {
+    let dir = match crate::common::cache_dir(args.cache_dir.as_deref()) {
         Some(d) => d,
         None => bail!("no cache folder: pass --cache-dir or set SCATTERFIT_CACHE"),
     };
     let cached = dir.join(spec.file_name()).is_file();
+    if !cached {
+        // The table is written there once built: find out now, not after the build.
+        crate::common::check_output_dir(&dir, "--cache-dir")?;
+    }
     let cost = spec.cost_estimate()?;
     let expected_s = cost.seconds(rayon::current_num_threads());
     if !args.quiet && !cached && expected_s > 10.0 {
-        eprintln!(
+        errln!(
             "expected work: {:.1e} interactions, about {} on {} threads",
             cost.interactions,
             crate::numeric::describe_seconds(expected_s),
@@ -185,17 +190,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&summary)?;
     } else {
-        println!("table   {} ({})", summary.path.display(), summary.status);
-        println!(
+        outln!("table   {} ({})", summary.path.display(), summary.status)?;
+        outln!(
             "eta {}  g {}  {} radial bins  {} photons/albedo",
             spec.eta(),
             spec.g(),
             summary.radial_bins,
             spec.photons_per_albedo()
-        );
-        println!("{:>10} {:>12} {:>10}", "albedo'", "Rd total", "s.e.");
+        )?;
+        outln!("{:>10} {:>12} {:>10}", "albedo'", "Rd total", "s.e.")?;
         for ((a, r), s) in spec.albedos().iter().zip(tot).zip(se) {
-            println!("{a:>10.6} {r:>12.6} {s:>10.6}");
+            outln!("{a:>10.6} {r:>12.6} {s:>10.6}")?;
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -30,7 +30,7 @@
 //!     .collect();
 //! let mut opts = FitOptions::new(Method::Proposed);
 //! opts.spot = Spot::Point;
-//! opts.selection.r_min_mm = 0.5;
+//! opts.selection = opts.selection.with_r_min_mm(0.5)?;
 //! let input = ChannelInput { eta: 1.3, albedo_prime: Some(truth.albedo_prime()), rd_total: None };
 //! let report = fit_channel(&ProfileData::new(rings)?, &input, &DipoleModel, &opts)?;
 //! assert!((report.sigma_s_prime.value / 1.2 - 1.0).abs() < 1e-6);
@@ -124,7 +124,7 @@ impl FitOptions {
             spot: Spot::Disk {
                 radius_mm: DEFAULT_SPOT_RADIUS_MM,
             },
-            selection: RingSelection::for_spot(DEFAULT_SPOT_RADIUS_MM),
+            selection: RingSelection::DEFAULT,
             normalise_with_spectro: false,
             start: None,
             patience: 100,

@@ -26,10 +26,25 @@ pub struct Ring {
     pub detection_limit: f64,
 }
 
-/// A measured radial profile of one channel, rings from the centre out.
+/// A measured radial profile of one channel, rings from the centre out. Made by
+/// [`ProfileData::new`] (also when read from JSON), so its radii are finite, ≥ 0 and increasing.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(try_from = "ProfileDataFields")]
 pub struct ProfileData {
     rings: Vec<Ring>,
+}
+
+/// [`ProfileData`] as written, before its checks.
+#[derive(Deserialize)]
+struct ProfileDataFields {
+    rings: Vec<Ring>,
+}
+
+impl TryFrom<ProfileDataFields> for ProfileData {
+    type Error = FitError;
+    fn try_from(f: ProfileDataFields) -> Result<Self> {
+        Self::new(f.rings)
+    }
 }
 
 impl ProfileData {
@@ -66,34 +81,148 @@ impl ProfileData {
     }
 }
 
-/// Which rings a fit may use.
+/// Which rings a fit may use. Made by [`RingSelection::new`] or [`RingSelection::for_spot`] and
+/// changed through the checked `with_*` methods (also when read from JSON), so it is always valid.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RingSelectionFields")]
 pub struct RingSelection {
-    /// Innermost radius fitted [mm]; rings inside are counted as "inside the spot". Default: the
-    /// spot's diameter (twice its radius), see [`RingSelection::for_spot`].
-    pub r_min_mm: f64,
-    /// Outermost radius fitted [mm] (∞: every ring of the profile).
-    pub r_max_mm: f64,
-    /// A ring is fitted only if its value is at least this multiple of its detection limit.
-    pub detection_factor: f64,
-    /// Relative standard error floor of a ring (calibration and merge accuracy): a ring's weight
-    /// never exceeds 1/floor² in the log residual.
-    pub relative_error_floor: f64,
+    r_min_mm: f64,
+    r_max_mm: f64,
+    detection_factor: f64,
+    relative_error_floor: f64,
+}
+
+/// [`RingSelection`] as written, before its checks.
+#[derive(Deserialize)]
+struct RingSelectionFields {
+    r_min_mm: f64,
+    r_max_mm: f64,
+    detection_factor: f64,
+    relative_error_floor: f64,
+}
+
+impl TryFrom<RingSelectionFields> for RingSelection {
+    type Error = FitError;
+    fn try_from(f: RingSelectionFields) -> Result<Self> {
+        Self::new(
+            f.r_min_mm,
+            f.r_max_mm,
+            f.detection_factor,
+            f.relative_error_floor,
+        )
+    }
 }
 
 impl RingSelection {
-    /// The defaults for a uniform light spot of radius `spot_radius_mm`: fit from one spot diameter
-    /// out, every ring above its detection limit, 0.5 % error floor.
-    pub fn for_spot(spot_radius_mm: f64) -> Self {
-        Self {
-            r_min_mm: 2.0 * spot_radius_mm,
-            r_max_mm: f64::INFINITY,
-            detection_factor: 1.0,
-            relative_error_floor: 5e-3,
-        }
+    /// The default error floor: 0.5 % (calibration and merge accuracy).
+    pub const DEFAULT_ERROR_FLOOR: f64 = 5e-3;
+
+    /// [`RingSelection::for_spot`] of the default spot (radius [`crate::DEFAULT_SPOT_RADIUS_MM`]).
+    pub const DEFAULT: Self = Self {
+        r_min_mm: 2.0 * crate::DEFAULT_SPOT_RADIUS_MM,
+        r_max_mm: f64::INFINITY,
+        detection_factor: 1.0,
+        relative_error_floor: Self::DEFAULT_ERROR_FLOOR,
+    };
+
+    /// Fit the rings from `r_min_mm` to `r_max_mm` (∞: every ring of the profile) [mm] whose value is
+    /// at least `detection_factor` × their detection limit, each weighted with a relative standard
+    /// error of at least `relative_error_floor` (a ring's weight never exceeds 1/floor² in the log
+    /// residual).
+    ///
+    /// # Errors
+    /// [`FitError::InvalidInput`] for r_min not finite and ≥ 0, r_max not above r_min, a factor not
+    /// finite and ≥ 0, or a floor not finite and > 0.
+    pub fn new(
+        r_min_mm: f64,
+        r_max_mm: f64,
+        detection_factor: f64,
+        relative_error_floor: f64,
+    ) -> Result<Self> {
+        let s = Self {
+            r_min_mm,
+            r_max_mm,
+            detection_factor,
+            relative_error_floor,
+        };
+        s.validate()?;
+        Ok(s)
     }
 
-    pub(crate) fn validate(&self) -> Result<()> {
+    /// The defaults for a uniform light spot of radius `spot_radius_mm`: fit from one spot diameter
+    /// out, every ring above its detection limit, 0.5 % error floor.
+    ///
+    /// # Errors
+    /// As [`RingSelection::new`] (a radius that is not finite and ≥ 0).
+    pub fn for_spot(spot_radius_mm: f64) -> Result<Self> {
+        Self::new(
+            2.0 * spot_radius_mm,
+            f64::INFINITY,
+            1.0,
+            Self::DEFAULT_ERROR_FLOOR,
+        )
+    }
+
+    /// The same with another innermost radius [mm].
+    ///
+    /// # Errors
+    /// As [`RingSelection::new`].
+    pub fn with_r_min_mm(self, r_min_mm: f64) -> Result<Self> {
+        Self::new(
+            r_min_mm,
+            self.r_max_mm,
+            self.detection_factor,
+            self.relative_error_floor,
+        )
+    }
+
+    /// The same with another outermost radius [mm].
+    ///
+    /// # Errors
+    /// As [`RingSelection::new`].
+    pub fn with_r_max_mm(self, r_max_mm: f64) -> Result<Self> {
+        Self::new(
+            self.r_min_mm,
+            r_max_mm,
+            self.detection_factor,
+            self.relative_error_floor,
+        )
+    }
+
+    /// The same with another detection factor (0: fit rings below their detection limit too).
+    ///
+    /// # Errors
+    /// As [`RingSelection::new`].
+    pub fn with_detection_factor(self, detection_factor: f64) -> Result<Self> {
+        Self::new(
+            self.r_min_mm,
+            self.r_max_mm,
+            detection_factor,
+            self.relative_error_floor,
+        )
+    }
+
+    /// Innermost radius fitted [mm]; rings inside are counted as "inside the spot".
+    pub fn r_min_mm(&self) -> f64 {
+        self.r_min_mm
+    }
+
+    /// Outermost radius fitted [mm] (∞: every ring of the profile).
+    pub fn r_max_mm(&self) -> f64 {
+        self.r_max_mm
+    }
+
+    /// A ring is fitted only if its value is at least this multiple of its detection limit.
+    pub fn detection_factor(&self) -> f64 {
+        self.detection_factor
+    }
+
+    /// Relative standard error floor of a ring.
+    pub fn relative_error_floor(&self) -> f64 {
+        self.relative_error_floor
+    }
+
+    fn validate(&self) -> Result<()> {
         check(
             self.r_min_mm.is_finite() && self.r_min_mm >= 0.0,
             "r_min_mm",
@@ -143,9 +272,8 @@ pub struct Selected {
 /// Applies `sel` to `profile`.
 ///
 /// # Errors
-/// [`FitError::InvalidInput`] for bad options.
+/// None today (the selection is valid by construction); kept for future checks.
 pub fn select_rings(profile: &ProfileData, sel: &RingSelection) -> Result<Selected> {
-    sel.validate()?;
     let mut s = Selected {
         r_mm: Vec::new(),
         value: Vec::new(),

@@ -3,8 +3,8 @@
 //! directions, and the proposed method on MCML's independent profiles.
 
 use scatterfit_fit::{
-    ChannelInput, DipoleModel, FitError, FitOptions, Method, ProfileData, Ring, Spot, Start,
-    fit_channel,
+    ChannelInput, DipoleModel, FitError, FitOptions, Method, ProfileData, Ring, RingSelection,
+    Spot, Start, fit_channel,
 };
 use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
@@ -306,7 +306,7 @@ fn rings_below_detection_are_excluded_not_fitted() {
     );
     assert!(rel(rep.sigma_a.value, sa) < 5e-3, "{}", rep.sigma_a.value);
     let mut blind = opts;
-    blind.selection.detection_factor = 0.0;
+    blind.selection = blind.selection.with_detection_factor(0.0).unwrap();
     let biased = fit_channel(&data, &input, &DipoleModel, &blind).unwrap();
     assert_eq!(biased.rings_below_detection, 0);
     assert!(
@@ -417,8 +417,8 @@ fn proposed_method_on_mcml_profiles() {
             .collect();
         let mut opts = FitOptions::new(Method::Proposed);
         opts.spot = Spot::Point;
-        opts.selection.r_min_mm = 1.0;
-        opts.selection.r_max_mm = 15.0;
+        opts.selection =
+            RingSelection::new(1.0, 15.0, 1.0, RingSelection::DEFAULT_ERROR_FLOOR).unwrap();
         let rep = fit_channel(
             &ProfileData::new(rings).unwrap(),
             &ChannelInput {

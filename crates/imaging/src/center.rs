@@ -7,12 +7,34 @@
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result};
 
-/// Options of [`find_spot_center`].
+/// Options of [`find_spot_center`]; built through [`CenterOptions::new`], so always valid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CenterOptions {
-    /// The spot is where the (channel-mean) radiance exceeds this fraction of the spot's robust
-    /// maximum. Default 0.01 (the centroid then uses the top two decades of the spot).
-    pub threshold_fraction: f64,
+    threshold_fraction: f64,
+}
+
+impl CenterOptions {
+    /// Options with the spot's threshold: the spot is where the (channel-mean) radiance exceeds
+    /// this fraction of the spot's robust maximum (default 0.01: the centroid then uses the top two
+    /// decades of the spot).
+    ///
+    /// # Errors
+    /// [`ImagingError::InvalidOption`] for a fraction outside (0, 1).
+    pub fn new(threshold_fraction: f64) -> Result<Self> {
+        if !(threshold_fraction > 0.0 && threshold_fraction < 1.0) {
+            return Err(ImagingError::InvalidOption {
+                name: "threshold_fraction",
+                value: threshold_fraction,
+                reason: "must lie in (0, 1)",
+            });
+        }
+        Ok(Self { threshold_fraction })
+    }
+
+    /// The threshold as a fraction of the spot's robust maximum, in (0, 1).
+    pub fn threshold_fraction(&self) -> f64 {
+        self.threshold_fraction
+    }
 }
 
 impl Default for CenterOptions {
@@ -23,17 +45,14 @@ impl Default for CenterOptions {
     }
 }
 
-/// A spot centre and what it was found from.
+/// A spot centre and what it was found from: found by [`find_spot_center`] or given through
+/// [`SpotCenter::given`], so its coordinates are finite and inside the image it belongs to.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpotCenter {
-    /// x in pixels (pixel centres at integers).
-    pub x: f64,
-    /// y in pixels.
-    pub y: f64,
-    /// Pixels in the spot's connected bright region (0 for a given centre).
-    pub spot_pixels: usize,
-    /// Radiance threshold that delimited the region (NaN for a given centre).
-    pub threshold: f64,
+    x: f64,
+    y: f64,
+    spot_pixels: usize,
+    threshold: f64,
 }
 
 impl SpotCenter {
@@ -62,9 +81,29 @@ impl SpotCenter {
         })
     }
 
-    /// `[x, y]`.
+    /// `[x, y]` in pixels (pixel centres at integers).
     pub fn xy(&self) -> [f64; 2] {
         [self.x, self.y]
+    }
+
+    /// x in pixels (pixel centres at integers).
+    pub fn x(&self) -> f64 {
+        self.x
+    }
+
+    /// y in pixels.
+    pub fn y(&self) -> f64 {
+        self.y
+    }
+
+    /// Pixels in the spot's connected bright region (0 for a given centre).
+    pub fn spot_pixels(&self) -> usize {
+        self.spot_pixels
+    }
+
+    /// Radiance threshold that delimited the region (NaN for a given centre).
+    pub fn threshold(&self) -> f64 {
+        self.threshold
     }
 }
 
@@ -83,17 +122,9 @@ impl SpotCenter {
 ///    noisy edge adds little, and a flat clipped core is symmetric and does not bias the result.
 ///
 /// # Errors
-/// [`ImagingError::InvalidOption`] for a fraction outside (0, 1), [`ImagingError::NoSpot`] if the image
-/// has no positive finite value.
+/// [`ImagingError::NoSpot`] if the image has no positive finite value.
 pub fn find_spot_center(img: &ImageBuf<f32>, opts: &CenterOptions) -> Result<SpotCenter> {
     let frac = opts.threshold_fraction;
-    if !(frac > 0.0 && frac < 1.0) {
-        return Err(ImagingError::InvalidOption {
-            name: "threshold_fraction",
-            value: frac,
-            reason: "must lie in (0, 1)",
-        });
-    }
     let (w, h) = (img.width(), img.height());
     let lum = |x: usize, y: usize| -> f64 { channel_mean(img.pixel(x, y).unwrap_or(&[])) };
     // 1. Binned, smoothed luminance.

@@ -137,7 +137,8 @@ pub enum Weighting {
     DebevecHat,
 }
 
-/// Options of [`merge`].
+/// Options of [`merge`]. Its fields are public: two enums, every combination valid (nothing to
+/// check, unlike [`LinearMergeOptions`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MergeOptions {
     /// Value of pixel-channels clipped in every exposure.
@@ -146,14 +147,43 @@ pub struct MergeOptions {
     pub weighting: Weighting,
 }
 
-/// Options of [`merge_linear_u16`].
+/// Options of [`merge_linear_u16`]; built through [`LinearMergeOptions::new`], so always valid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearMergeOptions {
-    /// Raw value at and above which a sample counts as saturated (many sensors clip below 65535,
-    /// e.g. 4095 × 16 for 12-bit data). Default 65535.
-    pub saturation: u16,
-    /// Value of pixel-channels clipped in every exposure.
-    pub clipped_fill: ClippedFill,
+    saturation: u16,
+    clipped_fill: ClippedFill,
+}
+
+impl LinearMergeOptions {
+    /// Options with the raw value at and above which a sample counts as saturated (many sensors
+    /// clip below 65535, e.g. 4095 × 16 for 12-bit data; default 65535) and the value of
+    /// pixel-channels clipped in every exposure.
+    ///
+    /// # Errors
+    /// [`ImagingError::InvalidOption`] for a saturation below 2 (the hat weight needs a range).
+    pub fn new(saturation: u16, clipped_fill: ClippedFill) -> Result<Self> {
+        if saturation < 2 {
+            return Err(ImagingError::InvalidOption {
+                name: "saturation",
+                value: f64::from(saturation),
+                reason: "must be ≥ 2",
+            });
+        }
+        Ok(Self {
+            saturation,
+            clipped_fill,
+        })
+    }
+
+    /// The saturation level [raw value], ≥ 2.
+    pub fn saturation(&self) -> u16 {
+        self.saturation
+    }
+
+    /// The value of pixel-channels clipped in every exposure.
+    pub fn clipped_fill(&self) -> ClippedFill {
+        self.clipped_fill
+    }
 }
 
 impl Default for LinearMergeOptions {
@@ -516,7 +546,7 @@ fn merge_row_lut(rows: &[&[u8]], t: &Tables, out: &mut [f32], den: &mut [f32]) {
 /// value counts as clipped low; saturation is judged on the raw value.
 ///
 /// # Errors
-/// Bracket errors, a dark frame of another shape, [`ImagingError::InvalidOption`] for saturation < 2,
+/// Bracket errors, a dark frame of another shape,
 /// [`ImagingError::DarkFrameAboveSignal`], [`ImagingError::NoValidRadiance`] (as [`merge`]).
 pub fn merge_linear_u16(
     frames: &[ImageBuf<u16>],
@@ -532,13 +562,6 @@ pub fn merge_linear_u16(
         check_dark(frames, times_s, d)?;
     }
     let sat = opts.saturation;
-    if sat < 2 {
-        return Err(ImagingError::InvalidOption {
-            name: "saturation",
-            value: f64::from(sat),
-            reason: "must be ≥ 2",
-        });
-    }
     // Hat weight over the signal range [dark, saturation] (called with dark < v < saturation).
     let weight = |v: u16, vd: u16| -> f32 { f32::from((v - vd).min(sat - v)) };
     let ln_t: Vec<f32> = times_s.iter().map(|t| t.ln() as f32).collect();

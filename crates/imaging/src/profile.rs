@@ -11,13 +11,60 @@ use crate::error::{ImagingError, Result, check_shape};
 /// for RGB, far more than a light spot's profile needs (the paper uses 300).
 pub const MAX_RINGS: usize = 1_000_000;
 
-/// Options of [`radial_profile`].
+/// Options of [`radial_profile`]; built through [`ProfileOptions::new`], so the ring count is
+/// bounded before anything is allocated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProfileOptions {
-    /// Ring width in pixels. Default 1.
-    pub ring_width_px: f64,
-    /// Outer radius in pixels (exclusive). Default 300, the paper's cut-off.
-    pub r_max_px: f64,
+    ring_width_px: f64,
+    r_max_px: f64,
+}
+
+impl ProfileOptions {
+    /// Rings of `ring_width_px` (default 1) out to `r_max_px` (exclusive; default 300, the paper's
+    /// cut-off), both in pixels.
+    ///
+    /// # Errors
+    /// [`ImagingError::InvalidOption`] for a width or radius that is not finite and > 0, or more than
+    /// [`MAX_RINGS`] rings (`ring_width_px` = 1e-300 would otherwise ask for an impossible
+    /// allocation).
+    pub fn new(ring_width_px: f64, r_max_px: f64) -> Result<Self> {
+        for (name, v) in [("ring_width_px", ring_width_px), ("r_max_px", r_max_px)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ImagingError::InvalidOption {
+                    name,
+                    value: v,
+                    reason: "must be finite and > 0",
+                });
+            }
+        }
+        let rings = (r_max_px / ring_width_px).ceil();
+        if rings > MAX_RINGS as f64 {
+            return Err(ImagingError::InvalidOption {
+                name: "r_max_px / ring_width_px",
+                value: rings,
+                reason: "more than 1 000 000 rings (MAX_RINGS); widen the rings or reduce r_max",
+            });
+        }
+        Ok(Self {
+            ring_width_px,
+            r_max_px,
+        })
+    }
+
+    /// Ring width [px].
+    pub fn ring_width_px(&self) -> f64 {
+        self.ring_width_px
+    }
+
+    /// Outer radius [px] (exclusive).
+    pub fn r_max_px(&self) -> f64 {
+        self.r_max_px
+    }
+
+    /// Number of rings, ⌈r_max / width⌉ ≤ [`MAX_RINGS`].
+    pub fn rings(&self) -> usize {
+        (self.r_max_px / self.ring_width_px).ceil() as usize
+    }
 }
 
 impl Default for ProfileOptions {
@@ -89,8 +136,8 @@ impl RadialProfile {
 /// `mask` (e.g. [`crate::HdrImage::clipped`]; same shape as `img`) is non-zero there.
 ///
 /// # Errors
-/// [`ImagingError::InvalidOption`] for a non-positive ring width, r_max or mm per pixel, or more
-/// than [`MAX_RINGS`] rings;
+/// [`ImagingError::InvalidOption`] for a non-positive mm per pixel (the ring options are valid by
+/// construction, [`ProfileOptions::new`]);
 /// [`ImagingError::CenterOutside`] for a non-finite centre; [`ImagingError::ShapeMismatch`] for a mask
 /// of another shape.
 pub fn radial_profile(
@@ -111,8 +158,6 @@ pub fn radial_profile(
             })
         }
     };
-    positive("ring_width_px", opts.ring_width_px)?;
-    positive("r_max_px", opts.r_max_px)?;
     positive("mm_per_pixel", mm_per_pixel)?;
     let [cx, cy] = center_px;
     let (w, h, ch) = (img.width(), img.height(), img.channels());
@@ -129,15 +174,7 @@ pub fn radial_profile(
     }
     let width = opts.ring_width_px;
     let r_max = opts.r_max_px;
-    let rings = (r_max / width).ceil();
-    if rings > MAX_RINGS as f64 {
-        return Err(ImagingError::InvalidOption {
-            name: "r_max_px / ring_width_px",
-            value: rings,
-            reason: "more than 1 000 000 rings (MAX_RINGS); widen the rings or reduce r_max",
-        });
-    }
-    let n_rings = rings as usize;
+    let n_rings = opts.rings();
     // Per ring: pixel count and Σr over in-image pixels; per ring and channel: n, Σv, Σv², Σr.
     let mut geo = vec![(0usize, 0.0f64); n_rings];
     let mut acc = vec![[0.0f64; 4]; n_rings * ch];
@@ -232,12 +269,13 @@ mod tests {
     #[test]
     fn ring_count_is_bounded() {
         let img = ImageBuf::filled(8, 8, 1, 1.0f32).unwrap();
-        for (width, r_max) in [(1e-300, 300.0), (1.0, 1e13), (1e-3, 1001.0)] {
-            let opts = ProfileOptions {
-                ring_width_px: width,
-                r_max_px: r_max,
-            };
-            let err = radial_profile(&img, [4.0, 4.0], None, 0.1, &opts).unwrap_err();
+        for (width, r_max) in [
+            (1e-300, 300.0),
+            (1.0, 1e13),
+            (1e-3, 1001.0),
+            (1e-300, 1e300),
+        ] {
+            let err = ProfileOptions::new(width, r_max).unwrap_err();
             assert!(
                 matches!(
                     err,
@@ -249,10 +287,7 @@ mod tests {
                 "{err:?}"
             );
         }
-        let opts = ProfileOptions {
-            ring_width_px: 1e-3,
-            r_max_px: 1000.0,
-        };
+        let opts = ProfileOptions::new(1e-3, 1000.0).unwrap();
         let p = radial_profile(&img, [4.0, 4.0], None, 0.1, &opts).unwrap();
         assert_eq!(p.rings.len(), MAX_RINGS);
     }

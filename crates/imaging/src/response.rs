@@ -143,16 +143,49 @@ impl ResponseCurve {
     }
 }
 
-/// Options of [`recover_response`].
+/// Options of [`recover_response`]; built through [`CalibrateOptions::new`], so always valid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrateOptions {
-    /// Number of sample pixels N per channel (OpenCV's default is 70; Debevec & Malik ask for
-    /// N(P − 1) > 255 with P frames). Default 100; [`recover_response`] accepts
-    /// [`min_response_samples`]`(P)` to [`MAX_RESPONSE_SAMPLES`].
-    pub samples: usize,
-    /// Smoothness weight λ of the second-difference rows (Debevec & Malik 1997, eq. 3). Default 10,
-    /// OpenCV's default.
-    pub lambda: f64,
+    samples: usize,
+    lambda: f64,
+}
+
+impl CalibrateOptions {
+    /// Options with N sample pixels per channel (OpenCV's default is 70; Debevec & Malik ask for
+    /// N(P − 1) > 255 with P frames; default 100) and the smoothness weight λ of the
+    /// second-difference rows (Debevec & Malik 1997, eq. 3; default 10, OpenCV's).
+    ///
+    /// # Errors
+    /// [`ImagingError::InvalidOption`] for N outside 1..=[`MAX_RESPONSE_SAMPLES`] (the lower bound
+    /// for a bracket, [`min_response_samples`]`(P)`, is checked by [`recover_response`], which
+    /// knows P) or λ not finite and ≥ 0.
+    pub fn new(samples: usize, lambda: f64) -> Result<Self> {
+        if !(1..=MAX_RESPONSE_SAMPLES).contains(&samples) {
+            return Err(ImagingError::InvalidOption {
+                name: "samples",
+                value: samples as f64,
+                reason: "must lie in 1..=1000 (MAX_RESPONSE_SAMPLES) sample pixels per channel",
+            });
+        }
+        if !(lambda.is_finite() && lambda >= 0.0) {
+            return Err(ImagingError::InvalidOption {
+                name: "lambda",
+                value: lambda,
+                reason: "must be finite and ≥ 0",
+            });
+        }
+        Ok(Self { samples, lambda })
+    }
+
+    /// Sample pixels per channel.
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// Smoothness weight λ.
+    pub fn lambda(&self) -> f64 {
+        self.lambda
+    }
 }
 
 impl Default for CalibrateOptions {

@@ -392,11 +392,18 @@ fn sample_count_is_bounded_by_the_unknowns() {
     assert_eq!(min_response_samples(2), 256);
     let s = scene();
     let frames = bracket(&s, 1.0, 7);
-    let opts = |samples| CalibrateOptions {
-        samples,
-        ..Default::default()
-    };
-    for n in [0, 1, 21, MAX_RESPONSE_SAMPLES + 1, usize::MAX] {
+    let opts = |samples| CalibrateOptions::new(samples, 10.0).unwrap();
+    // Outside 1..=1000 the options cannot be made at all; below the bracket's minimum the recovery
+    // refuses them.
+    for n in [0, MAX_RESPONSE_SAMPLES + 1, usize::MAX] {
+        assert!(matches!(
+            CalibrateOptions::new(n, 10.0),
+            Err(ImagingError::InvalidOption { .. })
+        ));
+    }
+    assert!(CalibrateOptions::new(100, -1.0).is_err());
+    assert!(CalibrateOptions::new(100, f64::INFINITY).is_err());
+    for n in [1, 21] {
         let err = recover_response(&frames, &times(), &opts(n)).unwrap_err();
         assert!(
             matches!(

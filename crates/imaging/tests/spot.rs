@@ -72,13 +72,16 @@ fn center_within_005_px_on_noisy_clipped_spot_with_speck() {
     ] {
         let img = noisy_spot(cx, cy, seed);
         let c = find_spot_center(&img, &CenterOptions::default()).unwrap();
-        let err = ((c.x - cx).powi(2) + (c.y - cy).powi(2)).sqrt();
-        eprintln!("seed {seed}: error {err:.4} px, {} spot px", c.spot_pixels);
+        let err = ((c.x() - cx).powi(2) + (c.y() - cy).powi(2)).sqrt();
+        eprintln!(
+            "seed {seed}: error {err:.4} px, {} spot px",
+            c.spot_pixels()
+        );
         assert!(
             err < 0.05,
             "seed {seed}: found ({:.3}, {:.3}), true ({cx}, {cy}), error {err:.4} px",
-            c.x,
-            c.y
+            c.x(),
+            c.y()
         );
     }
 }
@@ -91,18 +94,18 @@ fn center_exact_on_clean_and_flat_topped_spots() {
     let img = render(400, 300, cx, cy, &[1.0], spot);
     let c = find_spot_center(&img, &CenterOptions::default()).unwrap();
     assert!(
-        (c.x - cx).abs() < 0.01 && (c.y - cy).abs() < 0.01,
+        (c.x() - cx).abs() < 0.01 && (c.y() - cy).abs() < 0.01,
         "({}, {})",
-        c.x,
-        c.y
+        c.x(),
+        c.y()
     );
     let flat = render(400, 300, cx, cy, &[1.0], |r| spot(r).min(400.0));
     let c = find_spot_center(&flat, &CenterOptions::default()).unwrap();
     assert!(
-        (c.x - cx).abs() < 0.01 && (c.y - cy).abs() < 0.01,
+        (c.x() - cx).abs() < 0.01 && (c.y() - cy).abs() < 0.01,
         "({}, {})",
-        c.x,
-        c.y
+        c.x(),
+        c.y()
     );
 }
 
@@ -114,13 +117,12 @@ fn center_refuses_bad_input() {
         Err(ImagingError::NoSpot { .. })
     ));
     let img = render(50, 40, 20.0, 20.0, &[1.0], spot);
-    let bad = CenterOptions {
-        threshold_fraction: 1.5,
-    };
-    assert!(matches!(
-        find_spot_center(&img, &bad),
-        Err(ImagingError::InvalidOption { .. })
-    ));
+    for bad in [1.5, 0.0, f64::NAN] {
+        assert!(matches!(
+            CenterOptions::new(bad),
+            Err(ImagingError::InvalidOption { .. })
+        ));
+    }
     assert!(SpotCenter::given(&img, 49.4, 39.5).is_ok());
     assert!(matches!(
         SpotCenter::given(&img, 50.0, 2.0),
@@ -140,10 +142,7 @@ fn profile_matches_analytic_function() {
     let scales = [1.0, 0.5, 0.25];
     let f = |r: f64| 100.0 * (-r / 25.0).exp() / (1.0 + r / 10.0);
     let img = render(260, 200, cx, cy, &scales, f);
-    let opts = ProfileOptions {
-        ring_width_px: 1.0,
-        r_max_px: 150.0,
-    };
+    let opts = ProfileOptions::new(1.0, 150.0).unwrap();
     let prof = radial_profile(&img, [cx, cy], None, 0.1, &opts).unwrap();
     assert_eq!(prof.rings.len(), 150);
     for (k, ring) in prof.rings.iter().enumerate().skip(2) {
@@ -215,10 +214,7 @@ fn profile_standard_error_and_exclusions() {
     }
     let mask_data: Vec<u8> = (0..w * h).map(|i| u8::from(i / w < 50)).collect();
     let mask = ImageBuf::new(w, h, 1, mask_data).unwrap();
-    let opts = ProfileOptions {
-        ring_width_px: 2.0,
-        r_max_px: 40.0,
-    };
+    let opts = ProfileOptions::new(2.0, 40.0).unwrap();
     let prof = radial_profile(&img, [80.0, 100.0], Some(&mask), 1.0, &opts).unwrap();
     let expected = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
@@ -241,14 +237,18 @@ fn profile_refuses_bad_input() {
     let ok = ProfileOptions::default();
     assert!(radial_profile(&img, [10.0, 10.0], None, 0.0, &ok).is_err());
     assert!(radial_profile(&img, [f64::NAN, 10.0], None, 0.1, &ok).is_err());
-    let bad = ProfileOptions {
-        ring_width_px: -1.0,
-        ..ok
-    };
-    assert!(matches!(
-        radial_profile(&img, [10.0, 10.0], None, 0.1, &bad),
-        Err(ImagingError::InvalidOption { .. })
-    ));
+    // Ring options are refused when made: a bad width, and (issue 10) a width that asks for an
+    // impossible number of rings ("capacity overflow" once) or a radius of 1e13 px.
+    for (width, r_max) in [(-1.0, 300.0), (1e-300, 300.0), (1.0, 1e13), (f64::NAN, 1.0)] {
+        assert!(
+            matches!(
+                ProfileOptions::new(width, r_max),
+                Err(ImagingError::InvalidOption { .. })
+            ),
+            "{width} {r_max}"
+        );
+    }
+    assert_eq!(ProfileOptions::new(1.0, 1e6).unwrap().rings(), 1_000_000);
     let mask = ImageBuf::filled(20, 21, 1, 0u8).unwrap();
     assert!(matches!(
         radial_profile(&img, [10.0, 10.0], Some(&mask), 0.1, &ok),

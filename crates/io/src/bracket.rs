@@ -346,14 +346,55 @@ pub struct BracketFrame {
 }
 
 /// A validated exposure bracket: at least two frames of one shape and bit depth, with distinct
-/// positive times, sorted by time (shortest first).
+/// positive times, sorted by time (shortest first). Made by [`read_bracket`] or [`Bracket::new`],
+/// which check all that; the frames are read through [`Bracket::frames`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bracket {
-    /// The frames, shortest exposure first.
-    pub frames: Vec<BracketFrame>,
+    frames: Vec<BracketFrame>,
 }
 
 impl Bracket {
+    /// A bracket from decoded frames, sorted by time.
+    ///
+    /// # Errors
+    /// [`BracketError::TooFewImages`] for fewer than two frames, [`BracketError::NonPositiveTime`]
+    /// for a time that is not finite and > 0, [`BracketError::ShapeMismatch`] for frames of
+    /// different size, channels or bit depth, [`BracketError::DuplicateTime`] for two equal times.
+    pub fn new(mut frames: Vec<BracketFrame>) -> Result<Self, BracketError> {
+        if frames.len() < 2 {
+            return Err(BracketError::TooFewImages {
+                count: frames.len(),
+            });
+        }
+        if let Some(f) = frames
+            .iter()
+            .find(|f| !(f.time_s.is_finite() && f.time_s > 0.0))
+        {
+            return Err(BracketError::NonPositiveTime {
+                where_: f.path.display().to_string(),
+                time_s: f.time_s,
+            });
+        }
+        for f in &frames[1..] {
+            check_shape(&frames[0].frame, &frames[0].path, &f.frame, &f.path)?;
+        }
+        let times: Vec<(PathBuf, f64)> =
+            frames.iter().map(|f| (f.path.clone(), f.time_s)).collect();
+        check_distinct_times(&times)?;
+        frames.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        Ok(Self { frames })
+    }
+
+    /// The frames, shortest exposure first.
+    pub fn frames(&self) -> &[BracketFrame] {
+        &self.frames
+    }
+
+    /// The frames, shortest exposure first, taken out of the bracket.
+    pub fn into_frames(self) -> Vec<BracketFrame> {
+        self.frames
+    }
+
     /// Shutter times Δt [s], in frame order.
     pub fn times_s(&self) -> Vec<f64> {
         self.frames.iter().map(|f| f.time_s).collect()
@@ -423,6 +464,26 @@ enum TimeOf {
 pub fn read_bracket(
     images: &[PathBuf],
     exposures: Option<&Path>,
+    on_frame_read: &(dyn Fn(&Path) + Sync),
+) -> Result<Bracket, BracketError> {
+    read_bracket_within(
+        images,
+        exposures,
+        crate::budget::memory_budget_bytes(),
+        on_frame_read,
+    )
+}
+
+/// [`read_bracket`] within a memory budget [bytes] (a command's `--max-memory-mib`) instead of the
+/// environment's: the frames' decoded size, read from their headers, is checked against it before
+/// any frame is decoded.
+///
+/// # Errors
+/// As [`read_bracket`].
+pub fn read_bracket_within(
+    images: &[PathBuf],
+    exposures: Option<&Path>,
+    budget: u64,
     on_frame_read: &(dyn Fn(&Path) + Sync),
 ) -> Result<Bracket, BracketError> {
     let plan: Vec<(PathBuf, TimeOf)> = match exposures {
@@ -495,7 +556,7 @@ pub fn read_bracket(
         })
         .collect();
     check_distinct_times(&known)?;
-    check_bracket_budget(&plan, crate::budget::memory_budget_bytes())?;
+    check_bracket_budget(&plan, budget)?;
 
     let decoded: Vec<Result<BracketFrame, BracketError>> = plan
         .par_iter()
@@ -520,26 +581,18 @@ pub fn read_bracket(
         })
         .collect();
     let frames: Vec<BracketFrame> = decoded.into_iter().collect::<Result<_, _>>()?;
-
-    for f in &frames[1..] {
-        check_shape(&frames[0].frame, &frames[0].path, &f.frame, &f.path)?;
-    }
-    let times: Vec<(PathBuf, f64)> = frames.iter().map(|f| (f.path.clone(), f.time_s)).collect();
-    check_distinct_times(&times)?;
-    let mut frames = frames;
-    frames.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-    Ok(Bracket { frames })
+    Bracket::new(frames)
 }
 
-/// Reads the frames' headers (not their pixels) and refuses a bracket whose decoded frames would
-/// not fit `budget` bytes: all frames at once, plus one transient copy (alpha dropped) per decoding
-/// thread. A header that cannot be read is left for the decoder to report.
-fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), BracketError> {
+/// The decoded size [bytes] of the frames `paths`, from their headers (not their pixels): the sum,
+/// the largest frame and the first frame's shape. Headers that cannot be read count 0 (the decoder
+/// reports them).
+pub fn decoded_size<'a>(paths: impl IntoIterator<Item = &'a Path>) -> (u64, u64, String) {
     use image::ImageDecoder;
     let mut total = 0u64;
     let mut largest = 0u64;
     let mut shape = String::new();
-    for (path, _) in plan {
+    for path in paths {
         let Ok(reader) = image::ImageReader::open(path).and_then(|r| r.with_guessed_format())
         else {
             continue;
@@ -557,6 +610,31 @@ fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), B
         total = total.saturating_add(bytes);
         largest = largest.max(bytes);
     }
+    (total, largest, shape)
+}
+
+/// The frames a bracket would read: the `images` given, else those listed in `exposures`.
+///
+/// # Errors
+/// The exposures CSV's errors.
+pub fn planned_frames(
+    images: &[PathBuf],
+    exposures: Option<&Path>,
+) -> Result<Vec<PathBuf>, BracketError> {
+    match exposures {
+        Some(csv) if images.is_empty() => Ok(read_exposures_csv(csv)?
+            .into_iter()
+            .map(|e| e.path)
+            .collect()),
+        _ => Ok(images.to_vec()),
+    }
+}
+
+/// Reads the frames' headers (not their pixels) and refuses a bracket whose decoded frames would
+/// not fit `budget` bytes: all frames at once, plus one transient copy (alpha dropped) per decoding
+/// thread. A header that cannot be read is left for the decoder to report.
+fn check_bracket_budget(plan: &[(PathBuf, TimeOf)], budget: u64) -> Result<(), BracketError> {
+    let (total, largest, shape) = decoded_size(plan.iter().map(|(p, _)| p.as_path()));
     let threads = rayon::current_num_threads() as u64;
     let needed = total.saturating_add(largest.saturating_mul(threads));
     if needed > budget {

@@ -473,8 +473,17 @@ impl RadianceFormat {
 /// # Errors
 /// [`ImageFileError`] naming the file: unreadable, not a float image, or unsupported EXR channels.
 pub fn read_radiance(path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
+    read_radiance_within(path, crate::budget::memory_budget_bytes())
+}
+
+/// [`read_radiance`] within a memory budget [bytes] (a command's `--max-memory-mib`) instead of
+/// the environment's.
+///
+/// # Errors
+/// As [`read_radiance`], and [`ImageFileError::TooLarge`].
+pub fn read_radiance_within(path: &Path, budget: u64) -> Result<ImageBuf<f32>, ImageFileError> {
     let bytes = read_bytes(path)?;
-    decode_radiance(&bytes, path, crate::budget::memory_budget_bytes())
+    decode_radiance(&bytes, path, budget)
 }
 
 /// [`read_radiance`] on the bytes of a file, within a memory budget [bytes] checked from the header

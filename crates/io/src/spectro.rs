@@ -39,6 +39,14 @@ pub enum SpectroCsvError {
     /// The bytes are not text we read (UTF-16 without BOM, a workbook, binary data, too large).
     #[error(transparent)]
     Text(TextError),
+    /// The columns do not make a reading (`SpectroReading::new` refused them).
+    #[error("{}: {source}", path.display())]
+    Reading {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: scatterfit_optics::OpticsError,
+    },
     /// The CSV structure is broken (unbalanced quotes, a row with too few fields, …).
     #[error("{path}: line {line}: {message}")]
     Malformed {
@@ -298,11 +306,8 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
     }
     check_coverage(&wavelengths)
         .map_err(|message| SpectroCsvError::Coverage { path: p(), message })?;
-    Ok(SpectroReading {
-        wavelengths_nm: wavelengths,
-        sci,
-        sce,
-    })
+    SpectroReading::new(wavelengths, sci, sce)
+        .map_err(|source| SpectroCsvError::Reading { path: p(), source })
 }
 
 /// The wavelengths must reach 400 and 700 nm with no gap wider than 10 nm in between.
@@ -348,10 +353,10 @@ pub fn write_spectro_csv(
     }
     text.push_str("wavelength_nm,sci,sce\n");
     for ((w, sci), sce) in reading
-        .wavelengths_nm
+        .wavelengths_nm()
         .iter()
-        .zip(&reading.sci)
-        .zip(&reading.sce)
+        .zip(reading.sci())
+        .zip(reading.sce())
     {
         let _ = writeln!(text, "{w},{sci:.6},{sce:.6}");
     }
@@ -390,14 +395,14 @@ mod tests {
     #[test]
     fn reads_fractions_and_percent_and_comments() {
         let r = parse(&good()).unwrap();
-        assert_eq!(r.wavelengths_nm.len(), 31);
-        assert_eq!((r.sci[3], r.sce[3]), (0.55, 0.51));
+        assert_eq!(r.wavelengths_nm().len(), 31);
+        assert_eq!((r.sci()[3], r.sce()[3]), (0.55, 0.51));
         let pct = format!(
             "# CM-600d export\n{}",
             csv_with(|w| format!("{w}, 55 , 51"), "Wavelength_nm,SCI_pct,SCE_pct")
         );
         let r = parse(&pct).unwrap();
-        assert!((r.sci[0] - 0.55).abs() < 1e-15 && (r.sce[30] - 0.51).abs() < 1e-15);
+        assert!((r.sci()[0] - 0.55).abs() < 1e-15 && (r.sce()[30] - 0.51).abs() < 1e-15);
         let extra = csv_with(|w| format!("{w},0.55,0.51,x"), "wavelength_nm,sci,sce,note");
         assert!(parse(&extra).is_ok(), "extra columns are ignored");
     }
@@ -474,7 +479,7 @@ mod tests {
         let e = err(&good().replace("600,0.55,0.51", "600,0.50,0.51"));
         assert!(e.contains("600 nm") && e.contains("swapped"), "{e}");
         let r = parse(&good().replace("600,0.55,0.51", "600,0.508,0.51")).unwrap();
-        assert!(r.sci[20] < r.sce[20]);
+        assert!(r.sci()[20] < r.sce()[20]);
     }
 
     #[test]

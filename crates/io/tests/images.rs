@@ -236,7 +236,7 @@ fn exif_exposure_times_are_read_and_sorted() {
     assert_eq!(t, 1.0 / 600.0);
     let bracket = read_bracket(&paths, None, &|_| {}).unwrap();
     assert_eq!(bracket.times_s(), vec![1.0 / 600.0, 1.0 / 60.0, 2.0]);
-    assert_eq!(bracket.frames[0].path, paths[1]);
+    assert_eq!(bracket.frames()[0].path, paths[1]);
 }
 
 #[test]
@@ -290,7 +290,7 @@ fn exposures_csv_resolves_paths_against_its_folder() {
     assert_eq!(entries[2].line, 5);
     let bracket = read_bracket(&[], Some(&csv), &|_| {}).unwrap();
     assert_eq!(bracket.times_s(), vec![1e-3, 0.01, 0.04]);
-    assert_eq!(bracket.frames[0].path, sub.join("f2.png"));
+    assert_eq!(bracket.frames()[0].path, sub.join("f2.png"));
     // Images named on the command line (another spelling of the same files) take their times from the CSV.
     let given = vec![
         dir.path().join("shots/./f1.png"),

@@ -30,15 +30,79 @@ pub const LOW_SPECULAR_WARNING: f64 = 0.01;
 /// Summary specular reflectances above this (η > 3) are not plausible for a dielectric.
 pub const MAX_PLAUSIBLE_SPECULAR: f64 = 0.25;
 
-/// One spectrophotometer reading: SCI and SCE reflectance spectra as fractions (0–1).
+/// One spectrophotometer reading: SCI and SCE reflectance spectra as fractions (0–1). Made through
+/// [`SpectroReading::new`], so its three columns have one length, its wavelengths increase and its
+/// reflectances are fractions.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpectroReading {
+    wavelengths_nm: Vec<f64>,
+    sci: Vec<f64>,
+    sce: Vec<f64>,
+}
+
+impl SpectroReading {
+    /// A reading from its wavelengths [nm] and the SCI and SCE reflectances at them (fractions).
+    ///
+    /// # Errors
+    /// [`OpticsError::Spectrum`] when the lengths differ, there are fewer than two wavelengths, a
+    /// wavelength is not finite and > 0 or does not increase, or a reflectance is not in [0, 1].
+    pub fn new(wavelengths_nm: Vec<f64>, sci: Vec<f64>, sce: Vec<f64>) -> Result<Self> {
+        if sci.len() != wavelengths_nm.len() || sce.len() != wavelengths_nm.len() {
+            return Err(OpticsError::Spectrum(format!(
+                "{} wavelengths, {} SCI and {} SCE values; every wavelength needs both",
+                wavelengths_nm.len(),
+                sci.len(),
+                sce.len()
+            )));
+        }
+        if wavelengths_nm.len() < 2 {
+            return Err(OpticsError::Spectrum(format!(
+                "{} wavelength(s); a spectrum needs at least two",
+                wavelengths_nm.len()
+            )));
+        }
+        if let Some(w) = wavelengths_nm
+            .iter()
+            .find(|w| !(w.is_finite() && **w > 0.0))
+        {
+            return Err(OpticsError::Spectrum(format!(
+                "wavelength {w} nm is not a positive number"
+            )));
+        }
+        if let Some(pair) = wavelengths_nm.windows(2).find(|p| p[1] <= p[0]) {
+            return Err(OpticsError::Spectrum(format!(
+                "wavelengths must increase: {} nm follows {} nm",
+                pair[1], pair[0]
+            )));
+        }
+        for (name, values) in [("SCI", &sci), ("SCE", &sce)] {
+            if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+                return Err(OpticsError::Spectrum(format!(
+                    "{name} reflectance {v} is not a fraction in [0, 1]"
+                )));
+            }
+        }
+        Ok(Self {
+            wavelengths_nm,
+            sci,
+            sce,
+        })
+    }
+
     /// Wavelengths [nm], strictly increasing.
-    pub wavelengths_nm: Vec<f64>,
-    /// Specular component included reflectance (fraction).
-    pub sci: Vec<f64>,
-    /// Specular component excluded reflectance (fraction).
-    pub sce: Vec<f64>,
+    pub fn wavelengths_nm(&self) -> &[f64] {
+        &self.wavelengths_nm
+    }
+
+    /// Specular component included reflectance (fraction) per wavelength.
+    pub fn sci(&self) -> &[f64] {
+        &self.sci
+    }
+
+    /// Specular component excluded reflectance (fraction) per wavelength.
+    pub fn sce(&self) -> &[f64] {
+        &self.sce
+    }
 }
 
 /// Options of the spectrophotometer stage.
@@ -161,7 +225,7 @@ impl SpectroAnalysis {
 /// [`OpticsError::InvalidParameter`] for a given η < 1. Channels whose Rd cannot be inverted are not
 /// errors: they carry `albedo_prime: None` and a `problem`.
 pub fn analyse(reading: &SpectroReading, options: &SpectroOptions) -> Result<SpectroAnalysis> {
-    let wl = &reading.wavelengths_nm;
+    let wl = reading.wavelengths_nm();
     if reading.sci.len() != wl.len() || reading.sce.len() != wl.len() {
         return Err(OpticsError::Spectrum(format!(
             "{} wavelengths, {} SCI and {} SCE values",
@@ -326,11 +390,7 @@ mod tests {
 
     /// A spectrally flat reading at 400–700 nm.
     fn flat(sci: f64, sce: f64) -> SpectroReading {
-        SpectroReading {
-            wavelengths_nm: grid(),
-            sci: vec![sci; 31],
-            sce: vec![sce; 31],
-        }
+        SpectroReading::new(grid(), vec![sci; 31], vec![sce; 31]).unwrap()
     }
 
     /// A sample of η = 1.5 (flat R₀ = 0.04 at 8°) with a flat SCE of 0.5: η comes back, and α′ per
@@ -339,11 +399,7 @@ mod tests {
     fn flat_specular_gives_eta_and_grey_albedo() {
         let wl = grid();
         let r0 = fresnel::fresnel_dielectric(8f64.to_radians().cos(), 1.5);
-        let reading = SpectroReading {
-            wavelengths_nm: wl,
-            sci: vec![0.5 + r0; 31],
-            sce: vec![0.5; 31],
-        };
+        let reading = SpectroReading::new(wl, vec![0.5 + r0; 31], vec![0.5; 31]).unwrap();
         let a = analyse(&reading, &SpectroOptions::default()).unwrap();
         // Schlick inversion of an exact-Fresnel specular: 1.5 to within Schlick's error at 8°.
         assert!((a.eta - 1.5).abs() < 2e-4, "{}", a.eta);

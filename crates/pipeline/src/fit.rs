@@ -31,7 +31,11 @@ pub struct FitSettings {
 
 impl FitSettings {
     /// The options of `scatterfit_fit` for these settings.
-    pub fn options(&self) -> FitOptions {
+    ///
+    /// # Errors
+    /// [`PipelineError::Input`] for a spot radius or r_min the ring selection refuses (the
+    /// manifest and the commands check both before).
+    pub fn options(&self) -> Result<FitOptions> {
         let mut o = FitOptions::new(match self.method {
             MethodName::Proposed => Method::Proposed,
             MethodName::Existing => Method::Existing,
@@ -39,12 +43,19 @@ impl FitSettings {
         o.spot = Spot::Disk {
             radius_mm: self.spot_radius_mm,
         };
-        o.selection = scatterfit_fit::RingSelection::for_spot(self.spot_radius_mm);
-        if let Some(r) = self.r_min_mm {
-            o.selection.r_min_mm = r;
+        let selection = scatterfit_fit::RingSelection::for_spot(self.spot_radius_mm);
+        o.selection = match self.r_min_mm {
+            Some(r) => selection.and_then(|s| s.with_r_min_mm(r)),
+            None => selection,
         }
+        .map_err(|e| PipelineError::Input(format!("the fitted rings: {e}")))?;
         o.normalise_with_spectro = self.normalise_with_spectro;
-        o
+        Ok(o)
+    }
+
+    /// The innermost fitted radius [mm]: the given one, else the spot's diameter.
+    pub fn r_min_mm(&self) -> f64 {
+        self.r_min_mm.unwrap_or(2.0 * self.spot_radius_mm)
     }
 }
 
@@ -118,7 +129,17 @@ pub fn fit_stage(
     settings: &FitSettings,
     model: &dyn ProfileModel,
 ) -> Vec<ChannelOutcome> {
-    let opts = settings.options();
+    let opts = match settings.options() {
+        Ok(o) => o,
+        Err(e) => {
+            return profiles
+                .iter()
+                .map(|_| ChannelOutcome::NotFitted {
+                    problem: e.to_string(),
+                })
+                .collect();
+        }
+    };
     let names = ["R", "G", "B"];
     profiles
         .iter()

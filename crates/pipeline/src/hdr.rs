@@ -140,7 +140,7 @@ pub fn read_and_merge(
     let bracket: Bracket =
         read_bracket(&inputs.images, inputs.exposures.as_deref(), on_frame_read)?;
     let dropped_alpha = bracket
-        .frames
+        .frames()
         .iter()
         .filter(|f| f.dropped_alpha)
         .map(|f| f.path.clone())
@@ -155,7 +155,7 @@ pub fn read_and_merge(
     };
     let read_s = t0.elapsed().as_secs_f64();
     let frames: Vec<FrameInfo> = bracket
-        .frames
+        .frames()
         .iter()
         .map(|f| FrameInfo {
             file: f.path.clone(),
@@ -170,10 +170,10 @@ pub fn read_and_merge(
         let context = context.to_string();
         move |source| PipelineError::Imaging { context, source }
     };
-    let depth = bracket.frames[0].frame.bit_depth();
+    let depth = bracket.frames()[0].frame.bit_depth();
     let mut stage = if depth == 8 {
         let bufs: Vec<ImageBuf<u8>> = bracket
-            .frames
+            .into_frames()
             .into_iter()
             .filter_map(|f| match f.frame {
                 CameraFrame::U8(b) => Some(b),
@@ -183,10 +183,8 @@ pub fn read_and_merge(
         let (response, kind, rms) = match &inputs.response {
             Some(path) => (load_response(path)?, "given", Vec::new()),
             None => {
-                let opts = CalibrateOptions {
-                    samples: inputs.samples,
-                    lambda: inputs.lambda,
-                };
+                let opts = CalibrateOptions::new(inputs.samples, inputs.lambda)
+                    .map_err(imaging("the response recovery's options"))?;
                 let cal = scatterfit_imaging::recover_response(&bufs, &times, &opts).map_err(
                     imaging("recovering the camera response (or give a known one with --response)"),
                 )?;
@@ -231,7 +229,7 @@ pub fn read_and_merge(
             )));
         }
         let bufs: Vec<ImageBuf<u16>> = bracket
-            .frames
+            .into_frames()
             .into_iter()
             .filter_map(|f| match f.frame {
                 CameraFrame::U16(b) => Some(b),
@@ -242,10 +240,8 @@ pub fn read_and_merge(
             CameraFrame::U16(b) => Some(b),
             CameraFrame::U8(_) => None,
         });
-        let opts = LinearMergeOptions {
-            saturation: inputs.saturation,
-            clipped_fill: inputs.clipped_fill,
-        };
+        let opts = LinearMergeOptions::new(inputs.saturation, inputs.clipped_fill)
+            .map_err(imaging("the 16-bit merge's options"))?;
         let hdr = scatterfit_imaging::merge_linear_u16(&bufs, &times, dark.as_ref(), &opts)
             .map_err(imaging("merging the 16-bit bracket"))?;
         let detection_limit = vec![DETECTION_DN_16BIT / t_max; hdr.radiance.channels()];

@@ -320,7 +320,7 @@ impl Measurement {
                     "model": self.settings.model.as_str(),
                     "albedo_model": self.settings.albedo_model.as_str(),
                     "normalise_with_spectro": self.settings.normalise_with_spectro,
-                    "r_min_mm": self.settings.options().selection.r_min_mm,
+                    "r_min_mm": self.settings.r_min_mm(),
                     "r_max_px": m.fit.r_max_px.unwrap_or(300.0),
                     "spot_radius_mm": self.settings.spot_radius_mm,
                     "response": self.hdr.response_kind,

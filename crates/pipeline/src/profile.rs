@@ -84,10 +84,13 @@ pub fn profile_stage(
         let data = m.data().iter().map(|&b| b & CLIPPED_HIGH).collect();
         ImageBuf::new(m.width(), m.height(), m.channels(), data).expect("same shape as the mask")
     });
-    let opts = ProfileOptions {
-        ring_width_px: settings.ring_width_px,
-        r_max_px: settings.r_max_px,
-    };
+    let opts =
+        ProfileOptions::new(settings.ring_width_px, settings.r_max_px).map_err(|source| {
+            PipelineError::Imaging {
+                context: "the profile's rings (check the ring width and r_max)".into(),
+                source,
+            }
+        })?;
     let profile = radial_profile(
         radiance,
         center.xy(),

@@ -139,10 +139,7 @@ pub fn render_spot_profile(
         setup.center_px(),
         None,
         setup.mm_per_pixel,
-        &ProfileOptions {
-            ring_width_px: 1.0,
-            r_max_px: setup.r_max_mm / setup.mm_per_pixel,
-        },
+        &ProfileOptions::new(1.0, setup.r_max_mm / setup.mm_per_pixel)?,
     )?;
     let ft = 1.0 - fresnel_dielectric(1.0, material.eta());
     let norm =

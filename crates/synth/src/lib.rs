@@ -103,12 +103,13 @@ pub fn synthesize(
     let bracket = rig::render_bracket(&profiles, rig, seed)?;
     let rd: [f64; 3] = std::array::from_fn(|c| profiles[c].rd_total.value);
     let reading = spectro::reading_for(rd, eta)?;
-    let xyz10 = colour::spectrum_to_xyz(&reading.wavelengths_nm, &reading.sce, Observer::TenDegree)
-        .map_err(|_| SynthError::InvalidParameter {
-            name: "spectrum",
-            value: 0.0,
-            reason: "the synthetic SCE spectrum does not cover 400–700 nm",
-        })?;
+    let xyz10 =
+        colour::spectrum_to_xyz(reading.wavelengths_nm(), reading.sce(), Observer::TenDegree)
+            .map_err(|_| SynthError::InvalidParameter {
+                name: "spectrum",
+                value: 0.0,
+                reason: "the synthetic SCE spectrum does not cover 400–700 nm",
+            })?;
     let lab10 = colour::xyz_to_lab(xyz10, Observer::TenDegree.d65_white());
     let channels = std::array::from_fn(|c| ChannelTruth {
         sigma_s_prime: sigma_s_prime[c],

@@ -69,11 +69,11 @@ pub fn reading_for(rd: [f64; 3], eta: f64) -> Result<SpectroReading, OutOfGamut>
             .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
         if min >= 0.0 && max + specular <= 1.0 {
             let sci = sce.iter().map(|s| s + specular).collect();
-            return Ok(SpectroReading {
-                wavelengths_nm: wavelengths,
-                sci,
-                sce,
-            });
+            // In [0, 1] by the test above, so the reading is valid; were it not, the nearest
+            // reading below is reported as out of gamut.
+            if let Ok(r) = SpectroReading::new(wavelengths.clone(), sci, sce.clone()) {
+                return Ok(r);
+            }
         }
         let excess = (-min).max(max + specular - 1.0);
         if best
@@ -151,7 +151,7 @@ mod tests {
             let rd: [f64; 3] = std::array::from_fn(|c| rd_total(a[c], m.eta));
             let r = reading_for(rd, m.eta).unwrap_or_else(|e| panic!("{}: {e}", m.name));
             let xyz =
-                colour::spectrum_to_xyz(&r.wavelengths_nm, &r.sce, Observer::TwoDegree).unwrap();
+                colour::spectrum_to_xyz(r.wavelengths_nm(), r.sce(), Observer::TwoDegree).unwrap();
             let rgb = colour::xyz_to_linear_srgb(xyz);
             for c in 0..3 {
                 // The 4-decimal sRGB matrices are inverses only to ~1e-4.
@@ -163,7 +163,7 @@ mod tests {
                     rd[c]
                 );
             }
-            let spec = r.sci[0] - r.sce[0];
+            let spec = r.sci()[0] - r.sce()[0];
             assert!((spec - scatterfit_optics::fresnel::r0_from_eta(m.eta)).abs() < 1e-4);
         }
     }
