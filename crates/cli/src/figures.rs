@@ -46,12 +46,14 @@ fn measured_series(m: &Measurement, c: usize, report: Option<&FitReport>) -> Vec
             points: inc,
             errors: Some(err),
             style: SeriesStyle::Measured,
+            colour: None,
         },
         Series {
             label: "not fitted (spot, below detection)".into(),
             points: exc,
             errors: None,
             style: SeriesStyle::Excluded,
+            colour: None,
         },
     ]
 }
@@ -82,6 +84,7 @@ fn model_series(
             .collect(),
         errors: None,
         style,
+        colour: None,
     })
 }
 

@@ -38,6 +38,8 @@ pub struct Series {
     pub errors: Option<Vec<f64>>,
     /// How the series is drawn.
     pub style: SeriesStyle,
+    /// A colour of its own (else the panel's), e.g. to tell several curves of one panel apart.
+    pub colour: Option<(u8, u8, u8)>,
 }
 
 /// How a [`Series`] is drawn.
@@ -788,14 +790,14 @@ where
         .draw()
         .map_err(err)?;
 
-    let (r, g, b) = panel.colour;
-    let colour = RGBColor(r, g, b);
-    // Measured markers in a lighter tint of the channel colour, so that a model curve drawn in the
-    // full colour stays visible on top of 300 dense rings and the scatter shows around it.
-    let marker_colour = tint(colour, 0.45);
     let x_px = f64::from(plot_area.dim_in_pixel().0.saturating_sub(96)).max(1.0);
     let mut labelled = false;
     for series in &panel.series {
+        let (r, g, b) = series.colour.unwrap_or(panel.colour);
+        let colour = RGBColor(r, g, b);
+        // Measured markers in a lighter tint of the channel colour, so that a model curve drawn in
+        // the full colour stays visible on top of 300 dense rings and the scatter shows around it.
+        let marker_colour = tint(colour, 0.45);
         // Plot-space points with their index (for the error bars); None where not drawable.
         let mapped: Vec<Option<(f64, f64)>> = series
             .points
@@ -1062,6 +1064,7 @@ mod tests {
             points,
             errors: None,
             style,
+            colour: None,
         }
     }
 
@@ -1442,6 +1445,7 @@ mod tests {
                 points: fitted,
                 errors: Some(errors),
                 style: SeriesStyle::Measured,
+                colour: None,
             };
             fig4.push(Panel {
                 title: name.into(),

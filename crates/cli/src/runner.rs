@@ -157,10 +157,28 @@ pub fn compare_dirs(
     quiet: bool,
     write_results: bool,
 ) -> anyhow::Result<(Vec<Pair>, Failures)> {
+    let (pairs, _, failed) = compare_dirs_exact(dirs, fit, jobs, quiet, write_results, false)?;
+    Ok((pairs, failed))
+}
+
+/// [`compare_dirs`], and with `exact` each sample also fitted beyond the paper: the Monte Carlo
+/// forward model with α′ from the Monte Carlo total (`None` where that fit cannot run).
+///
+/// # Errors
+/// Only when the worker threads cannot start.
+pub fn compare_dirs_exact(
+    dirs: &[PathBuf],
+    fit: &crate::common::FitArgs,
+    jobs: usize,
+    quiet: bool,
+    write_results: bool,
+    exact: bool,
+) -> anyhow::Result<(Vec<Pair>, Vec<Option<MeasurementResult>>, Failures)> {
     let mut overrides = fit.overrides()?;
     overrides.method = Some(MethodName::Proposed);
     let outcomes = measure_many(dirs, &overrides, jobs, quiet, &|_, _| {})?;
     let mut pairs = Vec::new();
+    let mut exacts = Vec::new();
     let mut failed = Vec::new();
     for o in outcomes {
         let proposed = match o.result {
@@ -189,10 +207,23 @@ pub fn compare_dirs(
         ) {
             failed.push((o.dir.clone(), format!("writing the plot: {e:#}")));
         }
+        if exact {
+            let settings = scatterfit_pipeline::fit::FitSettings {
+                model: scatterfit_io::manifest::ModelName::Mc,
+                albedo_model: scatterfit_io::manifest::AlbedoModelName::Mc,
+                ..proposed.settings
+            };
+            exacts.push(
+                proposed
+                    .refit_with(settings)
+                    .ok()
+                    .map(|m| m.to_result(Some("profile.csv"))),
+            );
+        }
         pairs.push((
             existing.to_result(Some("profile.csv")),
             proposed.to_result(Some("profile.csv")),
         ));
     }
-    Ok((pairs, failed))
+    Ok((pairs, exacts, failed))
 }

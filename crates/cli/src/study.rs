@@ -487,9 +487,20 @@ fn figure(rows: &[Row], combos: &[Combo]) -> Figure {
                     }
         })
         .map(|c| {
+            let n = etas.len().max(2) as f64 - 1.0;
+            let base = match c.model {
+                ModelName::Dipole => (200.0, 30.0, 30.0),
+                ModelName::BetterDipole => (200.0, 120.0, 0.0),
+                ModelName::Pbd => (20.0, 140.0, 40.0),
+                ModelName::Mc => (30.0, 70.0, 200.0),
+            };
             let series = etas
                 .iter()
-                .map(|&e| {
+                .enumerate()
+                .map(|(k, &e)| {
+                    // Light (η small) to dark (η large) shades of the model's colour.
+                    let t = 0.75 - 0.75 * k as f64 / n;
+                    let shade = |v: f64| (v + (255.0 - v) * t).round() as u8;
                     let mut pts: Vec<(f64, f64)> = rows
                         .iter()
                         .filter(|r| {
@@ -510,6 +521,7 @@ fn figure(rows: &[Row], combos: &[Combo]) -> Figure {
                         points: pts,
                         errors: None,
                         style: SeriesStyle::Line,
+                        colour: Some((shade(base.0), shade(base.1), shade(base.2))),
                     }
                 })
                 .collect();
