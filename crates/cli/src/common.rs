@@ -144,7 +144,7 @@ pub enum ModelArg {
     /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (slow: ~2 ms per
     /// evaluation).
     Pbd,
-    /// Monte Carlo tables shipped with scatterfit (exact transport; g = 0, η 1.0–2.4, α′ up to
+    /// Monte Carlo tables shipped with scatterfit (exact transport; g = 0, η 1.0–2.5, α′ up to
     /// 0.9999).
     Mc,
 }

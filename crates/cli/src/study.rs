@@ -35,7 +35,7 @@ pub struct Args {
         value_name = "DIR"
     )]
     pub output_dir: PathBuf,
-    /// Refractive indices η, each in [1, 2.4] (the Monte Carlo tables' range).
+    /// Refractive indices η, each in [1, 2.5] (the Monte Carlo tables' range).
     #[arg(long, value_delimiter = ',', default_values_t = [1.0, 1.2, 1.4, 1.6, 2.0, 2.4])]
     pub etas: Vec<f64>,
     /// Reduced albedos α′, each in [0.3, 0.9999].
@@ -148,8 +148,8 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
     if args.etas.is_empty() || args.albedos.is_empty() {
         bail!("give at least one η and one α′");
     }
-    if let Some(e) = args.etas.iter().find(|e| !(1.0..=2.4).contains(*e)) {
-        bail!("--etas: {e} is outside [1, 2.4], the range of the Monte Carlo tables");
+    if let Some(e) = args.etas.iter().find(|e| !(1.0..=2.5).contains(*e)) {
+        bail!("--etas: {e} is outside [1, 2.5], the range of the Monte Carlo tables");
     }
     if let Some(a) = args.albedos.iter().find(|a| !(0.3..=0.9999).contains(*a)) {
         bail!("--albedos: {a} is outside [0.3, 0.9999]");

@@ -108,7 +108,7 @@ impl McModel {
         Self { set }
     }
 
-    /// The model on the tables shipped with scatterfit (g = 0, η 1.0–2.4, α′ 0.02–0.9999), parsed
+    /// The model on the tables shipped with scatterfit (g = 0, η 1.0–2.5, α′ 0.02–0.9999), parsed
     /// once per process.
     ///
     /// # Errors
