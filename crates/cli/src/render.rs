@@ -18,6 +18,7 @@ use anyhow::{Context, bail};
 use glam::DVec3;
 use scatterfit_imaging::ImageBuf;
 use scatterfit_io::image_files::{CameraFrame, write_camera_frame, write_radiance};
+use scatterfit_io::manifest::ModelName;
 use scatterfit_io::mesh::read_mesh;
 use scatterfit_io::profile_csv::read_profile_csv;
 use scatterfit_io::result_json::{MeasurementResult, read_result_json};
@@ -102,10 +103,10 @@ pub struct Args {
     /// Which of the paper's rendering methods.
     #[arg(long, value_enum, default_value_t = MethodArg::Both)]
     pub method: MethodArg,
-    /// The profile model for the texture-space method (only `dipole` so far; default: the
-    /// result's own model, which must then be dipole).
-    #[arg(long, value_name = "NAME")]
-    pub model: Option<String>,
+    /// The profile model of the texture-space method: dipole, better-dipole, pbd or mc (default: the
+    /// model the result was fitted with; dipole for published parameters).
+    #[arg(long, value_enum)]
+    pub model: Option<crate::common::ModelArg>,
     /// Write the luminance (grey) instead of colour, like the paper's Figure 5.
     #[arg(long)]
     pub gray: bool,
@@ -297,6 +298,8 @@ const EXISTING_2014: [(&str, [(f64, f64); 3]); 3] = [
 struct Params {
     /// Display name.
     name: String,
+    /// The forward model the parameters were fitted with (`dipole` for published ones).
+    model: ModelName,
     /// `proposed`, `existing`, or the result's method.
     method: String,
     /// Where it came from (a path or "published …").
@@ -307,7 +310,63 @@ struct Params {
     result: Option<(MeasurementResult, PathBuf)>,
 }
 
-fn load_params(spec: &str, model: Option<&str>) -> anyhow::Result<Params> {
+/// A model of `scatterfit_optics::model` or `scatterfit_mc` as the renderer's radial profile.
+struct Profile<T>(T);
+
+impl<T: scatterfit_optics::model::ProfileModel + Send + Sync> scatterfit_render::RadialProfile
+    for Profile<T>
+{
+    fn rd(&self, r_mm: f64) -> f64 {
+        self.0.rd(r_mm).max(0.0)
+    }
+    fn rd_total(&self) -> f64 {
+        self.0.rd_total()
+    }
+}
+
+/// The renderer's material for `p` with its profile model (`model` overrides the fitted one).
+fn material_for(p: &Params, model: Option<ModelName>) -> anyhow::Result<Material> {
+    use scatterfit_optics::OpticalProperties;
+    use scatterfit_optics::model::DiffusionModel;
+    use scatterfit_render::RadialProfile;
+    let model = model.unwrap_or(p.model);
+    if model == ModelName::Dipole {
+        return Ok(Material::dipole(p.coefficients, p.eta)?);
+    }
+    let mut profiles: Vec<Box<dyn RadialProfile>> = Vec::with_capacity(3);
+    for &(sp, sa) in &p.coefficients {
+        let props = OpticalProperties::new(sp, sa, p.eta)?;
+        let profile: Box<dyn RadialProfile> = match model {
+            ModelName::BetterDipole => {
+                Box::new(Profile(DiffusionModel::BetterDipole.profile(&props)?))
+            }
+            ModelName::Pbd => Box::new(Profile(DiffusionModel::Pbd.profile(&props)?)),
+            _ => {
+                let set = scatterfit_fit::McModel::bundled().map_err(anyhow::Error::msg)?;
+                Box::new(Profile(
+                    scatterfit_mc::McProfile::new(set.tables(), &props).with_context(|| {
+                        format!(
+                            "{}: the Monte Carlo tables do not cover σ′s = {sp}, σa = {sa}, η = {}",
+                            p.name, p.eta
+                        )
+                    })?,
+                ))
+            }
+        };
+        profiles.push(profile);
+    }
+    let profiles: [Box<dyn RadialProfile>; 3] = profiles
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("three channels"))?;
+    Ok(Material::with_profiles(
+        p.coefficients,
+        p.eta,
+        profiles,
+        model.as_str(),
+    )?)
+}
+
+fn load_params(spec: &str, model: Option<ModelName>) -> anyhow::Result<Params> {
     let path = Path::new(spec);
     if !path.exists() {
         let key = spec.trim().to_ascii_lowercase().replace([' ', '_'], "-");
@@ -319,6 +378,7 @@ fn load_params(spec: &str, model: Option<&str>) -> anyhow::Result<Params> {
                 EXISTING_2014.iter().find(|(n, _)| *n == base),
             ) {
                 return Ok(Params {
+                    model: ModelName::Dipole,
                     name: base.replace('-', " "),
                     method: "existing".into(),
                     source: "published: Choi et al. 2014, Figure 5 (existing method; η of Table 1)"
@@ -333,6 +393,7 @@ fn load_params(spec: &str, model: Option<&str>) -> anyhow::Result<Params> {
             .find(|m| m.name == key)
         {
             return Ok(Params {
+                model: ModelName::Dipole,
                 name: m.name.replace('-', " "),
                 method: "proposed".into(),
                 source: "published: Choi et al. 2014, Table 1".into(),
@@ -357,14 +418,19 @@ fn load_params(spec: &str, model: Option<&str>) -> anyhow::Result<Params> {
         );
     }
     let result = read_result_json(path)?;
-    let fitted = result.model.trim().to_ascii_lowercase();
-    if model.is_none() && fitted != "dipole" {
-        bail!(
-            "{spec}: the parameters were fitted with the `{}` model, but render has only the \
-             dipole so far; pass --model dipole to render them with the dipole anyway",
-            result.model
-        );
-    }
+    let fitted = match result.model.trim().to_ascii_lowercase().as_str() {
+        "dipole" => ModelName::Dipole,
+        "better-dipole" => ModelName::BetterDipole,
+        "pbd" => ModelName::Pbd,
+        "mc" => ModelName::Mc,
+        other => match model {
+            Some(m) => m,
+            None => bail!(
+                "{spec}: the parameters were fitted with a model render does not know (`{other}`); \
+                 pass --model dipole|better-dipole|pbd|mc"
+            ),
+        },
+    };
     let coefficients = result.coefficients().map_err(|ch| -> anyhow::Error {
         let c = match ch {
             "r" => &result.channels.r,
@@ -388,6 +454,7 @@ fn load_params(spec: &str, model: Option<&str>) -> anyhow::Result<Params> {
         .map(Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("."));
     Ok(Params {
+        model: fitted,
         name: result.name.clone(),
         method: result.method.clone(),
         source: path.display().to_string(),
@@ -463,14 +530,6 @@ struct ChannelMse {
 
 /// Runs `scatterfit render`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    if let Some(m) = &args.model
-        && !m.eq_ignore_ascii_case("dipole")
-    {
-        bail!(
-            "--model {m}: render has only the `dipole` profile model so far (better-dipole, pbd \
-             and mc will come with the fit); use --model dipole"
-        );
-    }
     let specs: Vec<String> = match (&args.params, &args.compare) {
         (Some(p), None) => vec![p.clone()],
         (None, Some(c)) => c.clone(),
@@ -539,7 +598,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let params: Vec<Params> = specs
         .iter()
-        .map(|s| load_params(s, args.model.as_deref()))
+        .map(|s| load_params(s, args.model.map(Into::into)))
         .collect::<anyhow::Result<_>>()?;
     let opts = RenderOptions {
         width: args.size.0,
@@ -648,8 +707,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let bar = progress_bar(&args, (jobs.len() * opts.height) as u64);
     let materials: Vec<Material> = params
         .iter()
-        .map(|p| Material::dipole(p.coefficients, p.eta))
-        .collect::<Result<_, _>>()?;
+        .map(|p| material_for(p, args.model.map(Into::into)))
+        .collect::<anyhow::Result<_>>()?;
     let mut renders = Vec::new();
     let mut summaries = Vec::new();
     for &(method, k) in &jobs {
@@ -1014,7 +1073,7 @@ fn run_profile(
         spot_radius_mm: spot,
     };
     setup.validate().context("the measurement geometry")?;
-    let material = Material::dipole(p.coefficients, p.eta)?;
+    let material = material_for(p, args.model.map(Into::into))?;
     let n = setup.image_size();
     let bar = progress_bar(args, n as u64);
     bar.set_message("slab + spot, texture-space dipole");

@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use crate::common::{cache_dir, check_output_files, parse_rgb, shutter};
 use crate::output::outln;
-use crate::twin::{Material, synthesize, write_sample};
+use crate::twin::{Material, synthesize, write_sample_with};
 
 /// Arguments of `scatterfit synth`.
 #[derive(Debug, clap::Args)]
@@ -42,6 +42,13 @@ pub struct Args {
     /// 2⁶⁴ − 1.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The forward model written into the manifest's `[fit]` (how `measure` will fit this sample;
+    /// the sample itself is always made by Monte Carlo).
+    #[arg(long, value_enum)]
+    pub model: Option<crate::common::ModelArg>,
+    /// The albedo model written into the manifest's `[fit]`.
+    #[arg(long, value_enum)]
+    pub albedo_model: Option<crate::common::AlbedoModelArg>,
     /// A small fast sample (256 × 256 px at 0.1 mm/px, a tenth of the photons) for trying the tool
     /// and for tests; not for accuracy studies.
     #[arg(long)]
@@ -132,7 +139,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         args.quiet || args.json,
         args.quick,
     )?;
-    write_sample(&args.output_dir, &sample)?;
+    write_sample_with(
+        &args.output_dir,
+        &sample,
+        scatterfit_io::manifest::FitSection {
+            model: args.model.map(Into::into),
+            albedo_model: args.albedo_model.map(Into::into),
+            ..Default::default()
+        },
+    )?;
     if args.json {
         crate::output::print_json(&Summary {
             output_dir: &args.output_dir,

@@ -64,8 +64,17 @@ pub fn synthesize(
     Ok(sample)
 }
 
-/// Writes a synthetic sample into `dir`.
+/// Writes a synthetic sample into `dir` (its manifest's `[fit]` at the defaults).
 pub fn write_sample(dir: &Path, s: &SyntheticSample) -> anyhow::Result<()> {
+    write_sample_with(dir, s, scatterfit_io::manifest::FitSection::default())
+}
+
+/// Writes a synthetic sample into `dir` with this `[fit]` in its manifest.
+pub fn write_sample_with(
+    dir: &Path,
+    s: &SyntheticSample,
+    fit: scatterfit_io::manifest::FitSection,
+) -> anyhow::Result<()> {
     let truth = serde_json::to_string_pretty(&s.truth).context("serialising the truth")?;
     write_sample_folder(
         dir,
@@ -83,6 +92,7 @@ pub fn write_sample(dir: &Path, s: &SyntheticSample) -> anyhow::Result<()> {
                  truth.json holds the parameters",
                 s.truth.name, s.truth.seed
             ),
+            fit,
         },
     )
     .map_err(anyhow::Error::msg)?;

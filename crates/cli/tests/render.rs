@@ -148,32 +148,36 @@ fn compare_makes_a_captioned_figure_5_grid_and_gray_works() {
     assert_eq!(exr.width(), 4 * 64 + 3 * 8);
 }
 
-/// A hand-written result.json with a measured profile that is exactly k × the spot-averaged
-/// dipole: the rendered profile must match it, so the MSE is small compared with the profile's
-/// own scale (the render's noise and the ring discretisation only).
-#[test]
-fn profile_mse_against_a_model_profile_is_small() {
+/// A hand-written result.json (fitted with `model`) with a measured profile that is exactly k × the
+/// spot-averaged `profile`: rendered with the result's model (or `--model`), the slab's profile must
+/// match it, so the MSE is small compared with the profile's own scale (the render's noise and the
+/// ring discretisation only). Returns each channel's MSE over (5e-3 Rd(1 mm))².
+fn profile_mse_ratio(
+    model: &str,
+    profile: &dyn Fn(&OpticalProperties) -> Box<dyn Fn(f64) -> f64>,
+    extra: &[&str],
+) -> [f64; 3] {
     let dir = tempfile::tempdir().unwrap();
     let (eta, mmpp, spot) = (1.3, 0.1, 0.3);
     let coeffs = [(1.2, 0.05), (1.0, 0.1), (0.8, 0.2)];
     let k = [2.0e4, 3.0e4, 4.0e4];
     // Spot average by a polar midpoint rule (independent of the renderer).
-    let avg = |d: &Dipole, r: f64| {
+    let avg = |d: &dyn Fn(f64) -> f64, r: f64| {
         let (nr, nt) = (48, 96);
         let mut s = 0.0;
         for i in 0..nr {
             let rho = spot * (i as f64 + 0.5) / nr as f64;
             for j in 0..nt {
                 let t = std::f64::consts::TAU * (j as f64 + 0.5) / nt as f64;
-                s += d.rd(((r - rho * t.cos()).powi(2) + (rho * t.sin()).powi(2)).sqrt()) * rho;
+                s += d(((r - rho * t.cos()).powi(2) + (rho * t.sin()).powi(2)).sqrt()) * rho;
             }
         }
         s * (spot / nr as f64) * (std::f64::consts::TAU / nt as f64)
             / (std::f64::consts::PI * spot * spot)
     };
-    let dipoles: Vec<Dipole> = coeffs
+    let profiles: Vec<Box<dyn Fn(f64) -> f64>> = coeffs
         .iter()
-        .map(|&(sp, sa)| Dipole::new(&OpticalProperties::new(sp, sa, eta).unwrap()))
+        .map(|&(sp, sa)| profile(&OpticalProperties::new(sp, sa, eta).unwrap()))
         .collect();
     let mut csv = String::from(
         "r_mm,r_px,value_r,stderr_r,count_r,value_g,stderr_g,count_g,value_b,stderr_b,count_b\n",
@@ -185,7 +189,7 @@ fn profile_mse_against_a_model_profile_is_small() {
         for c in 0..3 {
             csv.push_str(&format!(
                 ",{},0.1,{}",
-                k[c] * avg(&dipoles[c], r),
+                k[c] * avg(&*profiles[c], r),
                 8 * ring + 4
             ));
         }
@@ -201,7 +205,7 @@ fn profile_mse_against_a_model_profile_is_small() {
         )
     };
     let result = format!(
-        r#"{{ "name": "model sample", "eta": {eta}, "method": "proposed", "model": "dipole",
+        r#"{{ "name": "model sample", "eta": {eta}, "method": "proposed", "model": "{model}",
              "channels": {{ "r": {}, "g": {}, "b": {} }},
              "inputs": {{ "profile": "profile.csv", "mm_per_pixel": {mmpp}, "spot_radius_mm": {spot} }},
              "version": "0.1.0" }}"#,
@@ -210,24 +214,24 @@ fn profile_mse_against_a_model_profile_is_small() {
         channel(2)
     );
     std::fs::write(dir.path().join("result.json"), result).unwrap();
-    let out = scatterfit(
-        dir.path(),
-        &[
-            "render",
-            "--params",
-            "result.json",
-            "--profile",
-            "--light-rays",
-            "20000",
-            "-o",
-            "cmp.csv",
-            "-o",
-            "slab.png",
-            "--json",
-        ],
-    );
+    let mut args = vec![
+        "render",
+        "--params",
+        "result.json",
+        "--profile",
+        "--light-rays",
+        "20000",
+        "-o",
+        "cmp.csv",
+        "-o",
+        "slab.png",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    let out = scatterfit(dir.path(), &args);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let json: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let mut ratio = [0.0; 3];
     for (c, ch) in json["profile"]["channels"]
         .as_array()
         .unwrap()
@@ -240,17 +244,45 @@ fn profile_mse_against_a_model_profile_is_small() {
             "rings outside the 0.3 mm spot: r = 0.35 … 3.95 mm"
         );
         // Relative scale: the profile at 1 mm. A 1 % error everywhere would give (0.01 Rd)².
-        let rd1 = avg(&dipoles[c], 1.0);
-        let mse = ch["mse"].as_f64().unwrap();
-        assert!(
-            mse < (5e-3 * rd1).powi(2),
-            "channel {c}: MSE {mse} vs Rd(1 mm) {rd1}"
-        );
-        assert!(ch["rms_log"].as_f64().unwrap() < 1e-2);
+        let rd1 = avg(&*profiles[c], 1.0);
+        ratio[c] = ch["mse"].as_f64().unwrap() / (5e-3 * rd1).powi(2);
     }
     let text = std::fs::read_to_string(dir.path().join("cmp.csv")).unwrap();
     assert!(text.starts_with("r_mm,rendered_r"));
     assert_eq!(text.lines().count(), 41);
+    ratio
+}
+
+#[test]
+fn profile_mse_against_a_model_profile_is_small() {
+    let dipole = |p: &OpticalProperties| -> Box<dyn Fn(f64) -> f64> {
+        let d = Dipole::new(p);
+        Box::new(move |r| d.rd(r))
+    };
+    let ratio = profile_mse_ratio("dipole", &dipole, &[]);
+    assert!(
+        ratio.iter().all(|&x| x < 1.0),
+        "MSE / (5e-3 Rd(1 mm))²: {ratio:?}"
+    );
+}
+
+/// The texture-space method renders with the model the parameters were fitted with: a profile made
+/// by the better dipole matches a render of a `better-dipole` result, and does not match the same
+/// parameters forced through the classical dipole (which is what render did before it knew models).
+#[test]
+fn render_uses_the_fitted_model() {
+    use scatterfit_optics::model::{DiffusionModel, ProfileModel};
+    let better = |p: &OpticalProperties| -> Box<dyn Fn(f64) -> f64> {
+        let m = DiffusionModel::BetterDipole.profile(p).unwrap();
+        Box::new(move |r| m.rd(r))
+    };
+    let own = profile_mse_ratio("better-dipole", &better, &[]);
+    assert!(own.iter().all(|&x| x < 1.0), "better dipole: {own:?}");
+    let forced = profile_mse_ratio("better-dipole", &better, &["--model", "dipole"]);
+    assert!(
+        forced.iter().any(|&x| x > 10.0),
+        "rendered with the classical dipole the profile should not match: {forced:?}"
+    );
 }
 
 #[test]
@@ -263,8 +295,8 @@ fn bad_input_is_refused_with_a_clear_message() {
             "not a published material",
         ),
         (
-            vec!["--params", "pink-plastic", "--model", "pbd", "-o", "x.png"],
-            "only the `dipole`",
+            vec!["--params", "pink-plastic", "--model", "sph", "-o", "x.png"],
+            "sph",
         ),
         (vec!["--params", "pink-plastic", "-o", "x.jpg"], ".png"),
         (

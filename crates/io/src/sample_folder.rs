@@ -12,7 +12,7 @@ use crate::image_files::CameraFrame;
 use crate::manifest::{CameraSection, FitSection, SampleManifest, SpectroSection};
 
 /// What goes into a sample folder.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct SampleFiles<'a> {
     /// The sample's name.
     pub name: &'a str,
@@ -33,6 +33,8 @@ pub struct SampleFiles<'a> {
     pub truth_json: Option<&'a str>,
     /// A line saying where the folder came from (top of the manifest and the spectro CSV).
     pub provenance: &'a str,
+    /// The manifest's `[fit]` (default: every key at its default).
+    pub fit: FitSection,
 }
 
 /// The files a sample folder holds, in the order written.
@@ -93,7 +95,7 @@ pub fn write_sample_folder(dir: &Path, s: &SampleFiles<'_>) -> Result<Vec<PathBu
             spot_diameter_mm: Some(s.spot_diameter_mm),
             ..Default::default()
         },
-        fit: FitSection::default(),
+        fit: s.fit.clone(),
         dir: dir.to_path_buf(),
     };
     let mut comment = s.provenance.to_string();

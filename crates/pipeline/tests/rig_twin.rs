@@ -50,6 +50,7 @@ fn proposed_method_meets_the_targets_on_twin_samples() {
                 spot_diameter_mm: 2.0 * rig.spot_radius_mm,
                 truth_json: None,
                 provenance: "test",
+                fit: Default::default(),
             },
         )
         .unwrap();
