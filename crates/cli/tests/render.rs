@@ -152,11 +152,10 @@ fn compare_makes_a_captioned_figure_5_grid_and_gray_works() {
 /// spot-averaged `profile`: rendered with the result's model (or `--model`), the slab's profile must
 /// match it, so the MSE is small compared with the profile's own scale (the render's noise and the
 /// ring discretisation only). Returns each channel's MSE over (5e-3 Rd(1 mm))².
-fn profile_mse_ratio(
-    model: &str,
-    profile: &dyn Fn(&OpticalProperties) -> Box<dyn Fn(f64) -> f64>,
-    extra: &[&str],
-) -> [f64; 3] {
+/// A radial profile Rd(r) (r in mm) made for some optical properties.
+type ProfileOf = dyn Fn(&OpticalProperties) -> Box<dyn Fn(f64) -> f64>;
+
+fn profile_mse_ratio(model: &str, profile: &ProfileOf, extra: &[&str]) -> [f64; 3] {
     let dir = tempfile::tempdir().unwrap();
     let (eta, mmpp, spot) = (1.3, 0.1, 0.3);
     let coeffs = [(1.2, 0.05), (1.0, 0.1), (0.8, 0.2)];
