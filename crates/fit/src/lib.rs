@@ -42,7 +42,7 @@
 
 mod error;
 pub mod model;
-pub mod problem;
+mod problem;
 pub mod profile;
 pub mod spot;
 
@@ -438,8 +438,7 @@ impl<'a> PreparedFit<'a> {
         // χ² when the model misfits (the ring errors then understate the scatter), never
         // deflated; then mapped to the logarithms of the reported parameters
         // y = (ln σ′s[, ln σa], ln k): C_y = T C Tᵀ with T = ∂y/∂(x, ln k).
-        let j = problem.full_jacobian();
-        let jtj: DMatrix<f64> = j.transpose() * &j;
+        let jtj = problem.full_jtj();
         let t = match self.unknowns {
             Unknowns::Existing => {
                 let [c0, c1] = phys.chain;
@@ -501,17 +500,13 @@ impl<'a> PreparedFit<'a> {
             Unknowns::Existing => (sp * sd[0], sa * sd[1], k * sd[2]),
         };
         let m = problem.model_values();
-        let m: Vec<f64> = if m.len() == n {
-            m.to_vec()
-        } else {
-            vec![f64::NAN; n]
-        };
+        let model_at = |i: usize| if m.len() == n { m[i] } else { f64::NAN };
         let mut fitted = Vec::with_capacity(n);
-        let (mut mse, mut msl) = (0.0, 0.0);
-        for (i, &model) in m.iter().enumerate() {
-            let y = self.selected.value[i];
-            mse += (y / k - model).powi(2);
-            msl += (y.ln() - ln_k - model.ln()).powi(2);
+        let mut mse = 0.0;
+        let inv_k = 1.0 / k;
+        for i in 0..n {
+            let (y, model) = (self.selected.value[i], model_at(i));
+            mse += (y * inv_k - model).powi(2);
             fitted.push(FittedRing {
                 index: self.selected.index[i],
                 r_mm: self.selected.r_mm[i],
@@ -520,6 +515,12 @@ impl<'a> PreparedFit<'a> {
                 sigma_ln: self.selected.sigma_ln[i],
             });
         }
+        // ln(k m) − ln y = eᵢ/wᵢ, the residual without its weight (no logarithms to take again).
+        let msl = if problem.valid && res.len() == n {
+            res.iter().zip(&self.w).map(|(e, w)| (e / w).powi(2)).sum()
+        } else {
+            f64::NAN
+        };
         let converged = termination.was_successful() && problem.valid;
         FitReport {
             method: self.opts.method,

@@ -192,6 +192,15 @@ impl SpotKernel {
         }
     }
 
+    /// [`SpotKernel::apply`] to two node arrays at once (a model and its derivative: each row's
+    /// weights are read once for both).
+    pub fn apply_pair(&self, f: &[f64], g: &[f64], out_f: &mut [f64], out_g: &mut [f64]) {
+        for ((row, of), og) in self.rows.iter().zip(out_f.iter_mut()).zip(out_g.iter_mut()) {
+            let end = row.first + row.weights.len();
+            (*of, *og) = dot2(&row.weights, &f[row.first..end], &g[row.first..end]);
+        }
+    }
+
     /// Keeps only the rows whose index is in `keep` (ascending), in that order.
     pub fn select_rows(&self, keep: &[usize]) -> Self {
         Self {
@@ -218,6 +227,31 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     }
     let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+/// (Σ wᵢaᵢ, Σ wᵢbᵢ), as [`dot`] with the weights loaded once.
+#[inline]
+fn dot2(w: &[f64], a: &[f64], b: &[f64]) -> (f64, f64) {
+    let n = w.len().min(a.len()).min(b.len());
+    let (w, a, b) = (&w[..n], &a[..n], &b[..n]);
+    let (mut acc_a, mut acc_b) = ([0.0; 4], [0.0; 4]);
+    let (cw, ca, cb) = (w.chunks_exact(4), a.chunks_exact(4), b.chunks_exact(4));
+    let (rw, ra, rb) = (cw.remainder(), ca.remainder(), cb.remainder());
+    for ((x, y), z) in cw.zip(ca).zip(cb) {
+        for k in 0..4 {
+            acc_a[k] += x[k] * y[k];
+            acc_b[k] += x[k] * z[k];
+        }
+    }
+    let (mut ta, mut tb) = (0.0, 0.0);
+    for ((x, y), z) in rw.iter().zip(ra).zip(rb) {
+        ta += x * y;
+        tb += x * z;
+    }
+    (
+        (acc_a[0] + acc_a[1]) + (acc_a[2] + acc_a[3]) + ta,
+        (acc_b[0] + acc_b[1]) + (acc_b[2] + acc_b[3]) + tb,
+    )
 }
 
 /// The weights of the ring at radius r: K_j = (2/πa²) ∫ B_j(s) s θ(s) ds.
