@@ -749,11 +749,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .enumerate()
                 .map(|(i, (&(method, k), img))| {
                     let p = &params[k];
+                    let model = args.model.map(ModelName::from).unwrap_or(p.model);
+                    // The texture-space method with another profile model says which.
+                    let (title, profile) = if method == Method::Dipole && model != ModelName::Dipole
+                    {
+                        (
+                            "texture-space method (§4.2)",
+                            format!(" · {} profile", model.as_str()),
+                        )
+                    } else {
+                        (method.title(), String::new())
+                    };
                     Ok(Panel {
                         image: rgb8(tone_map(img, &tone)?),
                         caption: vec![
-                            format!("({}) {}", letters[i.min(3)], method.title()),
-                            format!("{} · {}", p.name, p.method),
+                            format!("({}) {title}", letters[i.min(3)]),
+                            format!("{} · {}{profile}", p.name, p.method),
                         ],
                     })
                 })
