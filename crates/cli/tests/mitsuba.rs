@@ -278,11 +278,17 @@ fn forward_models_against_mitsuba() {
             let dipole = scatterfit_optics::dipole::rd_total(a, eta);
             let mc = table.rd_total(a).unwrap();
             let pct = |x: f64| format!("{:+.1} %", 100.0 * (x / truth - 1.0));
+            let improved = |m: scatterfit_optics::model::DiffusionModel| {
+                m.rd_total(a, eta)
+                    .map_or_else(|e| e.to_string(), |v| format!("{v:.4} ({})", pct(v)))
+            };
             println!(
-                "| {eta} | {a} | {truth:.4} ± {:.4} | {dipole:.4} | {} | {mc:.4} | {} | pending | pending |",
+                "| {eta} | {a} | {truth:.4} ± {:.4} | {dipole:.4} | {} | {mc:.4} | {} | {} | {} |",
                 r.stderr[1],
                 pct(dipole),
-                pct(mc)
+                pct(mc),
+                improved(scatterfit_optics::model::DiffusionModel::BetterDipole),
+                improved(scatterfit_optics::model::DiffusionModel::Pbd),
             );
             eprintln!(
                 "η = {eta}, α′ = {a}: {} px × {} spp in {:.1} s (Mitsuba {})",
