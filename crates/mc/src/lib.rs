@@ -29,6 +29,7 @@
 
 mod beam;
 pub mod bundled;
+mod cache;
 mod engine;
 mod error;
 mod fresnel;

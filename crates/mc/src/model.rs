@@ -26,7 +26,7 @@ use scatterfit_optics::{OpticalProperties, ProfileModel, ProfileSample};
 
 use crate::error::{McError, Result, check};
 use crate::smooth::{Knots, SmoothParams, fit_row, kappa0};
-use crate::table::{CacheStatus, catmull_rom_weights, write_atomic};
+use crate::table::{CacheStatus, catmull_rom_weights};
 use crate::white::{WhiteSpec, WhiteTally, simulate};
 
 /// Version of the `McTable` file format; files of another version are rebuilt.
@@ -703,14 +703,7 @@ impl McTable {
     /// # Errors
     /// `Io` when it cannot be read, `Format` when it is not a table of this format version.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| McError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        Self::from_json(&text).map_err(|message| McError::Format {
-            path: path.to_owned(),
-            message,
-        })
+        crate::cache::read_with(path, Self::from_json)
     }
 
     /// Parses a table from JSON (a file's text, or one shipped inside a program).
@@ -726,11 +719,7 @@ impl McTable {
     /// # Errors
     /// `Io` on any file-system error (the target is then untouched).
     pub fn save(&self, path: &Path) -> Result<()> {
-        let json = serde_json::to_vec(self).map_err(|e| McError::Format {
-            path: path.to_owned(),
-            message: e.to_string(),
-        })?;
-        write_atomic(path, &json)
+        crate::cache::save_json(self, path)
     }
 
     /// The table for `spec` from the cache folder `dir` when a file made with the same spec and
@@ -744,15 +733,13 @@ impl McTable {
         progress: &(dyn Fn(u64, u64) + Sync),
     ) -> Result<(Self, CacheStatus, PathBuf)> {
         spec.white()?;
-        let path = dir.join(spec.file_name());
-        if let Ok(table) = Self::load(&path)
-            && table.spec == *spec
-        {
-            return Ok((table, CacheStatus::Loaded, path));
-        }
-        let table = Self::build(spec, progress)?;
-        table.save(&path)?;
-        Ok((table, CacheStatus::Built, path))
+        crate::cache::load_or_build(
+            dir.join(spec.file_name()),
+            Self::load,
+            |t| t.spec == *spec,
+            || Self::build(spec, progress),
+            Self::save,
+        )
     }
 }
 

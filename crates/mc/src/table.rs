@@ -6,7 +6,6 @@
 //! Rd(r; σ′t, α′) = σ′t² R̂(σ′t r; α′) exactly (same g, η). Tables are cached on disk with the
 //! parameters that made them and a format version; a cached file is reused only when both match.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -574,13 +573,8 @@ impl ProfileTable {
     /// # Errors
     /// `Io` when it cannot be read, `Format` when it is not a table of this format version.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| McError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        serde_json::from_str(&text).map_err(|e| McError::Format {
-            path: path.to_owned(),
-            message: e.to_string(),
+        crate::cache::read_with(path, |text| {
+            serde_json::from_str(text).map_err(|e| e.to_string())
         })
     }
 
@@ -589,11 +583,7 @@ impl ProfileTable {
     /// # Errors
     /// `Io` on any file-system error (the target is then untouched).
     pub fn save(&self, path: &Path) -> Result<()> {
-        let json = serde_json::to_vec(self).map_err(|e| McError::Format {
-            path: path.to_owned(),
-            message: e.to_string(),
-        })?;
-        write_atomic(path, &json)
+        crate::cache::save_json(self, path)
     }
 
     /// The table for `spec` from the cache folder `dir` when a file made with the same spec and
@@ -607,48 +597,14 @@ impl ProfileTable {
         progress: &(dyn Fn(u64, u64) + Sync),
     ) -> Result<(Self, CacheStatus, PathBuf)> {
         spec.validate()?;
-        let path = dir.join(spec.file_name());
-        if let Ok(table) = Self::load(&path)
-            && table.spec == *spec
-        {
-            return Ok((table, CacheStatus::Loaded, path));
-        }
-        let table = Self::build(spec, progress)?;
-        table.save(&path)?;
-        Ok((table, CacheStatus::Built, path))
+        crate::cache::load_or_build(
+            dir.join(spec.file_name()),
+            Self::load,
+            |t| t.spec == *spec,
+            || Self::build(spec, progress),
+            Self::save,
+        )
     }
-}
-
-/// Writes `bytes` to `path` atomically: a temporary file in the same folder (created if missing),
-/// synced, then renamed over the target. (mc does not depend on io, whose `write_atomic` does the same.)
-///
-/// # Errors
-/// `Io` on any file-system error (the target is then untouched).
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let io = |source| McError::Io {
-        path: path.to_owned(),
-        source,
-    };
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(io)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
 }
 
 /// Catmull-Rom weights at `x` over the `n` strictly increasing nodes `node(k)` (pbrt-v3's

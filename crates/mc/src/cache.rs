@@ -1,0 +1,94 @@
+//! Table files: JSON read and written atomically, and the cache rule shared by every table type —
+//! reuse a file only when it was made with the same spec (and format), else simulate and save.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::error::{McError, Result};
+use crate::table::CacheStatus;
+
+/// The text of `path`, parsed by `parse` (a table's own JSON reader, which validates).
+///
+/// # Errors
+/// `Io` when the file cannot be read, `Format` (with the parser's message) when it does not parse.
+pub(crate) fn read_with<T>(
+    path: &Path,
+    parse: impl FnOnce(&str) -> std::result::Result<T, String>,
+) -> Result<T> {
+    let text = std::fs::read_to_string(path).map_err(|source| McError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    parse(&text).map_err(|message| McError::Format {
+        path: path.to_owned(),
+        message,
+    })
+}
+
+/// `value` as JSON at `path`, atomically ([`write_atomic`]).
+///
+/// # Errors
+/// `Format` if it cannot be serialised, `Io` on any file-system error (the target is then untouched).
+pub(crate) fn save_json<T: Serialize>(value: &T, path: &Path) -> Result<()> {
+    let json = serde_json::to_vec(value).map_err(|e| McError::Format {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    write_atomic(path, &json)
+}
+
+/// The cache rule: the table at `path` when `load` reads it and `matches` accepts it (same spec),
+/// else `build`, saved at `path` by `save`.
+///
+/// # Errors
+/// As `build`, or `save`'s when the cache cannot be written.
+pub(crate) fn load_or_build<T>(
+    path: PathBuf,
+    load: impl FnOnce(&Path) -> Result<T>,
+    matches: impl FnOnce(&T) -> bool,
+    build: impl FnOnce() -> Result<T>,
+    save: impl FnOnce(&T, &Path) -> Result<()>,
+) -> Result<(T, CacheStatus, PathBuf)> {
+    if let Ok(table) = load(&path)
+        && matches(&table)
+    {
+        return Ok((table, CacheStatus::Loaded, path));
+    }
+    let table = build()?;
+    save(&table, &path)?;
+    Ok((table, CacheStatus::Built, path))
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same folder (created if missing),
+/// synced, then renamed over the target. (mc does not depend on io, whose `write_atomic` does the same.)
+///
+/// # Errors
+/// `Io` on any file-system error (the target is then untouched).
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let io = |source| McError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io)
+}
