@@ -16,8 +16,8 @@ pub struct MeasurementFailed(pub String);
 /// True when `err` (or a cause) is a failed measurement: exit 1. The classes: the CLI's
 /// [`MeasurementFailed`], [`scatterfit_pipeline::PipelineError::is_measurement_failure`] (every
 /// command that runs a pipeline stage) and [`scatterfit_imaging::ImagingError::is_failed_measurement`]
-/// (`merge`, which calls the imaging crate itself: an all-saturated bracket, exposure times in the
-/// wrong order). Everything else is bad usage or input (exit 2).
+/// (an imaging error anywhere in the chain, e.g. the source of a pipeline error: an all-saturated
+/// bracket, exposure times in the wrong order). Everything else is bad usage or input (exit 2).
 pub fn is_measurement_failure(err: &anyhow::Error) -> bool {
     err.chain().any(|e| {
         e.is::<MeasurementFailed>()

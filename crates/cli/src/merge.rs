@@ -1,23 +1,20 @@
 //! `scatterfit merge`: an exposure bracket → an HDR radiance map (Debevec & Malik 1997).
 //!
-//! Reads the frames (in parallel), recovers the camera response (or takes a known one), merges,
-//! saves the radiance map (EXR or HDR) and the response (CSV), and prints a summary. 8-bit frames use a
-//! response curve; 16-bit frames are merged as linear data (raw or linear TIFF).
+//! The pipeline's HDR stage (`scatterfit_pipeline::hdr`) reads the frames (in parallel), recovers
+//! the camera response (or takes a known one) and merges; this command checks its flags and
+//! outputs first, shows the reading's progress, checks the merge's memory, saves the radiance map
+//! (EXR or HDR) and the response (CSV), and prints a summary. 8-bit frames use a response curve;
+//! 16-bit frames are merged as linear data (raw or linear TIFF).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
 use crate::output::{errln, outln};
 use anyhow::{Context, bail};
-use scatterfit_imaging::{
-    CalibrateOptions, ClippedFill, HdrImage, ImageBuf, LEVELS, LinearMergeOptions, MergeOptions,
-    ResponseCurve,
-};
-use scatterfit_io::bracket::{Bracket, read_bracket_within};
-use scatterfit_io::image_files::{CameraFrame, read_camera_frame, write_radiance};
-use scatterfit_io::response_csv::{ResponseTable, read_response_csv, write_response_csv};
+use scatterfit_imaging::{ClippedFill, Weighting};
+use scatterfit_io::image_files::write_radiance;
+use scatterfit_io::response_csv::{ResponseTable, write_response_csv};
+use scatterfit_pipeline::hdr::{self, FrameInfo, HdrInputs, HdrStage};
 use serde::Serialize;
 
 /// What to store for a pixel-channel clipped in every exposure (it is always counted and reported).
@@ -96,7 +93,7 @@ pub struct Args {
 #[derive(Debug, Serialize)]
 pub struct Summary {
     /// The frames, shortest exposure first.
-    pub frames: Vec<FrameSummary>,
+    pub frames: Vec<FrameInfo>,
     /// Image size and kind, e.g. `6000×4000 RGB 8-bit`.
     pub image: String,
     /// Width [px].
@@ -127,15 +124,6 @@ pub struct Summary {
     pub merge_s: f64,
 }
 
-/// One frame in the summary.
-#[derive(Debug, Serialize)]
-pub struct FrameSummary {
-    /// The file.
-    pub file: PathBuf,
-    /// Shutter time [s].
-    pub time_s: f64,
-}
-
 fn default_response_out(output: &Path) -> PathBuf {
     let stem = output
         .file_stem()
@@ -143,189 +131,49 @@ fn default_response_out(output: &Path) -> PathBuf {
     output.with_file_name(format!("{stem}.response.csv"))
 }
 
-/// Reads a response CSV into a curve with 256 levels.
-fn load_response(path: &Path) -> anyhow::Result<ResponseCurve> {
-    let table = read_response_csv(path)?;
-    if table.levels() != LEVELS {
-        bail!(
-            "{}: {} rows, but a response for 8-bit frames lists g(z) for z = 0..255 (256 rows)",
-            path.display(),
-            table.levels()
-        );
-    }
-    let g: Vec<[f64; LEVELS]> = table
-        .g
-        .iter()
-        .map(|c| {
-            let mut t = [0.0; LEVELS];
-            t.copy_from_slice(c);
-            t
-        })
-        .collect();
-    ResponseCurve::from_log_exposure(g)
-        .with_context(|| format!("camera response {}", path.display()))
-}
-
-/// The outcome of reading and merging, before anything is written.
-pub(crate) struct Merged {
-    pub hdr: HdrImage,
-    pub response: Option<ResponseCurve>,
-    pub response_kind: &'static str,
-    pub rms: Vec<f64>,
-    pub read_s: f64,
-    pub merge_s: f64,
-    pub frames: Vec<FrameSummary>,
-    pub image: String,
-}
-
-/// Reads the bracket and merges it (shared by `run` and the benchmark).
-pub(crate) fn read_and_merge(args: &Args, progress: bool) -> anyhow::Result<Merged> {
-    let t0 = Instant::now();
-    let bar = if progress && std::io::stderr().is_terminal() {
-        let n = if args.images.is_empty() {
-            0
-        } else {
-            args.images.len() as u64
-        };
-        let bar = indicatif::ProgressBar::new(n);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "reading frames {bar:30} {pos}/{len} {elapsed}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar
-    } else {
-        indicatif::ProgressBar::hidden()
+/// The pipeline's inputs for these flags and the memory budget [bytes] (the sample count is set
+/// once the frames are counted).
+fn hdr_inputs(args: &Args, budget: u64) -> HdrInputs {
+    let mut inputs = HdrInputs::new(args.exposures.clone(), args.images.clone());
+    inputs.response.clone_from(&args.response);
+    inputs.dark.clone_from(&args.dark);
+    inputs.lambda = args.lambda;
+    inputs.saturation = args.saturation;
+    inputs.clipped_fill = fill(args.clipped_fill);
+    inputs.weighting = match args.weighting {
+        WeightingArg::NoiseOptimal => Weighting::NoiseOptimal,
+        WeightingArg::DebevecHat => Weighting::DebevecHat,
     };
+    inputs.memory_budget = Some(budget);
+    inputs
+}
+
+/// Reads the bracket (with a progress bar unless `quiet`), notes dropped alpha channels, checks the
+/// merge's memory against the budget and merges, through the pipeline's HDR stage.
+fn read_and_merge(args: &Args, quiet: bool) -> anyhow::Result<HdrStage> {
     let budget = crate::numeric::memory_budget(args.max_memory_mib);
-    let bracket: Bracket =
-        read_bracket_within(&args.images, args.exposures.as_deref(), budget, &|_| {
-            bar.inc(1)
-        })
-        .context("reading the exposure bracket")?;
+    let mut inputs = hdr_inputs(args, budget);
+    let bar = crate::common::bar(
+        args.images.len() as u64,
+        "reading frames {bar:30} {pos}/{len} {elapsed}",
+        quiet,
+    );
+    let read = hdr::read_frames(&inputs, &|_| bar.inc(1))?;
     bar.finish_and_clear();
-    for f in bracket.frames().iter().filter(|f| f.dropped_alpha) {
-        errln!("note: {}: alpha channel ignored", f.path.display());
+    for path in &read.dropped_alpha {
+        errln!("note: {}: alpha channel ignored", path.display());
     }
-    let dark = match &args.dark {
-        Some(path) => {
-            let d = read_camera_frame(path).context("reading the dark frame")?;
-            bracket.check_same_shape(&d.frame, path)?;
-            Some(d.frame)
-        }
-        None => None,
-    };
-    let read_s = t0.elapsed().as_secs_f64();
-    let frames: Vec<FrameSummary> = bracket
-        .frames()
-        .iter()
-        .map(|f| FrameSummary {
-            file: f.path.clone(),
-            time_s: f.time_s,
-        })
-        .collect();
-    let image = bracket.describe();
-    let times = bracket.times_s();
     // The merge's own allocations (radiance f32 + clipping mask + the encoded file), beside the
     // frames already read, before any is made.
-    let first = &bracket.frames()[0].frame;
-    let samples = (first.width() * first.height() * first.channels()) as u64;
-    let frames_bytes = samples * u64::from(first.bit_depth() / 8) * bracket.frames().len() as u64;
     crate::numeric::check_memory(
-        &format!("merging {} frames of {image}", bracket.frames().len()),
-        frames_bytes + samples * (4 + 1 + 4),
+        &format!("merging {} frames of {}", read.frames.len(), read.image),
+        read.decoded_bytes() + read.samples_per_frame() * (4 + 1 + 4),
         budget,
     )?;
-    let t1 = Instant::now();
-    let first = first.bit_depth();
-    let merged = if first == 8 {
-        let bufs: Vec<ImageBuf<u8>> = bracket
-            .into_frames()
-            .into_iter()
-            .filter_map(|f| match f.frame {
-                CameraFrame::U8(b) => Some(b),
-                _ => None,
-            })
-            .collect();
-        let (response, kind, rms) = match &args.response {
-            Some(path) => (load_response(path)?, "given", Vec::new()),
-            None => {
-                let samples = args.samples.unwrap_or_else(|| {
-                    100.max(scatterfit_imaging::min_response_samples(bufs.len()))
-                });
-                let opts = CalibrateOptions::new(samples, args.lambda)
-                    .context("response recovery options")?;
-                let cal = scatterfit_imaging::recover_response(&bufs, &times, &opts).context(
-                    "recovering the camera response (or give a known one with --response)",
-                )?;
-                let rms = cal.solutions.iter().map(|s| s.rms_residual).collect();
-                (cal.response, "recovered", rms)
-            }
-        };
-        let dark = dark.and_then(|d| match d {
-            CameraFrame::U8(b) => Some(b),
-            _ => None,
-        });
-        let opts = MergeOptions {
-            clipped_fill: fill(args.clipped_fill),
-            weighting: match args.weighting {
-                WeightingArg::NoiseOptimal => scatterfit_imaging::Weighting::NoiseOptimal,
-                WeightingArg::DebevecHat => scatterfit_imaging::Weighting::DebevecHat,
-            },
-        };
-        let hdr = scatterfit_imaging::merge(&bufs, &times, &response, dark.as_ref(), &opts)
-            .context("merging the bracket")?;
-        drop(bufs);
-        Merged {
-            hdr,
-            response: Some(response),
-            response_kind: kind,
-            rms,
-            read_s,
-            merge_s: 0.0,
-            frames,
-            image,
-        }
-    } else {
-        if let Some(path) = &args.response {
-            bail!(
-                "{}: a response curve applies to 8-bit frames; these frames are 16-bit and are merged as \
-                 linear data — drop --response",
-                path.display()
-            );
-        }
-        let bufs: Vec<ImageBuf<u16>> = bracket
-            .into_frames()
-            .into_iter()
-            .filter_map(|f| match f.frame {
-                CameraFrame::U16(b) => Some(b),
-                _ => None,
-            })
-            .collect();
-        let dark = dark.and_then(|d| match d {
-            CameraFrame::U16(b) => Some(b),
-            _ => None,
-        });
-        let opts = LinearMergeOptions::new(args.saturation, fill(args.clipped_fill))
-            .context("--saturation")?;
-        let hdr = scatterfit_imaging::merge_linear_u16(&bufs, &times, dark.as_ref(), &opts)
-            .context("merging the 16-bit bracket")?;
-        Merged {
-            hdr,
-            response: None,
-            response_kind: "linear",
-            rms: Vec::new(),
-            read_s,
-            merge_s: 0.0,
-            frames,
-            image,
-        }
-    };
-    Ok(Merged {
-        merge_s: t1.elapsed().as_secs_f64(),
-        ..merged
-    })
+    inputs.samples = args
+        .samples
+        .unwrap_or_else(|| hdr::default_response_samples(read.frames.len()));
+    Ok(hdr::merge_frames(read, &inputs)?)
 }
 
 fn fill(f: Fill) -> ClippedFill {
@@ -416,8 +264,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
     }
 
-    let merged = read_and_merge(&args, !args.json)?;
-    let Merged {
+    let HdrStage {
         hdr,
         response,
         response_kind,
@@ -426,7 +273,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         merge_s,
         frames,
         image,
-    } = merged;
+        ..
+    } = read_and_merge(&args, args.json)?;
     let (width, height) = (hdr.radiance.width(), hdr.radiance.height());
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for (&v, &m) in hdr.radiance.data().iter().zip(hdr.clipped.data()) {
@@ -540,224 +388,4 @@ fn print_summary(s: &Summary) -> anyhow::Result<()> {
         outln!("wrote         {}", r.display())?;
     }
     Ok(())
-}
-
-/// A synthetic spot bracket: a radially decaying radiance (a light spot on a translucent sample)
-/// through a gamma-2.2 camera with a 1 % shot-like noise, 13 shutter times 1/600 s … 3 s.
-pub(crate) fn synthetic_bracket(width: usize, height: usize) -> (Vec<ImageBuf<u8>>, Vec<f64>) {
-    use rayon::prelude::*;
-    let n = 13;
-    let times: Vec<f64> = (0..n)
-        .map(|k| (1.0f64 / 600.0) * (1800.0f64).powf(k as f64 / (n - 1) as f64))
-        .collect();
-    let (cx, cy) = (width as f64 * 0.5 + 0.3, height as f64 * 0.5 - 0.2);
-    let scale = width.min(height) as f64 / 40.0;
-    let frames = times
-        .par_iter()
-        .enumerate()
-        .map(|(j, &t)| {
-            let mut data = vec![0u8; width * height * 3];
-            data.par_chunks_mut(width * 3)
-                .enumerate()
-                .for_each(|(y, row)| {
-                    let mut state =
-                        (y as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (j as u64 + 1);
-                    for x in 0..width {
-                        let r = ((x as f64 - cx).powi(2) + (y as f64 - cy).powi(2)).sqrt();
-                        let e = 200.0 * (-r / scale).exp() / (1.0 + r / scale) + 0.002;
-                        for (c, k) in [1.0, 0.7, 0.45].iter().enumerate() {
-                            state ^= state << 13;
-                            state ^= state >> 7;
-                            state ^= state << 17;
-                            let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-                            let x_exp = (e * k * t * (1.0 + 0.02 * u)).clamp(0.0, 1.0);
-                            row[x * 3 + c] = (255.0 * x_exp.powf(1.0 / 2.2)).round() as u8;
-                        }
-                    }
-                });
-            ImageBuf::new(width, height, 3, data).expect("width × height × 3 samples")
-        })
-        .collect();
-    (frames, times)
-}
-
-/// Writes a bracket as fast-compressed PNGs plus `exposures.csv` into `dir`.
-pub(crate) fn write_bracket_png(
-    dir: &Path,
-    frames: Vec<ImageBuf<u8>>,
-    times: &[f64],
-) -> anyhow::Result<PathBuf> {
-    use rayon::prelude::*;
-    frames
-        .into_par_iter()
-        .enumerate()
-        .try_for_each(|(j, f)| -> anyhow::Result<()> {
-            let path = dir.join(format!("frame_{j:02}.png"));
-            Ok(scatterfit_io::image_files::write_camera_frame(
-                &path,
-                &CameraFrame::U8(f),
-            )?)
-        })?;
-    write_exposures_csv(dir, "png", "exposures.csv", times)
-}
-
-/// Writes a bracket as JPEGs of the given quality plus `exposures_jpeg.csv` into `dir` (frames are
-/// borrowed: the PNG bracket is written from the same frames afterwards).
-pub(crate) fn write_bracket_jpeg(
-    dir: &Path,
-    frames: &[ImageBuf<u8>],
-    times: &[f64],
-    quality: u8,
-) -> anyhow::Result<PathBuf> {
-    use rayon::prelude::*;
-    frames
-        .par_iter()
-        .enumerate()
-        .try_for_each(|(j, f)| -> anyhow::Result<()> {
-            let path = dir.join(format!("frame_{j:02}.jpg"));
-            Ok(scatterfit_io::image_files::write_jpeg(&path, f, quality)?)
-        })?;
-    write_exposures_csv(dir, "jpg", "exposures_jpeg.csv", times)
-}
-
-fn write_exposures_csv(
-    dir: &Path,
-    ext: &str,
-    name: &str,
-    times: &[f64],
-) -> anyhow::Result<PathBuf> {
-    let mut csv = String::from("file,time_s\n");
-    for (j, t) in times.iter().enumerate() {
-        csv.push_str(&format!("frame_{j:02}.{ext},{t}\n"));
-    }
-    let csv_path = dir.join(name);
-    scatterfit_io::atomic::write_atomic(&csv_path, csv.as_bytes())
-        .with_context(|| format!("writing {}", csv_path.display()))?;
-    Ok(csv_path)
-}
-
-/// Contributes this area's figures to `scatterfit bench`: the end-to-end merge of a 13-exposure
-/// 24-MP 8-bit RGB bracket (PNG files read from disk, response recovered, merged; the same from
-/// quality-90 JPEGs) and the radial
-/// profile of the 24-MP radiance map. Set `SCATTERFIT_BENCH_BRACKET_DIR` to keep the bracket there
-/// (for timing `scatterfit merge` itself, e.g. under `/usr/bin/time -v`).
-pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
-    use crate::bench::Figure;
-    let (width, height) = if args.quick {
-        (1200, 800)
-    } else {
-        (6000, 4000)
-    };
-    let mp = (width * height) as f64 / 1e6;
-    let threads = rayon::current_num_threads();
-    let (frames, times) = synthetic_bracket(width, height);
-    let keep = std::env::var_os("SCATTERFIT_BENCH_BRACKET_DIR").map(PathBuf::from);
-    let temp = tempfile::tempdir().context("creating a temporary folder for the bracket")?;
-    let dir = match &keep {
-        Some(d) => {
-            std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
-            d.clone()
-        }
-        None => temp.path().to_path_buf(),
-    };
-    // JPEG first (it borrows the frames), quality 90 as a camera would write; then the PNGs.
-    let jpeg_csv = write_bracket_jpeg(&dir, &frames, &times, 90)?;
-    let csv = write_bracket_png(&dir, frames, &times)?;
-    let merge_args = Args {
-        images: Vec::new(),
-        exposures: Some(csv),
-        response: None,
-        dark: None,
-        lambda: 10.0,
-        samples: None,
-        saturation: u16::MAX,
-        clipped_fill: Fill::Nan,
-        weighting: WeightingArg::NoiseOptimal,
-        output: dir.join("radiance.exr"),
-        response_out: None,
-        force: true,
-        max_memory_mib: None,
-        json: true,
-    };
-    let t0 = Instant::now();
-    let merged = read_and_merge(&merge_args, false)?;
-    let total = t0.elapsed().as_secs_f64();
-    let note = format!("13 × {mp:.0} MP RGB 8-bit PNG, {threads} threads");
-    let mut figures = vec![
-        Figure {
-            name: format!("merge end to end: read + recover + merge, {mp:.0} MP"),
-            value: total,
-            unit: "s".into(),
-            note: note.clone(),
-        },
-        Figure {
-            name: "  of which reading (decode 13 PNG)".into(),
-            value: merged.read_s,
-            unit: "s".into(),
-            note: note.clone(),
-        },
-        Figure {
-            name: "  of which response recovery + merge".into(),
-            value: merged.merge_s,
-            unit: "s".into(),
-            note,
-        },
-    ];
-    drop(merged.hdr.clipped);
-    let radiance = merged.hdr.radiance;
-    // The same bracket as quality-90 JPEGs (files as a camera writes them): reading only, then the
-    // whole read + recover + merge. The PNG result is kept for the profile below.
-    let jpeg_args = Args {
-        exposures: Some(jpeg_csv),
-        output: dir.join("radiance_jpeg.exr"),
-        ..merge_args
-    };
-    let t0 = Instant::now();
-    let jpeg = read_and_merge(&jpeg_args, false)?;
-    let jpeg_total = t0.elapsed().as_secs_f64();
-    drop(jpeg.hdr);
-    let jpeg_note = format!("13 × {mp:.0} MP RGB 8-bit JPEG quality 90, {threads} threads");
-    figures.push(Figure {
-        name: format!("merge end to end from JPEG: read + recover + merge, {mp:.0} MP"),
-        value: jpeg_total,
-        unit: "s".into(),
-        note: jpeg_note.clone(),
-    });
-    figures.push(Figure {
-        name: "  of which reading (decode 13 JPEG)".into(),
-        value: jpeg.read_s,
-        unit: "s".into(),
-        note: jpeg_note,
-    });
-    let center = scatterfit_imaging::find_spot_center(&radiance, &Default::default())?;
-    let opts = scatterfit_imaging::ProfileOptions::default();
-    let reps = 10;
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        std::hint::black_box(scatterfit_imaging::radial_profile(
-            &radiance,
-            center.xy(),
-            None,
-            0.1,
-            &opts,
-        )?);
-    }
-    figures.push(Figure {
-        name: format!("radial profile, {mp:.0} MP, r_max 300 px, 1 px rings"),
-        value: t0.elapsed().as_secs_f64() / f64::from(reps) * 1e3,
-        unit: "ms".into(),
-        note: format!("mean of {reps}"),
-    });
-    let t0 = Instant::now();
-    std::hint::black_box(scatterfit_imaging::find_spot_center(
-        &radiance,
-        &Default::default(),
-    )?);
-    figures.push(Figure {
-        name: format!("spot centre, {mp:.0} MP"),
-        value: t0.elapsed().as_secs_f64() * 1e3,
-        unit: "ms".into(),
-        note: String::new(),
-    });
-    Ok(figures)
 }

@@ -1,5 +1,4 @@
-//! `scatterfit simulate`: Monte Carlo photon transport (MCML physics) in a slab or half-space, and the
-//! Monte Carlo figures of `scatterfit bench`.
+//! `scatterfit simulate`: Monte Carlo photon transport (MCML physics) in a slab or half-space.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -364,54 +363,4 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// The two speed cases: (name, sample, photons at full size).
-fn speed_cases(quick: bool) -> anyhow::Result<Vec<(&'static str, Sample, u64, &'static str)>> {
-    let k = if quick { 10 } else { 1 };
-    Ok(vec![
-        (
-            "10 cm slab n=1.4 μa=0.1/cm μs=10/cm g=0",
-            Sample::slab(Layer::new(0.01, 1.0, 0.0, 1.4, 100.0)?, 1.0)?,
-            200_000 / k,
-            "MCML (C, gcc -O3) ≈ 1.0e5 photons/s per core on the reference machine",
-        ),
-        (
-            "standard slab (van de Hulst) g=0.75 τ=2",
-            Sample::slab(Layer::new(1.0, 9.0, 0.75, 1.0, 0.2)?, 1.0)?,
-            4_000_000 / k,
-            "MCML (C, gcc -O3) ≈ 4e6 photons/s per core on the reference machine",
-        ),
-    ])
-}
-
-/// Contributes this area's figures to `scatterfit bench`: photons/s of both speed cases on one
-/// thread and on all threads (grid 0.1 mm × 200, as MCML's 0.01 cm × 200).
-pub fn bench(args: &crate::bench::Args) -> anyhow::Result<Vec<crate::bench::Figure>> {
-    let mut figures = Vec::new();
-    let all = rayon::current_num_threads();
-    for (name, sample, photons, note) in speed_cases(args.quick)? {
-        for threads in [1, all] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()?;
-            let sim = Simulation::new(
-                sample.clone(),
-                Beam::pencil(),
-                RadialGrid::uniform(0.1, 200)?,
-                photons,
-                1,
-            )?;
-            let start = Instant::now();
-            let _ = pool.install(|| sim.run());
-            let rate = photons as f64 / start.elapsed().as_secs_f64();
-            figures.push(crate::bench::Figure {
-                name: format!("mc {name}, {threads} thread(s)"),
-                value: rate,
-                unit: "photons/s".into(),
-                note: format!("{photons} photons; {note}"),
-            });
-        }
-    }
-    Ok(figures)
 }

@@ -33,6 +33,12 @@ pub enum PipelineError {
     /// The exposure bracket is missing or inconsistent.
     #[error("reading the exposure bracket: {0}")]
     Bracket(#[from] BracketError),
+    /// The dark frame is unreadable.
+    #[error("reading the dark frame: {0}")]
+    DarkFrame(#[source] ImageFileError),
+    /// The dark frame's size, channels or bit depth differ from the bracket's frames.
+    #[error(transparent)]
+    DarkFrameShape(BracketError),
     /// An image file is unreadable.
     #[error(transparent)]
     Image(#[from] ImageFileError),

@@ -14,7 +14,7 @@ use scatterfit_imaging::{
     CalibrateOptions, ClippedFill, HdrImage, ImageBuf, LEVELS, LinearMergeOptions, MergeOptions,
     ResponseCurve, Weighting,
 };
-use scatterfit_io::bracket::{Bracket, read_bracket};
+use scatterfit_io::bracket::{Bracket, read_bracket_within};
 use scatterfit_io::image_files::{CameraFrame, read_camera_frame};
 use scatterfit_io::response_csv::read_response_csv;
 use serde::Serialize;
@@ -45,7 +45,8 @@ pub struct HdrInputs {
     pub dark: Option<PathBuf>,
     /// Smoothness λ of the response recovery.
     pub lambda: f64,
-    /// Sample pixels per channel for the response recovery.
+    /// Sample pixels per channel for the response recovery ([`default_response_samples`] gives
+    /// the usual choice for a bracket).
     pub samples: usize,
     /// 16-bit saturation value.
     pub saturation: u16,
@@ -53,11 +54,14 @@ pub struct HdrInputs {
     pub clipped_fill: ClippedFill,
     /// 8-bit sample weighting.
     pub weighting: Weighting,
+    /// Memory budget in bytes that the decoded frames are checked against before any is decoded;
+    /// `None` for the environment's ([`scatterfit_io::budget::memory_budget_bytes`]).
+    pub memory_budget: Option<u64>,
 }
 
 impl HdrInputs {
-    /// Defaults (λ = 10, 100 samples, 65535 saturation, NaN fill, noise-optimal weighting) for a
-    /// bracket listed in `exposures`.
+    /// Defaults (λ = 10, 100 samples, 65535 saturation, NaN fill, noise-optimal weighting, the
+    /// environment's memory budget) for a bracket listed in `exposures`.
     pub fn new(exposures: Option<PathBuf>, images: Vec<PathBuf>) -> Self {
         Self {
             images,
@@ -69,6 +73,7 @@ impl HdrInputs {
             saturation: u16::MAX,
             clipped_fill: ClippedFill::Nan,
             weighting: Weighting::NoiseOptimal,
+            memory_budget: None,
         }
     }
 
@@ -127,18 +132,78 @@ pub struct HdrStage {
     pub merge_s: f64,
 }
 
-/// Reads the bracket and merges it. `on_frame_read` is called once per decoded frame.
+/// The bracket (and dark frame) read and checked, before any pixel work: the first half of
+/// [`read_and_merge`], for a caller that reports on the frames or checks the merge's memory before
+/// merging ([`FramesRead::decoded_bytes`], [`FramesRead::samples_per_frame`]).
+#[derive(Debug, Clone)]
+pub struct FramesRead {
+    bracket: Bracket,
+    dark: Option<CameraFrame>,
+    /// The frames, shortest first.
+    pub frames: Vec<FrameInfo>,
+    /// e.g. `1024×1024 RGB 8-bit`.
+    pub image: String,
+    /// Frames whose alpha channel was dropped.
+    pub dropped_alpha: Vec<PathBuf>,
+    /// Wall time reading [s].
+    pub read_s: f64,
+}
+
+impl FramesRead {
+    /// Samples (pixels × channels) in one frame, which the merged map has too.
+    pub fn samples_per_frame(&self) -> u64 {
+        let first = &self.bracket.frames()[0].frame;
+        (first.width() * first.height() * first.channels()) as u64
+    }
+
+    /// Bytes the decoded frames hold.
+    pub fn decoded_bytes(&self) -> u64 {
+        let first = &self.bracket.frames()[0].frame;
+        self.samples_per_frame()
+            * u64::from(first.bit_depth() / 8)
+            * self.bracket.frames().len() as u64
+    }
+}
+
+/// The default number of sample pixels per channel for the response recovery of a bracket of
+/// `frames` frames: 100, or Debevec & Malik's minimum ⌈256/(P − 1)⌉ when that is larger.
+pub fn default_response_samples(frames: usize) -> usize {
+    100.max(scatterfit_imaging::min_response_samples(frames))
+}
+
+/// Reads the bracket and merges it: [`read_frames`] then [`merge_frames`]. `on_frame_read` is
+/// called once per decoded frame.
 ///
 /// # Errors
-/// [`PipelineError::Bracket`] / [`PipelineError::Image`] / [`PipelineError::ResponseCsv`] for bad
-/// files; [`PipelineError::Imaging`] when the response cannot be recovered or the merge fails.
+/// As [`read_frames`] and [`merge_frames`].
 pub fn read_and_merge(
     inputs: &HdrInputs,
     on_frame_read: &(dyn Fn(&Path) + Sync),
 ) -> Result<HdrStage> {
+    merge_frames(read_frames(inputs, on_frame_read)?, inputs)
+}
+
+/// Reads the bracket (its decoded size checked against `inputs.memory_budget` first) and the dark
+/// frame. `on_frame_read` is called once per decoded frame.
+///
+/// # Errors
+/// [`PipelineError::Bracket`] for a bracket that cannot be read or is inconsistent;
+/// [`PipelineError::DarkFrame`] / [`PipelineError::DarkFrameShape`] for a dark frame that cannot
+/// be read or differs in shape from the frames.
+pub fn read_frames(
+    inputs: &HdrInputs,
+    on_frame_read: &(dyn Fn(&Path) + Sync),
+) -> Result<FramesRead> {
     let t0 = Instant::now();
-    let bracket: Bracket =
-        read_bracket(&inputs.images, inputs.exposures.as_deref(), on_frame_read)?;
+    let budget = inputs
+        .memory_budget
+        .unwrap_or_else(scatterfit_io::budget::memory_budget_bytes);
+    let bracket: Bracket = read_bracket_within(
+        &inputs.images,
+        inputs.exposures.as_deref(),
+        budget,
+        on_frame_read,
+    )?;
     let dropped_alpha = bracket
         .frames()
         .iter()
@@ -147,14 +212,15 @@ pub fn read_and_merge(
         .collect();
     let dark = match &inputs.dark {
         Some(path) => {
-            let d = read_camera_frame(path)?;
-            bracket.check_same_shape(&d.frame, path)?;
+            let d = read_camera_frame(path).map_err(PipelineError::DarkFrame)?;
+            bracket
+                .check_same_shape(&d.frame, path)
+                .map_err(PipelineError::DarkFrameShape)?;
             Some(d.frame)
         }
         None => None,
     };
-    let read_s = t0.elapsed().as_secs_f64();
-    let frames: Vec<FrameInfo> = bracket
+    let frames = bracket
         .frames()
         .iter()
         .map(|f| FrameInfo {
@@ -163,6 +229,34 @@ pub fn read_and_merge(
         })
         .collect();
     let image = bracket.describe();
+    Ok(FramesRead {
+        bracket,
+        dark,
+        frames,
+        image,
+        dropped_alpha,
+        read_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Merges a bracket read by [`read_frames`]: 8-bit frames through the given response
+/// (`inputs.response`) or one recovered from the frames (`inputs.samples`, `inputs.lambda`),
+/// 16-bit frames as linear data (`inputs.saturation`); the dark frame subtracted; the detection
+/// limit per channel.
+///
+/// # Errors
+/// [`PipelineError::ResponseCsv`] / [`PipelineError::Input`] for a bad response file or a response
+/// given for 16-bit frames; [`PipelineError::Imaging`] when the response cannot be recovered or the
+/// merge fails.
+pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
+    let FramesRead {
+        bracket,
+        dark,
+        frames,
+        image,
+        dropped_alpha,
+        read_s,
+    } = read;
     let times = bracket.times_s();
     let t_max = times.iter().copied().fold(0.0f64, f64::max);
     let t1 = Instant::now();
@@ -224,7 +318,7 @@ pub fn read_and_merge(
         if let Some(path) = &inputs.response {
             return Err(PipelineError::Input(format!(
                 "{}: a response curve applies to 8-bit frames; these frames are 16-bit and are \
-                 merged as linear data — drop the response",
+                 merged as linear data — drop --response (or camera.response in the manifest)",
                 path.display()
             )));
         }

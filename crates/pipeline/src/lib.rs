@@ -1,7 +1,9 @@
 //! scatterfit-pipeline: the measurement, one function per stage.
 //!
 //! 1. [`spectro::spectro_stage`] — η from SCI − SCE, Rd and α′ per channel;
-//! 2. [`hdr::read_and_merge`] — the exposure bracket → a radiance map and its detection limits;
+//! 2. [`hdr::read_and_merge`] — the exposure bracket → a radiance map and its detection limits
+//!    (in two halves, [`hdr::read_frames`] and [`hdr::merge_frames`], for a caller that reports
+//!    between them);
 //! 3. [`profile::profile_stage`] — spot centre and radial profile Rd(r);
 //! 4. [`fit::fit_stage`] — σ′s and σa per channel.
 //!
