@@ -280,7 +280,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                 let opts = CalibrateOptions::new(inputs.samples, inputs.lambda)
                     .map_err(imaging("the response recovery's options"))?;
                 let cal = scatterfit_imaging::recover_response(&bufs, &times, &opts).map_err(
-                    imaging("recovering the camera response (or give a known one with --response)"),
+                    imaging("recovering the camera response (or give a known one: --response for merge, camera.response in sample.toml for measure)"),
                 )?;
                 let rms = cal.solutions.iter().map(|s| s.rms_residual).collect();
                 (cal.response, "recovered", rms)
