@@ -170,9 +170,10 @@ fn read_and_merge(args: &Args, quiet: bool) -> anyhow::Result<HdrStage> {
         read.decoded_bytes() + read.samples_per_frame() * (4 + 1 + 4),
         budget,
     )?;
-    inputs.samples = args
-        .samples
-        .unwrap_or_else(|| hdr::default_response_samples(read.frames.len()));
+    inputs.samples = Some(
+        args.samples
+            .unwrap_or_else(|| hdr::default_response_samples(read.frames.len())),
+    );
     Ok(hdr::merge_frames(read, &inputs)?)
 }
 

@@ -45,9 +45,9 @@ pub struct HdrInputs {
     pub dark: Option<PathBuf>,
     /// Smoothness λ of the response recovery.
     pub lambda: f64,
-    /// Sample pixels per channel for the response recovery ([`default_response_samples`] gives
-    /// the usual choice for a bracket).
-    pub samples: usize,
+    /// Sample pixels per channel for the response recovery; `None` for
+    /// [`default_response_samples`] of the bracket's frame count (what `measure` uses).
+    pub samples: Option<usize>,
     /// 16-bit saturation value.
     pub saturation: u16,
     /// What to store for pixel-channels clipped in every exposure.
@@ -60,7 +60,7 @@ pub struct HdrInputs {
 }
 
 impl HdrInputs {
-    /// Defaults (λ = 10, 100 samples, 65535 saturation, NaN fill, noise-optimal weighting, the
+    /// Defaults (λ = 10, the bracket's default sample count, 65535 saturation, NaN fill, noise-optimal weighting, the
     /// environment's memory budget) for a bracket listed in `exposures`.
     pub fn new(exposures: Option<PathBuf>, images: Vec<PathBuf>) -> Self {
         Self {
@@ -69,7 +69,7 @@ impl HdrInputs {
             response: None,
             dark: None,
             lambda: 10.0,
-            samples: 100,
+            samples: None,
             saturation: u16::MAX,
             clipped_fill: ClippedFill::Nan,
             weighting: Weighting::NoiseOptimal,
@@ -277,7 +277,10 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
         let (response, kind, rms) = match &inputs.response {
             Some(path) => (load_response(path)?, "given", Vec::new()),
             None => {
-                let opts = CalibrateOptions::new(inputs.samples, inputs.lambda)
+                let samples = inputs
+                    .samples
+                    .unwrap_or_else(|| default_response_samples(bufs.len()));
+                let opts = CalibrateOptions::new(samples, inputs.lambda)
                     .map_err(imaging("the response recovery's options"))?;
                 let cal = scatterfit_imaging::recover_response(&bufs, &times, &opts).map_err(
                     imaging("recovering the camera response (or give a known one: --response for merge, camera.response in sample.toml for measure)"),

@@ -39,7 +39,7 @@ fn write_bracket(dir: &Path) -> HdrInputs {
     }
     std::fs::write(dir.join("exposures.csv"), csv).unwrap();
     let mut inputs = HdrInputs::new(Some(dir.join("exposures.csv")), Vec::new());
-    inputs.samples = 60;
+    inputs.samples = Some(60);
     inputs
 }
 
