@@ -132,6 +132,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         albedo_prime: albedo,
         problems: Default::default(),
         warnings: Vec::new(),
+        uncertainty: scatterfit_pipeline::spectro::SpectroUncertainty::none(args.eta, rd, albedo),
     };
     let settings = FitSettings {
         method,
@@ -149,11 +150,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .map_or_else(|| "profile".into(), |s| s.to_string_lossy().into_owned()),
         eta: args.eta,
         eta_source: "given".into(),
+        eta_stderr: None,
+        spectro_repeatability: None,
         method: method.as_str().into(),
         model: model_name.as_str().into(),
         albedo_model: "given".into(),
         channels: Channels::from_array(std::array::from_fn(|c| {
-            channel_result(&fits[c], &spectro, c)
+            channel_result(&fits[c], &spectro, c, None)
         })),
         inputs: Inputs {
             profile: Some(args.profile.to_string_lossy().into_owned()),

@@ -6,8 +6,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use scatterfit_io::result_json::{ChannelStatus, MeasurementResult, write_result_json};
-use scatterfit_io::result_table::{sig4, table1_csv, table1_markdown};
+use scatterfit_io::result_json::{MeasurementResult, write_result_json};
+use scatterfit_io::result_table::{
+    errors_note, sig4, table1_csv, table1_markdown, value_with_errors,
+};
 use scatterfit_pipeline::Measurement;
 
 /// Writes every result file of `m` into `dir` (created if missing); returns the result and the
@@ -50,35 +52,38 @@ pub fn write_measurement(
 /// A human summary of one result: η and, per channel, σ′s ± error, σa ± error, α′, MSE, time.
 pub fn summary_text(r: &MeasurementResult) -> String {
     let mut t = String::new();
+    let eta = match r.eta_stderr {
+        Some(e) => format!("{:.4} ± {}", r.eta, sig4(e)),
+        None => format!("{:.4}", r.eta),
+    };
     let _ = writeln!(
         t,
-        "{}: η = {:.4} ({}), method {}, model {}",
-        r.name, r.eta, r.eta_source, r.method, r.model
+        "{}: η = {eta} ({}), method {}, model {}",
+        r.name, r.eta_source, r.method, r.model
     );
     let _ = writeln!(
         t,
-        "  ch  {:<22} {:<24} {:<8} {:<10} {:>9} {:>6}",
+        "  ch  {:<30} {:<32} {:<8} {:<10} {:>9} {:>6}",
         "σ′s [mm⁻¹]", "σa [mm⁻¹]", "α′", "MSE", "fit [µs]", "rings"
     );
     for (name, c) in ["R", "G", "B"].iter().zip(r.channels.as_array()) {
-        let pm = |v: Option<f64>, e: Option<f64>, key: &str| -> String {
-            if c.status == ChannelStatus::Failed {
-                "failed".into()
-            } else if c.unconstrained.iter().any(|u| u == key) {
-                "unconstrained".into()
-            } else {
-                match (v, e) {
-                    (Some(v), Some(e)) => format!("{} ± {}", sig4(v), sig4(e)),
-                    (Some(v), None) => sig4(v),
-                    _ => "—".into(),
-                }
-            }
-        };
         let _ = writeln!(
             t,
-            "  {name}   {:<22} {:<24} {:<8} {:<10} {:>9.1} {:>6}",
-            pm(c.sigma_s_prime, c.sigma_s_prime_stderr, "sigma_s_prime"),
-            pm(c.sigma_a, c.sigma_a_stderr, "sigma_a"),
+            "  {name}   {:<30} {:<32} {:<8} {:<10} {:>9.1} {:>6}",
+            value_with_errors(
+                c,
+                c.sigma_s_prime,
+                c.sigma_s_prime_stderr,
+                c.sigma_s_prime_stderr_spectro,
+                "sigma_s_prime"
+            ),
+            value_with_errors(
+                c,
+                c.sigma_a,
+                c.sigma_a_stderr,
+                c.sigma_a_stderr_spectro,
+                "sigma_a"
+            ),
             c.albedo_prime.map_or("—".into(), |a| format!("{a:.5}")),
             c.mse.map_or("—".into(), sig4),
             c.fit_time_s * 1e6,
@@ -87,6 +92,10 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         if let Some(p) = &c.problem {
             let _ = writeln!(t, "      note: {p}");
         }
+    }
+    let errors = errors_note(std::slice::from_ref(r));
+    if !errors.is_empty() {
+        let _ = write!(t, "  {errors}");
     }
     t
 }

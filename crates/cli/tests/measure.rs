@@ -162,6 +162,17 @@ fn synth_then_measure() {
     let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     let got = v["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
     assert!((got / want - 1.0).abs() < 0.05, "3 frames: {got} vs {want}");
+    // Every number has its uncertainty: η's and, per channel, α′'s and the spectrophotometer's part
+    // of σ′s and σa (the default repeatability, 0.5 %), beside the fit's.
+    assert_eq!(v["spectro_repeatability"].as_f64(), Some(0.005));
+    assert!(v["eta_stderr"].as_f64().unwrap() > 0.0);
+    for key in [
+        "albedo_prime_stderr",
+        "sigma_s_prime_stderr_spectro",
+        "sigma_a_stderr_spectro",
+    ] {
+        assert!(v["channels"]["g"][key].as_f64().unwrap() > 0.0, "{key}");
+    }
 }
 
 /// Bad input anywhere in a sample folder gets exit 2 and a message naming the file and the key.
@@ -173,8 +184,12 @@ fn bad_sample_folders_are_named() {
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("sample.toml"), "{}", out.stderr);
     std::fs::create_dir(d.join("s")).unwrap();
-    let cases: [(&str, &str); 5] = [
+    let cases: [(&str, &str); 6] = [
         ("name = 1\n", "name"),
+        (
+            "[spectro]\nfile = \"spectro.csv\"\nrepeatability = 5\n[camera]\nexposures = \"e.csv\"\nmm_per_pixel = 0.1\n",
+            "spectro.repeatability",
+        ),
         (
             "[spectro]\nfile = \"spectro.csv\"\n[camera]\nexposures = \"e.csv\"\nmm_per_pixel = -2\n",
             "camera.mm_per_pixel",

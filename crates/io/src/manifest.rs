@@ -9,6 +9,7 @@
 //! # lab = [62.1, 35.2, 4.0]     # measured L*a*b* (D65), used for colour instead of the SCE spectrum
 //! # lab_observer = 10           # 10 (the instrument default) or 2
 //! # eta = 1.45                  # a known η instead of the one from SCI − SCE (matte samples)
+//! # repeatability = 0.005       # relative standard deviation of a reading (default 0.5 %)
 //!
 //! [camera]
 //! exposures = "exposures.csv"   # header: file,time_s ; or omit and read ExposureTime from EXIF
@@ -156,7 +157,15 @@ pub struct SpectroSection {
     pub lab_observer: Option<u32>,
     /// A known η instead of the one from SCI − SCE.
     pub eta: Option<f64>,
+    /// Relative standard deviation of a reading, the same factor on SCI and SCE at every
+    /// wavelength (a re-placed sample, the calibration): what the uncertainties of η, α′ and,
+    /// through them, σ′s and σa are propagated from. Default [`DEFAULT_SPECTRO_REPEATABILITY`].
+    pub repeatability: Option<f64>,
 }
+
+/// The default relative repeatability of a spectrophotometer reading (0.5 %): an assumption, to be
+/// replaced by the spread of repeated readings of the user's own sample (re-placed each time).
+pub const DEFAULT_SPECTRO_REPEATABILITY: f64 = 0.005;
 
 /// `[camera]`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -328,6 +337,17 @@ pub fn parse_manifest(
             format!("= {eta}: the relative refractive index must lie in [1, 3]"),
         ));
     }
+    if let Some(r) = m.spectro.repeatability
+        && !(r.is_finite() && (0.0..=0.2).contains(&r))
+    {
+        return Err(invalid(
+            "spectro.repeatability",
+            format!(
+                "= {r}: the relative standard deviation of a reading must lie in [0, 0.2] \
+                 (0.005 is 0.5 %; 0 ignores the spectrophotometer's uncertainty)"
+            ),
+        ));
+    }
     match m.camera.mm_per_pixel {
         None => {
             return Err(invalid(
@@ -434,6 +454,9 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     }
     if let Some(e) = m.spectro.eta {
         t.push_str(&format!("eta = {e}\n"));
+    }
+    if let Some(r) = m.spectro.repeatability {
+        t.push_str(&format!("repeatability = {r}\n"));
     }
     t.push_str("\n[camera]\n");
     if let Some(f) = &m.camera.exposures {

@@ -90,6 +90,17 @@ pub struct ChannelResult {
     pub sigma_a: Option<f64>,
     /// Its standard error [mm⁻¹].
     pub sigma_a_stderr: Option<f64>,
+    /// The part of σ′s's uncertainty that comes from the spectrophotometer (its η and α′ at the
+    /// reading's repeatability, propagated through refits) [mm⁻¹]; add it in quadrature to the
+    /// fit's standard error for the total. `None` without a reading (or when a refit failed).
+    #[serde(default)]
+    pub sigma_s_prime_stderr_spectro: Option<f64>,
+    /// The same for σa [mm⁻¹].
+    #[serde(default)]
+    pub sigma_a_stderr_spectro: Option<f64>,
+    /// Standard error of α′ from the reading's repeatability (its Rd and η).
+    #[serde(default)]
+    pub albedo_prime_stderr: Option<f64>,
     /// Reduced albedo α′ = σ′s/(σ′s + σa): from the spectrophotometer (proposed method) or from the
     /// fitted coefficients (existing method).
     pub albedo_prime: Option<f64>,
@@ -209,6 +220,12 @@ pub struct MeasurementResult {
     /// Where η came from: `spectro` (SCI − SCE) or `given`.
     #[serde(default)]
     pub eta_source: String,
+    /// Standard error of η from the reading's repeatability (`None` when η was given).
+    #[serde(default)]
+    pub eta_stderr: Option<f64>,
+    /// The spectrophotometer's relative repeatability the uncertainties assume.
+    #[serde(default)]
+    pub spectro_repeatability: Option<f64>,
     /// `proposed` or `existing`.
     pub method: String,
     /// The forward model of the profile fit, e.g. `dipole`.
@@ -352,6 +369,9 @@ mod tests {
             sigma_s_prime_stderr: Some(0.01),
             sigma_a: Some(sa),
             sigma_a_stderr: Some(0.001),
+            sigma_s_prime_stderr_spectro: None,
+            sigma_a_stderr_spectro: None,
+            albedo_prime_stderr: None,
             albedo_prime: Some(sp / (sp + sa)),
             rd_total: Some(0.5),
             scale: Some(2.0),
@@ -376,6 +396,8 @@ mod tests {
             name: "pink plastic".into(),
             eta: 1.2886,
             eta_source: "spectro".into(),
+            eta_stderr: None,
+            spectro_repeatability: None,
             method: "proposed".into(),
             model: "dipole".into(),
             albedo_model: "diffusion".into(),

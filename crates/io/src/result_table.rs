@@ -35,17 +35,59 @@ pub fn sig4(v: f64) -> String {
 
 /// "value ± stderr", or the reason there is none.
 fn with_error(c: &ChannelResult, v: Option<f64>, e: Option<f64>, name: &str) -> String {
+    value_with_errors(c, v, e, None, name)
+}
+
+/// "value ± fit" or, when the spectrophotometer's part is known, "value ± fit ± spectro"; "failed"
+/// or "unconstrained" where there is no measurement.
+pub fn value_with_errors(
+    c: &ChannelResult,
+    v: Option<f64>,
+    fit: Option<f64>,
+    spectro: Option<f64>,
+    name: &str,
+) -> String {
     if c.status == ChannelStatus::Failed {
         return "failed".into();
     }
     if c.unconstrained.iter().any(|u| u == name) {
         return "unconstrained".into();
     }
-    match (v, e) {
-        (Some(v), Some(e)) => format!("{} ± {}", sig4(v), sig4(e)),
-        (Some(v), None) => sig4(v),
+    match (v, fit, spectro) {
+        (Some(v), Some(e), Some(s)) => format!("{} ± {} ± {}", sig4(v), sig4(e), sig4(s)),
+        (Some(v), Some(e), None) => format!("{} ± {}", sig4(v), sig4(e)),
+        (Some(v), None, _) => sig4(v),
         _ => "—".into(),
     }
+}
+
+/// The line under a table that says what its ± mean (empty when no result carries the
+/// spectrophotometer's part).
+pub fn errors_note(results: &[MeasurementResult]) -> String {
+    let eps: Vec<f64> = results
+        .iter()
+        .filter(|r| {
+            r.channels
+                .as_array()
+                .iter()
+                .any(|c| c.sigma_s_prime_stderr_spectro.is_some())
+        })
+        .filter_map(|r| r.spectro_repeatability)
+        .collect();
+    let Some(&e) = eps.first() else {
+        return String::new();
+    };
+    let all_same = eps.iter().all(|&x| x == e);
+    format!(
+        "Errors: value ± fit (the profile's noise, from the fit's Jacobian) ± spectrophotometer (η \
+         and α′ at the reading's repeatability of {}, propagated by refits); add them in \
+         quadrature for the total.\n",
+        if all_same {
+            format!("{:.2} %", 100.0 * e)
+        } else {
+            "spectro.repeatability".into()
+        }
+    )
 }
 
 /// Table 1 as CSV: one row per material and channel.
@@ -53,7 +95,8 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
     let mut t = String::from(
         "material,channel,status,sigma_s_prime_mm-1,sigma_s_prime_stderr,sigma_a_mm-1,sigma_a_stderr,\
          albedo_prime,rd_total,eta,method,model,fit_time_s,iterations,mse_mm-4,rms_log_residual,\
-         chi2_reduced,rings_used,rings_inside_spot,rings_below_detection,problem\n",
+         chi2_reduced,rings_used,rings_inside_spot,rings_below_detection,problem,\
+         sigma_s_prime_stderr_spectro,sigma_a_stderr_spectro,albedo_prime_stderr,eta_stderr\n",
     );
     for r in results {
         for (name, c) in CHANNELS.iter().zip(r.channels.as_array()) {
@@ -64,7 +107,7 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
             };
             let _ = writeln!(
                 t,
-                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 csv_text(&r.name),
                 num(c.sigma_s_prime, 6),
                 num(c.sigma_s_prime_stderr, 6),
@@ -84,6 +127,10 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 c.rings_inside_spot,
                 c.rings_below_detection,
                 csv_text(c.problem.as_deref().unwrap_or("")),
+                num(c.sigma_s_prime_stderr_spectro, 6),
+                num(c.sigma_a_stderr_spectro, 8),
+                num(c.albedo_prime_stderr, 6),
+                num(r.eta_stderr, 6),
             );
         }
     }
@@ -108,10 +155,10 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
     for r in results {
         for (k, (name, c)) in CHANNELS.iter().zip(r.channels.as_array()).enumerate() {
             let material = if k == 0 { r.name.as_str() } else { "" };
-            let eta = if k == 1 {
-                format!("{:.4}", r.eta)
-            } else {
-                String::new()
+            let eta = match (k, r.eta_stderr) {
+                (1, Some(e)) => format!("{:.4} ± {}", r.eta, sig4(e)),
+                (1, None) => format!("{:.4}", r.eta),
+                _ => String::new(),
             };
             let time = if c.status == ChannelStatus::Failed && c.iterations == 0 {
                 "—".into()
@@ -121,9 +168,25 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
             let _ = writeln!(
                 t,
                 "| {material} | {name} | {} | {} | {eta} | {} | {time} | {} |",
-                with_error(c, c.sigma_s_prime, c.sigma_s_prime_stderr, "sigma_s_prime"),
-                with_error(c, c.sigma_a, c.sigma_a_stderr, "sigma_a"),
-                c.albedo_prime.map_or("—".into(), |a| format!("{a:.5}")),
+                value_with_errors(
+                    c,
+                    c.sigma_s_prime,
+                    c.sigma_s_prime_stderr,
+                    c.sigma_s_prime_stderr_spectro,
+                    "sigma_s_prime"
+                ),
+                value_with_errors(
+                    c,
+                    c.sigma_a,
+                    c.sigma_a_stderr,
+                    c.sigma_a_stderr_spectro,
+                    "sigma_a"
+                ),
+                match (c.albedo_prime, c.albedo_prime_stderr) {
+                    (Some(a), Some(e)) => format!("{a:.5} ± {}", sig4(e)),
+                    (Some(a), None) => format!("{a:.5}"),
+                    _ => "—".into(),
+                },
                 c.mse.map_or("—".into(), sig4),
             );
         }
@@ -139,6 +202,11 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
                 })
         })
         .collect();
+    let errors = errors_note(results);
+    if !errors.is_empty() {
+        t.push('\n');
+        t.push_str(&errors);
+    }
     if !notes.is_empty() {
         t.push('\n');
         t.push_str(&notes.join("\n"));

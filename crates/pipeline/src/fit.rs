@@ -2,7 +2,7 @@
 
 use scatterfit_fit::{
     ChannelInput, Diffusion, DipoleModel, FitOptions, FitReport, McModel, Method, ProfileData,
-    ProfileModel, Spot,
+    ProfileModel, Spot, Start,
 };
 use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
 use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
@@ -171,9 +171,90 @@ pub fn fit_stage(
         .collect()
 }
 
-/// A channel's row of `result.json`.
-pub fn channel_result(outcome: &ChannelOutcome, spectro: &SpectroStage, c: usize) -> ChannelResult {
+/// The part of a channel's uncertainty that the spectrophotometer contributes [mm⁻¹].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpectroErrors {
+    /// Standard error of σ′s from η and α′.
+    pub sigma_s_prime: f64,
+    /// Standard error of σa from η and α′.
+    pub sigma_a: f64,
+}
+
+/// Propagates the spectrophotometer's uncertainty ([`SpectroStage::uncertainty`]) to σ′s and σa:
+/// each fitted channel is refitted at the two perturbed readings — × (1 − ε) and × (1 + ε), which
+/// move Rd (hence α′) and η together — from the fit's own solution as the start, and the standard
+/// error is half the difference of the two refits (central differences at ±1 standard deviation:
+/// first-order error propagation, no derivative of the fit itself needed; `tests/uncertainty.rs`
+/// checks it against the spread of refits of many randomly scaled readings). The existing method
+/// does not use α′: only its η moves. `None` for a channel that was not fitted, or when a perturbed
+/// α′ cannot be inverted or a refit does not converge (the uncertainty is then unknown, not zero).
+pub fn propagate_spectro(
+    profiles: &[ProfileData],
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    model: &dyn ProfileModel,
+    fits: &[ChannelOutcome],
+) -> Vec<Option<SpectroErrors>> {
+    let Ok(opts) = settings.options() else {
+        return vec![None; fits.len()];
+    };
+    let u = &spectro.uncertainty;
+    let proposed = settings.method == MethodName::Proposed;
+    fits.iter()
+        .zip(profiles)
+        .enumerate()
+        .map(|(c, (outcome, data))| {
+            let report = outcome.report().filter(|r| r.converged)?;
+            if u.repeatability == 0.0 {
+                return Some(SpectroErrors {
+                    sigma_s_prime: 0.0,
+                    sigma_a: 0.0,
+                });
+            }
+            let mut o = opts;
+            o.start = Some(Start {
+                sigma_s_prime: report.sigma_s_prime.value,
+                sigma_a: Some(report.sigma_a.value),
+                scale: None,
+            });
+            let refit = |k: usize| -> Option<(f64, f64)> {
+                let input = ChannelInput {
+                    eta: u.eta_pm[k],
+                    albedo_prime: if proposed {
+                        Some(u.albedo_pm.get(c)?[k]?)
+                    } else {
+                        spectro.albedo_prime.get(c).copied().flatten()
+                    },
+                    rd_total: Some(u.rd_pm.get(c)?[k]),
+                };
+                let r = scatterfit_fit::fit_channel(data, &input, model, &o).ok()?;
+                r.converged
+                    .then_some((r.sigma_s_prime.value, r.sigma_a.value))
+            };
+            let (lo, hi) = (refit(0)?, refit(1)?);
+            Some(SpectroErrors {
+                sigma_s_prime: 0.5 * (hi.0 - lo.0).abs(),
+                sigma_a: 0.5 * (hi.1 - lo.1).abs(),
+            })
+        })
+        .collect()
+}
+
+/// A channel's row of `result.json`, with the spectrophotometer's part of its uncertainty when
+/// it was propagated ([`propagate_spectro`]).
+pub fn channel_result(
+    outcome: &ChannelOutcome,
+    spectro: &SpectroStage,
+    c: usize,
+    spectro_errors: Option<&SpectroErrors>,
+) -> ChannelResult {
     let rd_total = spectro.rd.get(c).copied();
+    let albedo_prime_stderr = spectro
+        .uncertainty
+        .albedo_prime_stderr
+        .get(c)
+        .copied()
+        .flatten();
     match outcome {
         ChannelOutcome::NotFitted { problem } => ChannelResult {
             status: ChannelStatus::Failed,
@@ -181,6 +262,9 @@ pub fn channel_result(outcome: &ChannelOutcome, spectro: &SpectroStage, c: usize
             sigma_s_prime_stderr: None,
             sigma_a: None,
             sigma_a_stderr: None,
+            sigma_s_prime_stderr_spectro: None,
+            sigma_a_stderr_spectro: None,
+            albedo_prime_stderr,
             albedo_prime: spectro.albedo_prime.get(c).copied().flatten(),
             rd_total,
             scale: None,
@@ -225,6 +309,12 @@ pub fn channel_result(outcome: &ChannelOutcome, spectro: &SpectroStage, c: usize
                 sigma_s_prime_stderr: finite(r.sigma_s_prime.stderr),
                 sigma_a: finite(r.sigma_a.value),
                 sigma_a_stderr: finite(r.sigma_a.stderr),
+                sigma_s_prime_stderr_spectro: spectro_errors.and_then(|e| finite(e.sigma_s_prime)),
+                sigma_a_stderr_spectro: spectro_errors.and_then(|e| finite(e.sigma_a)),
+                // The existing method's α′ comes from its fitted coefficients, not the reading.
+                albedo_prime_stderr: (r.method == Method::Proposed)
+                    .then_some(albedo_prime_stderr)
+                    .flatten(),
                 albedo_prime: finite(r.albedo_prime),
                 rd_total,
                 scale: finite(r.scale.value),

@@ -14,7 +14,8 @@ use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
 use crate::fit::{
-    ChannelOutcome, FitSettings, albedo_model_for, channel_result, fit_stage, model_for,
+    ChannelOutcome, FitSettings, SpectroErrors, albedo_model_for, channel_result, fit_stage,
+    model_for, propagate_spectro,
 };
 use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
 use crate::profile::{ProfileSettings, ProfileStage, profile_stage};
@@ -66,6 +67,8 @@ pub struct Measurement {
     pub profile: ProfileStage,
     /// Per channel.
     pub fits: Vec<ChannelOutcome>,
+    /// Per channel, the spectrophotometer's part of the uncertainty ([`propagate_spectro`]).
+    pub spectro_errors: Vec<Option<SpectroErrors>>,
     /// Wall times per stage [s].
     pub timings: Timings,
 }
@@ -200,6 +203,7 @@ pub fn measure_sample(
         .map(|c| profile.channel_data(c))
         .collect::<Result<_>>()?;
     let fits = fit_stage(&data, &spectro, &settings, model);
+    let spectro_errors = propagate_spectro(&data, &spectro, &settings, model, &fits);
     let fit_s = t_fit.elapsed().as_secs_f64();
     let timings = Timings {
         spectro_s,
@@ -216,6 +220,7 @@ pub fn measure_sample(
         hdr,
         profile,
         fits,
+        spectro_errors,
         timings,
     })
 }
@@ -250,6 +255,7 @@ impl Measurement {
             .map(|c| self.profile.channel_data(c))
             .collect::<Result<_>>()?;
         let fits = fit_stage(&data, &spectro, &settings, model);
+        let spectro_errors = propagate_spectro(&data, &spectro, &settings, model, &fits);
         let mut timings = self.timings;
         timings.fit_s = t.elapsed().as_secs_f64();
         Ok(Measurement {
@@ -259,6 +265,7 @@ impl Measurement {
             hdr: self.hdr.clone(),
             profile: self.profile.clone(),
             fits,
+            spectro_errors,
             timings,
         })
     }
@@ -295,12 +302,19 @@ impl Measurement {
             })
             .collect();
         let channels = Channels::from_array(std::array::from_fn(|c| {
-            channel_result(&self.fits[c], &self.spectro, c)
+            channel_result(
+                &self.fits[c],
+                &self.spectro,
+                c,
+                self.spectro_errors.get(c).and_then(Option::as_ref),
+            )
         }));
         MeasurementResult {
             name: m.display_name(),
             eta: self.spectro.eta,
             eta_source: self.spectro.eta_source.into(),
+            eta_stderr: self.spectro.uncertainty.eta_stderr,
+            spectro_repeatability: Some(self.spectro.uncertainty.repeatability),
             method: self.settings.method.as_str().into(),
             model: self.settings.model.as_str().into(),
             albedo_model: self.settings.albedo_model.as_str().into(),

@@ -31,21 +31,92 @@ pub struct SpectroStage {
     pub problems: [Option<String>; 3],
     /// Things the user should know.
     pub warnings: Vec<String>,
+    /// The reading's uncertainty and what it does to η and α′.
+    pub uncertainty: SpectroUncertainty,
+}
+
+/// The spectrophotometer's uncertainty, propagated: a reading scaled by 1 ± ε (the same relative
+/// error on SCI and SCE at every wavelength — a re-placed sample, the white calibration) moves Rd
+/// by ±εRd and the specular part SCI − SCE by ±ε(SCI − SCE), hence η, together (one error, so
+/// the two effects are correlated, not added in quadrature); α′ follows from both. The fit
+/// propagates the two perturbed readings to σ′s and σa by refitting (`fit::propagate_spectro`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SpectroUncertainty {
+    /// ε, the relative standard deviation of a reading.
+    pub repeatability: f64,
+    /// Standard error of η: half the spread of η at specular × (1 ± ε); `None` when η is given.
+    pub eta_stderr: Option<f64>,
+    /// η at the specular part × (1 − ε) and × (1 + ε) (η itself when given).
+    pub eta_pm: [f64; 2],
+    /// Rd per channel × (1 − ε), × (1 + ε).
+    pub rd_pm: [[f64; 2]; 3],
+    /// α′ per channel of the readings × (1 − ε) and × (1 + ε): at (Rd₋, η₋) and (Rd₊, η₊); `None`
+    /// where it cannot be inverted.
+    pub albedo_pm: [[Option<f64>; 2]; 3],
+    /// Standard error of α′ per channel, |α′(Rd₊, η₊) − α′(Rd₋, η₋)|/2 (first-order propagation
+    /// by central differences at ±1 standard deviation).
+    pub albedo_prime_stderr: [Option<f64>; 3],
+}
+
+impl SpectroUncertainty {
+    /// Nothing to propagate: η, Rd and α′ taken as exact (given by the user, not read).
+    pub fn none(eta: f64, rd: [f64; 3], albedo_prime: [Option<f64>; 3]) -> Self {
+        Self {
+            repeatability: 0.0,
+            eta_stderr: None,
+            eta_pm: [eta; 2],
+            rd_pm: rd.map(|r| [r; 2]),
+            albedo_pm: albedo_prime.map(|a| [a; 2]),
+            albedo_prime_stderr: [None; 3],
+        }
+    }
 }
 
 impl SpectroStage {
     /// The same reading with α′ from another model's total Rd(α′, η).
     pub fn with_albedo_model(&self, albedo: &dyn ProfileModel) -> SpectroStage {
         from_rd(
-            self.file.clone(),
-            self.analysis.clone(),
-            self.rd,
-            self.eta,
-            self.eta_source,
-            self.warnings.clone(),
+            Reading {
+                file: self.file.clone(),
+                analysis: self.analysis.clone(),
+                rd: self.rd,
+                eta: self.eta,
+                eta_source: self.eta_source,
+                warnings: self.warnings.clone(),
+                repeatability: self.uncertainty.repeatability,
+                eta_pm: self.uncertainty.eta_pm,
+            },
             albedo,
         )
     }
+}
+
+/// What the stage is computed from.
+struct Reading {
+    file: Option<PathBuf>,
+    analysis: Option<SpectroAnalysis>,
+    rd: [f64; 3],
+    eta: f64,
+    eta_source: &'static str,
+    warnings: Vec<String>,
+    repeatability: f64,
+    eta_pm: [f64; 2],
+}
+
+/// η at the specular part × (1 ∓ ε) by the same Schlick inversion at 8° as the summary η (Choi et
+/// al. 2014, eq. 6, `optics::fresnel`); η itself for both when it was given or cannot be perturbed.
+fn eta_pm(analysis: &SpectroAnalysis, repeatability: f64) -> [f64; 2] {
+    if analysis.eta_source == scatterfit_optics::spectro::EtaSource::Given {
+        return [analysis.eta; 2];
+    }
+    let at = |f: f64| {
+        scatterfit_optics::fresnel::eta_from_specular_schlick(
+            analysis.specular_mean * f,
+            scatterfit_optics::fresnel::D8_VIEWING_ANGLE_DEG,
+        )
+        .unwrap_or(analysis.eta)
+    };
+    [at(1.0 - repeatability), at(1.0 + repeatability)]
 }
 
 /// Reads and analyses the reading of `manifest` (or its L\*a\*b\* with a given η). `eta` overrides
@@ -69,11 +140,15 @@ pub fn spectro_stage(
         };
         (Lab { l, a, b }, observer)
     });
+    let repeatability = manifest
+        .spectro
+        .repeatability
+        .unwrap_or(scatterfit_io::manifest::DEFAULT_SPECTRO_REPEATABILITY);
     match &manifest.spectro.file {
         Some(file) => {
             let path = manifest.resolve(file);
             let reading = scatterfit_io::spectro::read_spectro_csv(&path)?;
-            from_reading(&reading, &path, lab, eta, albedo)
+            from_reading(&reading, &path, lab, eta, repeatability, albedo)
         }
         None => {
             let eta = eta.ok_or_else(|| {
@@ -83,12 +158,25 @@ pub fn spectro_stage(
                 PipelineError::Input("without a spectro file, give spectro.lab".into())
             })?;
             let rd = scatterfit_optics::colour::lab_to_linear_srgb(lab, observer);
-            Ok(from_rd(None, None, rd, eta, "given", Vec::new(), albedo))
+            Ok(from_rd(
+                Reading {
+                    file: None,
+                    analysis: None,
+                    rd,
+                    eta,
+                    eta_source: "given",
+                    warnings: Vec::new(),
+                    repeatability,
+                    eta_pm: [eta; 2],
+                },
+                albedo,
+            ))
         }
     }
 }
 
-/// The stage from a reading already in memory (`path` names it in messages).
+/// The stage from a reading already in memory (`path` names it in messages); `repeatability` is
+/// the reading's relative standard deviation ([`SpectroUncertainty`]).
 ///
 /// # Errors
 /// As [`spectro_stage`].
@@ -97,6 +185,7 @@ pub fn from_reading(
     path: &Path,
     lab: Option<(Lab, Observer)>,
     eta: Option<f64>,
+    repeatability: f64,
     albedo: &dyn ProfileModel,
 ) -> Result<SpectroStage> {
     if let Some(e) = eta
@@ -119,26 +208,33 @@ pub fn from_reading(
     };
     let warnings = analysis.warnings.clone();
     let eta = analysis.eta;
+    let eta_pm = eta_pm(&analysis, repeatability);
     Ok(from_rd(
-        Some(path.to_path_buf()),
-        Some(analysis),
-        rd,
-        eta,
-        source,
-        warnings,
+        Reading {
+            file: Some(path.to_path_buf()),
+            analysis: Some(analysis),
+            rd,
+            eta,
+            eta_source: source,
+            warnings,
+            repeatability,
+            eta_pm,
+        },
         albedo,
     ))
 }
 
-fn from_rd(
-    file: Option<PathBuf>,
-    analysis: Option<SpectroAnalysis>,
-    rd: [f64; 3],
-    eta: f64,
-    eta_source: &'static str,
-    warnings: Vec<String>,
-    albedo: &dyn ProfileModel,
-) -> SpectroStage {
+fn from_rd(reading: Reading, albedo: &dyn ProfileModel) -> SpectroStage {
+    let Reading {
+        file,
+        analysis,
+        rd,
+        eta,
+        eta_source,
+        warnings,
+        repeatability,
+        eta_pm,
+    } = reading;
     let names = ["R", "G", "B"];
     let mut albedo_prime = [None; 3];
     let mut problems: [Option<String>; 3] = Default::default();
@@ -157,6 +253,16 @@ fn from_rd(
             }
         }
     }
+    let rd_pm: [[f64; 2]; 3] =
+        std::array::from_fn(|c| [rd[c] * (1.0 - repeatability), rd[c] * (1.0 + repeatability)]);
+    let albedo_pm: [[Option<f64>; 2]; 3] = std::array::from_fn(|c| {
+        std::array::from_fn(|k| albedo.albedo_from_rd(rd_pm[c][k], eta_pm[k]).ok())
+    });
+    let albedo_prime_stderr = std::array::from_fn(|c| match albedo_pm[c] {
+        [Some(a0), Some(a1)] => Some(0.5 * (a1 - a0).abs()),
+        _ => None,
+    });
+    let eta_stderr = (eta_source != "given").then_some(0.5 * (eta_pm[1] - eta_pm[0]).abs());
     SpectroStage {
         file,
         analysis,
@@ -166,5 +272,13 @@ fn from_rd(
         albedo_prime,
         problems,
         warnings,
+        uncertainty: SpectroUncertainty {
+            repeatability,
+            eta_stderr,
+            eta_pm,
+            rd_pm,
+            albedo_pm,
+            albedo_prime_stderr,
+        },
     }
 }
