@@ -327,7 +327,7 @@ fn study_sample(
             normalise_with_spectro: false,
             ..base.settings
         };
-        let m = base.refit_with(settings)?;
+        let m = base.refit_values_only(settings)?;
         let result = m.to_result(None);
         for (c, ch) in result.channels.as_array().iter().enumerate() {
             let t = &truth["channels"][c];

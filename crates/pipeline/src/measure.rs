@@ -247,6 +247,20 @@ impl Measurement {
     /// # Errors
     /// [`PipelineError::Input`] when a model cannot be loaded.
     pub fn refit_with(&self, settings: FitSettings) -> Result<Measurement> {
+        self.refit_inner(settings, true)
+    }
+
+    /// [`Measurement::refit_with`] without the spectrophotometer's uncertainty (no refits at the
+    /// perturbed readings; `spectro_errors` all `None`): for studies that compare values only —
+    /// with PBD the propagation would triple the fitting time.
+    ///
+    /// # Errors
+    /// As [`Measurement::refit_with`].
+    pub fn refit_values_only(&self, settings: FitSettings) -> Result<Measurement> {
+        self.refit_inner(settings, false)
+    }
+
+    fn refit_inner(&self, settings: FitSettings, propagate: bool) -> Result<Measurement> {
         let model = model_for(settings.model)?;
         let albedo = albedo_model_for(settings.albedo_model, settings.model)?;
         let spectro = self.spectro.with_albedo_model(albedo);
@@ -255,7 +269,11 @@ impl Measurement {
             .map(|c| self.profile.channel_data(c))
             .collect::<Result<_>>()?;
         let fits = fit_stage(&data, &spectro, &settings, model);
-        let spectro_errors = propagate_spectro(&data, &spectro, &settings, model, &fits);
+        let spectro_errors = if propagate {
+            propagate_spectro(&data, &spectro, &settings, model, &fits)
+        } else {
+            vec![None; fits.len()]
+        };
         let mut timings = self.timings;
         timings.fit_s = t.elapsed().as_secs_f64();
         Ok(Measurement {
