@@ -7,9 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use scatterfit_io::result_json::{MeasurementResult, write_result_json};
-use scatterfit_io::result_table::{
-    errors_note, sig4, table1_csv, table1_markdown, value_with_errors,
-};
+use scatterfit_io::result_table::{errors_note, sig4, sigma_cells, table1_csv, table1_markdown};
 use scatterfit_pipeline::Measurement;
 
 /// Writes every result file of `m` into `dir` (created if missing); returns the result and the
@@ -67,23 +65,10 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         "σ′s [mm⁻¹]", "σa [mm⁻¹]", "α′", "MSE", "fit [µs]", "rings"
     );
     for (name, c) in ["R", "G", "B"].iter().zip(r.channels.as_array()) {
+        let [sp, sa] = sigma_cells(c);
         let _ = writeln!(
             t,
-            "  {name}   {:<30} {:<32} {:<8} {:<10} {:>9.1} {:>6}",
-            value_with_errors(
-                c,
-                c.sigma_s_prime,
-                c.sigma_s_prime_stderr,
-                c.sigma_s_prime_stderr_spectro,
-                "sigma_s_prime"
-            ),
-            value_with_errors(
-                c,
-                c.sigma_a,
-                c.sigma_a_stderr,
-                c.sigma_a_stderr_spectro,
-                "sigma_a"
-            ),
+            "  {name}   {sp:<30} {sa:<32} {:<8} {:<10} {:>9.1} {:>6}",
             c.albedo_prime.map_or("—".into(), |a| format!("{a:.5}")),
             c.mse.map_or("—".into(), sig4),
             c.fit_time_s * 1e6,

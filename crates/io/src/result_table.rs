@@ -61,6 +61,26 @@ pub fn value_with_errors(
     }
 }
 
+/// σ′s and σa of a channel as "value ± fit ± spectro" ([`value_with_errors`]).
+pub fn sigma_cells(c: &ChannelResult) -> [String; 2] {
+    [
+        value_with_errors(
+            c,
+            c.sigma_s_prime,
+            c.sigma_s_prime_stderr,
+            c.sigma_s_prime_stderr_spectro,
+            "sigma_s_prime",
+        ),
+        value_with_errors(
+            c,
+            c.sigma_a,
+            c.sigma_a_stderr,
+            c.sigma_a_stderr_spectro,
+            "sigma_a",
+        ),
+    ]
+}
+
 /// The line under a table that says what its ± mean (empty when no result carries the
 /// spectrophotometer's part).
 pub fn errors_note(results: &[MeasurementResult]) -> String {
@@ -165,23 +185,10 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
             } else {
                 format!("{:.0}", c.fit_time_s * 1e6)
             };
+            let [sp, sa] = sigma_cells(c);
             let _ = writeln!(
                 t,
-                "| {material} | {name} | {} | {} | {eta} | {} | {time} | {} |",
-                value_with_errors(
-                    c,
-                    c.sigma_s_prime,
-                    c.sigma_s_prime_stderr,
-                    c.sigma_s_prime_stderr_spectro,
-                    "sigma_s_prime"
-                ),
-                value_with_errors(
-                    c,
-                    c.sigma_a,
-                    c.sigma_a_stderr,
-                    c.sigma_a_stderr_spectro,
-                    "sigma_a"
-                ),
+                "| {material} | {name} | {sp} | {sa} | {eta} | {} | {time} | {} |",
                 match (c.albedo_prime, c.albedo_prime_stderr) {
                     (Some(a), Some(e)) => format!("{a:.5} ± {}", sig4(e)),
                     (Some(a), None) => format!("{a:.5}"),

@@ -62,11 +62,12 @@ pub(crate) fn load_or_build<T>(
 }
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder (created if missing),
-/// synced, then renamed over the target. (mc does not depend on io, whose `write_atomic` does the same.)
+/// synced, then renamed over the target. (mc does not depend on io, whose `write_atomic` does the same;
+/// synth's profile cache uses this one.)
 ///
 /// # Errors
 /// `Io` on any file-system error (the target is then untouched).
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io = |source| McError::Io {
         path: path.to_owned(),
         source,

@@ -29,7 +29,7 @@
 
 mod beam;
 pub mod bundled;
-mod cache;
+pub mod cache;
 mod engine;
 mod error;
 mod fresnel;

@@ -18,8 +18,7 @@
 //! channel with little absorption walks long (MCML's implicit capture keeps a photon until its
 //! weight α^n falls to the roulette threshold) and gets fewer photons, down to a floor.
 
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution, Normal, Poisson};
@@ -366,34 +365,9 @@ impl McProfile {
             return Ok((p, true));
         }
         let p = Self::simulate(spec, progress)?;
-        save_atomic(&path, &serde_json::to_vec(&p).unwrap_or_default())?;
+        scatterfit_mc::cache::write_atomic(&path, &serde_json::to_vec(&p).unwrap_or_default())?;
         Ok((p, false))
     }
-}
-
-fn save_atomic(path: &Path, bytes: &[u8]) -> Result<(), SynthError> {
-    let io = |source| SynthError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(io)?;
-    let tmp: PathBuf = dir.join(format!(
-        ".{}.tmp-{}",
-        path.file_name()
-            .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
 }
 
 /// A Monte Carlo profile made smooth enough to render: ln Rd interpolated linearly between bin
