@@ -1,5 +1,5 @@
 //! Every forward model against exact transport: MCML's independent radial profiles (physics.md §4.5;
-//! fixture `tests/data/mcml_profiles_wide.csv`, a trimmed copy of `reference/mcml_profiles.csv`:
+//! `data/reference/mcml_profiles.csv`, the project's copy of the shared reference:
 //! η ∈ {1.0, 1.4, 2.0} × α′ ∈ {0.3, 0.6, 0.9, 0.99, 0.999}, g = 0, σ′t = 1 mm⁻¹, 2·10⁶ photons per
 //! case, 0.05 mm bins) and adding-doubling totals (physics.md §4.3).
 //!
@@ -24,37 +24,36 @@ struct Case {
     eta: f64,
     albedo: f64,
     total: f64,
-    /// (r, Rd(r)) per bin (the last, overflow bin already dropped in the fixture).
+    /// (r, Rd(r)) per bin (the last, overflow bin dropped).
     bins: Vec<(f64, f64)>,
 }
 
 fn cases() -> Vec<Case> {
-    let text = include_str!("data/mcml_profiles_wide.csv");
-    let mut totals = Vec::new();
+    // eta,albedo_prime,rd_total,r_specular,r_mm,rd_per_mm2 — 400 bins per case, the last one the
+    // overflow beyond 20 mm (dropped).
+    let text = include_str!("../../../data/reference/mcml_profiles.csv");
     let mut cases: Vec<Case> = Vec::new();
     for line in text.lines() {
-        if let Some(rest) = line.strip_prefix("# rd_total,") {
-            totals = rest.split(',').map(|x| x.parse().unwrap()).collect();
-        } else if let Some(header) = line.strip_prefix("r_mm,") {
-            for (k, col) in header.split(',').enumerate() {
-                // "eta1.4_a0.99"
-                let (e, a) = col.trim_start_matches("eta").split_once("_a").unwrap();
-                cases.push(Case {
-                    eta: e.parse().unwrap(),
-                    albedo: a.parse().unwrap(),
-                    total: totals[k],
-                    bins: Vec::new(),
-                });
-            }
-        } else if !line.starts_with('#') && !line.is_empty() {
-            let f: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
-            for (k, c) in cases.iter_mut().enumerate() {
-                c.bins.push((f[0], f[k + 1]));
-            }
+        if line.starts_with('#') || line.starts_with("eta") || line.is_empty() {
+            continue;
+        }
+        let f: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let (eta, albedo, total, r, v) = (f[0], f[1], f[2], f[4], f[5]);
+        match cases.last_mut() {
+            Some(c) if c.eta == eta && c.albedo == albedo => c.bins.push((r, v)),
+            _ => cases.push(Case {
+                eta,
+                albedo,
+                total,
+                bins: vec![(r, v)],
+            }),
         }
     }
+    for c in &mut cases {
+        assert_eq!(c.bins.len(), 400);
+        c.bins.pop();
+    }
     assert_eq!(cases.len(), 15);
-    assert!(cases.iter().all(|c| c.bins.len() == 399));
     cases
 }
 
