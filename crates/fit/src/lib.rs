@@ -255,46 +255,7 @@ impl<'a> PreparedFit<'a> {
         opts: &FitOptions,
     ) -> Result<Self> {
         let t0 = Instant::now();
-        check(
-            input.eta.is_finite() && input.eta >= 1.0,
-            "eta",
-            input.eta,
-            "the relative refractive index must be finite and ≥ 1",
-        )?;
-        let unknowns = match opts.method {
-            Method::Existing => Unknowns::Existing,
-            Method::Proposed => {
-                let a = input.albedo_prime.unwrap_or(f64::NAN);
-                check(
-                    a > 0.0 && a <= 1.0,
-                    "albedo_prime",
-                    a,
-                    "the proposed method needs the spectrophotometer's reduced albedo α′ in (0, 1]",
-                )?;
-                let c = 1.0 / a - 1.0;
-                if opts.normalise_with_spectro {
-                    // The flux is filled in below, once the rings are known.
-                    Unknowns::Normalised { c, flux: 0.0 }
-                } else {
-                    Unknowns::Proposed { c }
-                }
-            }
-        };
-        if opts.normalise_with_spectro {
-            check(
-                opts.method == Method::Proposed,
-                "normalise_with_spectro",
-                1.0,
-                "applies to the proposed method only (the existing method has no α′)",
-            )?;
-            let rd = input.rd_total.unwrap_or(f64::NAN);
-            check(
-                rd > 0.0 && rd <= 1.0,
-                "rd_total",
-                rd,
-                "normalising with the spectrophotometer needs its diffuse reflectance Rd in (0, 1]",
-            )?;
-        }
+        let unknowns = unknowns_for(input, opts)?;
         let selected = select_rings(profile, &opts.selection)?;
         let needed = unknowns.count() + 2;
         if selected.r_mm.len() < needed {
@@ -338,6 +299,33 @@ impl<'a> PreparedFit<'a> {
             kernel,
             unknowns,
             prepare_time_s: t0.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The same prepared rings and spot kernel for another input (η, α′, Rd) and start: a refit at
+    /// perturbed spectrophotometer values costs the solve only, not the kernel's construction
+    /// (`pipeline::fit::propagate_spectro`).
+    ///
+    /// # Errors
+    /// As [`PreparedFit::new`] for a bad η, α′ or Rd.
+    pub fn with_input(&self, input: &ChannelInput, start: Option<Start>) -> Result<Self> {
+        let unknowns = match (unknowns_for(input, &self.opts)?, self.unknowns) {
+            (Unknowns::Normalised { c, .. }, Unknowns::Normalised { flux, .. }) => {
+                Unknowns::Normalised { c, flux }
+            }
+            (u, _) => u,
+        };
+        Ok(Self {
+            model: self.model,
+            input: *input,
+            opts: FitOptions { start, ..self.opts },
+            selected: self.selected.clone(),
+            ln_y: self.ln_y.clone(),
+            w: self.w.clone(),
+            area: self.area.clone(),
+            kernel: self.kernel.clone(),
+            unknowns,
+            prepare_time_s: 0.0,
         })
     }
 
@@ -557,6 +545,52 @@ impl<'a> PreparedFit<'a> {
             fitted,
         }
     }
+}
+
+/// The unknowns for `input` and `opts`, after checking η, α′ (proposed) and Rd (normalised); the
+/// normalised method's flux is left 0 for the caller to fill in from the rings.
+fn unknowns_for(input: &ChannelInput, opts: &FitOptions) -> Result<Unknowns> {
+    check(
+        input.eta.is_finite() && input.eta >= 1.0,
+        "eta",
+        input.eta,
+        "the relative refractive index must be finite and ≥ 1",
+    )?;
+    let unknowns = match opts.method {
+        Method::Existing => Unknowns::Existing,
+        Method::Proposed => {
+            let a = input.albedo_prime.unwrap_or(f64::NAN);
+            check(
+                a > 0.0 && a <= 1.0,
+                "albedo_prime",
+                a,
+                "the proposed method needs the spectrophotometer's reduced albedo α′ in (0, 1]",
+            )?;
+            let c = 1.0 / a - 1.0;
+            if opts.normalise_with_spectro {
+                // The caller fills in the flux once the rings are known.
+                Unknowns::Normalised { c, flux: 0.0 }
+            } else {
+                Unknowns::Proposed { c }
+            }
+        }
+    };
+    if opts.normalise_with_spectro {
+        check(
+            opts.method == Method::Proposed,
+            "normalise_with_spectro",
+            1.0,
+            "applies to the proposed method only (the existing method has no α′)",
+        )?;
+        let rd = input.rd_total.unwrap_or(f64::NAN);
+        check(
+            rd > 0.0 && rd <= 1.0,
+            "rd_total",
+            rd,
+            "normalising with the spectrophotometer needs its diffuse reflectance Rd in (0, 1]",
+        )?;
+    }
+    Ok(unknowns)
 }
 
 /// Fits one channel: [`PreparedFit::new`] then [`PreparedFit::solve`].

@@ -1,8 +1,8 @@
 //! Stage 4: the fit per channel, and its conversion into the result file's shape.
 
 use scatterfit_fit::{
-    ChannelInput, Diffusion, DipoleModel, FitOptions, FitReport, McModel, Method, ProfileData,
-    ProfileModel, Spot, Start,
+    ChannelInput, Diffusion, DipoleModel, FitOptions, FitReport, McModel, Method, PreparedFit,
+    ProfileData, ProfileModel, Spot, Start,
 };
 use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
 use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
@@ -211,14 +211,13 @@ pub fn propagate_spectro(
                     sigma_a: 0.0,
                 });
             }
-            let mut o = opts;
-            o.start = Some(Start {
+            let start = Some(Start {
                 sigma_s_prime: report.sigma_s_prime.value,
                 sigma_a: Some(report.sigma_a.value),
                 scale: None,
             });
-            let refit = |k: usize| -> Option<(f64, f64)> {
-                let input = ChannelInput {
+            let input = |k: usize| -> Option<ChannelInput> {
+                Some(ChannelInput {
                     eta: u.eta_pm[k],
                     albedo_prime: if proposed {
                         Some(u.albedo_pm.get(c)?[k]?)
@@ -226,12 +225,17 @@ pub fn propagate_spectro(
                         spectro.albedo_prime.get(c).copied().flatten()
                     },
                     rd_total: Some(u.rd_pm.get(c)?[k]),
-                };
-                let r = scatterfit_fit::fit_channel(data, &input, model, &o).ok()?;
+                })
+            };
+            let values = |r: FitReport| {
                 r.converged
                     .then_some((r.sigma_s_prime.value, r.sigma_a.value))
             };
-            let (lo, hi) = (refit(0)?, refit(1)?);
+            // One preparation (rings, spot kernel) for both refits.
+            let lo_fit =
+                PreparedFit::new(data, &input(0)?, model, &FitOptions { start, ..opts }).ok()?;
+            let hi = values(lo_fit.with_input(&input(1)?, start).ok()?.solve())?;
+            let lo = values(lo_fit.solve())?;
             Some(SpectroErrors {
                 sigma_s_prime: 0.5 * (hi.0 - lo.0).abs(),
                 sigma_a: 0.5 * (hi.1 - lo.1).abs(),
