@@ -23,7 +23,7 @@ impl PublishedMaterial {
 }
 
 /// The seven materials of Choi, Lee & Chin (2014), Table 1 (σ′s and σa in mm⁻¹, one η per
-/// material); also in `shared/reference/materials.csv`.
+/// material); also in `data/reference/materials.csv`.
 #[rustfmt::skip]
 pub const CHOI_2014: [PublishedMaterial; 7] = [
     PublishedMaterial { name: "pink-plastic", source: "choi2014", sigma_s_prime: [1.979, 1.893, 1.992], sigma_a: [0.000792, 0.049600, 0.022700], eta: 1.2886 },
@@ -36,7 +36,8 @@ pub const CHOI_2014: [PublishedMaterial; 7] = [
 ];
 
 /// Jensen, Marschner, Levoy & Hanrahan (2001), measured materials as pbrt-v3/v4 carry them
-/// (physics.md §1.5; `shared/reference/materials.csv`). The paper gives no η; Jensen et al. used 1.3.
+/// (docs/physics.md §1.5; `data/reference/materials.csv`). pbrt stores no η; we use 1.3, the index
+/// Jensen et al. are believed to have measured with (docs/physics.md §1.5: unverified).
 #[rustfmt::skip]
 pub const JENSEN_2001: [PublishedMaterial; 11] = [
     PublishedMaterial { name: "apple", source: "jensen2001", sigma_s_prime: [2.29, 2.39, 1.97], sigma_a: [0.0030, 0.0034, 0.046], eta: 1.3 },
@@ -67,14 +68,56 @@ pub fn by_name(name: &str) -> Option<&'static PublishedMaterial> {
 mod tests {
     use super::*;
 
-    /// The tables agree with the reference sheet `shared/reference/materials.csv` (copied values
-    /// checked here against the ones pbrt carries, physics.md §1.5, for three spot checks).
+    /// The published tables as `data/reference/materials.csv` has them (copied from Choi et al.
+    /// 2014, Table 1, and from pbrt's `MeasuredSS` for Jensen et al. 2001; `data/reference/README.md`).
+    const MATERIALS_CSV: &str = include_str!("../../../data/reference/materials.csv");
+
+    /// Every row of `data/reference/materials.csv` is a built-in material with the same source,
+    /// σ′s, σa and η (an empty η is Jensen et al.'s 1.3), and every built-in material is a row.
     #[test]
-    fn lookup_and_spot_checks() {
-        assert_eq!(by_name("Pink Plastic").unwrap().eta, 1.2886);
+    fn tables_match_the_reference_csv() {
+        let mut lines = MATERIALS_CSV
+            .lines()
+            .filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(
+            header,
+            [
+                "name",
+                "source",
+                "sigma_s_prime_r",
+                "sigma_s_prime_g",
+                "sigma_s_prime_b",
+                "sigma_a_r",
+                "sigma_a_g",
+                "sigma_a_b",
+                "eta"
+            ]
+        );
+        let mut names = Vec::new();
+        for line in lines {
+            let f: Vec<&str> = line.split(',').collect();
+            assert_eq!(f.len(), header.len(), "{line}");
+            let num = |k: usize| -> f64 { f[k].parse().unwrap_or_else(|_| panic!("{line}")) };
+            let m = by_name(f[0]).unwrap_or_else(|| panic!("{} is not built in", f[0]));
+            assert_eq!(m.name, f[0]);
+            assert_eq!(m.source, f[1], "{line}");
+            assert_eq!(m.sigma_s_prime, [num(2), num(3), num(4)], "{line}");
+            assert_eq!(m.sigma_a, [num(5), num(6), num(7)], "{line}");
+            let eta = if f[8].is_empty() { 1.3 } else { num(8) };
+            assert_eq!(m.eta, eta, "{line}");
+            names.push(f[0]);
+        }
+        let built_in: Vec<&str> = all().map(|m| m.name).collect();
+        assert_eq!(names, built_in, "same materials, same order");
+        assert_eq!(CHOI_2014.len(), 7, "Choi et al. 2014, Table 1");
+    }
+
+    #[test]
+    fn lookup_normalises_the_name() {
+        assert_eq!(by_name("Pink Plastic").unwrap().name, "pink-plastic");
+        assert_eq!(by_name(" WOOD_TILE ").unwrap().name, "wood-tile");
         assert_eq!(by_name("skin_1"), None);
-        assert_eq!(by_name("skin1").unwrap().sigma_a, [0.032, 0.17, 0.48]);
-        assert_eq!(by_name("marble").unwrap().sigma_s_prime, [2.19, 2.62, 3.00]);
-        assert_eq!(all().count(), 18);
+        assert_eq!(by_name("unobtainium"), None);
     }
 }

@@ -647,14 +647,65 @@ mod tests {
         assert!((0.3..0.8).contains(&(slope * cam.read_noise_e)));
     }
 
-    /// The photon budget gives absorbing channels more photons than transparent ones, within bounds.
+    /// What the step budget buys: the Monte Carlo work a channel really costs. For each channel of
+    /// the paper's seven materials, the photons [`photons_for`] grants times the random-walk steps per
+    /// photon that the engine counts on a short run of the same half-space (launch + scattering
+    /// events; 4096 photons estimate the heavy-tailed mean to about 20 %) is compared with the
+    /// documented budget, 2·10⁷ steps per channel on the paper's rig and 2·10⁶ on the quick one
+    /// (ARCHITECTURE.md, "synth: the rig twin").
+    ///
+    /// The budget is a floor: the step model 2 + 1.2√n_max ignores the boundary's internal
+    /// reflection, which sends a photon back into the medium about 1/(1 − Fdr(η)) times before it
+    /// escapes (Fdr: docs/physics.md §1.2), and under-counts the return-time tail, so a channel
+    /// costs more than the budget — measured 2.4× (nephrite, η = 1.08) to 10× (red aluminum R,
+    /// η = 2.41) — but not more than 3/(1 − Fdr(η)) times it. A count held at a bound is exempt from
+    /// the side that bound decides (the floor of photons may exceed the budget, the ceiling fall
+    /// short of it). A tenfold smaller budget puts the work of most channels below the floor.
     #[test]
     fn photon_budget() {
-        let rig = RigSpec::paper();
-        let clear = photons_for(1.979, 0.000792, &rig);
-        let dark = photons_for(1.189, 1.189, &rig);
-        assert!(dark > clear);
-        assert!(clear >= rig.min_photons && dark <= rig.max_photons);
+        for (rig, budget) in [(RigSpec::paper(), 2e7), (RigSpec::quick(), 2e6)] {
+            let mut inside_the_bounds = 0;
+            for m in crate::materials::CHOI_2014 {
+                for c in 0..3 {
+                    let (sp, sa) = (m.sigma_s_prime[c], m.sigma_a[c]);
+                    let photons = photons_for(sp, sa, &rig);
+                    let layer = Layer::from_reduced(sp, sa, rig.g, m.eta, f64::INFINITY).unwrap();
+                    let beam = Beam::new(BeamProfile::Disk {
+                        radius: rig.spot_radius_mm,
+                    })
+                    .unwrap();
+                    let grid = RadialGrid::from_edges(vec![0.0, 1.0]).unwrap();
+                    let short = 4096;
+                    let run =
+                        Simulation::new(Sample::slab(layer, 1.0).unwrap(), beam, grid, short, 7)
+                            .unwrap()
+                            .run();
+                    let steps_per_photon = 1.0 + run.interactions as f64 / short as f64;
+                    let ratio = photons as f64 * steps_per_photon / budget;
+                    let most = 3.0 / (1.0 - scatterfit_optics::dipole::f_dr(m.eta));
+                    let what = format!(
+                        "{} {c}: {photons} photons × {steps_per_photon:.1} steps = {ratio:.2} × the \
+                         budget (at most {most:.2})",
+                        m.name
+                    );
+                    if photons < rig.max_photons {
+                        assert!(ratio >= 1.0, "{what}");
+                    }
+                    if photons > rig.min_photons {
+                        assert!(ratio <= most, "{what}");
+                    }
+                    if photons > rig.min_photons && photons < rig.max_photons {
+                        inside_the_bounds += 1;
+                    }
+                }
+            }
+            assert!(
+                inside_the_bounds >= 10,
+                "{inside_the_bounds} channels inside the bounds"
+            );
+            // Absorbing channels walk shorter and get more photons than clear ones.
+            assert!(photons_for(1.189, 1.189, &rig) > photons_for(1.979, 0.000792, &rig));
+        }
     }
 
     /// The smoother leaves a clean profile alone, extrapolates a pure far field exactly, and
