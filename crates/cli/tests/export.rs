@@ -1,19 +1,10 @@
 //! Integration tests of `scatterfit export`: the real binary in a temporary folder.
 
+mod common;
+
+use common::{read_text, run, temp_dir};
+
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn scatterfit(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scatterfit"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
 
 /// A result file as `scatterfit measure` writes it (the stable names of ARCHITECTURE.md), with
 /// Jensen et al. 2001's skin1 coefficients (physics.md §1.5): σ′s = 0.74, 0.88, 1.01 and σa = 0.032,
@@ -40,17 +31,17 @@ fn write_result(path: &Path, b_channel: Option<&str>) {
 /// Without -o the export goes to stdout; with --scale m every coefficient is 1000× the mm⁻¹ one.
 #[test]
 fn json_to_stdout_in_both_units() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     write_result(&dir.path().join("result.json"), None);
-    let mm = scatterfit(&["export", "result.json", "--to", "json"], dir.path());
-    assert!(mm.status.success(), "{}", stderr(&mm));
-    let m = scatterfit(
-        &["export", "result.json", "--to", "json", "--scale", "m"],
+    let mm = run(dir.path(), &["export", "result.json", "--to", "json"]);
+    assert_eq!(mm.code, 0, "{}", mm.stderr);
+    let m = run(
         dir.path(),
+        &["export", "result.json", "--to", "json", "--scale", "m"],
     );
-    assert!(m.status.success(), "{}", stderr(&m));
-    let mm: serde_json::Value = serde_json::from_slice(&mm.stdout).unwrap();
-    let m: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
+    assert_eq!(m.code, 0, "{}", m.stderr);
+    let mm: serde_json::Value = serde_json::from_str(&mm.stdout).unwrap();
+    let m: serde_json::Value = serde_json::from_str(&m.stdout).unwrap();
     assert_eq!(mm["unit"], "mm");
     assert_eq!(m["unit"], "m");
     for c in ["r", "g", "b"] {
@@ -70,21 +61,22 @@ fn json_to_stdout_in_both_units() {
 /// input is never overwritten.
 #[test]
 fn output_file_rules() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     write_result(&dir.path().join("result.json"), None);
-    let ok = scatterfit(
-        &["export", "result.json", "--to", "pbrt", "-o", "skin.pbrt"],
+    let ok = run(
         dir.path(),
+        &["export", "result.json", "--to", "pbrt", "-o", "skin.pbrt"],
     );
-    assert!(ok.status.success(), "{}", stderr(&ok));
-    let text = std::fs::read_to_string(dir.path().join("skin.pbrt")).unwrap();
+    assert_eq!(ok.code, 0, "{}", ok.stderr);
+    let text = read_text(&dir.path().join("skin.pbrt"));
     assert!(
         text.contains("\"rgb sigma_a\" [ 0.032 0.17 0.48 ]"),
         "{text}"
     );
     assert!(ok.stdout.is_empty());
 
-    let wrong = scatterfit(
+    let wrong = run(
+        dir.path(),
         &[
             "export",
             "result.json",
@@ -93,23 +85,20 @@ fn output_file_rules() {
             "-o",
             "skin.pbrt",
         ],
-        dir.path(),
     );
-    assert_eq!(wrong.status.code(), Some(2));
-    assert!(stderr(&wrong).contains(".xml"), "{}", stderr(&wrong));
+    assert_eq!(wrong.code, 2);
+    assert!(wrong.stderr.contains(".xml"), "{}", wrong.stderr);
 
-    let exists = scatterfit(
-        &["export", "result.json", "--to", "pbrt", "-o", "skin.pbrt"],
+    let exists = run(
         dir.path(),
+        &["export", "result.json", "--to", "pbrt", "-o", "skin.pbrt"],
     );
-    assert_eq!(exists.status.code(), Some(2));
-    assert!(stderr(&exists).contains("--force"), "{}", stderr(&exists));
+    assert_eq!(exists.code, 2);
+    assert!(exists.stderr.contains("--force"), "{}", exists.stderr);
     // The refusal left the file as it was.
-    assert_eq!(
-        std::fs::read_to_string(dir.path().join("skin.pbrt")).unwrap(),
-        text
-    );
-    let forced = scatterfit(
+    assert_eq!(read_text(&dir.path().join("skin.pbrt")), text);
+    let forced = run(
+        dir.path(),
         &[
             "export",
             "result.json",
@@ -121,17 +110,13 @@ fn output_file_rules() {
             "--scale",
             "m",
         ],
-        dir.path(),
     );
-    assert!(forced.status.success(), "{}", stderr(&forced));
-    assert!(
-        std::fs::read_to_string(dir.path().join("skin.pbrt"))
-            .unwrap()
-            .contains("\"rgb sigma_a\" [ 32 170 480 ]")
-    );
+    assert_eq!(forced.code, 0, "{}", forced.stderr);
+    assert!(read_text(&dir.path().join("skin.pbrt")).contains("\"rgb sigma_a\" [ 32 170 480 ]"));
 
     let input_before = std::fs::read(dir.path().join("result.json")).unwrap();
-    let onto_input = scatterfit(
+    let onto_input = run(
+        dir.path(),
         &[
             "export",
             "result.json",
@@ -141,10 +126,9 @@ fn output_file_rules() {
             "./result.json",
             "--force",
         ],
-        dir.path(),
     );
-    assert_eq!(onto_input.status.code(), Some(2));
-    assert!(stderr(&onto_input).contains("is the input"));
+    assert_eq!(onto_input.code, 2);
+    assert!(onto_input.stderr.contains("is the input"));
     assert_eq!(
         std::fs::read(dir.path().join("result.json")).unwrap(),
         input_before
@@ -154,17 +138,17 @@ fn output_file_rules() {
 /// A failed channel: nothing is exported, exit 1, the message names the channel and its problem.
 #[test]
 fn failed_channel_exits_1_naming_it() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let failed = r#"{ "status": "failed", "sigma_s_prime": null, "sigma_s_prime_stderr": null,
         "sigma_a": null, "sigma_a_stderr": null, "albedo_prime": null, "rd_total": null, "mse": null,
         "problem": "linear sRGB Rd is 0: out of gamut" }"#;
     write_result(&dir.path().join("result.json"), Some(failed));
-    let out = scatterfit(
-        &["export", "result.json", "--to", "mitsuba", "-o", "m.xml"],
+    let out = run(
         dir.path(),
+        &["export", "result.json", "--to", "mitsuba", "-o", "m.xml"],
     );
-    assert_eq!(out.status.code(), Some(1));
-    let err = stderr(&out);
+    assert_eq!(out.code, 1);
+    let err = &out.stderr;
     assert!(err.contains("result.json"), "{err}");
     assert!(err.contains("channel b"), "{err}");
     assert!(err.contains("out of gamut"), "{err}");
@@ -174,39 +158,39 @@ fn failed_channel_exits_1_naming_it() {
 /// An unconstrained channel is exported with a warning on stderr (silenced by --quiet).
 #[test]
 fn unconstrained_channel_warns() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let unconstrained = r#"{ "status": "unconstrained", "unconstrained": ["sigma_a"],
         "sigma_s_prime": 1.01, "sigma_s_prime_stderr": 0.1, "sigma_a": 0.48, "sigma_a_stderr": 5.0,
         "albedo_prime": 0.68, "rd_total": 0.13, "mse": 1e-6 }"#;
     write_result(&dir.path().join("result.json"), Some(unconstrained));
-    let out = scatterfit(&["export", "result.json", "--to", "blender"], dir.path());
-    assert!(out.status.success(), "{}", stderr(&out));
-    let err = stderr(&out);
+    let out = run(dir.path(), &["export", "result.json", "--to", "blender"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let err = &out.stderr;
     assert!(err.contains("warning: channel b is unconstrained"), "{err}");
-    assert!(String::from_utf8_lossy(&out.stdout).contains("import bpy"));
-    let quiet = scatterfit(
-        &["export", "result.json", "--to", "blender", "--quiet"],
+    assert!(out.stdout.contains("import bpy"));
+    let quiet = run(
         dir.path(),
+        &["export", "result.json", "--to", "blender", "--quiet"],
     );
-    assert!(quiet.status.success());
-    assert!(quiet.stderr.is_empty(), "{}", stderr(&quiet));
+    assert_eq!(quiet.code, 0);
+    assert!(quiet.stderr.is_empty(), "{}", quiet.stderr);
 }
 
 /// Bad input: a missing file and a file that is not a result are exit 2 with the file named.
 #[test]
 fn bad_input_exits_2() {
-    let dir = tempfile::tempdir().unwrap();
-    let missing = scatterfit(&["export", "nope.json", "--to", "json"], dir.path());
-    assert_eq!(missing.status.code(), Some(2));
-    assert!(stderr(&missing).contains("nope.json"));
+    let dir = temp_dir();
+    let missing = run(dir.path(), &["export", "nope.json", "--to", "json"]);
+    assert_eq!(missing.code, 2);
+    assert!(missing.stderr.contains("nope.json"));
     std::fs::write(dir.path().join("x.json"), "{\"a\": 1}").unwrap();
-    let junk = scatterfit(&["export", "x.json", "--to", "json"], dir.path());
-    assert_eq!(junk.status.code(), Some(2));
+    let junk = run(dir.path(), &["export", "x.json", "--to", "json"]);
+    assert_eq!(junk.code, 2);
     assert!(
-        stderr(&junk).contains("not a scatterfit result"),
+        junk.stderr.contains("not a scatterfit result"),
         "{}",
-        stderr(&junk)
+        junk.stderr
     );
-    let bad_format = scatterfit(&["export", "x.json", "--to", "povray"], dir.path());
-    assert_eq!(bad_format.status.code(), Some(2));
+    let bad_format = run(dir.path(), &["export", "x.json", "--to", "povray"]);
+    assert_eq!(bad_format.code, 2);
 }

@@ -4,30 +4,14 @@
 //! (Z = round(255 · clip(E·Δt)^(1/2.2))), so the expectations (radiance ratios, the response up to its
 //! gauge, which pixels are clipped everywhere) come from the construction, not from the program.
 
+mod common;
+
+use common::{read_text, run, temp_dir};
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use scatterfit_imaging::ImageBuf;
 use scatterfit_io::image_files::{CameraFrame, read_radiance, write_camera_frame, write_radiance};
-
-struct Outcome {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
-
-fn scatterfit(dir: &Path, args: &[&str]) -> Outcome {
-    let out = Command::new(env!("CARGO_BIN_EXE_scatterfit"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("run scatterfit");
-    Outcome {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
 
 const W: usize = 48;
 const H: usize = 40;
@@ -84,9 +68,9 @@ fn write_bracket(dir: &Path) -> Vec<String> {
 
 #[test]
 fn merge_then_profile_end_to_end() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     write_bracket(dir.path());
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "merge",
@@ -136,7 +120,7 @@ fn merge_then_profile_end_to_end() {
     );
 
     // Response: written beside the output, g(z) − g(128) = 2.2 ln(z/128) up to the recovery's error.
-    let response = std::fs::read_to_string(dir.path().join("radiance.response.csv")).unwrap();
+    let response = read_text(&dir.path().join("radiance.response.csv"));
     let rows: Vec<Vec<f64>> = response
         .lines()
         .skip(1)
@@ -156,7 +140,7 @@ fn merge_then_profile_end_to_end() {
 
     // Profile with the known centre: ring means follow the scene's radial function.
     let center = format!("{CX},{CY}");
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "profile",
@@ -172,7 +156,7 @@ fn merge_then_profile_end_to_end() {
         ],
     );
     assert_eq!(out.code, 0, "{}", out.stderr);
-    let text = std::fs::read_to_string(dir.path().join("profile.csv")).unwrap();
+    let text = read_text(&dir.path().join("profile.csv"));
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
@@ -196,7 +180,7 @@ fn merge_then_profile_end_to_end() {
     }
 
     // The centre is found near the scene's centre when not given (the clipped corner is ignored).
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "profile",
@@ -222,9 +206,9 @@ fn merge_then_profile_end_to_end() {
 
 #[test]
 fn known_response_and_hdr_output() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     write_bracket(dir.path());
-    let first = scatterfit(
+    let first = run(
         dir.path(),
         &[
             "merge",
@@ -242,7 +226,7 @@ fn known_response_and_hdr_output() {
             || first.stdout.contains("clipped in every exposure")
     );
     // Merging again with the saved response gives the same map (same curve, same frames).
-    let second = scatterfit(
+    let second = run(
         dir.path(),
         &[
             "merge",
@@ -278,9 +262,9 @@ fn write_png(path: &Path, w: usize, h: usize, channels: usize, value: u8) {
 /// Runs `merge` on a folder prepared by `setup` and expects exit code 2 with every `needles` in the
 /// message.
 fn refused(setup: impl FnOnce(&Path), args: &[&str], needles: &[&str]) {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     setup(dir.path());
-    let out = scatterfit(dir.path(), args);
+    let out = run(dir.path(), args);
     assert_eq!(
         out.code, 2,
         "expected exit code 2 for {args:?}; stderr: {}",
@@ -488,10 +472,10 @@ fn refuses_a_dark_frame_of_another_shape() {
 #[test]
 fn never_overwrites_an_input() {
     let csv = "file,time_s\na.png,0.01\nb.png,0.02\n";
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     two_frames(dir.path());
     std::fs::write(dir.path().join("t.csv"), csv).unwrap();
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "merge",
@@ -509,16 +493,13 @@ fn never_overwrites_an_input() {
         "{}",
         out.stderr
     );
-    assert_eq!(
-        std::fs::read_to_string(dir.path().join("t.csv")).unwrap(),
-        csv
-    );
+    assert_eq!(read_text(&dir.path().join("t.csv")), csv);
 
     let map = ImageBuf::new(4, 4, 3, vec![1.0f32; 48]).unwrap();
     let exr: PathBuf = dir.path().join("map.exr");
     write_radiance(&exr, &map).unwrap();
     let before = std::fs::read(&exr).unwrap();
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "profile",
@@ -540,9 +521,9 @@ fn never_overwrites_an_input() {
 
 #[test]
 fn profile_refuses_bad_options_and_non_radiance_input() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     write_png(&dir.path().join("frame.png"), 8, 6, 3, 60);
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "profile",
@@ -561,13 +542,13 @@ fn profile_refuses_bad_options_and_non_radiance_input() {
     );
     let map = ImageBuf::new(4, 4, 3, vec![1.0f32; 48]).unwrap();
     write_radiance(&dir.path().join("map.exr"), &map).unwrap();
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &["profile", "map.exr", "--mm-per-pixel", "0", "-o", "p.csv"],
     );
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("--mm-per-pixel"), "{}", out.stderr);
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "profile",
@@ -602,7 +583,7 @@ fn merge_16_bit_linear_bracket_end_to_end() {
         // 1 … 1e8 counts/s along x, modulated along y and per channel.
         [1.0, 0.7, 0.4][c] * 10f64.powf(8.0 * x as f64 / (w - 1) as f64) * (1.0 + 0.01 * y as f64)
     };
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let mut csv = String::from("file,time_s\n");
     for (j, &t) in ts.iter().enumerate() {
         let mut data = Vec::with_capacity(w * h * 3);
@@ -619,7 +600,7 @@ fn merge_16_bit_linear_bracket_end_to_end() {
         csv.push_str(&format!("{name},{t}\n"));
     }
     std::fs::write(dir.path().join("exposures.csv"), csv).unwrap();
-    let out = scatterfit(
+    let out = run(
         dir.path(),
         &[
             "merge",

@@ -1,20 +1,18 @@
 //! Integration tests of `scatterfit simulate` and `scatterfit table`: the real binary in a temporary
 //! folder.
 
-use std::process::Command;
+mod common;
 
-fn scatterfit() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_scatterfit"))
-}
+use common::{command, read_text, temp_dir, text};
 
 /// A small simulation writes a CSV profile and JSON whose totals obey R_sp + Rd + Tt + A = 1, and the
 /// standard slab's Rd agrees with van de Hulst's 0.09739 (physics.md §4.2) within 4 s.e.
 #[test]
 fn simulate_writes_profile_and_json() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let csv = dir.path().join("profile.csv");
     // Standard slab in graphics units: σ′s = σs(1 − g) = 9 × 0.25 = 2.25 mm⁻¹, σa = 1, d = 0.2 mm.
-    let out = scatterfit()
+    let out = command()
         .args([
             "simulate",
             "--sigma-s-prime",
@@ -38,11 +36,7 @@ fn simulate_writes_profile_and_json() {
         .arg(&csv)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let r = &v["result"];
     let rd = r["rd_total"]["value"].as_f64().unwrap();
@@ -53,7 +47,7 @@ fn simulate_writes_profile_and_json() {
         + r["transmittance"]["value"].as_f64().unwrap()
         + r["absorbed"]["value"].as_f64().unwrap();
     assert!((sum - 1.0).abs() < 1e-3);
-    let text = std::fs::read_to_string(&csv).unwrap();
+    let text = read_text(&csv);
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
@@ -128,13 +122,13 @@ fn simulate_refuses_bad_input() {
         ),
     ];
     for (args, needle) in cases {
-        let out = scatterfit().arg("simulate").args(args).output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
+        let out = command().arg("simulate").args(args).output().unwrap();
+        let err = text(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
     }
     // η < 1 is accepted when asked for.
-    let out = scatterfit()
+    let out = command()
         .args([
             "simulate",
             "--sigma-s-prime",
@@ -153,9 +147,9 @@ fn simulate_refuses_bad_input() {
 /// `table` builds into the given cache folder, then reuses the file.
 #[test]
 fn table_builds_then_reuses_cache() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let run = || {
-        let out = scatterfit()
+        let out = command()
             .args([
                 "table",
                 "--eta",
@@ -169,11 +163,7 @@ fn table_builds_then_reuses_cache() {
             .arg(dir.path())
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert!(out.status.success(), "{}", text(&out.stderr));
         serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
     };
     let first = run();
@@ -221,13 +211,8 @@ fn simulate_refuses_unbounded_work_and_memory_up_front() {
         } else {
             &["--sigma-s-prime", "1"][..]
         };
-        let out = scatterfit()
-            .args(base)
-            .args(sp)
-            .args(args)
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
+        let out = command().args(base).args(sp).args(args).output().unwrap();
+        let err = text(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         for needle in needles {
             assert!(err.contains(needle), "{args:?}: {needle} not in {err}");
@@ -239,7 +224,7 @@ fn simulate_refuses_unbounded_work_and_memory_up_front() {
         );
     }
     // A slab without absorption is fine, and counts take scientific notation.
-    let out = scatterfit()
+    let out = command()
         .args(base)
         .args([
             "--sigma-s-prime",
@@ -252,16 +237,12 @@ fn simulate_refuses_unbounded_work_and_memory_up_front() {
         .args(["--photons", "1e4", "--json"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["result"]["photons"], 10_000);
     assert!(json["result"]["interactions"].as_u64().unwrap() > 10_000);
     // The work budget can be lowered (and raised) explicitly.
-    let out = scatterfit()
+    let out = command()
         .args(base)
         .args([
             "--sigma-s-prime",
@@ -281,7 +262,7 @@ fn simulate_refuses_unbounded_work_and_memory_up_front() {
 /// their ranges; nothing is written to the cache.
 #[test]
 fn table_refuses_unbounded_work_up_front() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cases: [(&[&str], &str); 4] = [
         (&["--g", "0.99999"], "--max-interactions"),
         (&["--albedos", "1e9"], "2 to 1000"),
@@ -289,13 +270,13 @@ fn table_refuses_unbounded_work_up_front() {
         (&["--g", "1"], "(−1, 1)"),
     ];
     for (args, needle) in cases {
-        let out = scatterfit()
+        let out = command()
             .args(["table", "--eta", "1.4", "--cache-dir"])
             .arg(dir.path())
             .args(args)
             .output()
             .unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
+        let err = text(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
     }

@@ -2,60 +2,17 @@
 //! and `demo` — with the real binary in a temporary folder, on quick rig-twin samples. Each exit-code
 //! class is pinned: 0 success, 1 a measurement that ran and failed, 2 bad usage or input.
 
-use std::path::Path;
-use std::process::{Command, Output};
-use std::sync::OnceLock;
+mod common;
 
-struct Run {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
-
-fn scatterfit(cwd: &Path, args: &[&str]) -> Run {
-    let out: Output = Command::new(env!("CARGO_BIN_EXE_scatterfit"))
-        .args(args)
-        .current_dir(cwd)
-        .env("SCATTERFIT_CACHE", cache())
-        .output()
-        .unwrap();
-    Run {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
-
-/// One Monte Carlo cache for the whole test binary, so each material is simulated once.
-fn cache() -> &'static Path {
-    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
-    DIR.get_or_init(|| tempfile::tempdir().unwrap()).path()
-}
-
-/// A quick twin sample of `material` in `cwd/dir`.
-fn synth(cwd: &Path, material: &str, dir: &str) {
-    let out = scatterfit(
-        cwd,
-        &[
-            "synth",
-            "--material",
-            material,
-            "--quick",
-            "-o",
-            dir,
-            "--quiet",
-        ],
-    );
-    assert_eq!(out.code, 0, "{}", out.stderr);
-}
+use common::{read_json, read_text, run_cached, synth_quick, temp_dir};
 
 /// synth → measure: the folder has every file the manifest names, measure writes its six files,
 /// result.json has the documented shape with channels keyed r, g, b, and σ′s is near the truth in
 /// truth.json (the fit issue's 5 % target on a channel well inside its range).
 #[test]
 fn synth_then_measure() {
-    let dir = tempfile::tempdir().unwrap();
-    synth(dir.path(), "wood-tile", "wood");
+    let dir = temp_dir();
+    synth_quick(dir.path(), "wood-tile", "wood");
     for f in [
         "sample.toml",
         "spectro.csv",
@@ -66,7 +23,7 @@ fn synth_then_measure() {
     ] {
         assert!(dir.path().join("wood").join(f).exists(), "{f}");
     }
-    let out = scatterfit(dir.path(), &["measure", "wood", "--quiet"]);
+    let out = run_cached(dir.path(), &["measure", "wood", "--quiet"]);
     assert_eq!(out.code, 0, "{}\n{}", out.stdout, out.stderr);
     assert!(out.stdout.contains("σ′s"), "{}", out.stdout);
     for f in [
@@ -79,13 +36,8 @@ fn synth_then_measure() {
     ] {
         assert!(dir.path().join("wood").join(f).exists(), "{f}");
     }
-    let r: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.path().join("wood/result.json")).unwrap(),
-    )
-    .unwrap();
-    let truth: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("wood/truth.json")).unwrap())
-            .unwrap();
+    let r: serde_json::Value = read_json(&dir.path().join("wood/result.json"));
+    let truth: serde_json::Value = read_json(&dir.path().join("wood/truth.json"));
     assert_eq!(r["method"], "proposed");
     assert_eq!(r["model"], "dipole");
     let got = r["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
@@ -106,7 +58,7 @@ fn synth_then_measure() {
     }
     assert_eq!(r["inputs"]["profile"], "profile.csv");
     // Measuring again replaces the command's own files; --output-dir writes elsewhere.
-    let out = scatterfit(
+    let out = run_cached(
         dir.path(),
         &["measure", "wood", "-o", "out", "--json", "--quiet"],
     );
@@ -126,7 +78,7 @@ fn synth_then_measure() {
         })
         .collect();
     let eta = r["eta"].as_f64().unwrap().to_string();
-    let out = scatterfit(
+    let out = run_cached(
         dir.path(),
         &[
             "fit",
@@ -143,18 +95,18 @@ fn synth_then_measure() {
     let refit = f["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
     assert!((refit / got - 1.0).abs() < 1e-6, "{refit} vs {got}");
     // The proposed method without α′ is bad usage.
-    let out = scatterfit(dir.path(), &["fit", "wood/profile.csv", "--eta", &eta]);
+    let out = run_cached(dir.path(), &["fit", "wood/profile.csv", "--eta", &eta]);
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("--albedo"), "{}", out.stderr);
 
     // A short bracket (3 of the 13 frames, 1/600 s, 0.07 s, 3 s) is measured too: the response
     // recovery takes Debevec & Malik's minimum ⌈256/(P − 1)⌉ = 128 sample pixels there, not the
     // 100 that suit long brackets (which it refused), and σ′s stays within the 5 % target.
-    let csv = std::fs::read_to_string(dir.path().join("wood/exposures.csv")).unwrap();
+    let csv = read_text(&dir.path().join("wood/exposures.csv"));
     let lines: Vec<&str> = csv.lines().collect();
     let short = [lines[0], lines[1], lines[7], lines[13]].join("\n");
     std::fs::write(dir.path().join("wood/exposures.csv"), short + "\n").unwrap();
-    let out = scatterfit(
+    let out = run_cached(
         dir.path(),
         &["measure", "wood", "-o", "short", "--json", "--quiet"],
     );
@@ -178,9 +130,9 @@ fn synth_then_measure() {
 /// Bad input anywhere in a sample folder gets exit 2 and a message naming the file and the key.
 #[test]
 fn bad_sample_folders_are_named() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
-    let out = scatterfit(d, &["measure", "nowhere", "--quiet"]);
+    let out = run_cached(d, &["measure", "nowhere", "--quiet"]);
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("sample.toml"), "{}", out.stderr);
     std::fs::create_dir(d.join("s")).unwrap();
@@ -209,14 +161,14 @@ fn bad_sample_folders_are_named() {
     ];
     for (manifest, key) in cases {
         std::fs::write(d.join("s/sample.toml"), manifest).unwrap();
-        let out = scatterfit(d, &["measure", "s", "--quiet"]);
+        let out = run_cached(d, &["measure", "s", "--quiet"]);
         assert_eq!(out.code, 2, "{manifest}: {}", out.stderr);
         assert!(out.stderr.contains(key), "{key}: {}", out.stderr);
         assert!(!d.join("s/result.json").exists());
     }
-    let out = scatterfit(d, &["measure", "s", "--method", "best"]);
+    let out = run_cached(d, &["measure", "s", "--method", "best"]);
     assert_eq!(out.code, 2);
-    let out = scatterfit(d, &["measure", "s", "--albedo-model", "exact"]);
+    let out = run_cached(d, &["measure", "s", "--albedo-model", "exact"]);
     assert_eq!(out.code, 2);
 }
 
@@ -224,16 +176,16 @@ fn bad_sample_folders_are_named() {
 /// error and exits 1; a matte sample (no specular reflection) is a failed measurement, exit 1.
 #[test]
 fn batch_survives_a_bad_sample_and_failures_exit_1() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
-    synth(d, "sulfur", "samples/sulfur");
+    synth_quick(d, "sulfur", "samples/sulfur");
     std::fs::create_dir_all(d.join("samples/broken")).unwrap();
     std::fs::write(
         d.join("samples/broken/sample.toml"),
         "[camera]\nmm_per_pixel = 0.1\n",
     )
     .unwrap();
-    let out = scatterfit(
+    let out = run_cached(
         d,
         &["batch", "samples", "-j", "2", "-o", "report", "--quiet"],
     );
@@ -243,13 +195,13 @@ fn batch_survives_a_bad_sample_and_failures_exit_1() {
         "{}",
         out.stderr
     );
-    let summary = std::fs::read_to_string(d.join("report/summary.csv")).unwrap();
+    let summary = read_text(&d.join("report/summary.csv"));
     assert!(summary.contains("sulfur,R,ok"), "{summary}");
     assert!(d.join("samples/sulfur/result.json").exists());
     assert!(d.join("report/summary.md").exists());
 
     // Matte: SCI = SCE, so η cannot be measured: exit 1 and the reason.
-    let spectro = std::fs::read_to_string(d.join("samples/sulfur/spectro.csv")).unwrap();
+    let spectro = read_text(&d.join("samples/sulfur/spectro.csv"));
     let matte: String = spectro
         .lines()
         .map(|l| {
@@ -263,11 +215,11 @@ fn batch_survives_a_bad_sample_and_failures_exit_1() {
         .collect::<Vec<_>>()
         .join("\n");
     std::fs::write(d.join("samples/sulfur/spectro.csv"), matte).unwrap();
-    let out = scatterfit(d, &["measure", "samples/sulfur", "--quiet"]);
+    let out = run_cached(d, &["measure", "samples/sulfur", "--quiet"]);
     assert_eq!(out.code, 1, "{}", out.stderr);
     assert!(out.stderr.contains("specular"), "{}", out.stderr);
     // …and with η given the same sample measures.
-    let out = scatterfit(
+    let out = run_cached(
         d,
         &["measure", "samples/sulfur", "--eta", "1.1159", "--quiet"],
     );
@@ -278,39 +230,36 @@ fn batch_survives_a_bad_sample_and_failures_exit_1() {
 /// folder it did not make; the quick demo runs and recovers the truth it prints.
 #[test]
 fn compare_synth_safety_and_quick_demo() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
-    synth(d, "nephrite", "n");
-    let out = scatterfit(d, &["compare", "n", "-o", "cmp", "--quiet"]);
+    synth_quick(d, "nephrite", "n");
+    let out = run_cached(d, &["compare", "n", "-o", "cmp", "--quiet"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    let table = std::fs::read_to_string(d.join("cmp/compare.md")).unwrap();
+    let table = read_text(&d.join("cmp/compare.md"));
     assert!(
         table.contains("nephrite") && table.contains("MSE"),
         "{table}"
     );
     assert!(d.join("n/compare.png").exists());
 
-    let out = scatterfit(
+    let out = run_cached(
         d,
         &["synth", "--material", "nephrite", "--quick", "-o", "n"],
     );
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("--force"), "{}", out.stderr);
-    let out = scatterfit(d, &["synth", "--material", "unobtainium", "-o", "x"]);
+    let out = run_cached(d, &["synth", "--material", "unobtainium", "-o", "x"]);
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("pink-plastic"), "{}", out.stderr);
 
     std::fs::create_dir(d.join("mine")).unwrap();
     std::fs::write(d.join("mine/thesis.tex"), "precious").unwrap();
-    let out = scatterfit(d, &["demo", "--quick", "-o", "mine", "--quiet"]);
+    let out = run_cached(d, &["demo", "--quick", "-o", "mine", "--quiet"]);
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("thesis.tex"), "{}", out.stderr);
-    assert_eq!(
-        std::fs::read_to_string(d.join("mine/thesis.tex")).unwrap(),
-        "precious"
-    );
+    assert_eq!(read_text(&d.join("mine/thesis.tex")), "precious");
 
-    let out = scatterfit(d, &["demo", "--quick", "-o", "demo", "--json", "--quiet"]);
+    let out = run_cached(d, &["demo", "--quick", "-o", "demo", "--json", "--quiet"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let rows: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert_eq!(rows.as_array().unwrap().len(), 7);
@@ -333,9 +282,9 @@ fn compare_synth_safety_and_quick_demo() {
 /// and the study's tables and plot are written; `measure --model mc` records the models it used.
 #[test]
 fn study_and_the_mc_model() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
-    let out = scatterfit(
+    let out = run_cached(
         d,
         &[
             "study",
@@ -368,8 +317,8 @@ fn study_and_the_mc_model() {
         assert!(d.join("s").join(f).exists(), "{f}");
     }
 
-    synth(d, "wood-tile", "w");
-    let out = scatterfit(d, &["measure", "w", "--model", "mc", "--json", "--quiet"]);
+    synth_quick(d, "wood-tile", "w");
+    let out = run_cached(d, &["measure", "w", "--model", "mc", "--json", "--quiet"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let r: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert_eq!(r["model"], "mc");
@@ -387,7 +336,7 @@ fn study_and_the_mc_model() {
 /// spectrophotometer's part is propagated.
 #[test]
 fn uncertainties_cover_the_truth_with_the_mc_model() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
     let mut z = Vec::new();
     for m in [
@@ -397,13 +346,11 @@ fn uncertainties_cover_the_truth_with_the_mc_model() {
         "sulfur",
         "brown-leather",
     ] {
-        synth(d, m, m);
-        let out = scatterfit(d, &["measure", m, "--model", "mc", "--json", "--quiet"]);
+        synth_quick(d, m, m);
+        let out = run_cached(d, &["measure", m, "--model", "mc", "--json", "--quiet"]);
         assert_eq!(out.code, 0, "{m}: {}", out.stderr);
         let r: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
-        let truth: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(d.join(m).join("truth.json")).unwrap())
-                .unwrap();
+        let truth: serde_json::Value = read_json(&d.join(m).join("truth.json"));
         for (i, c) in ["r", "g", "b"].iter().enumerate() {
             let ch = &r["channels"][c];
             for k in ["sigma_s_prime", "sigma_a"] {

@@ -24,6 +24,10 @@
 //! `forward_models_against_mitsuba` (ignored; run by hand) is the higher-quality comparison of each
 //! forward model's total Rd with the path tracer that BENCHMARKS.md reports.
 
+mod common;
+
+use common::{command, temp_dir, workspace_root};
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -44,21 +48,12 @@ fn required() -> bool {
     std::env::var("SCATTERFIT_REQUIRE_MITSUBA").is_ok_and(|v| v == "1")
 }
 
-fn workspace_root() -> PathBuf {
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    manifest
-        .parent()
-        .and_then(Path::parent)
-        .unwrap_or(manifest)
-        .to_path_buf()
-}
-
 /// The Python that has `mitsuba`, or `None` (after saying why) when the test is to be skipped.
 fn mitsuba_python(test: &str) -> Option<PathBuf> {
     let python = std::env::var_os("SCATTERFIT_MITSUBA_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| workspace_root().join(".ci/venv/bin/python"));
-    let home = tempfile::tempdir().unwrap();
+    let home = temp_dir();
     let ok = python.exists()
         && Command::new(&python)
             .args(["-c", "import mitsuba"])
@@ -102,7 +97,7 @@ fn write_result(path: &Path, eta: f64, channels: [(f64, f64, Option<f64>); 3]) {
 /// `scatterfit export RESULT --to mitsuba --scale UNIT -o OUT` (the real binary).
 fn export(dir: &Path, unit: &str) -> PathBuf {
     let out = dir.join(format!("material-{unit}.xml"));
-    let o = Command::new(env!("CARGO_BIN_EXE_scatterfit"))
+    let o = command()
         .args([
             "export",
             "result.json",
@@ -190,7 +185,7 @@ fn thick_slab_shows_total_diffuse_reflectance() {
     let Some(python) = mitsuba_python("thick_slab_shows_total_diffuse_reflectance") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     write_result(
         &dir.path().join("result.json"),
         THICK_ETA,
@@ -219,7 +214,7 @@ fn thin_slab_in_metres_matches_adding_doubling() {
     let Some(python) = mitsuba_python("thin_slab_in_metres_matches_adding_doubling") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     // σt = 0.01 mm⁻¹ = 10 m⁻¹: τ = 1 at 0.1 m.
     let sigma_t_mm = 0.01;
     let c = (
@@ -262,7 +257,7 @@ fn forward_models_against_mitsuba() {
         let spec = TableSpec::new(eta, 0.0, 32, 200_000).unwrap();
         let (table, _, _) = ProfileTable::load_or_build(&spec, &cache, &|_, _| {}).unwrap();
         for a in [0.3, 0.6, 0.9, 0.95, 0.99, 0.999] {
-            let dir = tempfile::tempdir().unwrap();
+            let dir = temp_dir();
             // σ′t = 1 mm⁻¹, the same α′ in every channel (one albedo per render: Mitsuba samples
             // distances and roulette on all channels at once, and mixed albedos add variance); a
             // half-space: 400 mm deep (400 mean free paths, 22 diffusion lengths at α′ = 0.999), 2000

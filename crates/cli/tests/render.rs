@@ -1,31 +1,13 @@
 //! `scatterfit render`, run as the real binary in a temporary folder: images, the Figure 5 grid,
 //! determinism, `--profile` against a measured profile made here from the model, and refusals.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
+
+use common::{read_text, run, temp_dir};
 
 use scatterfit_io::image_files::{read_camera_frame, read_radiance};
 use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
-
-struct Outcome {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
-
-fn scatterfit(dir: &Path, args: &[&str]) -> Outcome {
-    let out = Command::new(env!("CARGO_BIN_EXE_scatterfit"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("run scatterfit");
-    Outcome {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
 
 /// Small and quick: 64×64, a coarse statue, few light rays.
 const QUICK: [&str; 8] = [
@@ -48,8 +30,8 @@ fn with_quick<'a>(args: &[&'a str]) -> Vec<&'a str> {
 
 #[test]
 fn renders_png_and_exr_deterministically() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = scatterfit(
+    let dir = temp_dir();
+    let out = run(
         dir.path(),
         &with_quick(&[
             "--params",
@@ -74,7 +56,7 @@ fn renders_png_and_exr_deterministically() {
     assert!(exr.data().iter().all(|v| v.is_finite() && *v >= 0.0));
     assert!(exr.data().iter().any(|v| *v > 0.0));
     // The same seed again gives the same bytes; an existing output needs --force.
-    let again = scatterfit(
+    let again = run(
         dir.path(),
         &with_quick(&[
             "--params",
@@ -87,7 +69,7 @@ fn renders_png_and_exr_deterministically() {
     );
     assert_eq!(again.code, 2);
     assert!(again.stderr.contains("--force"), "{}", again.stderr);
-    let b = scatterfit(
+    let b = run(
         dir.path(),
         &with_quick(&[
             "--params",
@@ -107,8 +89,8 @@ fn renders_png_and_exr_deterministically() {
 
 #[test]
 fn compare_makes_a_captioned_figure_5_grid_and_gray_works() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = scatterfit(
+    let dir = temp_dir();
+    let out = run(
         dir.path(),
         &with_quick(&[
             "--compare",
@@ -156,7 +138,7 @@ fn compare_makes_a_captioned_figure_5_grid_and_gray_works() {
 type ProfileOf = dyn Fn(&OpticalProperties) -> Box<dyn Fn(f64) -> f64>;
 
 fn profile_mse_ratio(model: &str, profile: &ProfileOf, extra: &[&str]) -> [f64; 3] {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let (eta, mmpp, spot) = (1.3, 0.1, 0.3);
     let coeffs = [(1.2, 0.05), (1.0, 0.1), (0.8, 0.2)];
     let k = [2.0e4, 3.0e4, 4.0e4];
@@ -227,7 +209,7 @@ fn profile_mse_ratio(model: &str, profile: &ProfileOf, extra: &[&str]) -> [f64; 
         "--json",
     ];
     args.extend_from_slice(extra);
-    let out = scatterfit(dir.path(), &args);
+    let out = run(dir.path(), &args);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let json: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     let mut ratio = [0.0; 3];
@@ -246,7 +228,7 @@ fn profile_mse_ratio(model: &str, profile: &ProfileOf, extra: &[&str]) -> [f64; 
         let rd1 = avg(&*profiles[c], 1.0);
         ratio[c] = ch["mse"].as_f64().unwrap() / (5e-3 * rd1).powi(2);
     }
-    let text = std::fs::read_to_string(dir.path().join("cmp.csv")).unwrap();
+    let text = read_text(&dir.path().join("cmp.csv"));
     assert!(text.starts_with("r_mm,rendered_r"));
     assert_eq!(text.lines().count(), 41);
     ratio
@@ -286,7 +268,7 @@ fn render_uses_the_fitted_model() {
 
 #[test]
 fn bad_input_is_refused_with_a_clear_message() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
@@ -339,7 +321,7 @@ fn bad_input_is_refused_with_a_clear_message() {
     )
     .unwrap();
     for (args, needle) in cases {
-        let out = scatterfit(d, &with_quick(&args));
+        let out = run(d, &with_quick(&args));
         // A result whose channel failed is a failed measurement (exit 1, as `export` says of it);
         // everything else here is bad usage or input.
         let class = if needle == "channel b" { 1 } else { 2 };

@@ -3,56 +3,24 @@
 //! spectro's are pinned in measure.rs, spectro.rs and export.rs), outputs checked before the work,
 //! never overwritten without --force, and Ctrl-C ending a run with 130 and no temporary file.
 
+mod common;
+
+use common::{Run, cached_command, read_json, read_text, run_cached, synth_quick, temp_dir, text};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
-
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_scatterfit"));
-    c.env("SCATTERFIT_CACHE", cache());
-    c
-}
-
-fn run(cwd: &Path, args: &[&str]) -> Output {
-    bin().args(args).current_dir(cwd).output().unwrap()
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().unwrap_or(-1)
-}
-
-/// One Monte Carlo cache for the whole test binary.
-fn cache() -> &'static Path {
-    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
-    DIR.get_or_init(|| tempfile::tempdir().unwrap()).path()
-}
 
 /// A quick rig-twin sample, measured once (result.json, profile.csv), shared by the tests:
 /// `synth --quick` makes it in about a second.
 fn sample() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let o = run(
-            dir.path(),
-            &[
-                "synth",
-                "--material",
-                "wood-tile",
-                "--quick",
-                "-o",
-                "wood",
-                "--quiet",
-            ],
-        );
-        assert_eq!(code(&o), 0, "{}", text(&o.stderr));
-        let o = run(dir.path(), &["measure", "wood", "--quiet"]);
-        assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+        let dir = temp_dir();
+        synth_quick(dir.path(), "wood-tile", "wood");
+        let o = run_cached(dir.path(), &["measure", "wood", "--quiet"]);
+        assert_eq!(o.code, 0, "{}", o.stderr);
         dir
     })
     .path()
@@ -72,16 +40,17 @@ fn spectro_csv(dir: &Path) -> PathBuf {
 /// Runs `args` with stdout a pipe whose reader is already closed, so the first write meets
 /// EPIPE: before this round every command panicked ("failed printing to stdout: Broken pipe",
 /// exit 101).
-fn into_closed_pipe(cwd: &Path, args: &[&str]) -> Output {
+fn into_closed_pipe(cwd: &Path, args: &[&str]) -> Run {
     let (reader, writer) = std::io::pipe().unwrap();
     drop(reader);
-    bin()
+    cached_command()
         .args(args)
         .current_dir(cwd)
         .stdout(Stdio::from(writer))
         .stderr(Stdio::piped())
         .output()
         .unwrap()
+        .into()
 }
 
 /// Every command, `| true` style: exit 0, nothing about a broken pipe or a panic on stderr, and
@@ -89,7 +58,7 @@ fn into_closed_pipe(cwd: &Path, args: &[&str]) -> Output {
 #[test]
 fn a_closed_stdout_ends_every_command_quietly() {
     let s = sample();
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
     std::fs::create_dir(d.join("tab")).unwrap();
     let spectro = spectro_csv(d);
@@ -186,8 +155,8 @@ fn a_closed_stdout_ends_every_command_quietly() {
     for args in &cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let o = into_closed_pipe(d, &args);
-        let err = text(&o.stderr);
-        assert_eq!(code(&o), 0, "{args:?}: {err}");
+        let err = &o.stderr;
+        assert_eq!(o.code, 0, "{args:?}: {err}");
         assert!(
             !err.contains("panicked") && !err.contains("Broken pipe"),
             "{args:?}: {err}"
@@ -208,7 +177,7 @@ fn a_closed_stdout_ends_every_command_quietly() {
         d,
         &["profile", "r.exr", "--mm-per-pixel", "0.1", "-o", "p.csv"],
     );
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(d.join("p.csv").exists());
 }
 
@@ -218,10 +187,10 @@ fn a_closed_stdout_ends_every_command_quietly() {
 #[test]
 fn merge_and_profile_exit_classes() {
     let wood = sample().join("wood");
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
     // Reversed times: the same frames, the times read bottom up.
-    let csv = std::fs::read_to_string(wood.join("exposures.csv")).unwrap();
+    let csv = read_text(&wood.join("exposures.csv"));
     let rows: Vec<(&str, &str)> = csv
         .lines()
         .skip(1)
@@ -238,18 +207,18 @@ fn merge_and_profile_exit_classes() {
         ));
     }
     std::fs::write(d.join("reversed.csv"), reversed).unwrap();
-    let o = run(
+    let o = run_cached(
         d,
         &["merge", "--exposures", "reversed.csv", "-o", "rev.exr"],
     );
-    let err = text(&o.stderr);
-    assert_eq!(code(&o), 1, "{err}");
+    let err = &o.stderr;
+    assert_eq!(o.code, 1, "{err}");
     assert!(err.contains("right order"), "{err}");
     assert!(!d.join("rev.exr").exists() && !d.join("rev.response.csv").exists());
 
     let exposures = wood.join("exposures.csv");
     let exposures = exposures.to_str().unwrap();
-    let o = run(
+    let o = run_cached(
         d,
         &[
             "merge",
@@ -261,12 +230,12 @@ fn merge_and_profile_exit_classes() {
             "a.exr",
         ],
     );
-    let err = text(&o.stderr);
-    assert_eq!(code(&o), 2, "{err}");
+    let err = &o.stderr;
+    assert_eq!(o.code, 2, "{err}");
     assert!(err.contains("22 to 1000"), "{err}");
     // An unwritable map (its folder is a file): refused before reading a frame, no orphan CSV.
     std::fs::write(d.join("plain"), b"x").unwrap();
-    let o = run(
+    let o = run_cached(
         d,
         &[
             "merge",
@@ -278,20 +247,20 @@ fn merge_and_profile_exit_classes() {
             "a.response.csv",
         ],
     );
-    assert_eq!(code(&o), 2, "{}", text(&o.stderr));
+    assert_eq!(o.code, 2, "{}", o.stderr);
     assert!(!d.join("a.response.csv").exists());
 
-    let o = run(d, &["merge", "--exposures", exposures, "-o", "a.exr"]);
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    let o = run_cached(d, &["merge", "--exposures", exposures, "-o", "a.exr"]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
     // An existing output is refused without --force and replaced with it.
-    let o = run(d, &["merge", "--exposures", exposures, "-o", "a.exr"]);
-    assert_eq!(code(&o), 2);
-    assert!(text(&o.stderr).contains("--force"), "{}", text(&o.stderr));
-    let o = run(
+    let o = run_cached(d, &["merge", "--exposures", exposures, "-o", "a.exr"]);
+    assert_eq!(o.code, 2);
+    assert!(o.stderr.contains("--force"), "{}", o.stderr);
+    let o = run_cached(
         d,
         &["merge", "--exposures", exposures, "-o", "a.exr", "--force"],
     );
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    assert_eq!(o.code, 0, "{}", o.stderr);
 
     for (args, needle) in [
         (
@@ -325,17 +294,17 @@ fn merge_and_profile_exit_classes() {
             "(0, 1e6] px",
         ),
     ] {
-        let o = run(d, &args);
-        let err = text(&o.stderr);
-        assert_eq!(code(&o), 2, "{args:?}: {err}");
+        let o = run_cached(d, &args);
+        let err = &o.stderr;
+        assert_eq!(o.code, 2, "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
-    let o = run(
+    let o = run_cached(
         d,
         &["profile", "a.exr", "--mm-per-pixel", "0.1", "-o", "p.csv"],
     );
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    assert_eq!(o.code, 0, "{}", o.stderr);
 }
 
 /// The Monte Carlo family has no failed-measurement class (nothing is measured): 0, or 2 for bad
@@ -343,7 +312,7 @@ fn merge_and_profile_exit_classes() {
 /// accepted, and counts written as `1e6`.
 #[test]
 fn simulate_outputs_and_exit_classes() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
     let base = [
         "simulate",
@@ -361,20 +330,15 @@ fn simulate_outputs_and_exit_classes() {
     let go = |extra: &[&str]| {
         let args = with(extra);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        run(d, &args)
+        run_cached(d, &args)
     };
     let o = go(&["--photons", "2e3", "-o", "p.json"]);
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let json: serde_json::Value = read_json(&d.join("p.json"));
     assert_eq!(json["result"]["photons"], 2000);
     let o = go(&["--photons", "2e3", "--out", "p.csv"]);
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
-    assert!(
-        std::fs::read_to_string(d.join("p.csv"))
-            .unwrap()
-            .starts_with("r_inner_mm")
-    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(read_text(&d.join("p.csv")).starts_with("r_inner_mm"));
     // Refused in milliseconds although the run would take minutes: the output first.
     for (extra, needle) in [
         (vec!["--photons", "1e8", "-o", "p.csv"], "--force"),
@@ -394,13 +358,13 @@ fn simulate_outputs_and_exit_classes() {
     ] {
         let t0 = Instant::now();
         let o = go(&extra);
-        let err = text(&o.stderr);
-        assert_eq!(code(&o), 2, "{extra:?}: {err}");
+        let err = &o.stderr;
+        assert_eq!(o.code, 2, "{extra:?}: {err}");
         assert!(err.contains(needle), "{extra:?}: {err}");
         assert!(t0.elapsed() < Duration::from_secs(5), "{extra:?}");
     }
     let o = go(&["--photons", "2e3", "-o", "p.csv", "--force"]);
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    assert_eq!(o.code, 0, "{}", o.stderr);
     // No temporary file was left by any of these.
     let left: Vec<String> = std::fs::read_dir(d)
         .unwrap()
@@ -417,8 +381,8 @@ fn simulate_outputs_and_exit_classes() {
 #[cfg(unix)]
 #[test]
 fn ctrl_c_ends_a_run_with_130_and_no_temporary() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut child = bin()
+    let dir = temp_dir();
+    let mut child = cached_command()
         .args([
             "simulate",
             "--sigma-s-prime",
@@ -463,11 +427,10 @@ fn ctrl_c_ends_a_run_with_130_and_no_temporary() {
 /// says of it), 2 (bad usage), with the memory of the panels checked before rendering.
 #[test]
 fn render_exit_classes_and_memory() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let d = dir.path();
     let result = sample().join("wood").join("result.json");
-    let mut json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&result).unwrap()).unwrap();
+    let mut json: serde_json::Value = read_json(&result);
     let quick = [
         "--shape",
         "sphere",
@@ -489,17 +452,17 @@ fn render_exit_classes_and_memory() {
         }
         args.push("--quiet");
         args.extend(extra);
-        run(d, &args)
+        run_cached(d, &args)
     };
     let o = render(result.to_str().unwrap(), "ok.png", &[]);
-    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    assert_eq!(o.code, 0, "{}", o.stderr);
     json["channels"]["b"]["status"] = "failed".into();
     json["channels"]["b"]["sigma_s_prime"] = serde_json::Value::Null;
     json["channels"]["b"]["sigma_a"] = serde_json::Value::Null;
     json["channels"]["b"]["problem"] = "no α′".into();
     std::fs::write(d.join("failed.json"), json.to_string()).unwrap();
     let o = render("failed.json", "f.png", &[]);
-    assert_eq!(code(&o), 1, "{}", text(&o.stderr));
+    assert_eq!(o.code, 1, "{}", o.stderr);
     assert!(!d.join("f.png").exists());
     for (extra, needle) in [
         (vec!["--spp", "0"], "1–4096"),
@@ -510,8 +473,8 @@ fn render_exit_classes_and_memory() {
         ),
     ] {
         let o = render("pink-plastic", "b.png", &extra);
-        let err = text(&o.stderr);
-        assert_eq!(code(&o), 2, "{extra:?}: {err}");
+        let err = &o.stderr;
+        assert_eq!(o.code, 2, "{extra:?}: {err}");
         assert!(err.contains(needle), "{extra:?}: {err}");
     }
 }
