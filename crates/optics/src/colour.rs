@@ -92,8 +92,8 @@ pub const WEIGHTS_STEP_NM: f64 = 10.0;
 
 /// D65 tristimulus weighting factors at 400, 410, …, 700 nm for (x̄, ȳ, z̄) of the 2° observer followed
 /// by the 10° observer, with the end wavelengths adjusted for data truncated to 400–700 nm as ASTM
-/// E308-18 prescribes. Computed with colour-science 0.4.7 (ASTM E2022 method) — copied from
-/// `shared/reference/astm_e308_weights_10nm.csv` (physics.md §6.3). Σ W_Y = 100.
+/// E308-18 prescribes. Computed with colour-science 0.4.7 (ASTM E2022 method, then the E308
+/// adjustment; docs/physics.md §6.3 says how), not copied from the printed tables. Σ W_Y = 100.
 #[rustfmt::skip]
 pub const WEIGHTS_D65: [[f64; 6]; 31] = [
     [0.130643, 0.003639, 0.618140, 0.143925, 0.015130, 0.643103],
