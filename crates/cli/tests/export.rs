@@ -7,8 +7,8 @@ use common::{read_text, run, temp_dir};
 use std::path::Path;
 
 /// A result file as `scatterfit measure` writes it (the stable names of ARCHITECTURE.md), with
-/// Jensen et al. 2001's skin1 coefficients (physics.md §1.5): σ′s = 0.74, 0.88, 1.01 and σa = 0.032,
-/// 0.17, 0.48 mm⁻¹. `b` is overridden by `b_channel` when given.
+/// Jensen et al. 2001's skin1 coefficients (docs/physics.md §1.5): σ′s = 0.74, 0.88, 1.01 and σa =
+/// 0.032, 0.17, 0.48 mm⁻¹. `b` is overridden by `b_channel` when given.
 fn write_result(path: &Path, b_channel: Option<&str>) {
     let ch = |sp: f64, sa: f64| {
         format!(

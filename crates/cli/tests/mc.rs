@@ -6,7 +6,7 @@ mod common;
 use common::{command, read_text, temp_dir, text};
 
 /// A small simulation writes a CSV profile and JSON whose totals obey R_sp + Rd + Tt + A = 1, and the
-/// standard slab's Rd agrees with van de Hulst's 0.09739 (physics.md §4.2) within 4 s.e.
+/// standard slab's Rd agrees with van de Hulst's 0.09739 (docs/physics.md §4.2) within 4 s.e.
 #[test]
 fn simulate_writes_profile_and_json() {
     let dir = temp_dir();

@@ -5,9 +5,9 @@
 //! What a pixel measures (see `mitsuba_slab.py`): a constant environment of radiance 1 and an
 //! orthographic camera looking along the normal give, by reciprocity, the slab's reflectance for
 //! collimated light at normal incidence: the Fresnel specular R0 = ((η − 1)/(η + 1))² plus the diffuse
-//! reflectance Rd (MCML's, physics.md §4.3: "UR1" there includes R0). A thick slab of the exported
-//! medium must therefore show `rd_total + R0` with `rd_total` exact transport's Rd for the result's α′
-//! and η — what a measurement with `albedo_model = "mc"` carries.
+//! reflectance Rd (MCML's, docs/physics.md §4.3: "UR1" there includes R0). A thick slab of the
+//! exported medium must therefore show `rd_total + R0` with `rd_total` exact transport's Rd for the
+//! result's α′ and η — what a measurement with `albedo_model = "mc"` carries.
 //!
 //! Tolerance: 4 standard errors of the render (pixel-to-pixel spread; box filter, independent pixels)
 //! plus 0.002 for what separates the render from the reference besides noise: float32 arithmetic and
@@ -32,12 +32,13 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Slab reflectance at normal incidence from exact transport (iadpython adding-doubling; physics.md
-/// §4.3, "n=1.4 R_d = UR1(Q40) − 0.027778"): a = α′ and Rd, semi-infinite, η = 1.4, g = 0.
+/// Slab reflectance at normal incidence from exact transport (iadpython adding-doubling;
+/// docs/physics.md §4.3, "n=1.4 R_d = UR1(Q40) − 0.027778"): a = α′ and Rd, semi-infinite, η = 1.4,
+/// g = 0.
 const THICK_ETA: f64 = 1.4;
 const THICK_CASES: [(f64, f64); 3] = [(0.8, 0.153054), (0.9, 0.250608), (0.95, 0.359139)];
 
-/// Finite slab (physics.md §4.4, "thin isotropic"): α = 0.95, optical thickness τ = 1, g = 0,
+/// Finite slab (docs/physics.md §4.4, "thin isotropic"): α = 0.95, optical thickness τ = 1, g = 0,
 /// η = 1.5 with air on both sides; total reflectance at normal incidence UR1 (R0 included) from
 /// iadpython, 0.27452 (Q = 32; 0.27453 at Q = 24; MC 0.27484 ± 0.0004).
 const THIN_ETA: f64 = 1.5;

@@ -15,8 +15,8 @@ fn write_reading(path: &Path, sce: f64, specular: f64) {
     std::fs::write(path, s).unwrap();
 }
 
-/// physics.md §5: a specular reflectance of 0.04 means η = 1.5 through Schlick; the JSON on stdout
-/// and the file written with --out carry the same result.
+/// docs/physics.md §5: a specular reflectance of 0.04 means η = 1.5 through Schlick; the JSON on
+/// stdout and the file written with --out carry the same result.
 #[test]
 fn spectro_json_reports_eta_and_albedo() {
     let dir = temp_dir();
@@ -37,8 +37,8 @@ fn spectro_json_reports_eta_and_albedo() {
     assert_eq!(file["eta"], v["eta"]);
 }
 
-/// η = 1.3 given explicitly and Rd = 0.5: α′ must be physics.md §1.6's 0.97258193 (grey, so every
-/// channel; the sRGB matrix rounding moves Rd by < 2e-4, α′ by < 3e-5).
+/// η = 1.3 given explicitly and Rd = 0.5: α′ must be docs/physics.md §1.6's 0.97258193 (grey, so
+/// every channel; the sRGB matrix rounding moves Rd by < 2e-4, α′ by < 3e-5).
 #[test]
 fn given_eta_and_grey_match_inversion_vector() {
     let dir = temp_dir();

@@ -23,8 +23,9 @@
 //!
 //! The Jacobian is analytic (the models' derivatives through the chain rule, plus the derivative of
 //! the projected ln k); residuals and Jacobian are computed once per parameter set in `set_params`
-//! (STYLE.md: cache shared work). Standard errors come from the full problem's Jacobian (ln k as a
-//! free column), whose covariance restricted to the coefficients equals the projected problem's.
+//! (ARCHITECTURE.md, "Code conventions": cache shared work). Standard errors come from the full
+//! problem's Jacobian (ln k as a free column), whose covariance restricted to the coefficients
+//! equals the projected problem's.
 
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};

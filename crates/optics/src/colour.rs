@@ -129,7 +129,7 @@ pub const WEIGHTS_D65: [[f64; 6]; 31] = [
     [0.150580, 0.054371, 0.000000, 0.110485, 0.042938, 0.000000],];
 
 /// XYZ of a reflectance spectrum (fractions 0–1) under D65 for `observer`:
-/// X = Σ_λ W_X(λ) R(λ), etc. (ASTM E308, weighting-factor method; physics.md §6.3).
+/// X = Σ_λ W_X(λ) R(λ), etc. (ASTM E308, weighting-factor method; docs/physics.md §6.3).
 ///
 /// The spectrum must cover 400–700 nm with steps of at most 10 nm (e.g. 400–700 at 10 nm, or 360–780
 /// at 5 nm). Values at 400, 410, …, 700 nm are taken directly when present, otherwise interpolated
@@ -235,7 +235,7 @@ fn lab_f(t: f64) -> f64 {
     }
 }
 
-/// Inverse of [`lab_f`] (physics.md §6.1).
+/// Inverse of [`lab_f`] (docs/physics.md §6.1).
 fn lab_f_inv(t: f64) -> f64 {
     const D: f64 = 6.0 / 29.0;
     if t > D {
@@ -257,7 +257,7 @@ pub fn xyz_to_lab(xyz: Xyz, white: Xyz) -> Lab {
     }
 }
 
-/// L\*a\*b\* → XYZ relative to `white` (inverse of CIE 15:2004 §8.2.1; physics.md §6.1).
+/// L\*a\*b\* → XYZ relative to `white` (inverse of CIE 15:2004 §8.2.1; docs/physics.md §6.1).
 pub fn lab_to_xyz(lab: Lab, white: Xyz) -> Xyz {
     let fy = (lab.l + 16.0) / 116.0;
     let fx = fy + lab.a / 500.0;
@@ -382,7 +382,7 @@ mod tests {
         (a - b).abs() <= tol
     }
 
-    /// physics.md §6.3: the weight sums reproduce the ASTM E308 white points.
+    /// docs/physics.md §6.3: the weight sums reproduce the ASTM E308 white points.
     #[test]
     fn white_points_are_weight_sums() {
         let w2 = Observer::TwoDegree.d65_white();
@@ -395,7 +395,7 @@ mod tests {
         );
     }
 
-    /// physics.md §6.2: Lab(60, 20, −30) with the ASTM E308 2° white.
+    /// docs/physics.md §6.2: Lab(60, 20, −30) with the ASTM E308 2° white.
     #[test]
     fn lab_to_xyz_and_srgb_reference_vectors() {
         let lab = Lab {
@@ -429,7 +429,7 @@ mod tests {
         );
     }
 
-    /// physics.md §6.2 last row: 10° Lab with the xy-derived whites, Bradford to the 2° white.
+    /// docs/physics.md §6.2 last row: 10° Lab with the xy-derived whites, Bradford to the 2° white.
     #[test]
     fn bradford_reference_vector() {
         let lab = Lab {
@@ -483,7 +483,7 @@ mod tests {
         }
     }
 
-    /// physics.md §6.2 extras: a neutral grey and a saturated green (computed there with the
+    /// docs/physics.md §6.2 extras: a neutral grey and a saturated green (computed there with the
     /// xy-derived D65/2° white 0.950456, 1, 1.089058).
     #[test]
     fn extra_lab_vectors() {
@@ -516,7 +516,7 @@ mod tests {
         }
     }
 
-    /// The ColorChecker "dark skin" spectrum (physics.md §6.4).
+    /// The ColorChecker "dark skin" spectrum (docs/physics.md §6.4).
     const DARK_SKIN: [f64; 31] = [
         0.061, 0.062, 0.062, 0.062, 0.062, 0.062, 0.062, 0.062, 0.062, 0.063, 0.065, 0.070, 0.076,
         0.079, 0.081, 0.084, 0.091, 0.103, 0.119, 0.134, 0.143, 0.147, 0.151, 0.158, 0.168, 0.179,
@@ -527,7 +527,8 @@ mod tests {
         (0..31).map(|i| 400.0 + 10.0 * i as f64).collect()
     }
 
-    /// physics.md §6.4: XYZ and L*a*b* of "dark skin", both observers, Lab white = weight sums.
+    /// docs/physics.md §6.4: XYZ and L*a*b* of "dark skin", both observers, Lab white = weight
+    /// sums.
     #[test]
     fn dark_skin_reference_vector() {
         let wl = grid();

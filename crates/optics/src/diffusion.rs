@@ -2,7 +2,8 @@
 //! exitance of one real/virtual source pair under d'Eon's boundary condition, with its derivatives,
 //! and a Gauss–Legendre quadrature on doubling panels for radial integrals.
 //!
-//! The pair term (pbrt-v4 `BeamDiffusionMS` integrand, physics.md §2.1 and §3), with σtr² = s2:
+//! The pair term (pbrt-v4 `BeamDiffusionMS` integrand, docs/physics.md §2.1 and §3), with σtr² =
+//! s2:
 //! ```text
 //! E = K·Φ + c_E·Ψ,  K = c_φ/D
 //! Φ = e^{−σtr d_r}/d_r − e^{−σtr d_v}/d_v                      (fluence, 4πD φ_D)

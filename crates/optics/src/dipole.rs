@@ -31,9 +31,10 @@ pub fn f_dr(eta: f64) -> f64 {
 
 /// The exact internal diffuse Fresnel reflectance 2∫₀¹ F(μ; 1/η) μ dμ of light inside a medium of
 /// index η meeting a smooth boundary to air (Born & Wolf Fresnel equations integrated over a
-/// Lambertian distribution; physics.md §1.2). Integrated with the substitution t = cos θ_transmitted
-/// (μ dμ = t dt/η², smooth on [0, 1]) and composite Simpson; the part beyond the critical angle
-/// (F = 1) is added in closed form. For η < 1 the roles swap and no total reflection occurs.
+/// Lambertian distribution; docs/physics.md §1.2). Integrated with the substitution t = cos
+/// θ_transmitted (μ dμ = t dt/η², smooth on [0, 1]) and composite Simpson; the part beyond the
+/// critical angle (F = 1) is added in closed form. For η < 1 the roles swap and no total reflection
+/// occurs.
 pub fn f_dr_exact(eta: f64) -> f64 {
     const N: usize = 400; // Simpson intervals; the integrand is smooth in t, error < 1e-10.
     let inv_eta = 1.0 / eta;
@@ -69,7 +70,7 @@ pub fn a_coefficient(eta: f64) -> f64 {
 /// Total diffuse reflectance of the classical dipole,
 /// Rd = (α′/2)(1 + e^{−(4/3)A√(3(1−α′))}) e^{−√(3(1−α′))} (Jensen et al. 2001, eq. 5; the seed's
 /// eq. (1) is this formula garbled in extraction). It is the exact integral ∫₀^∞ 2πr Rd(r) dr of
-/// [`Dipole::rd`] (physics.md §1.3).
+/// [`Dipole::rd`] (docs/physics.md §1.3).
 pub fn rd_total(albedo_prime: f64, eta: f64) -> f64 {
     let s = (3.0 * (1.0 - albedo_prime)).max(0.0).sqrt();
     rd_total_of_s(s, 4.0 / 3.0 * a_coefficient(eta))
@@ -157,7 +158,8 @@ pub struct ProfileSample {
 }
 
 /// The classical dipole for one set of optical properties, with the shared quantities (α′, σtr, zr,
-/// zv and the derivative factors) computed once ([STYLE.md]: cache shared work per parameter set).
+/// zv and the derivative factors) computed once (ARCHITECTURE.md, "Code conventions": cache shared
+/// work per parameter set).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dipole {
     props: OpticalProperties,
@@ -339,7 +341,8 @@ mod tests {
         OpticalProperties::new(sigma_s_prime, sigma_a, eta).unwrap()
     }
 
-    /// physics.md §1.2: Jensen's polynomial Fdr, A, and the exact internal diffuse reflectance.
+    /// docs/physics.md §1.2: Jensen's polynomial Fdr, A, and the exact internal diffuse
+    /// reflectance.
     #[test]
     fn fdr_and_a_match_reference_table() {
         let table = [
@@ -361,7 +364,7 @@ mod tests {
         assert!(f_dr_exact(1.0).abs() < 1e-12);
     }
 
-    /// physics.md §1.4: profile vectors for σa = 0.01, σ′s = 1, η = 1.3.
+    /// docs/physics.md §1.4: profile vectors for σa = 0.01, σ′s = 1, η = 1.3.
     #[test]
     fn profile_matches_reference_vectors() {
         let d = Dipole::new(&props(0.01, 1.0, 1.3));
@@ -384,7 +387,7 @@ mod tests {
         }
     }
 
-    /// physics.md §1.3: closed-form totals (which equal scipy's quad of the profile).
+    /// docs/physics.md §1.3: closed-form totals (which equal scipy's quad of the profile).
     #[test]
     fn closed_form_total_matches_reference() {
         let table = [
@@ -403,9 +406,9 @@ mod tests {
         }
     }
 
-    /// physics.md §1.3's η = 1 row (0.08773287) was computed with the raw polynomial Fdr(1) = 0.0016
-    /// (A = 1.003205); with our Fdr(1) := 0 (A = 1) the same formula must give the reference when fed
-    /// that A, and a slightly larger value with A = 1.
+    /// docs/physics.md §1.3's η = 1 row (0.08773287) was computed with the raw polynomial Fdr(1) =
+    /// 0.0016 (A = 1.003205); with our Fdr(1) := 0 (A = 1) the same formula must give the reference
+    /// when fed that A, and a slightly larger value with A = 1.
     #[test]
     fn eta_one_row_uses_raw_polynomial() {
         let s = (3.0f64 * 0.5).sqrt();
@@ -515,7 +518,7 @@ mod tests {
         assert!((d.rd_total() - 1.0).abs() < 1e-15);
     }
 
-    /// physics.md §1.6: inversion vectors at η = 1.3.
+    /// docs/physics.md §1.6: inversion vectors at η = 1.3.
     #[test]
     fn inversion_matches_reference_vectors() {
         for (rd, want) in [
@@ -568,7 +571,8 @@ mod tests {
         assert_eq!(albedo_from_rd(1.0, 1.3).unwrap(), 1.0);
     }
 
-    /// pbrt's Jensen-2001 table (physics.md §1.5): Rd at η = 1.3 and 1.5 computed from its σ's.
+    /// pbrt's Jensen-2001 table (docs/physics.md §1.5): Rd at η = 1.3 and 1.5 computed from its
+    /// σ's.
     #[test]
     fn jensen_table_totals() {
         // (σ′s, σa, Rd at η=1.3, Rd at η=1.5), Apple R and Skin1 G, Marble B.

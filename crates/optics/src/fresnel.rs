@@ -95,7 +95,7 @@ pub const FRESNEL_MOMENT_MAX_ETA: f64 = 2.5;
 
 /// First Fresnel moment C₁(η) ≈ ∫₀¹ F_r(μ) μ dμ of the internal reflectance (light inside a medium of
 /// index η meeting a boundary to air), as pbrt's polynomial fit (pbrt-v3 `core/bssrdf.cpp`
-/// `FresnelMoment1`, pbrt-v4 `util/scattering.cpp`; physics.md §2.1):
+/// `FresnelMoment1`, pbrt-v4 `util/scattering.cpp`; docs/physics.md §2.1):
 /// −4.61686 + 11.1136η − 10.4646η² + 5.11455η³ − 1.27198η⁴ + 0.12746η⁵.
 /// At η = 1 it gives 0.00217 instead of 0 (a fit artefact that pbrt keeps; so do we, to stay pbrt's
 /// model). Trusted for 1 ≤ η ≤ [`FRESNEL_MOMENT_MAX_ETA`].
@@ -105,7 +105,7 @@ pub fn fresnel_moment1(eta: f64) -> f64 {
 }
 
 /// Second Fresnel moment C₂(η) ≈ ∫₀¹ F_r(μ) μ² dμ of the internal reflectance, pbrt's polynomial fit
-/// (pbrt-v3 `core/bssrdf.cpp` `FresnelMoment2`; physics.md §2.1):
+/// (pbrt-v3 `core/bssrdf.cpp` `FresnelMoment2`; docs/physics.md §2.1):
 /// −547.033 + 45.3087/η³ − 218.725/η² + 458.843/η + 404.557η − 189.519η² + 54.9327η³ − 9.00603η⁴
 /// + 0.63942η⁵ (−0.00221 at η = 1, kept as pbrt does). Trusted for 1 ≤ η ≤ [`FRESNEL_MOMENT_MAX_ETA`].
 pub fn fresnel_moment2(eta: f64) -> f64 {
@@ -137,7 +137,7 @@ fn check_specular(specular: f64) -> Result<()> {
 mod tests {
     use super::*;
 
-    /// physics.md §5: η = 1.5 → R₀ = 0.04; at 8° Schlick 0.04000000, exact 0.04000629.
+    /// docs/physics.md §5: η = 1.5 → R₀ = 0.04; at 8° Schlick 0.04000000, exact 0.04000629.
     #[test]
     fn schlick_and_exact_at_8_degrees_match_reference() {
         let cos8 = 8f64.to_radians().cos();
@@ -146,7 +146,7 @@ mod tests {
         assert!((fresnel_dielectric(cos8, 1.5) - 0.040_006_29).abs() < 5e-9);
     }
 
-    /// physics.md §5: R₀ for other indices.
+    /// docs/physics.md §5: R₀ for other indices.
     #[test]
     fn r0_reference_vectors() {
         for (eta, r0) in [
@@ -159,7 +159,8 @@ mod tests {
         }
     }
 
-    /// physics.md §5: measured specular → η through Schlick, and exact inversion of 0.04 at 8°.
+    /// docs/physics.md §5: measured specular → η through Schlick, and exact inversion of 0.04 at
+    /// 8°.
     #[test]
     fn specular_to_eta_reference_vectors() {
         for (spec, eta) in [
@@ -175,7 +176,7 @@ mod tests {
         assert!((exact - 1.499951).abs() < 1e-6, "{exact}");
     }
 
-    /// physics.md §5: Schlick's error grows off-normal (η = 1.5).
+    /// docs/physics.md §5: Schlick's error grows off-normal (η = 1.5).
     #[test]
     fn schlick_error_off_normal_matches_reference() {
         for (deg, s, e) in [(45.0_f64, 0.04207, 0.05024), (60.0, 0.07000, 0.08919)] {
@@ -206,9 +207,9 @@ mod tests {
         }
     }
 
-    /// physics.md §2.1: pbrt's Fresnel-moment polynomials at η = 1.33, 1.5 and their η = 1 artefact;
-    /// and they stay near the exact moments ∫F μⁱ dμ (computed here by Simpson's rule on the exact
-    /// Fresnel formula, an independent route) up to `FRESNEL_MOMENT_MAX_ETA`.
+    /// docs/physics.md §2.1: pbrt's Fresnel-moment polynomials at η = 1.33, 1.5 and their η = 1
+    /// artefact; and they stay near the exact moments ∫F μⁱ dμ (computed here by Simpson's rule on
+    /// the exact Fresnel formula, an independent route) up to `FRESNEL_MOMENT_MAX_ETA`.
     #[test]
     fn fresnel_moments_match_reference() {
         for (eta, m1, m2) in [

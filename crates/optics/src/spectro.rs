@@ -3,10 +3,11 @@
 //! diffuse reflectance Rd and the reduced albedo α′.
 //!
 //! - **η**: the specular reflectance is SCI − SCE (the light trap of a d/8 sphere removes the mirror
-//!   reflection of the 8° viewing beam; physics.md §5). Per wavelength and as a summary: the summary
-//!   uses the luminance-weighted mean specular reflectance Σ W_Y(λ)(SCI − SCE)(λ) / Σ W_Y (D65, 2°),
-//!   inverted through Schlick's approximation at 8° (the paper's method); the exact-Fresnel inversion is
-//!   reported beside it. Per channel: the specular spectrum's linear sRGB, inverted the same way.
+//!   reflection of the 8° viewing beam; docs/physics.md §5). Per wavelength and as a summary: the
+//!   summary uses the luminance-weighted mean specular reflectance Σ W_Y(λ)(SCI − SCE)(λ) / Σ W_Y
+//!   (D65, 2°), inverted through Schlick's approximation at 8° (the paper's method); the
+//!   exact-Fresnel inversion is reported beside it. Per channel: the specular spectrum's linear
+//!   sRGB, inverted the same way.
 //! - **Colour**: the SCE spectrum (the diffuse part) → XYZ (ASTM E308, both observers) → L\*a\*b\* and
 //!   linear sRGB (2°). A measured L\*a\*b\* replaces the spectrum for Rd when given.
 //! - **α′**: per channel, the inverse of the dipole's total diffuse reflectance Rd(α′, η)
@@ -23,8 +24,9 @@ use crate::fresnel::{self, D8_VIEWING_ANGLE_DEG};
 /// about 0.1 % reflectance already moves η by ≈ 0.01 near η = 1.5, so smaller spreads are noise.
 pub const DISPERSION_THRESHOLD: f64 = 0.02;
 
-/// Summary specular reflectances below this give η < 1.22; physics.md §5 caveat (1): on semi-gloss or
-/// rough surfaces part of the specular lobe escapes the light trap, so SCI − SCE underestimates R₀.
+/// Summary specular reflectances below this give η < 1.22; docs/physics.md §5 caveat (1): on
+/// semi-gloss or rough surfaces part of the specular lobe escapes the light trap, so SCI − SCE
+/// underestimates R₀.
 pub const LOW_SPECULAR_WARNING: f64 = 0.01;
 
 /// Summary specular reflectances above this (η > 3) are not plausible for a dielectric.
@@ -429,7 +431,7 @@ mod tests {
         };
         let a = analyse(&reading, &opts).unwrap();
         assert_eq!(a.colour_source, ColourSource::Lab2);
-        // physics.md §6.2 with the ASTM 2° white.
+        // docs/physics.md §6.2 with the ASTM 2° white.
         for (ch, want) in a.channels.iter().zip([0.319066, 0.241743, 0.561175]) {
             assert!((ch.rd_total - want).abs() < 2e-5);
         }

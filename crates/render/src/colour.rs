@@ -1,9 +1,9 @@
 //! The subsurface colour method: Choi, Lee & Chin 2014, §4.1, eqs. (3)–(5), after Groenhuis et al.
 //! 1983 (their ref. [9]) and a colour-rendering model (their ref. [20]).
 //!
-//! Groenhuis' T(d), R(d) and P(g) could not be found outside the seed paper (physics.md §9), so eqs.
-//! (3) and (4) are implemented **as printed** there. They describe a layer of thickness d lit from the
-//! top, to first order in the optical depth: the unscattered beam is attenuated as
+//! Groenhuis' T(d), R(d) and P(g) could not be found outside the seed paper (docs/physics.md §9),
+//! so eqs. (3) and (4) are implemented **as printed** there. They describe a layer of thickness d
+//! lit from the top, to first order in the optical depth: the unscattered beam is attenuated as
 //! 1 − σa x − σ′s P(g) x, a fraction σ′s P(g) dx is sent back from depth x and attenuated again on the
 //! way out, and the beam reaching the bottom is partly reflected (F_dr,b) and partly transmitted:
 //!

@@ -11,8 +11,8 @@
 //! with E the irradiance *transmitted into* the surface (Ft(η, ωi) times the incident irradiance).
 //! Sampling N surface points with pdf p(xi) = E(xi)/Φ, Φ = ∫E dA the total transmitted flux, gives
 //! B ≈ (Φ/N) Σ Rd(rk) and eq. (6), L = Ft E′avg Σ Rd/(Nπ) — which holds only when "E′avg" is the
-//! total flux Φ (physics.md §9; the printed symbol suggests an average irradiance, which would be off
-//! by the lit area). The unit test `uniform_plane_gives_ft_e_rd_over_pi` checks the
+//! total flux Φ (docs/physics.md §9; the printed symbol suggests an average irradiance, which would
+//! be off by the lit area). The unit test `uniform_plane_gives_ft_e_rd_over_pi` checks the
 //! normalisation: uniform E on a plane gives L = Ft·E·Rd/π.
 //!
 //! **Sampling E** (Chang et al.'s importance sampling, without a texture atlas): each light shoots a
@@ -522,8 +522,8 @@ mod tests {
         Scene::new(mesh, lights, camera).unwrap()
     }
 
-    /// physics.md §9: uniform transmitted irradiance E on a plane gives L = Ft(ωo)·E·Rd/π with Rd
-    /// the profile's total. A 100 mm plate (σtr ≥ 0.54 mm⁻¹, so Rd has fallen by e^−27 at its
+    /// docs/physics.md §9: uniform transmitted irradiance E on a plane gives L = Ft(ωo)·E·Rd/π with
+    /// Rd the profile's total. A 100 mm plate (σtr ≥ 0.54 mm⁻¹, so Rd has fallen by e^−27 at its
     /// edge) lit by parallel light at normal incidence, the incident irradiance E/Ft(η, 1) so that
     /// the transmitted one is E. The estimate at one point carries the jittered sampling's noise
     /// (0.2 mm spacing against profiles of width zr ≈ 0.5–1 mm); we average 32 points 1.3 mm apart

@@ -234,8 +234,8 @@ mod tests {
     use super::super::{Format, SceneUnit, export};
     use super::*;
 
-    /// Blender: radius · scale = 1/σtr in scene units (physics.md §1.5: the marble's 1/σtr is 8.509,
-    /// 5.566, 3.951 mm), base colour = the measured Rd.
+    /// Blender: radius · scale = 1/σtr in scene units (docs/physics.md §1.5: the marble's 1/σtr is
+    /// 8.509, 5.566, 3.951 mm), base colour = the measured Rd.
     #[test]
     fn blender_values_and_script() {
         let r = marble();
@@ -268,7 +268,7 @@ mod tests {
     }
 
     /// Without rd_total the base colour falls back to the dipole's Rd, with a warning: at the marble's
-    /// R channel α′ = 0.999042, η = 1.5, physics.md §1.3 gives 0.83019146.
+    /// R channel α′ = 0.999042, η = 1.5, docs/physics.md §1.3 gives 0.83019146.
     #[test]
     fn blender_base_colour_falls_back_to_the_dipole() {
         let mut r = marble();

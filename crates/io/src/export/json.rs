@@ -44,7 +44,7 @@ mod tests {
                 1e-12
             ));
         }
-        // physics.md §1.5: the marble's 1/σtr is 8.509, 5.566, 3.951 mm.
+        // docs/physics.md §1.5: the marble's 1/σtr is 8.509, 5.566, 3.951 mm.
         let (mm, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
         for (ch, want) in mm.channels.as_array().iter().zip([8.509, 5.566, 3.951]) {
             assert!((ch.diffusion_length.unwrap() - want).abs() < 5e-4);

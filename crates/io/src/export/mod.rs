@@ -513,8 +513,8 @@ mod fixtures {
         }
     }
 
-    /// Jensen et al. 2001's marble (pbrt's table, physics.md §1.5): σ′s = 2.19, 2.62, 3.00 and
-    /// σa = 0.0021, 0.0041, 0.0071 mm⁻¹; Rd at η = 1.5 from physics.md's computed column.
+    /// Jensen et al. 2001's marble (pbrt's table, docs/physics.md §1.5): σ′s = 2.19, 2.62, 3.00 and
+    /// σa = 0.0021, 0.0041, 0.0071 mm⁻¹; Rd at η = 1.5 from docs/physics.md's computed column.
     pub(super) fn marble() -> MeasurementResult {
         MeasurementResult {
             name: "marble".into(),

@@ -7,8 +7,8 @@ use super::{
 };
 
 /// A pbrt-v4 scene-file fragment: a `subsurface` named material (pbrt's tabulated photon-beam-diffusion
-/// BSSRDF; physics.md §2) and, for pbrt's volumetric path tracer, a `homogeneous` named medium with the
-/// same coefficients behind a `dielectric` named material.
+/// BSSRDF; docs/physics.md §2) and, for pbrt's volumetric path tracer, a `homogeneous` named medium
+/// with the same coefficients behind a `dielectric` named material.
 ///
 /// Units: pbrt reads `sigma_a`, `sigma_s` per scene unit and multiplies them by `scale`
 /// (pbrt-v4 `SubsurfaceMaterial::GetBSSRDF`, `HomogeneousMedium`); we write them per `params.unit` and
