@@ -245,6 +245,7 @@ fn thin_slab_in_metres_matches_adding_doubling() {
 #[ignore = "benchmark: minutes of rendering; BENCHMARKS.md reports its output"]
 fn forward_models_against_mitsuba() {
     use scatterfit_mc::table::{ProfileTable, TableSpec};
+    use scatterfit_optics::{DiffusionModel, ModelFamily};
     let Some(python) = mitsuba_python("forward_models_against_mitsuba") else {
         return;
     };
@@ -278,8 +279,8 @@ fn forward_models_against_mitsuba() {
             let dipole = scatterfit_optics::dipole::rd_total(a, eta);
             let mc = table.rd_total(a).unwrap();
             let pct = |x: f64| format!("{:+.1} %", 100.0 * (x / truth - 1.0));
-            let improved = |m: scatterfit_optics::model::DiffusionModel| {
-                m.rd_total(a, eta)
+            let improved = |m: DiffusionModel| {
+                m.rd_total(a, eta, 0.0)
                     .map_or_else(|e| e.to_string(), |v| format!("{v:.4} ({})", pct(v)))
             };
             println!(
@@ -287,8 +288,8 @@ fn forward_models_against_mitsuba() {
                 r.stderr[1],
                 pct(dipole),
                 pct(mc),
-                improved(scatterfit_optics::model::DiffusionModel::BetterDipole),
-                improved(scatterfit_optics::model::DiffusionModel::Pbd),
+                improved(DiffusionModel::BetterDipole),
+                improved(DiffusionModel::Pbd),
             );
             eprintln!(
                 "η = {eta}, α′ = {a}: {} px × {} spp in {:.1} s (Mitsuba {})",
