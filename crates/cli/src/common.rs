@@ -93,7 +93,7 @@ pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::
 pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
     let dir = given
         .map(Path::to_path_buf)
-        .or_else(scatterfit_mc::table::default_cache_dir);
+        .or_else(scatterfit_mc::cache::default_cache_dir);
     if let Some(d) = &dir {
         scatterfit_io::atomic::sweep_on_interrupt(d);
     }

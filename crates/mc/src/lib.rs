@@ -42,7 +42,6 @@ mod phase;
 mod rng;
 mod sample;
 pub mod smooth;
-pub mod table;
 pub mod white;
 
 pub use beam::{Beam, BeamProfile};
