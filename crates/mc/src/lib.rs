@@ -1,6 +1,6 @@
 //! Monte Carlo photon transport with MCML's physics, the profile tables built from it (the `mc`
 //! forward model: [`McTable`], [`McTableSet`], [`McProfile`]), and the one place where a model's
-//! name becomes a model ([`family`], [`albedo_family`]).
+//! name becomes a model ([`family()`], [`albedo_family()`]).
 //!
 //! The engine follows Wang, Jacques & Zheng 1995 (MCML; the algorithm is summarised in
 //! `reference/physics.md` §4.1) in millimetres: a collimated beam enters a stack of plane-parallel

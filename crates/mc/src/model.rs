@@ -9,7 +9,7 @@
 //! * [`McTableSet`] — tables for several η (same g and layout); interpolates in η.
 //! * [`McProfile`] — the model for one set of optical properties, implementing
 //!   [`scatterfit_optics::ProfileModel`]; the set is the `mc` [`scatterfit_optics::ModelFamily`]
-//!   ([`crate::family`]).
+//!   (the [`family`](mod@crate::family) module).
 //!
 //! Similarity (pbrt's `TabulatedBSSRDF::Sr`, physics.md §2.3): with σs = σ′s/(1 − g), σt = σa + σs and
 //! a = σs/σt, Rd(r) = σt² R̂(σt r; a) exactly (same η, g). For g = 0, σt = σ′t and a = α′.
