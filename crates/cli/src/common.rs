@@ -5,7 +5,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
-use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
+use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_pipeline::Overrides;
 
 /// A measurement that ran and failed (exit code 1), as opposed to bad input (2).
@@ -93,7 +93,7 @@ pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::
 pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
     let dir = given
         .map(Path::to_path_buf)
-        .or_else(scatterfit_mc::table::default_cache_dir);
+        .or_else(scatterfit_mc::cache::default_cache_dir);
     if let Some(d) = &dir {
         scatterfit_io::atomic::sweep_on_interrupt(d);
     }
@@ -125,11 +125,11 @@ pub enum MethodArg {
     Existing,
 }
 
-impl From<MethodArg> for MethodName {
+impl From<MethodArg> for Method {
     fn from(m: MethodArg) -> Self {
         match m {
-            MethodArg::Proposed => MethodName::Proposed,
-            MethodArg::Existing => MethodName::Existing,
+            MethodArg::Proposed => Method::Proposed,
+            MethodArg::Existing => Method::Existing,
         }
     }
 }
@@ -158,11 +158,11 @@ pub enum AlbedoModelArg {
     Mc,
 }
 
-impl From<AlbedoModelArg> for AlbedoModelName {
+impl From<AlbedoModelArg> for AlbedoModel {
     fn from(m: AlbedoModelArg) -> Self {
         match m {
-            AlbedoModelArg::Diffusion => AlbedoModelName::Diffusion,
-            AlbedoModelArg::Mc => AlbedoModelName::Mc,
+            AlbedoModelArg::Diffusion => AlbedoModel::Diffusion,
+            AlbedoModelArg::Mc => AlbedoModel::Mc,
         }
     }
 }

@@ -7,7 +7,7 @@ use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_io::result_table::sig4;
 use scatterfit_optics::OpticalProperties;
 use scatterfit_pipeline::Measurement;
-use scatterfit_pipeline::fit::{ChannelOutcome, model_for};
+use scatterfit_pipeline::fit::ChannelOutcome;
 
 use crate::plot::{Figure, Panel, Series, SeriesStyle};
 
@@ -65,7 +65,7 @@ fn model_series(
     label: &str,
     style: SeriesStyle,
 ) -> Option<Series> {
-    let model = model_for(m.settings.model).ok()?;
+    let model = scatterfit_mc::family(m.settings.model).ok()?;
     let props =
         OpticalProperties::new(report.sigma_s_prime.value, report.sigma_a.value, report.eta)
             .ok()?;

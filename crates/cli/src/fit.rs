@@ -7,10 +7,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use scatterfit_fit::ProfileData;
-use scatterfit_io::manifest::{MethodName, ModelName};
 use scatterfit_io::profile_csv::read_profile_csv;
 use scatterfit_io::result_json::{Channels, Inputs, MeasurementResult, write_result_json};
-use scatterfit_pipeline::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage, model_for};
+use scatterfit_optics::{AlbedoModel, Method, ModelName};
+use scatterfit_pipeline::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage};
 use scatterfit_pipeline::profile::channel_from_table;
 use scatterfit_pipeline::spectro::SpectroStage;
 
@@ -74,8 +74,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.spot_diameter_mm
         );
     }
-    let method: MethodName = args.method.into();
-    if method == MethodName::Proposed && args.albedo.is_none() {
+    let method: Method = args.method.into();
+    if method == Method::Proposed && args.albedo.is_none() {
         bail!(
             "the proposed method needs the reduced albedo per channel: --albedo R,G,B (from \
              `scatterfit spectro`), or use --method existing"
@@ -112,7 +112,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
     }
     let model_name: ModelName = args.model.into();
-    let model = model_for(model_name)?;
+    let model = scatterfit_mc::family(model_name)?;
     let table = read_profile_csv(&args.profile)?;
     let data: Vec<ProfileData> = ["r", "g", "b"]
         .iter()
@@ -120,9 +120,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .collect::<Result<_, _>>()
         .with_context(|| format!("{}", args.profile.display()))?;
     let albedo = args.albedo.map_or([None; 3], |a| a.map(Some));
-    let rd = args
-        .rd
-        .unwrap_or_else(|| albedo.map(|a| a.map_or(f64::NAN, |a| model.rd_total(a, args.eta))));
+    let rd = args.rd.unwrap_or_else(|| {
+        albedo.map(|a| {
+            a.map_or(f64::NAN, |a| {
+                model.rd_total(a, args.eta, 0.0).unwrap_or(f64::NAN)
+            })
+        })
+    });
     let spectro = SpectroStage {
         file: None,
         analysis: None,
@@ -137,7 +141,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let settings = FitSettings {
         method,
         model: model_name,
-        albedo_model: scatterfit_io::manifest::AlbedoModelName::Diffusion,
+        albedo_model: AlbedoModel::Diffusion,
         spot_radius_mm: 0.5 * args.spot_diameter_mm,
         r_min_mm: args.r_min_mm,
         normalise_with_spectro: args.normalise_with_spectro,
@@ -152,8 +156,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eta_source: "given".into(),
         eta_stderr: None,
         spectro_repeatability: None,
-        method: method.as_str().into(),
-        model: model_name.as_str().into(),
+        method: method.name().into(),
+        model: model_name.name().into(),
         albedo_model: "given".into(),
         channels: Channels::from_array(std::array::from_fn(|c| {
             channel_result(&fits[c], &spectro, c, None)
@@ -162,8 +166,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             profile: Some(args.profile.to_string_lossy().into_owned()),
             spot_radius_mm: Some(settings.spot_radius_mm),
             options: serde_json::json!({
-                "method": method.as_str(),
-                "model": model_name.as_str(),
+                "method": method.name(),
+                "model": model_name.name(),
                 "normalise_with_spectro": args.normalise_with_spectro,
                 "r_min_mm": settings.r_min_mm(),
             }),

@@ -18,10 +18,10 @@ use anyhow::{Context, bail};
 use glam::DVec3;
 use scatterfit_imaging::ImageBuf;
 use scatterfit_io::image_files::{CameraFrame, write_camera_frame, write_radiance};
-use scatterfit_io::manifest::ModelName;
 use scatterfit_io::mesh::read_mesh;
 use scatterfit_io::profile_csv::read_profile_csv;
 use scatterfit_io::result_json::{MeasurementResult, read_result_json};
+use scatterfit_optics::{ModelName, Rgb};
 use scatterfit_render::colour::ColourParams;
 use scatterfit_render::figure::{FigureStyle, Panel, compose, compose_linear};
 use scatterfit_render::texture_space::{DipoleParams, Evaluation};
@@ -310,60 +310,13 @@ struct Params {
     result: Option<(MeasurementResult, PathBuf)>,
 }
 
-/// A model of `scatterfit_optics::model` or `scatterfit_mc` as the renderer's radial profile.
-struct Profile<T>(T);
-
-impl<T: scatterfit_optics::model::ProfileModel + Send + Sync> scatterfit_render::RadialProfile
-    for Profile<T>
-{
-    fn rd(&self, r_mm: f64) -> f64 {
-        self.0.rd(r_mm).max(0.0)
-    }
-    fn rd_total(&self) -> f64 {
-        self.0.rd_total()
-    }
-}
-
-/// The renderer's material for `p` with its profile model (`model` overrides the fitted one).
+/// The renderer's material for `p` with its profile model (`model` overrides the fitted one), made
+/// by the one name → model factory.
 fn material_for(p: &Params, model: Option<ModelName>) -> anyhow::Result<Material> {
-    use scatterfit_optics::OpticalProperties;
-    use scatterfit_optics::model::DiffusionModel;
-    use scatterfit_render::RadialProfile;
     let model = model.unwrap_or(p.model);
-    if model == ModelName::Dipole {
-        return Ok(Material::dipole(p.coefficients, p.eta)?);
-    }
-    let mut profiles: Vec<Box<dyn RadialProfile>> = Vec::with_capacity(3);
-    for &(sp, sa) in &p.coefficients {
-        let props = OpticalProperties::new(sp, sa, p.eta)?;
-        let profile: Box<dyn RadialProfile> = match model {
-            ModelName::BetterDipole => {
-                Box::new(Profile(DiffusionModel::BetterDipole.profile(&props)?))
-            }
-            ModelName::Pbd => Box::new(Profile(DiffusionModel::Pbd.profile(&props)?)),
-            _ => {
-                let set = scatterfit_fit::McModel::bundled().map_err(anyhow::Error::msg)?;
-                Box::new(Profile(
-                    scatterfit_mc::McProfile::new(set.tables(), &props).with_context(|| {
-                        format!(
-                            "{}: the Monte Carlo tables do not cover σ′s = {sp}, σa = {sa}, η = {}",
-                            p.name, p.eta
-                        )
-                    })?,
-                ))
-            }
-        };
-        profiles.push(profile);
-    }
-    let profiles: [Box<dyn RadialProfile>; 3] = profiles
-        .try_into()
-        .map_err(|_| anyhow::anyhow!("three channels"))?;
-    Ok(Material::with_profiles(
-        p.coefficients,
-        p.eta,
-        profiles,
-        model.as_str(),
-    )?)
+    let family = scatterfit_mc::family(model)?;
+    Material::new(family, Rgb::from_array(p.coefficients), p.eta, 0.0)
+        .with_context(|| p.name.clone())
 }
 
 fn load_params(spec: &str, model: Option<ModelName>) -> anyhow::Result<Params> {
@@ -418,16 +371,19 @@ fn load_params(spec: &str, model: Option<ModelName>) -> anyhow::Result<Params> {
         );
     }
     let result = read_result_json(path)?;
-    let fitted = match result.model.trim().to_ascii_lowercase().as_str() {
-        "dipole" => ModelName::Dipole,
-        "better-dipole" => ModelName::BetterDipole,
-        "pbd" => ModelName::Pbd,
-        "mc" => ModelName::Mc,
-        other => match model {
+    let fitted = match result
+        .model
+        .trim()
+        .to_ascii_lowercase()
+        .parse::<ModelName>()
+    {
+        Ok(m) => m,
+        Err(_) => match model {
             Some(m) => m,
             None => bail!(
-                "{spec}: the parameters were fitted with a model render does not know (`{other}`); \
-                 pass --model dipole|better-dipole|pbd|mc"
+                "{spec}: the parameters were fitted with a model render does not know (`{}`); \
+                 pass --model dipole|better-dipole|pbd|mc",
+                result.model.trim().to_ascii_lowercase()
             ),
         },
     };
@@ -753,10 +709,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     // The texture-space method with another profile model says which.
                     let (title, profile) = if method == Method::Dipole && model != ModelName::Dipole
                     {
-                        (
-                            "texture-space method (§4.2)",
-                            format!(" · {} profile", model.as_str()),
-                        )
+                        ("texture-space method (§4.2)", format!(" · {model} profile"))
                     } else {
                         (method.title(), String::new())
                     };

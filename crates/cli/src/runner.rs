@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use rayon::prelude::*;
-use scatterfit_io::manifest::MethodName;
 use scatterfit_io::result_json::MeasurementResult;
+use scatterfit_optics::Method;
 use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
 
 /// One sample's outcome.
@@ -175,7 +175,7 @@ pub fn compare_dirs_exact(
     exact: bool,
 ) -> anyhow::Result<(Vec<Pair>, Vec<Option<MeasurementResult>>, Failures)> {
     let mut overrides = fit.overrides()?;
-    overrides.method = Some(MethodName::Proposed);
+    overrides.method = Some(Method::Proposed);
     let outcomes = measure_many(dirs, &overrides, jobs, quiet, &|_, _| {})?;
     let mut pairs = Vec::new();
     let mut exacts = Vec::new();
@@ -188,7 +188,7 @@ pub fn compare_dirs_exact(
                 continue;
             }
         };
-        let existing = match proposed.refit(MethodName::Existing) {
+        let existing = match proposed.refit(Method::Existing) {
             Ok(m) => m,
             Err(e) => {
                 failed.push((o.dir, e.to_string()));
@@ -209,8 +209,8 @@ pub fn compare_dirs_exact(
         }
         if exact {
             let settings = scatterfit_pipeline::fit::FitSettings {
-                model: scatterfit_io::manifest::ModelName::Mc,
-                albedo_model: scatterfit_io::manifest::AlbedoModelName::Mc,
+                model: scatterfit_optics::ModelName::Mc,
+                albedo_model: scatterfit_optics::AlbedoModel::Mc,
                 ..proposed.settings
             };
             exacts.push(

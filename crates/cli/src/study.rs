@@ -14,7 +14,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use rayon::prelude::*;
-use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
+use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_pipeline::fit::FitSettings;
 use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
 use serde::Serialize;
@@ -74,17 +74,17 @@ pub struct Args {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Combo {
     model: ModelName,
-    albedo: AlbedoModelName,
-    method: MethodName,
+    albedo: AlbedoModel,
+    method: Method,
 }
 
 impl Combo {
     fn label(self) -> String {
         format!(
             "{} + {} α′, {}",
-            self.model.as_str(),
-            self.albedo.as_str(),
-            self.method.as_str()
+            self.model.name(),
+            self.albedo.name(),
+            self.method.name()
         )
     }
 }
@@ -116,12 +116,8 @@ fn combos(no_pbd: bool) -> Vec<Combo> {
         if no_pbd && model == ModelName::Pbd {
             continue;
         }
-        let albedo = if model == ModelName::Mc {
-            AlbedoModelName::Mc
-        } else {
-            AlbedoModelName::Diffusion
-        };
-        for method in [MethodName::Proposed, MethodName::Existing] {
+        let albedo = AlbedoModel::default_for(model);
+        for method in [Method::Proposed, Method::Existing] {
             v.push(Combo {
                 model,
                 albedo,
@@ -133,13 +129,13 @@ fn combos(no_pbd: bool) -> Vec<Combo> {
     // dipole's α′.
     v.push(Combo {
         model: ModelName::Dipole,
-        albedo: AlbedoModelName::Mc,
-        method: MethodName::Proposed,
+        albedo: AlbedoModel::Mc,
+        method: Method::Proposed,
     });
     v.push(Combo {
         model: ModelName::Mc,
-        albedo: AlbedoModelName::Diffusion,
-        method: MethodName::Proposed,
+        albedo: AlbedoModel::Diffusion,
+        method: Method::Proposed,
     });
     v
 }
@@ -339,9 +335,9 @@ fn study_sample(
             rows.push(Row {
                 eta,
                 albedo_prime: albedos[c],
-                model: combo.model.as_str(),
-                albedo_model: combo.albedo.as_str(),
-                method: combo.method.as_str(),
+                model: combo.model.name(),
+                albedo_model: combo.albedo.name(),
+                method: combo.method.name(),
                 status: format!("{:?}", ch.status).to_lowercase(),
                 sigma_s_prime_error: rel(ch.sigma_s_prime, sp),
                 sigma_a_error: rel(ch.sigma_a, sa),
@@ -401,9 +397,9 @@ fn summary_markdown(rows: &[Row], combos: &[Combo]) -> String {
     let of = |c: &Combo| {
         rows.iter()
             .filter(|r| {
-                r.model == c.model.as_str()
-                    && r.albedo_model == c.albedo.as_str()
-                    && r.method == c.method.as_str()
+                r.model == c.model.name()
+                    && r.albedo_model == c.albedo.name()
+                    && r.method == c.method.name()
             })
             .collect::<Vec<_>>()
     };
@@ -434,7 +430,7 @@ fn summary_markdown(rows: &[Row], combos: &[Combo]) -> String {
         a.dedup();
         a
     };
-    for c in combos.iter().filter(|c| c.method == MethodName::Proposed) {
+    for c in combos.iter().filter(|c| c.method == Method::Proposed) {
         let rs = of(c);
         let _ = writeln!(t, "**{}**\n", c.label());
         let _ = write!(t, "| η \\ α′ |");
@@ -477,15 +473,7 @@ fn figure(rows: &[Row], combos: &[Combo]) -> Figure {
     };
     let panels = combos
         .iter()
-        .filter(|c| {
-            c.method == MethodName::Proposed
-                && c.albedo
-                    == if c.model == ModelName::Mc {
-                        AlbedoModelName::Mc
-                    } else {
-                        AlbedoModelName::Diffusion
-                    }
-        })
+        .filter(|c| c.method == Method::Proposed && c.albedo == AlbedoModel::default_for(c.model))
         .map(|c| {
             let n = etas.len().max(2) as f64 - 1.0;
             let base = match c.model {
@@ -505,8 +493,8 @@ fn figure(rows: &[Row], combos: &[Combo]) -> Figure {
                         .iter()
                         .filter(|r| {
                             r.eta == e
-                                && r.model == c.model.as_str()
-                                && r.albedo_model == c.albedo.as_str()
+                                && r.model == c.model.name()
+                                && r.albedo_model == c.albedo.name()
                                 && r.method == "proposed"
                         })
                         .filter_map(|r| {

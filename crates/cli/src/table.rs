@@ -1,4 +1,7 @@
-//! `scatterfit table`: builds (or shows) a cached Monte Carlo profile table Rd(α′, r) for one η and g.
+//! `scatterfit table`: builds (or shows) a cached Monte Carlo table for one η and g — the table the
+//! `mc` forward model uses (`scatterfit_mc::McTable`: a white Monte Carlo run smoothed per albedo;
+//! the tables shipped with scatterfit for g = 0 are such tables, with the default photons) — and can
+//! write it to a file.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -6,7 +9,8 @@ use std::process::ExitCode;
 
 use crate::output::{errln, outln};
 use anyhow::{Context, bail};
-use scatterfit_mc::table::{CacheStatus, ProfileTable, TableSpec};
+use scatterfit_mc::McTableSpec;
+use scatterfit_mc::cache::CacheStatus;
 use serde::Serialize;
 
 /// Arguments of `scatterfit table`. Every number is checked before any work (exit 2 when out of
@@ -14,28 +18,38 @@ use serde::Serialize;
 /// `--max-memory-mib` before it starts.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Relative refractive index η of the material: 1 to 10 (below 1 with --allow-eta-below-one).
+    /// Relative refractive index η of the material: 1 to 10.
     #[arg(long, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub eta: f64,
-    /// Henyey–Greenstein asymmetry g, in (−1, 1); the work grows like 1/(1 − g) as g → 1.
+    /// Henyey–Greenstein asymmetry g, in (−1, 1). The table is in the single-scattering albedo
+    /// a = σs/σt (0.02 … 0.9999), so for g > 0 it covers α′ = a(1 − g)/(1 − ag) up to less than
+    /// 0.9999.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub g: f64,
-    /// Number of reduced albedos α′ (equally spaced in √(1 − α′) from 0 to 0.999): a count, 2 to
+    /// Number of albedo nodes (equally spaced in √(1 − a) from a = 0.02 to 0.9999): a count, 4 to
     /// 1000.
-    #[arg(long, default_value = "32", value_parser = crate::numeric::parse_size)]
+    #[arg(long, default_value = "64", value_parser = crate::numeric::parse_size)]
     pub albedos: usize,
-    /// Photons per albedo: a count ≥ 1 (2e5 is fine); the expected work must fit --max-interactions.
-    #[arg(long, default_value = "200000", value_parser = crate::numeric::parse_count)]
-    pub photons_per_albedo: u64,
-    /// A coarse table that builds in seconds (16 albedos × 50 000 photons); overrides the two above.
+    /// Full-length photons: a count ≥ 1; 4× and 16× as many photons trace the paths shorter than
+    /// 1024 and 64 interactions. The default is the shipped tables' (1–2 min on two cores at g = 0);
+    /// the expected work must fit --max-interactions.
+    #[arg(long, default_value = "2e6", value_parser = crate::numeric::parse_count)]
+    pub photons: u64,
+    /// A coarse table that builds in seconds (20 000 full-length photons, the default albedos);
+    /// overrides --photons and --albedos. Enough for g = 0 and 0.5; at g ≳ 0.7 the lowest albedos
+    /// then reflect too little light to smooth: use --photons 2e5 or more.
     #[arg(long)]
     pub coarse: bool,
     /// Cache folder (default: $SCATTERFIT_CACHE, else $XDG_CACHE_HOME/scatterfit, else ~/.cache/scatterfit).
     #[arg(long)]
     pub cache_dir: Option<PathBuf>,
-    /// Accept η < 1.
+    /// Also write the table to this file (`.json`, the compact form of the shipped tables: no raw
+    /// profiles; checked before the build; an existing file only with --force).
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Replace an existing output file.
     #[arg(long)]
-    pub allow_eta_below_one: bool,
+    pub force: bool,
     #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
           help = crate::numeric::MAX_INTERACTIONS_HELP)]
     pub max_interactions: u64,
@@ -49,21 +63,15 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Most albedos of a table: far more than interpolation needs (the default is 32).
+/// Most albedo nodes of a table: far more than interpolation needs (the default is 64).
 const MAX_ALBEDOS: usize = 1000;
 
 /// Checks the flags' ranges, then the spec's expected work and memory, before anything is built.
-fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
-    if !(args.eta > 0.0 && args.eta <= 10.0) {
+fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
+    if !(args.eta >= 1.0 && args.eta <= 10.0) {
         bail!(
-            "--eta {}: the relative refractive index must lie in (0, 10]",
+            "--eta {}: the relative refractive index must lie in [1, 10]",
             crate::numeric::show(args.eta)
-        );
-    }
-    if args.eta < 1.0 && !args.allow_eta_below_one {
-        bail!(
-            "--eta {}: below 1 is unusual for a solid; pass --allow-eta-below-one if you mean it",
-            args.eta
         );
     }
     if !(args.g > -1.0 && args.g < 1.0) {
@@ -73,26 +81,28 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
         );
     }
     if !args.coarse {
-        if !(2..=MAX_ALBEDOS).contains(&args.albedos) {
+        if !(4..=MAX_ALBEDOS).contains(&args.albedos) {
             bail!(
-                "--albedos {}: a table has 2 to {MAX_ALBEDOS} albedos",
+                "--albedos {}: a table has 4 to {MAX_ALBEDOS} albedos",
                 args.albedos
             );
         }
-        if args.photons_per_albedo == 0 {
-            bail!("--photons-per-albedo 0: trace at least one photon per albedo");
+        if args.photons == 0 {
+            bail!("--photons 0: trace at least one photon");
         }
     }
     let spec = if args.coarse {
-        TableSpec::coarse(args.eta, args.g)
+        McTableSpec::coarse(args.eta, args.g)
     } else {
-        TableSpec::new(args.eta, args.g, args.albedos, args.photons_per_albedo)
+        McTableSpec::new(args.eta, args.g, args.photons).map(|mut s| {
+            s.albedo_count = args.albedos;
+            s
+        })
     }
     .context("bad table parameters")?;
     let cost = spec.cost_estimate()?;
-    // The table itself: value and standard error per albedo and bin, plus the JSON text.
-    let bins = spec.radial_edges().len() - 1;
-    let table_bytes = (spec.albedos().len() as u64) * (bins as u64 + 1) * 16 * 4;
+    // The table itself beside the tallies: coefficients and raw profiles, and the JSON text.
+    let table_bytes = (spec.albedo_count as u64) * (spec.radial_bins as u64 + 64) * 8 * 6;
     crate::numeric::check_memory(
         "the table",
         cost.memory_bytes + table_bytes,
@@ -100,15 +110,13 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
     )?;
     if cost.interactions > args.max_interactions as f64 {
         bail!(
-            "building this table is expected to take about {:.1e} interactions ({} albedos × {} \
-             photons, {:.3e} per photon on average; g = {} multiplies them by about 1/(1 − g)), \
-             about {} on {} threads, more than the work budget of {:.1e} (--max-interactions); use \
-             fewer photons or albedos, a g further from 1, or raise --max-interactions",
+            "building this table is expected to take about {:.1e} interactions ({} photons, \
+             {:.3e} per photon on average; η and g lengthen the walks), about {} on {} threads, \
+             more than the work budget of {:.1e} (--max-interactions); use fewer photons, or raise \
+             --max-interactions",
             cost.interactions,
-            spec.albedos().len(),
-            spec.photons_per_albedo(),
+            spec.photons.iter().sum::<u64>(),
             cost.interactions_per_photon,
-            spec.g(),
             crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
             rayon::current_num_threads(),
             args.max_interactions as f64,
@@ -119,15 +127,20 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
 
 #[derive(Debug, Serialize)]
 struct Summary {
+    /// The cache file.
     path: PathBuf,
     status: &'static str,
+    /// The file written with -o.
+    output: Option<PathBuf>,
     eta: f64,
     g: f64,
+    /// The albedo nodes (single-scattering albedo a; α′ for g = 0).
     albedos: Vec<f64>,
     rd_total: Vec<f64>,
     rd_total_stderr: Vec<f64>,
     radial_bins: usize,
-    photons_per_albedo: u64,
+    /// Photons per stratum: paths cut at 64 and 1024 interactions, and full length.
+    photons: Vec<u64>,
 }
 
 /// Runs `scatterfit table`.
@@ -137,6 +150,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(d) => d,
         None => bail!("no cache folder: pass --cache-dir or set SCATTERFIT_CACHE"),
     };
+    if let Some(out) = &args.output {
+        crate::common::check_output_file(
+            out,
+            "-o",
+            crate::common::Format {
+                extensions: &["json"],
+                what: "the table is written as JSON",
+            },
+            &[],
+            args.force,
+        )?;
+    }
     let cached = dir.join(spec.file_name()).is_file();
     if !cached {
         // The table is written there once built: find out now, not after the build.
@@ -162,13 +187,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
         bar
     });
-    let (table, status, path) = ProfileTable::load_or_build(&spec, &dir, &|done, total| {
-        if let Some(b) = &bar {
-            b.set_length(total);
-            b.set_position(done);
-        }
-    })
-    .with_context(|| format!("building the table in {}", dir.display()))?;
+    let (table, status, path) =
+        scatterfit_mc::McTable::load_or_build(&spec, &dir, &|done, total| {
+            if let Some(b) = &bar {
+                b.set_length(total);
+                b.set_position(done);
+            }
+        })
+        .with_context(|| format!("building the table in {}", dir.display()))?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -179,27 +205,42 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             CacheStatus::Loaded => "loaded from cache",
             _ => "built and cached",
         },
-        eta: spec.eta(),
-        g: spec.g(),
-        albedos: spec.albedos().to_vec(),
+        output: args.output.clone(),
+        eta: spec.eta,
+        g: spec.g,
+        albedos: table.albedos().to_vec(),
         rd_total: tot.to_vec(),
         rd_total_stderr: se.to_vec(),
-        radial_bins: table.centers().len(),
-        photons_per_albedo: spec.photons_per_albedo(),
+        radial_bins: spec.radial_bins,
+        photons: spec.photons.clone(),
     };
+    if let Some(out) = &args.output {
+        let json = serde_json::to_vec(&table.clone().compact())
+            .context("the table does not serialise (a defect)")?;
+        scatterfit_io::atomic::write_atomic(out, &json)
+            .with_context(|| format!("-o {}", out.display()))?;
+    }
     if args.json {
         crate::output::print_json(&summary)?;
     } else {
         outln!("table   {} ({})", summary.path.display(), summary.status)?;
+        if let Some(out) = &summary.output {
+            outln!("wrote   {}", out.display())?;
+        }
         outln!(
-            "eta {}  g {}  {} radial bins  {} photons/albedo",
-            spec.eta(),
-            spec.g(),
+            "eta {}  g {}  {} radial bins  photons {}",
+            spec.eta,
+            spec.g,
             summary.radial_bins,
-            spec.photons_per_albedo()
+            spec.photons
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(" + ")
         )?;
-        outln!("{:>10} {:>12} {:>10}", "albedo'", "Rd total", "s.e.")?;
-        for ((a, r), s) in spec.albedos().iter().zip(tot).zip(se) {
+        let head = if spec.g == 0.0 { "albedo'" } else { "albedo" };
+        outln!("{head:>10} {:>12} {:>10}", "Rd total", "s.e.")?;
+        for ((a, r), s) in table.albedos().iter().zip(tot).zip(se) {
             outln!("{a:>10.6} {r:>12.6} {s:>10.6}")?;
         }
     }

@@ -240,7 +240,7 @@ fn thin_slab_in_metres_matches_adding_doubling() {
 #[test]
 #[ignore = "benchmark: minutes of rendering; BENCHMARKS.md reports its output"]
 fn forward_models_against_mitsuba() {
-    use scatterfit_mc::table::{ProfileTable, TableSpec};
+    use scatterfit_optics::{DiffusionModel, ModelFamily, ModelName};
     let Some(python) = mitsuba_python("forward_models_against_mitsuba") else {
         return;
     };
@@ -248,15 +248,14 @@ fn forward_models_against_mitsuba() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1024);
-    let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mc-tables");
+    // The `mc` model's tables (the shipped set; η 1.0, 1.4 and 2.0 are table nodes).
+    let mc_family = scatterfit_mc::family(ModelName::Mc).unwrap();
     println!(
         "| η | α′ | Mitsuba Rd (± s.e.) | dipole Rd | dipole error | MC table Rd | MC table error | \
          better dipole | PBD |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     for eta in [1.0, 1.4, 2.0] {
-        let spec = TableSpec::new(eta, 0.0, 32, 200_000).unwrap();
-        let (table, _, _) = ProfileTable::load_or_build(&spec, &cache, &|_, _| {}).unwrap();
         for a in [0.3, 0.6, 0.9, 0.95, 0.99, 0.999] {
             let dir = temp_dir();
             // σ′t = 1 mm⁻¹, the same α′ in every channel (one albedo per render: Mitsuba samples
@@ -272,10 +271,10 @@ fn forward_models_against_mitsuba() {
             let r = render(&python, &fragment, 2000.0, 400.0, false, spp);
             let truth = r.mean[1] - r0(eta);
             let dipole = scatterfit_optics::dipole::rd_total(a, eta);
-            let mc = table.rd_total(a).unwrap();
+            let mc = mc_family.rd_total(a, eta, 0.0).unwrap();
             let pct = |x: f64| format!("{:+.1} %", 100.0 * (x / truth - 1.0));
-            let improved = |m: scatterfit_optics::model::DiffusionModel| {
-                m.rd_total(a, eta)
+            let improved = |m: DiffusionModel| {
+                m.rd_total(a, eta, 0.0)
                     .map_or_else(|e| e.to_string(), |v| format!("{v:.4} ({})", pct(v)))
             };
             println!(
@@ -283,8 +282,8 @@ fn forward_models_against_mitsuba() {
                 r.stderr[1],
                 pct(dipole),
                 pct(mc),
-                improved(scatterfit_optics::model::DiffusionModel::BetterDipole),
-                improved(scatterfit_optics::model::DiffusionModel::Pbd),
+                improved(DiffusionModel::BetterDipole),
+                improved(DiffusionModel::Pbd),
             );
             eprintln!(
                 "η = {eta}, α′ = {a}: {} px × {} spp in {:.1} s (Mitsuba {})",

@@ -252,7 +252,7 @@ fn profile_mse_against_a_model_profile_is_small() {
 /// parameters forced through the classical dipole (which is what render did before it knew models).
 #[test]
 fn render_uses_the_fitted_model() {
-    use scatterfit_optics::model::{DiffusionModel, ProfileModel};
+    use scatterfit_optics::{DiffusionModel, ModelFamily};
     let better = |p: &OpticalProperties| -> Box<dyn Fn(f64) -> f64> {
         let m = DiffusionModel::BetterDipole.profile(p).unwrap();
         Box::new(move |r| m.rd(r))

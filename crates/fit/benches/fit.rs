@@ -1,11 +1,9 @@
 //! Fit speed: one channel of a 300-ring profile (0.05 mm rings, a 1 mm spot convolved into the
 //! model, rings from 1 mm out), as `scatterfit measure` fits it.
 
-use scatterfit_fit::{
-    ChannelInput, DipoleModel, FitOptions, Method, PreparedFit, ProfileData, Ring, Spot,
-};
-use scatterfit_optics::OpticalProperties;
+use scatterfit_fit::{ChannelInput, FitOptions, Method, PreparedFit, ProfileData, Ring, Spot};
 use scatterfit_optics::dipole::Dipole;
+use scatterfit_optics::{DiffusionModel, OpticalProperties};
 
 fn main() {
     divan::main();
@@ -48,16 +46,26 @@ fn options(method: Method, disk: bool) -> FitOptions {
 #[divan::bench(args = [true, false])]
 fn proposed_solve(bencher: divan::Bencher, disk: bool) {
     let (p, input) = profile();
-    let prepared =
-        PreparedFit::new(&p, &input, &DipoleModel, &options(Method::Proposed, disk)).unwrap();
+    let prepared = PreparedFit::new(
+        &p,
+        &input,
+        &DiffusionModel::Dipole,
+        &options(Method::Proposed, disk),
+    )
+    .unwrap();
     bencher.bench(|| divan::black_box(prepared.solve()));
 }
 
 #[divan::bench(args = [true, false])]
 fn existing_solve(bencher: divan::Bencher, disk: bool) {
     let (p, input) = profile();
-    let prepared =
-        PreparedFit::new(&p, &input, &DipoleModel, &options(Method::Existing, disk)).unwrap();
+    let prepared = PreparedFit::new(
+        &p,
+        &input,
+        &DiffusionModel::Dipole,
+        &options(Method::Existing, disk),
+    )
+    .unwrap();
     bencher.bench(|| divan::black_box(prepared.solve()));
 }
 
@@ -65,5 +73,7 @@ fn existing_solve(bencher: divan::Bencher, disk: bool) {
 fn prepare_with_spot_kernel(bencher: divan::Bencher) {
     let (p, input) = profile();
     let o = options(Method::Proposed, true);
-    bencher.bench(|| divan::black_box(PreparedFit::new(&p, &input, &DipoleModel, &o).unwrap()));
+    bencher.bench(|| {
+        divan::black_box(PreparedFit::new(&p, &input, &DiffusionModel::Dipole, &o).unwrap())
+    });
 }

@@ -20,8 +20,8 @@
 //! residual MSE of the paper's Table 2.
 //!
 //! ```
-//! use scatterfit_fit::{ChannelInput, DipoleModel, FitOptions, Method, ProfileData, Ring, Spot, fit_channel};
-//! use scatterfit_optics::{OpticalProperties, dipole::Dipole};
+//! use scatterfit_fit::{ChannelInput, FitOptions, Method, ProfileData, Ring, Spot, fit_channel};
+//! use scatterfit_optics::{DiffusionModel, OpticalProperties, dipole::Dipole};
 //! // A profile with no noise from a known dipole (σ′s = 1.2, σa = 0.03 mm⁻¹, η = 1.3), scale 5.
 //! let truth = OpticalProperties::new(1.2, 0.03, 1.3)?;
 //! let d = Dipole::new(&truth);
@@ -32,7 +32,7 @@
 //! opts.spot = Spot::Point;
 //! opts.selection = opts.selection.with_r_min_mm(0.5)?;
 //! let input = ChannelInput { eta: 1.3, albedo_prime: Some(truth.albedo_prime()), rd_total: None };
-//! let report = fit_channel(&ProfileData::new(rings)?, &input, &DipoleModel, &opts)?;
+//! let report = fit_channel(&ProfileData::new(rings)?, &input, &DiffusionModel::Dipole, &opts)?;
 //! assert!((report.sigma_s_prime.value / 1.2 - 1.0).abs() < 1e-6);
 //! assert!((report.scale.value / 5.0 - 1.0).abs() < 1e-6);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -53,32 +53,19 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 pub use error::{FitError, Result};
-pub use model::{Diffusion, DipoleModel, McModel, ProfileModel, Spot, model_profile, node_spacing};
+pub use model::{Spot, model_profile, node_spacing};
 pub use profile::{ProfileData, Ring, RingSelection, Selected, select_rings};
 pub use spot::SpotKernel;
 
 use error::check;
 use problem::{Data, Forward, Problem, Unknowns};
 
-/// Which unknowns are fitted.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Method {
-    /// Choi, Lee & Chin 2014: α′ from the spectrophotometer, unknowns σ′s and the scale k.
-    Proposed,
-    /// Jensen et al. 2001: unknowns σ′s, σa and the scale k.
-    Existing,
-}
-
-impl Method {
-    /// `proposed` or `existing`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Proposed => "proposed",
-            Method::Existing => "existing",
-        }
-    }
-}
+/// Which unknowns are fitted (the vocabulary's [`Method`], re-exported): `Proposed` — Choi, Lee &
+/// Chin 2014, α′ from the spectrophotometer, unknowns σ′s and the scale k; `Existing` — Jensen et al.
+/// 2001, unknowns σ′s, σa and k.
+pub use scatterfit_optics::Method;
+/// The forward model's family and name (re-exported from `scatterfit_optics`).
+pub use scatterfit_optics::{ModelFamily, ModelName};
 
 /// A user-given starting point (replaces the automatic start).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -173,8 +160,8 @@ pub struct FittedRing {
 pub struct FitReport {
     /// The method.
     pub method: Method,
-    /// The forward model's name.
-    pub model: String,
+    /// The forward model.
+    pub model: ModelName,
     /// η used.
     pub eta: f64,
     /// σ′s [mm⁻¹].
@@ -230,7 +217,7 @@ impl FitReport {
 /// A fit made ready: rings selected and the spot kernel built. Solving it is the part whose speed
 /// matters (it runs per channel, per method); preparing is per profile geometry.
 pub struct PreparedFit<'a> {
-    model: &'a dyn ProfileModel,
+    model: &'a dyn ModelFamily,
     input: ChannelInput,
     opts: FitOptions,
     selected: Selected,
@@ -251,7 +238,7 @@ impl<'a> PreparedFit<'a> {
     pub fn new(
         profile: &ProfileData,
         input: &ChannelInput,
-        model: &'a dyn ProfileModel,
+        model: &'a dyn ModelFamily,
         opts: &FitOptions,
     ) -> Result<Self> {
         let t0 = Instant::now();
@@ -512,7 +499,7 @@ impl<'a> PreparedFit<'a> {
         let converged = termination.was_successful() && problem.valid;
         FitReport {
             method: self.opts.method,
-            model: self.model.name().to_string(),
+            model: self.model.name(),
             eta: self.input.eta,
             sigma_s_prime: Estimate {
                 value: sp,
@@ -601,7 +588,7 @@ fn unknowns_for(input: &ChannelInput, opts: &FitOptions) -> Result<Unknowns> {
 pub fn fit_channel(
     profile: &ProfileData,
     input: &ChannelInput,
-    model: &dyn ProfileModel,
+    model: &dyn ModelFamily,
     opts: &FitOptions,
 ) -> Result<FitReport> {
     Ok(PreparedFit::new(profile, input, model, opts)?.solve())

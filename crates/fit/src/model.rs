@@ -1,158 +1,19 @@
 //! Forward models of the radial profile: what the fit compares the measurement with.
 //!
-//! A model maps optical properties to Rd(r) [mm⁻²] and its derivatives in σ′s and σa at a set of
-//! radii, and gives the total diffuse reflectance Rd(α′, η) of the same physics and its inverse
-//! (the spectrophotometer's α′ "by the same physics", and `--normalise-with-spectro`). The
-//! classical dipole of Jensen et al. 2001 is the paper's model ([`DipoleModel`]); the better dipole
-//! (d'Eon 2012) and photon beam diffusion (Habel et al. 2013, as pbrt-v4) come from
-//! `scatterfit_optics::model` ([`Diffusion`]), the Monte Carlo tables from `scatterfit_mc`
-//! ([`McModel`]). A model that cannot evaluate a parameter set (η or α′ outside its range) fills
-//! the profile with NaN, which the solver treats as a point it may not visit.
+//! A model is a `scatterfit_optics::ModelFamily`: it maps optical properties to Rd(r) [mm⁻²] and its
+//! derivatives in σ′s and σa at a set of radii (`ModelFamily::eval`, the solver's hot path), and
+//! gives the total diffuse reflectance Rd(α′, η) of the same physics and its inverse (the
+//! spectrophotometer's α′ "by the same physics"). The classical dipole of Jensen et al. 2001 is the
+//! paper's model (`scatterfit_optics::DiffusionModel::Dipole`); the better dipole (d'Eon 2012) and
+//! photon beam diffusion (Habel et al. 2013, as pbrt-v4) are the other diffusion models, and the
+//! Monte Carlo tables are `scatterfit_mc`'s family (`scatterfit_mc::family` turns a name into any of
+//! them). A model that cannot evaluate a parameter set (η or α′ outside its range) fills the profile
+//! with NaN, which the solver treats as a point it may not visit. This module adds the light spot:
+//! [`Spot`], and [`model_profile`] for the curve drawn beside a measurement.
 
-use std::sync::OnceLock;
-
-use scatterfit_mc::{McProfile, McTableSet};
-use scatterfit_optics::OpticalProperties;
-use scatterfit_optics::dipole::{Dipole, ProfileSample};
-use scatterfit_optics::model::{DiffusionModel, ProfileModel as OpticsProfile};
+use scatterfit_optics::{ModelFamily, OpticalProperties, ProfileSample};
 
 use crate::spot::SpotKernel;
-
-/// A forward model of the radial profile of a semi-infinite medium lit by a pencil beam.
-pub trait ProfileModel: Sync {
-    /// Short name, as written in results (`dipole`, …).
-    fn name(&self) -> &'static str;
-
-    /// Rd(r) and ∂Rd/∂σ′s, ∂Rd/∂σa at every radius of `radii_mm` (written to `out`, same length).
-    fn eval(&self, props: &OpticalProperties, radii_mm: &[f64], out: &mut [ProfileSample]);
-
-    /// Total diffuse reflectance ∫2πr Rd(r) dr at reduced albedo α′ and index η (NaN where the
-    /// model does not cover them).
-    fn rd_total(&self, albedo_prime: f64, eta: f64) -> f64;
-
-    /// The reduced albedo α′ whose total diffuse reflectance is `rd` at η: the inverse of
-    /// [`ProfileModel::rd_total`].
-    ///
-    /// # Errors
-    /// Why not (Rd outside what the model can produce, η outside its range), for people.
-    fn albedo_from_rd(&self, rd: f64, eta: f64) -> std::result::Result<f64, String>;
-}
-
-const NAN_SAMPLE: ProfileSample = ProfileSample {
-    rd: f64::NAN,
-    d_sigma_s_prime: f64::NAN,
-    d_sigma_a: f64::NAN,
-};
-
-/// The classical dipole, Jensen, Marschner, Levoy & Hanrahan 2001, eq. 4 (the forward model of
-/// Choi, Lee & Chin 2014), with analytic derivatives ([`Dipole::profile_with_derivatives_into`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct DipoleModel;
-
-impl ProfileModel for DipoleModel {
-    fn name(&self) -> &'static str {
-        "dipole"
-    }
-
-    fn eval(&self, props: &OpticalProperties, radii_mm: &[f64], out: &mut [ProfileSample]) {
-        Dipole::new(props).profile_with_derivatives_into(radii_mm, out);
-    }
-
-    fn rd_total(&self, albedo_prime: f64, eta: f64) -> f64 {
-        scatterfit_optics::dipole::rd_total(albedo_prime, eta)
-    }
-
-    fn albedo_from_rd(&self, rd: f64, eta: f64) -> std::result::Result<f64, String> {
-        scatterfit_optics::dipole::albedo_from_rd(rd, eta).map_err(|e| e.to_string())
-    }
-}
-
-/// A diffusion model of `scatterfit_optics::model` by name: the classical dipole, the better
-/// dipole (d'Eon 2012, physics.md §3) or photon beam diffusion (Habel et al. 2013, physics.md §2),
-/// each with its own total Rd(α′, η) and inverse.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Diffusion(pub DiffusionModel);
-
-impl ProfileModel for Diffusion {
-    fn name(&self) -> &'static str {
-        self.0.name()
-    }
-
-    fn eval(&self, props: &OpticalProperties, radii_mm: &[f64], out: &mut [ProfileSample]) {
-        match self.0.profile(props) {
-            Ok(m) => m.profile_with_derivatives_into(radii_mm, out),
-            Err(_) => out.fill(NAN_SAMPLE),
-        }
-    }
-
-    fn rd_total(&self, albedo_prime: f64, eta: f64) -> f64 {
-        self.0.rd_total(albedo_prime, eta).unwrap_or(f64::NAN)
-    }
-
-    fn albedo_from_rd(&self, rd: f64, eta: f64) -> std::result::Result<f64, String> {
-        self.0.albedo_from_rd(rd, eta).map_err(|e| e.to_string())
-    }
-}
-
-/// The Monte Carlo forward model: Rd(r) from MCML-physics tables by similarity scaling, smooth in
-/// α′, η and r with analytic derivatives of the interpolant (`scatterfit_mc::McProfile`), and the
-/// tables' total Rd and its inverse (α′ "by the Monte Carlo method", done exactly).
-#[derive(Debug, Clone)]
-pub struct McModel {
-    set: McTableSet,
-}
-
-impl McModel {
-    /// The model on a table set (e.g. one built for another g with `McTableSet::load_or_build`).
-    pub fn new(set: McTableSet) -> Self {
-        Self { set }
-    }
-
-    /// The model on the tables shipped with scatterfit (g = 0, η 1.0–2.5, α′ 0.02–0.9999), parsed
-    /// once per process.
-    ///
-    /// # Errors
-    /// The tables do not parse (a build defect), as text.
-    pub fn bundled() -> std::result::Result<&'static McModel, String> {
-        static MODEL: OnceLock<std::result::Result<McModel, String>> = OnceLock::new();
-        MODEL
-            .get_or_init(|| {
-                McTableSet::bundled()
-                    .map(McModel::new)
-                    .map_err(|e| e.to_string())
-            })
-            .as_ref()
-            .map_err(Clone::clone)
-    }
-
-    /// The table set.
-    pub fn tables(&self) -> &McTableSet {
-        &self.set
-    }
-}
-
-impl ProfileModel for McModel {
-    fn name(&self) -> &'static str {
-        "mc"
-    }
-
-    fn eval(&self, props: &OpticalProperties, radii_mm: &[f64], out: &mut [ProfileSample]) {
-        match McProfile::new(&self.set, props) {
-            Ok(m) => m.profile_with_derivatives_into(radii_mm, out),
-            Err(_) => out.fill(NAN_SAMPLE),
-        }
-    }
-
-    fn rd_total(&self, albedo_prime: f64, eta: f64) -> f64 {
-        self.set.rd_total(albedo_prime, eta).unwrap_or(f64::NAN)
-    }
-
-    fn albedo_from_rd(&self, rd: f64, eta: f64) -> std::result::Result<f64, String> {
-        self.set
-            .albedo_from_rd_total(rd, eta)
-            .map_err(|e| e.to_string())
-    }
-}
 
 /// How the light spot enters the model.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -172,16 +33,12 @@ pub enum Spot {
 /// # Errors
 /// As [`SpotKernel::new`].
 pub fn model_profile(
-    model: &dyn ProfileModel,
+    model: &dyn ModelFamily,
     props: &OpticalProperties,
     spot: Spot,
     radii_mm: &[f64],
 ) -> crate::Result<Vec<f64>> {
-    let zero = ProfileSample {
-        rd: 0.0,
-        d_sigma_s_prime: 0.0,
-        d_sigma_a: 0.0,
-    };
+    let zero = ProfileSample::ZERO;
     match spot {
         Spot::Point => {
             let mut out = vec![zero; radii_mm.len()];

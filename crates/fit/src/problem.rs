@@ -29,10 +29,8 @@
 
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
-use scatterfit_optics::OpticalProperties;
-use scatterfit_optics::dipole::ProfileSample;
+use scatterfit_optics::{ModelFamily, OpticalProperties, ProfileSample};
 
-use crate::model::ProfileModel;
 use crate::spot::SpotKernel;
 
 /// The range of coefficients [mm⁻¹] the solver may visit; outside it a trial point gets a penalty
@@ -87,7 +85,7 @@ pub(crate) struct Data<'a> {
 /// The model side of a problem.
 #[derive(Clone, Copy)]
 pub(crate) struct Forward<'a> {
-    pub model: &'a dyn ProfileModel,
+    pub model: &'a dyn ModelFamily,
     pub eta: f64,
     /// The spot convolution, or `None` for a point of incidence.
     pub kernel: Option<&'a SpotKernel>,

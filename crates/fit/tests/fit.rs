@@ -3,11 +3,11 @@
 //! directions, and the proposed method on MCML's independent profiles.
 
 use scatterfit_fit::{
-    ChannelInput, DipoleModel, FitError, FitOptions, Method, ProfileData, Ring, RingSelection,
-    Spot, Start, fit_channel,
+    ChannelInput, FitError, FitOptions, Method, ProfileData, Ring, RingSelection, Spot, Start,
+    fit_channel,
 };
-use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
+use scatterfit_optics::{DiffusionModel, OpticalProperties};
 
 /// Disk average of the dipole over a uniform spot of radius `a` centred `r` away, by brute-force
 /// midpoint quadrature in polar coordinates around the spot centre — independent of the fit
@@ -79,7 +79,13 @@ fn recovers_known_parameters_with_the_spot() {
             rd_total: Some(d.rd_total()),
         };
         for method in [Method::Proposed, Method::Existing] {
-            let rep = fit_channel(&data, &input, &DipoleModel, &FitOptions::new(method)).unwrap();
+            let rep = fit_channel(
+                &data,
+                &input,
+                &DiffusionModel::Dipole,
+                &FitOptions::new(method),
+            )
+            .unwrap();
             assert!(rep.converged, "{method:?} {sp}: {}", rep.termination);
             assert!(
                 rel(rep.sigma_s_prime.value, sp) < 2e-3,
@@ -103,7 +109,7 @@ fn recovers_known_parameters_with_the_spot() {
         // Normalised with the spectrophotometer: k from the flux, σ′s alone.
         let mut opts = FitOptions::new(Method::Proposed);
         opts.normalise_with_spectro = true;
-        let rep = fit_channel(&data, &input, &DipoleModel, &opts).unwrap();
+        let rep = fit_channel(&data, &input, &DiffusionModel::Dipole, &opts).unwrap();
         assert!(rep.converged && rel(rep.sigma_s_prime.value, sp) < 2e-3);
         assert!(rel(rep.scale.value, 7.0) < 5e-3);
     }
@@ -132,7 +138,7 @@ fn converges_from_starts_off_by_ten() {
                     sigma_a: Some(sa * f),
                     scale: Some(3.0 / f),
                 });
-                let rep = fit_channel(&data, &input, &DipoleModel, &opts).unwrap();
+                let rep = fit_channel(&data, &input, &DiffusionModel::Dipole, &opts).unwrap();
                 assert!(rep.converged, "{method:?} ×{f} {sp}: {}", rep.termination);
                 assert!(
                     rel(rep.sigma_s_prime.value, sp) < 1e-4,
@@ -173,7 +179,7 @@ fn standard_errors_match_a_finite_difference_jacobian() {
     };
     let mut opts = FitOptions::new(Method::Existing);
     opts.spot = Spot::Point;
-    let rep = fit_channel(&data, &input, &DipoleModel, &opts).unwrap();
+    let rep = fit_channel(&data, &input, &DiffusionModel::Dipole, &opts).unwrap();
     assert!(rep.converged);
     // Residuals of x = (ln σ′s, ln σa, ln k) built from Dipole::rd, differentiated numerically.
     let used: Vec<usize> = rep.fitted.iter().map(|f| f.index).collect();
@@ -251,13 +257,13 @@ fn ignoring_the_spot_biases_sigma_s() {
         let disk = fit_channel(
             &data,
             &input,
-            &DipoleModel,
+            &DiffusionModel::Dipole,
             &FitOptions::new(Method::Proposed),
         )
         .unwrap();
         let mut opts = FitOptions::new(Method::Proposed);
         opts.spot = Spot::Point;
-        let point = fit_channel(&data, &input, &DipoleModel, &opts).unwrap();
+        let point = fit_channel(&data, &input, &DiffusionModel::Dipole, &opts).unwrap();
         assert!(rel(disk.sigma_s_prime.value, sp) < 2e-3);
         worst_point = worst_point.max(rel(point.sigma_s_prime.value, sp));
     }
@@ -298,7 +304,7 @@ fn rings_below_detection_are_excluded_not_fitted() {
         rd_total: None,
     };
     let opts = FitOptions::new(Method::Existing);
-    let rep = fit_channel(&data, &input, &DipoleModel, &opts).unwrap();
+    let rep = fit_channel(&data, &input, &DiffusionModel::Dipole, &opts).unwrap();
     assert!(
         rep.rings_below_detection > 50,
         "{}",
@@ -307,7 +313,7 @@ fn rings_below_detection_are_excluded_not_fitted() {
     assert!(rel(rep.sigma_a.value, sa) < 5e-3, "{}", rep.sigma_a.value);
     let mut blind = opts;
     blind.selection = blind.selection.with_detection_factor(0.0).unwrap();
-    let biased = fit_channel(&data, &input, &DipoleModel, &blind).unwrap();
+    let biased = fit_channel(&data, &input, &DiffusionModel::Dipole, &blind).unwrap();
     assert_eq!(biased.rings_below_detection, 0);
     assert!(
         rel(biased.sigma_a.value, sa) > 0.05,
@@ -339,7 +345,7 @@ fn signal_only_inside_the_spot_is_refused() {
             albedo_prime: Some(1.0 / 3.0),
             rd_total: None,
         },
-        &DipoleModel,
+        &DiffusionModel::Dipole,
         &FitOptions::new(Method::Proposed),
     )
     .unwrap_err();
@@ -365,7 +371,7 @@ fn a_flat_direction_is_reported_unconstrained() {
             albedo_prime: None,
             rd_total: None,
         },
-        &DipoleModel,
+        &DiffusionModel::Dipole,
         &opts,
     )
     .unwrap();
@@ -426,7 +432,7 @@ fn proposed_method_on_mcml_profiles() {
                 albedo_prime: Some(alpha),
                 rd_total: None,
             },
-            &DipoleModel,
+            &DiffusionModel::Dipole,
             &opts,
         )
         .unwrap();

@@ -77,73 +77,9 @@ pub enum ManifestError {
     },
 }
 
-/// The fitting method named in a manifest.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum MethodName {
-    /// Choi, Lee & Chin 2014: α′ from the spectrophotometer, σ′s (and the scale) fitted.
-    #[default]
-    Proposed,
-    /// Jensen et al. 2001: σ′s, σa (and the scale) fitted.
-    Existing,
-}
-
-/// The forward model named in a manifest.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ModelName {
-    /// The classical dipole, Jensen et al. 2001.
-    #[default]
-    Dipole,
-    /// d'Eon 2012, "A better dipole".
-    BetterDipole,
-    /// Photon beam diffusion, Habel et al. 2013.
-    Pbd,
-    /// Monte Carlo profile tables.
-    Mc,
-}
-
-/// How α′ is obtained from the spectrophotometer's diffuse reflectance.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum AlbedoModelName {
-    /// The diffusion model's own total Rd(α′, η) inverted (the dipole's closed form for the paper).
-    Diffusion,
-    /// The Monte Carlo tables' total Rd(α′, η) inverted ("by the Monte Carlo method", exactly).
-    Mc,
-}
-
-impl AlbedoModelName {
-    /// The name as written.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            AlbedoModelName::Diffusion => "diffusion",
-            AlbedoModelName::Mc => "mc",
-        }
-    }
-}
-
-impl MethodName {
-    /// The name as written.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            MethodName::Proposed => "proposed",
-            MethodName::Existing => "existing",
-        }
-    }
-}
-
-impl ModelName {
-    /// The name as written.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            ModelName::Dipole => "dipole",
-            ModelName::BetterDipole => "better-dipole",
-            ModelName::Pbd => "pbd",
-            ModelName::Mc => "mc",
-        }
-    }
-}
+/// The names of `[fit]`: the vocabulary's own types (one definition, in `scatterfit_optics`), read
+/// and written as the same strings (`proposed`, `better-dipole`, `mc`, …).
+pub use scatterfit_optics::{AlbedoModel, Method, ModelName};
 
 /// `[spectro]`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -194,12 +130,12 @@ pub struct CameraSection {
 #[serde(deny_unknown_fields)]
 pub struct FitSection {
     /// proposed | existing.
-    pub method: Option<MethodName>,
+    pub method: Option<Method>,
     /// dipole | better-dipole | pbd | mc.
     pub model: Option<ModelName>,
     /// diffusion | mc: how α′ is obtained from the spectrophotometer's Rd (default: the physics of
     /// `model`: mc for the mc model, else diffusion).
-    pub albedo_model: Option<AlbedoModelName>,
+    pub albedo_model: Option<AlbedoModel>,
     /// Outermost profile radius [px] (default 300, the paper's).
     pub r_max_px: Option<f64>,
     /// Innermost fitted radius [mm] (default: the spot diameter).
@@ -411,7 +347,7 @@ pub fn parse_manifest(
     {
         return Err(invalid("fit.r_min_mm", format!("= {r}: must be ≥ 0 mm")));
     }
-    if m.fit.normalise_with_spectro == Some(true) && m.fit.method == Some(MethodName::Existing) {
+    if m.fit.normalise_with_spectro == Some(true) && m.fit.method == Some(Method::Existing) {
         return Err(invalid(
             "fit.normalise_with_spectro",
             "applies to the proposed method only (the existing method has no α′)".into(),
@@ -494,11 +430,11 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     t.push_str("\n[fit]                         # every key optional\n");
     t.push_str(&format!(
         "method = \"{}\"           # proposed | existing\n",
-        m.fit.method.unwrap_or_default().as_str()
+        m.fit.method.unwrap_or_default().name()
     ));
     t.push_str(&format!(
         "model = \"{}\"              # dipole | better-dipole | pbd | mc\n",
-        m.fit.model.unwrap_or_default().as_str()
+        m.fit.model.unwrap_or_default().name()
     ));
     t.push_str(&format!(
         "r_max_px = {}                # the paper's cut-off\n",
@@ -508,7 +444,7 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
         t.push_str(&format!("r_min_mm = {r}\n"));
     }
     if let Some(a) = m.fit.albedo_model {
-        t.push_str(&format!("albedo_model = \"{}\"\n", a.as_str()));
+        t.push_str(&format!("albedo_model = \"{}\"\n", a.name()));
     }
     if let Some(b) = m.fit.normalise_with_spectro {
         t.push_str(&format!("normalise_with_spectro = {b}\n"));
@@ -555,20 +491,53 @@ model = "dipole"
 r_max_px = 300
 "#;
 
-    /// The documented example parses, and what is written reads back the same.
+    /// The documented example parses; what is written reads back the same, every `[fit]` key
+    /// included — with values that differ from the defaults, so a writer that dropped one (and let
+    /// the reader fall back to its default) would fail here.
     #[test]
     fn round_trip() {
         let m = parse(GOOD).unwrap();
-        assert_eq!(m.fit.method, Some(MethodName::Existing));
+        assert_eq!(m.fit.method, Some(Method::Existing));
         assert_eq!(
             m.resolve(Path::new("spectro.csv")),
             PathBuf::from("s/spectro.csv")
         );
-        let back = parse(&manifest_to_toml(&m, "made by a test")).unwrap();
+        let mut m = m;
+        m.spectro.repeatability = Some(0.01);
+        m.camera.center_px = Some([101.5, 99.25]);
+        m.fit = FitSection {
+            method: Some(Method::Existing),
+            model: Some(ModelName::Mc),
+            albedo_model: Some(AlbedoModel::Diffusion),
+            r_max_px: Some(250.0),
+            r_min_mm: Some(1.5),
+            normalise_with_spectro: Some(false),
+        };
+        // None of these is what an absent key means.
+        assert_ne!(m.fit.model.unwrap(), ModelName::default());
+        assert_ne!(m.fit.method.unwrap(), Method::default());
+        assert_ne!(
+            m.fit.albedo_model.unwrap(),
+            AlbedoModel::default_for(m.fit.model.unwrap())
+        );
+        let text = manifest_to_toml(&m, "made by a test");
+        let back = parse(&text).unwrap();
         assert_eq!(back.spectro, m.spectro);
         assert_eq!(back.camera, m.camera);
-        assert_eq!(back.fit.method, m.fit.method);
+        assert_eq!(back.fit, m.fit, "{text}");
         assert_eq!(back.name, m.name);
+        // Every model and albedo model survives the round trip.
+        for model in ModelName::ALL {
+            for albedo in AlbedoModel::ALL {
+                m.fit.model = Some(model);
+                m.fit.albedo_model = Some(albedo);
+                let back = parse(&manifest_to_toml(&m, "")).unwrap();
+                assert_eq!(
+                    (back.fit.model, back.fit.albedo_model),
+                    (Some(model), Some(albedo))
+                );
+            }
+        }
     }
 
     /// Each mistake names the key and says what to do.

@@ -9,7 +9,7 @@
 //! (the `mc` model from the tables in TABLE_DIR, else the shipped set).
 
 use scatterfit_mc::model::{McProfile, McTableSet};
-use scatterfit_optics::{DiffusionModel, OpticalProperties, ProfileModel};
+use scatterfit_optics::{DiffusionModel, ModelFamily, OpticalProperties, ProfileModel};
 
 /// One MCML case: η, α′, total Rd and the (r, Rd(r)) bins.
 struct Case {
@@ -102,12 +102,7 @@ fn main() {
         let p = OpticalProperties::new(c.albedo, 1.0 - c.albedo, c.eta).expect("props");
         let mut models: Vec<(String, Box<dyn ProfileModel>)> = DiffusionModel::ALL
             .iter()
-            .map(|m| {
-                (
-                    m.name().to_owned(),
-                    Box::new(m.profile(&p).expect("model")) as Box<dyn ProfileModel>,
-                )
-            })
+            .map(|m| (m.name().to_string(), m.profile(&p).expect("model")))
             .collect();
         if let Some(set) = &mc
             && let Ok(m) = McProfile::new(set, &p)

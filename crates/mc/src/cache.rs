@@ -1,5 +1,6 @@
-//! Table files: JSON read and written atomically, and the cache rule shared by every table type —
-//! reuse a file only when it was made with the same spec (and format), else simulate and save.
+//! Table files: the cache folder ([`default_cache_dir`]), JSON read and written atomically, and the
+//! cache rule — reuse a file only when it was made with the same spec (and format), else simulate
+//! and save ([`CacheStatus`] says which happened).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -7,7 +8,29 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::error::{McError, Result};
-use crate::table::CacheStatus;
+
+/// How a `load_or_build` obtained its table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CacheStatus {
+    /// Read from a cache file made with the same spec and format.
+    Loaded,
+    /// Simulated and written to the cache (no usable file was there).
+    Built,
+}
+
+/// The cache folder: `$SCATTERFIT_CACHE`, else `$XDG_CACHE_HOME/scatterfit`, else
+/// `$HOME/.cache/scatterfit`; `None` when none of these is set.
+pub fn default_cache_dir() -> Option<PathBuf> {
+    let var = |k| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    var("SCATTERFIT_CACHE")
+        .or_else(|| var("XDG_CACHE_HOME").map(|p| p.join("scatterfit")))
+        .or_else(|| var("HOME").map(|p| p.join(".cache").join("scatterfit")))
+}
 
 /// The text of `path`, parsed by `parse` (a table's own JSON reader, which validates).
 ///

@@ -61,6 +61,12 @@ pub enum McError {
         /// What was wrong.
         message: String,
     },
+    /// The tables compiled into the crate do not load (a build defect, not the user's).
+    #[error(
+        "the Monte Carlo tables shipped with scatterfit do not load: {0}; this is a defect of the \
+         build: choose another model (--model dipole) and report it"
+    )]
+    BundledTables(String),
 }
 
 /// Result type of this crate.

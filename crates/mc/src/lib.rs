@@ -1,4 +1,6 @@
-//! Monte Carlo photon transport with MCML's physics, and the profile tables built from it.
+//! Monte Carlo photon transport with MCML's physics, the profile tables built from it (the `mc`
+//! forward model: [`McTable`], [`McTableSet`], [`McProfile`]), and the one place where a model's
+//! name becomes a model ([`family()`], [`albedo_family()`]).
 //!
 //! The engine follows Wang, Jacques & Zheng 1995 (MCML; the algorithm is summarised in
 //! `reference/physics.md` §4.1) in millimetres: a collimated beam enters a stack of plane-parallel
@@ -32,6 +34,7 @@ pub mod bundled;
 pub mod cache;
 mod engine;
 mod error;
+pub mod family;
 mod fresnel;
 mod grid;
 pub mod model;
@@ -39,7 +42,6 @@ mod phase;
 mod rng;
 mod sample;
 pub mod smooth;
-pub mod table;
 pub mod white;
 
 pub use beam::{Beam, BeamProfile};
@@ -48,6 +50,7 @@ pub use engine::{
     ROULETTE_THRESHOLD, Simulation, SimulationResult,
 };
 pub use error::{McError, Result};
+pub use family::{albedo_family, bundled_tables, family};
 pub use fresnel::{FresnelSample, fresnel_mcml};
 pub use grid::RadialGrid;
 pub use model::{McProfile, McTable, McTableSet, McTableSpec};

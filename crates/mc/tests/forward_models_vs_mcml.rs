@@ -13,7 +13,7 @@
 //!   free paths, and the total).
 
 use scatterfit_mc::model::{McProfile, McTableSet};
-use scatterfit_optics::{DiffusionModel, OpticalProperties, ProfileModel};
+use scatterfit_optics::{DiffusionModel, ModelFamily, OpticalProperties, ProfileModel};
 
 /// MCML photons per case.
 const PHOTONS: f64 = 2e6;
@@ -219,7 +219,7 @@ fn diffusion_models_usable_only_where_stated() {
     let dist = |model: DiffusionModel, eta: f64, a: f64| {
         let c = at(eta, a);
         let p = OpticalProperties::new(a, 1.0 - a, eta).unwrap();
-        distance(&model.profile(&p).unwrap(), c)
+        distance(model.profile(&p).unwrap().as_ref(), c)
     };
     let usable = |(med, tot): (f64, f64)| med <= 0.10 && tot <= 0.05;
     // Classical dipole: usable only at high albedo (α′ ≳ 0.99) and η ≤ 1.4; never at η = 2.

@@ -1,27 +1,54 @@
-//! Accuracy of profile-table lookups between the tabulated albedos and radii: the default table
-//! layout (η = 1.4, g = 0, 32 albedos × 200 000 photons, the CLI's default) against direct
-//! simulations at off-node α′ and on a half-bin-shifted radial grid, and its total Rd and α′
-//! inversion against adding-doubling (physics.md §4.3). Fixed seeds; tolerances in standard errors
-//! plus a stated interpolation tolerance.
+//! Accuracy of Monte Carlo table lookups between the tabulated albedos and radii: the table that
+//! `scatterfit table --eta 1.4` builds and `--model mc` uses (the shipped η = 1.4 table, the default
+//! layout of `McTableSpec::new`: 64 albedos, 216 radial bins, 2·10⁶ full-length photons), looked up
+//! through `McProfile`, against direct simulations of the MCML engine (an independent tracer: implicit
+//! capture and roulette instead of the white run's albedo weights) at off-node α′ and on radial grids
+//! whose bins fall between the table's; and its total Rd and α′ inversion against adding-doubling
+//! (physics.md §4.3). Fixed seeds; tolerances in standard errors plus a stated interpolation
+//! tolerance.
 
 use std::sync::OnceLock;
 
-use scatterfit_mc::table::{ProfileTable, TableSpec};
-use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation, SimulationResult};
+use scatterfit_mc::{
+    Beam, Layer, McProfile, McTable, McTableSet, RadialGrid, Sample, Simulation, SimulationResult,
+};
+use scatterfit_optics::{OpticalProperties, ProfileModel};
 
 const ETA: f64 = 1.4;
 
-fn table() -> &'static ProfileTable {
-    static T: OnceLock<ProfileTable> = OnceLock::new();
+/// Relative standard error of a table lookup: the smoothed model's own noise, 0.1–0.2 % RMS
+/// (BENCHMARKS.md, "mc model noise"); taken at its upper end.
+const LOOKUP_REL_SE: f64 = 0.002;
+
+/// The shipped η = 1.4 table.
+fn table() -> &'static McTable {
+    static T: OnceLock<McTable> = OnceLock::new();
     T.get_or_init(|| {
-        let spec = TableSpec::new(ETA, 0.0, 32, 200_000).unwrap();
-        ProfileTable::build(&spec, &|_, _| {}).unwrap()
+        let set = scatterfit_mc::bundled_tables().unwrap();
+        let t = set.tables().iter().find(|t| t.spec().eta == ETA).unwrap();
+        assert_eq!(
+            t.spec(),
+            &scatterfit_mc::McTableSpec::new(ETA, 0.0, 2_000_000).unwrap()
+        );
+        t.clone()
     })
 }
 
-fn direct(alpha: f64, grid: RadialGrid, photons: u64, seed: u64) -> SimulationResult {
+/// The table alone as a model (η = 1.4 exactly, no interpolation in η).
+fn set() -> &'static McTableSet {
+    static S: OnceLock<McTableSet> = OnceLock::new();
+    S.get_or_init(|| McTableSet::new(vec![table().clone()]).unwrap())
+}
+
+fn direct(
+    sigma_s_prime: f64,
+    sigma_a: f64,
+    grid: RadialGrid,
+    photons: u64,
+    seed: u64,
+) -> SimulationResult {
     let half = Sample::slab(
-        Layer::from_reduced(alpha, 1.0 - alpha, 0.0, ETA, f64::INFINITY).unwrap(),
+        Layer::from_reduced(sigma_s_prime, sigma_a, 0.0, ETA, f64::INFINITY).unwrap(),
         1.0,
     )
     .unwrap();
@@ -39,29 +66,62 @@ fn chi2_999(k: usize) -> f64 {
     k * (1.0 - h + 3.0902 * h.sqrt()).powi(3)
 }
 
-/// Compares lookups `at(ρ)` with a direct profile on `grid`, bins whose direct relative s.e. is
-/// ≤ 5 % and whose centre lies inside the table: χ² with the combined s.e. below χ²₀.₉₉₉, and each
-/// bin within 4 s.e. + `tol` (relative). `rel_se(ρ)` is the lookup's relative s.e.
+/// The model's average over the annulus [a, b] (8-point Gauss–Legendre in r of 2πr Rd(r) over the
+/// annulus area: the tally's definition of a bin).
+fn bin_average(m: &dyn ProfileModel, a: f64, b: f64) -> f64 {
+    const GL: [(f64, f64); 4] = [
+        (0.183_434_642_495_650, 0.362_683_783_378_362),
+        (0.525_532_409_916_329, 0.313_706_645_877_887),
+        (0.796_666_477_413_627, 0.222_381_034_453_374),
+        (0.960_289_856_497_536, 0.101_228_536_290_376),
+    ];
+    let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+    let s: f64 = GL
+        .iter()
+        .flat_map(|&(x, w)| [(mid - half * x, w), (mid + half * x, w)])
+        .map(|(r, w)| w * half * 2.0 * std::f64::consts::PI * r * m.rd(r))
+        .sum();
+    s / (std::f64::consts::PI * (b * b - a * a))
+}
+
+/// Compares the model's bin averages with a direct profile on `grid`, in bins whose direct relative
+/// s.e. is ≤ 5 % and whose optical radius (× σ′t) lies inside the Monte Carlo data of the table rows
+/// `rows` (beyond it the model is the smoother's extrapolation): χ² with the combined s.e. below
+/// χ²₀.₉₉₉, and each bin within 4 s.e. + `tol` (relative).
 fn compare(
     what: &str,
     grid: &RadialGrid,
     d: &SimulationResult,
-    at: &dyn Fn(f64) -> f64,
-    rel_se: &dyn Fn(f64) -> f64,
+    m: &dyn ProfileModel,
+    sigma_t: f64,
+    rows: &[usize],
     tol: f64,
 ) {
-    let last = *table().centers().last().unwrap();
+    let t = table();
+    let rho_lo = rows
+        .iter()
+        .map(|&k| t.rho_data_min()[k])
+        .fold(0.0, f64::max);
+    let rho_hi = rows
+        .iter()
+        .map(|&k| t.rho_data_max()[k])
+        .fold(f64::INFINITY, f64::min);
+    let edges = grid.edges();
     let (mut chi2, mut used) = (0.0, 0);
     for (i, e) in d.rd_profile.iter().enumerate() {
-        let rho = grid.center(i);
-        if rho > last || e.value <= 0.0 || e.stderr > 0.05 * e.value {
+        let (a, b) = (edges[i], edges[i + 1]);
+        if a * sigma_t < rho_lo
+            || b * sigma_t > rho_hi
+            || e.value <= 0.0
+            || e.stderr > 0.05 * e.value
+        {
             continue;
         }
-        let v = at(rho);
-        let se = (e.stderr.powi(2) + (v * rel_se(rho)).powi(2)).sqrt();
+        let v = bin_average(m, a, b);
+        let se = (e.stderr.powi(2) + (v * LOOKUP_REL_SE).powi(2)).sqrt();
         assert!(
             (v - e.value).abs() <= 4.0 * se + tol * e.value,
-            "{what}, ρ = {rho}: lookup {v} vs direct {e:?}"
+            "{what}, r ∈ [{a}, {b}]: lookup {v} vs direct {e:?}"
         );
         chi2 += ((v - e.value) / se).powi(2);
         used += 1;
@@ -73,50 +133,41 @@ fn compare(
     );
 }
 
-/// Relative s.e. of table row `i` at the bin holding ρ.
-fn row_rel_se(i: usize, rho: f64) -> f64 {
-    let t = table();
-    let j = t
-        .centers()
-        .partition_point(|&c| c < rho)
-        .min(t.centers().len() - 1);
-    let v = t.profile(i)[j];
-    if v > 0.0 {
-        t.profile_stderr(i)[j] / v
-    } else {
-        0.0
-    }
-}
-
-/// Between albedo nodes: α′ midway (in √(1 − α′)) between default nodes 17–18, 28–29 and 30–31
-/// (α′ ≈ 0.794, 0.988, 0.998, where the profile changes fastest between nodes: R̂ ∝
-/// exp(−√(3(1 − α′))ρ) far out), direct simulation on the table's own grid (so no radial
-/// interpolation enters). Interpolation tolerance 3 % per bin on top of 4 s.e.; χ² with s.e. only.
-/// (Linear interpolation of R̂ in √(1 − α′), the previous scheme, failed this at α′ ≈ 0.998 with
-/// χ²/dof ≈ 12 and a 53 % error at ρ ≈ 48.)
+/// Between albedo nodes: α′ midway (in √(1 − α′)) between the nodes around 0.794, 0.988 and 0.998
+/// (where the profile changes fastest between nodes: R̂ ∝ exp(−√(3(1 − α′))ρ) far out), σ′t = 1,
+/// direct simulation on the table's own radial bins. Interpolation tolerance 3 % per bin on top of
+/// 4 s.e.; χ² with s.e. only. (Linear interpolation of R̂ in √(1 − α′), the scheme of the first table
+/// system, failed this at α′ ≈ 0.998 with χ²/dof ≈ 12 and a 53 % error at ρ ≈ 48.)
 #[test]
 fn profile_between_albedos_matches_direct_simulation() {
     let t = table();
-    let a = t.spec().albedos();
-    let grid = RadialGrid::from_edges(t.spec().radial_edges().to_vec()).unwrap();
-    for (k, seed) in [(17usize, 71u64), (28, 72), (30, 73)] {
+    let a = t.albedos();
+    let grid = RadialGrid::from_edges(t.spec().radial_edges()).unwrap();
+    for (target, seed) in [(0.794, 71u64), (0.988, 72), (0.998, 73)] {
+        let k = a.partition_point(|&x| x < target) - 1;
         let u = 0.5 * ((1.0 - a[k]).sqrt() + (1.0 - a[k + 1]).sqrt());
         let alpha = 1.0 - u * u;
-        let d = direct(alpha, grid.clone(), 300_000, seed);
+        let d = direct(alpha, 1.0 - alpha, grid.clone(), 300_000, seed);
+        let m = McProfile::new(
+            set(),
+            &OpticalProperties::new(alpha, 1.0 - alpha, ETA).unwrap(),
+        )
+        .unwrap();
         compare(
             &format!("α′ = {alpha}"),
             &grid,
             &d,
-            &|rho| t.rd(rho, 1.0, alpha).unwrap(),
-            &|rho| row_rel_se(k, rho).max(row_rel_se(k + 1, rho)),
+            &m,
+            1.0,
+            &[k, k + 1],
             0.03,
         );
     }
 }
 
-/// Between radial bin centres: at a tabulated albedo (nodes 9, 21, 28: α′ ≈ 0.48, 0.88, 0.98) and
-/// σ′t = 2 mm⁻¹, a direct simulation whose bin edges are the table's geometric bin midpoints / σ′t,
-/// so every direct centre falls between two table centres. Tolerance as above (3 % per bin).
+/// Between radial bins: at tabulated albedos (the nodes nearest 0.48, 0.88, 0.98) and σ′t = 2 mm⁻¹,
+/// a direct simulation whose bin edges are the table's geometric bin midpoints / σ′t, so every
+/// direct bin straddles two of the table's. Tolerance as above (3 % per bin).
 #[test]
 fn profile_between_radii_matches_direct_simulation() {
     let t = table();
@@ -125,38 +176,48 @@ fn profile_between_radii_matches_direct_simulation() {
     let mut edges = vec![0.0];
     edges.extend((1..e.len() - 1).map(|j| (e[j] * e[j + 1]).sqrt() / st));
     let grid = RadialGrid::from_edges(edges).unwrap();
-    for (k, seed) in [(9usize, 81u64), (21, 82), (28, 83)] {
-        let alpha = t.spec().albedos()[k];
+    for (target, seed) in [(0.48, 81u64), (0.88, 82), (0.98, 83)] {
+        let a = t.albedos();
+        let k = a.partition_point(|&x| x < target);
+        let k = if k > 0 && target - a[k - 1] < a[k] - target {
+            k - 1
+        } else {
+            k
+        };
+        let alpha = a[k];
         // σ′t = 2: σ′s = 2α′, σa = 2(1 − α′).
-        let half = Sample::slab(
-            Layer::from_reduced(2.0 * alpha, 2.0 * (1.0 - alpha), 0.0, ETA, f64::INFINITY).unwrap(),
-            1.0,
-        )
-        .unwrap();
-        let d = Simulation::new(half, Beam::pencil(), grid.clone(), 300_000, seed)
-            .unwrap()
-            .run();
+        let d = direct(
+            2.0 * alpha,
+            2.0 * (1.0 - alpha),
+            grid.clone(),
+            300_000,
+            seed,
+        );
+        let props = OpticalProperties::new(2.0 * alpha, 2.0 * (1.0 - alpha), ETA).unwrap();
+        let m = McProfile::new(set(), &props).unwrap();
         compare(
             &format!("α′ = {alpha}, σ′t = {st}"),
             &grid,
             &d,
-            &|rho| t.rd(rho, st, alpha).unwrap(),
-            &|rho| row_rel_se(k, rho * st),
+            &m,
+            st,
+            &[k],
             0.03,
         );
     }
 }
 
-/// Total Rd at off-node α′ (0.5, 0.8, 0.9, 0.95, 0.99: none is a default node) against
-/// adding-doubling, n = 1.4, g = 0 (physics.md §4.3: iadpython Q = 40 UR1 − R_sp, quadrature
-/// uncertainty 5e-5), within 3 s.e. (the larger s.e. of the two bracketing nodes) + an
-/// interpolation tolerance of 5e-4; and α′ from that Rd (the MC inversion) within the same
+/// Total Rd at off-node α′ (0.5, 0.8, 0.9, 0.95, 0.99: each at least a tenth of a node interval
+/// from the nodes) against adding-doubling,
+/// n = 1.4, g = 0 (physics.md §4.3: iadpython Q = 40 UR1 − R_sp, quadrature uncertainty 5e-5),
+/// within 3 s.e. (the larger s.e. of the two bracketing nodes) + an interpolation tolerance of 5e-4;
+/// and α′ from that Rd (the table's inversion, as `--albedo-model mc` runs it) within the same
 /// tolerance divided by the slope dRd/dα′ (central difference of the table's Rd(α′)).
 #[test]
 fn total_rd_and_inversion_match_adding_doubling() {
     let t = table();
     let (_, se) = t.totals();
-    let a = t.spec().albedos();
+    let a = t.albedos();
     for (alpha, reference) in [
         (0.5, 0.052305),
         (0.8, 0.153054),
@@ -164,11 +225,15 @@ fn total_rd_and_inversion_match_adding_doubling() {
         (0.95, 0.359139),
         (0.99, 0.603603),
     ] {
-        assert!(
-            a.iter().all(|&x| (x - alpha).abs() > 1e-3),
-            "α′ = {alpha} is a node"
-        );
         let i = a.partition_point(|&x| x < alpha);
+        // At least a tenth of the node interval (in √(1 − α′), the interpolation's coordinate) from
+        // either node: a lookup between nodes, not at one.
+        let u = |v: f64| (1.0 - v).sqrt();
+        let frac = (u(a[i - 1]) - u(alpha)) / (u(a[i - 1]) - u(a[i]));
+        assert!(
+            (0.1..=0.9).contains(&frac),
+            "α′ = {alpha} is (nearly) a node"
+        );
         let s = se[i - 1].max(se[i]);
         let tol = 3.0 * (s * s + 5e-5f64.powi(2)).sqrt() + 5e-4;
         let rd = t.rd_total(alpha).unwrap();
@@ -178,7 +243,7 @@ fn total_rd_and_inversion_match_adding_doubling() {
         );
         let h = 1e-4;
         let slope = (t.rd_total(alpha + h).unwrap() - t.rd_total(alpha - h).unwrap()) / (2.0 * h);
-        let inverted = t.albedo_from_rd_total(reference).unwrap();
+        let inverted = set().albedo_from_rd_total(reference, ETA).unwrap();
         assert!(
             (inverted - alpha).abs() <= tol / slope,
             "Rd {reference}: α′ {inverted} vs {alpha} (tolerance {})",

@@ -3,8 +3,11 @@
 //! source (physics.md §1), conservation, the similarity law and determinism. Every statistical check
 //! states its tolerance in standard errors and uses a fixed seed.
 
-use scatterfit_mc::table::{ProfileTable, TableSpec};
-use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationResult};
+use scatterfit_mc::{
+    Beam, BeamProfile, Layer, McProfile, McTable, McTableSet, McTableSpec, RadialGrid, Sample,
+    Simulation, SimulationResult,
+};
+use scatterfit_optics::{OpticalProperties, ProfileModel};
 
 fn run(sample: Sample, beam: Beam, grid: RadialGrid, photons: u64, seed: u64) -> SimulationResult {
     Simulation::new(sample, beam, grid, photons, seed)
@@ -325,21 +328,33 @@ fn far_field_approaches_dipole_near_field_does_not() {
     );
 }
 
-/// The similarity law: a table built at σ′t = 1 and scaled by σ′t² R̂(σ′t r) matches a direct
-/// simulation at σ′t = 2.5 mm⁻¹ bin for bin (the direct grid is the table grid divided by σ′t, and the
-/// lookup is at the bin centres, so no interpolation enters). Chi-square over the first 40 bins with
-/// the combined s.e., below χ²₀.₉₉₉(40) = 73.40 (scipy `chi2.ppf(0.999, 40)`); totals within 3 s.e.
+/// The similarity law: a Monte Carlo table (the `mc` model's, [`McTable`]) built at σt = 1 and
+/// scaled by σt² R̂(σt r) matches a direct simulation at σ′t = 2.5 mm⁻¹ bin for bin (the direct grid
+/// is the table grid divided by σ′t, so no radial interpolation enters; α′ = 0.9 is a node of the
+/// table). The table's raw tally (a white run: albedo weights aⁿ on non-absorbing photons) against
+/// the engine (implicit capture and roulette): chi-square over the first 40 bins with the combined
+/// s.e., below χ²₀.₉₉₉(40) = 73.40 (scipy `chi2.ppf(0.999, 40)`); totals within 3 s.e. And the
+/// smoothed model at σ′t = 2.5 (`McProfile`) equals σt² times itself at σt = 1 at r/σt (1e-12).
 #[test]
 fn similarity_scaling_matches_direct_simulation() {
     let eta = 1.4;
-    let spec = TableSpec::new(eta, 0.0, 2, 100_000)
-        .unwrap()
-        .with_albedos(vec![0.5, 0.9])
-        .unwrap();
-    let table = ProfileTable::build(&spec, &|_, _| {}).unwrap();
+    // Four albedos 0.5 … 0.9 (equally spaced in √(1 − a)), 64 bins to 200 mean free paths; the
+    // largest albedo 0.9 ends photons after 114 interactions (weight ≤ e⁻¹²), so one stratum.
+    let mut spec = McTableSpec::with_strata(eta, 0.0, vec![100_000], vec![]).unwrap();
+    spec.albedo_count = 4;
+    spec.albedo_min = 0.5;
+    spec.albedo_max = 0.9;
+    spec.rho_min = 0.005;
+    spec.rho_max = 200.0;
+    spec.radial_bins = 63;
+    let table = McTable::build(&spec, &|_, _| {}).unwrap();
+    let k = table.albedos().len() - 1;
+    let alpha = table.albedos()[k];
+    assert!((alpha - 0.9).abs() < 1e-12);
+    let raw = table.raw().unwrap();
+    let bins = raw.edges.len() - 1;
     let st = 2.5;
-    let alpha = 0.9;
-    let g = RadialGrid::from_edges(spec.radial_edges().iter().map(|e| e / st).collect()).unwrap();
+    let g = RadialGrid::from_edges(raw.edges.iter().map(|e| e / st).collect()).unwrap();
     let half = Sample::slab(
         Layer::from_reduced(alpha * st, (1.0 - alpha) * st, 0.0, eta, f64::INFINITY).unwrap(),
         1.0,
@@ -350,16 +365,15 @@ fn similarity_scaling_matches_direct_simulation() {
     assert!(within(
         direct.rd_total.value,
         direct.rd_total.stderr,
-        tot[1],
-        tot_se[1],
+        tot[k],
+        tot_se[k],
         3.0
     ));
     let mut chi2 = 0.0;
     let mut used = 0;
     for i in 0..40 {
-        let scaled = table.rd(g.center(i), st, alpha).unwrap();
-        let scaled_se = st * st * table.profile_stderr(1)[i];
-        assert!((scaled - st * st * table.profile(1)[i]).abs() <= 1e-12 * scaled.abs());
+        let scaled = st * st * raw.rd[k * bins + i];
+        let scaled_se = st * st * raw.rd_stderr[k * bins + i];
         let d = direct.rd_profile[i];
         let var = d.stderr.powi(2) + scaled_se.powi(2);
         if var > 0.0 {
@@ -369,4 +383,16 @@ fn similarity_scaling_matches_direct_simulation() {
     }
     assert!(used >= 30);
     assert!(chi2 < 73.40, "chi² = {chi2} over {used} bins");
+    let set = McTableSet::new(vec![table]).unwrap();
+    let unit = OpticalProperties::new(alpha, 1.0 - alpha, eta).unwrap();
+    let scaled = OpticalProperties::new(alpha * st, (1.0 - alpha) * st, eta).unwrap();
+    let (m1, m2) = (
+        McProfile::new(&set, &unit).unwrap(),
+        McProfile::new(&set, &scaled).unwrap(),
+    );
+    for i in 1..bins {
+        let r = g.center(i);
+        let (a, b) = (m2.rd(r), st * st * m1.rd(r * st));
+        assert!((a - b).abs() <= 1e-12 * b.abs(), "r = {r}: {a} vs {b}");
+    }
 }

@@ -3,7 +3,7 @@
 
 use divan::{Bencher, black_box};
 use scatterfit_optics::dipole::{Dipole, albedo_from_rd, rd_total};
-use scatterfit_optics::{DiffusionModel, OpticalProperties};
+use scatterfit_optics::{DiffusionModel, ModelFamily, OpticalProperties};
 
 fn main() {
     divan::main();
@@ -68,27 +68,19 @@ fn total(bencher: Bencher) {
     bencher.bench_local(|| rd_total(black_box(0.97), black_box(1.3)));
 }
 
-/// Every forward model through the `ProfileModel` trait: Rd(r) + both derivatives at the 300 radii,
-/// model construction included (one Levenberg–Marquardt iteration's model work).
+/// Every forward model through `ModelFamily::eval` (what the fit calls): Rd(r) + both derivatives at
+/// the 300 radii, model construction included (one Levenberg–Marquardt iteration's model work).
 #[divan::bench(
     name = "model Rd(r) + derivatives, 300 radii",
     args = [DiffusionModel::Dipole, DiffusionModel::BetterDipole, DiffusionModel::Pbd]
 )]
 fn model_profile_with_derivatives(bencher: Bencher, model: DiffusionModel) {
-    use scatterfit_optics::{ProfileModel, ProfileSample};
+    use scatterfit_optics::ProfileSample;
     let radii = radii();
     let props = OpticalProperties::new(1.979, 0.0496, 1.2886).unwrap();
-    let mut out = vec![
-        ProfileSample {
-            rd: 0.0,
-            d_sigma_s_prime: 0.0,
-            d_sigma_a: 0.0
-        };
-        radii.len()
-    ];
+    let mut out = vec![ProfileSample::ZERO; radii.len()];
     bencher.bench_local(|| {
-        let m = model.profile(black_box(&props)).unwrap();
-        m.profile_with_derivatives_into(&radii, &mut out);
+        model.eval(black_box(&props), &radii, &mut out);
         black_box(&out);
     });
 }
@@ -99,7 +91,6 @@ fn model_profile_with_derivatives(bencher: Bencher, model: DiffusionModel) {
     args = [DiffusionModel::Dipole, DiffusionModel::BetterDipole, DiffusionModel::Pbd]
 )]
 fn model_profile(bencher: Bencher, model: DiffusionModel) {
-    use scatterfit_optics::ProfileModel;
     let radii = radii();
     let props = OpticalProperties::new(1.979, 0.0496, 1.2886).unwrap();
     bencher.bench_local(|| {
@@ -108,13 +99,17 @@ fn model_profile(bencher: Bencher, model: DiffusionModel) {
     });
 }
 
-/// Total Rd(α′, η) per model (closed form for the dipoles, quadrature for PBD).
+/// Total Rd(α′, η, g = 0) per model (closed form for the dipoles, quadrature for PBD).
 #[divan::bench(
     name = "model total Rd(α′, η)",
     args = [DiffusionModel::Dipole, DiffusionModel::BetterDipole, DiffusionModel::Pbd]
 )]
 fn model_total(bencher: Bencher, model: DiffusionModel) {
-    bencher.bench_local(|| model.rd_total(black_box(0.97), black_box(1.3)).unwrap());
+    bencher.bench_local(|| {
+        model
+            .rd_total(black_box(0.97), black_box(1.3), 0.0)
+            .unwrap()
+    });
 }
 
 /// α′(Rd = 0.5, η = 1.3) per model (bracketed root finding on the totals).
@@ -125,7 +120,7 @@ fn model_total(bencher: Bencher, model: DiffusionModel) {
 fn model_inversion(bencher: Bencher, model: DiffusionModel) {
     bencher.bench_local(|| {
         model
-            .albedo_from_rd(black_box(0.5), black_box(1.3))
+            .albedo_from_rd(black_box(0.5), black_box(1.3), 0.0)
             .unwrap()
     });
 }

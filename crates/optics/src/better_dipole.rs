@@ -6,8 +6,9 @@
 //! the paper* (physics.md §3, §10 item 2). The model is pbrt's photon-beam integrand evaluated at the
 //! single depth zr = 1/σ′t with κ = 1.
 //!
-//! Parameters and domains: σ′s > 0, σa ≥ 0 [mm⁻¹], 1 ≤ η ≤ [`FRESNEL_MOMENT_MAX_ETA`] (the Fresnel
-//! moments are pbrt's polynomial fits, [`fresnel_moment1`], [`fresnel_moment2`]).
+//! Parameters and domains: σ′s > 0, σa ≥ 0 [mm⁻¹], 1 ≤ η ≤ [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`] (the Fresnel
+//! moments are pbrt's polynomial fits, [`crate::fresnel::fresnel_moment1`],
+//! [`crate::fresnel::fresnel_moment2`]).
 //!
 //! ```text
 //! σ′t = σ′s + σa,  α′ = σ′s/σ′t,  C₁, C₂ = Fresnel moments of η
@@ -30,52 +31,17 @@
 
 use std::f64::consts::PI;
 
-use crate::diffusion::{Pair, PairTerm, exp_diff_over_sigma};
-use crate::dipole::ProfileSample;
+use crate::diffusion::{Boundary, Pair, PairTerm, check_albedo, exp_diff_over_sigma, invert_total};
 use crate::dual::{Dual, Real};
-use crate::error::{OpticsError, Result, eta_at_least_one};
-use crate::fresnel::{FRESNEL_MOMENT_MAX_ETA, fresnel_moment1, fresnel_moment2};
-use crate::model::ProfileModel;
+use crate::error::Result;
+use crate::family::{ProfileModel, ProfileSample};
 use crate::properties::OpticalProperties;
-
-/// The boundary constants of one η: A, C_φ, C_E.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Boundary {
-    /// A = (1 + 3C₂)/(1 − 2C₁).
-    pub a: f64,
-    /// C_φ = ¼(1 − 2C₁).
-    pub c_phi: f64,
-    /// C_E = ½(1 − 3C₂).
-    pub c_e: f64,
-}
-
-impl Boundary {
-    /// The constants for η, refusing η outside [1, [`FRESNEL_MOMENT_MAX_ETA`]].
-    pub(crate) fn new(eta: f64) -> Result<Self> {
-        eta_at_least_one(eta)?;
-        if eta > FRESNEL_MOMENT_MAX_ETA {
-            return Err(OpticsError::InvalidParameter {
-                name: "eta",
-                value: eta,
-                reason: "the improved-diffusion models (better dipole, photon beam diffusion) use \
-                         pbrt's Fresnel-moment polynomials, which are fitted for 1 ≤ η ≤ 2.5; use the \
-                         classical dipole or the Monte Carlo model for larger η",
-            });
-        }
-        let (c1, c2) = (fresnel_moment1(eta), fresnel_moment2(eta));
-        Ok(Self {
-            a: (1.0 + 3.0 * c2) / (1.0 - 2.0 * c1),
-            c_phi: 0.25 * (1.0 - 2.0 * c1),
-            c_e: 0.5 * (1.0 - 3.0 * c2),
-        })
-    }
-}
 
 /// The boundary coefficient A(η) = (1 + 3C₂)/(1 − 2C₁) of d'Eon's boundary condition (physics.md §3;
 /// 2.949348 at η = 1.4, against the classical dipole's 3.250697).
 ///
 /// # Errors
-/// `InvalidParameter` for η outside [1, [`FRESNEL_MOMENT_MAX_ETA`]].
+/// `InvalidParameter` for η outside [1, [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`]].
 pub fn a_coefficient(eta: f64) -> Result<f64> {
     Ok(Boundary::new(eta)?.a)
 }
@@ -100,7 +66,7 @@ impl BetterDipole {
     /// The better dipole for `props` (formulas in the module documentation).
     ///
     /// # Errors
-    /// `InvalidParameter` for η > [`FRESNEL_MOMENT_MAX_ETA`].
+    /// `InvalidParameter` for η > [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`].
     pub fn new(props: &OpticalProperties) -> Result<Self> {
         let bc = Boundary::new(props.eta())?;
         let sp = Dual::variable(props.sigma_s_prime(), 0);
@@ -196,22 +162,10 @@ fn total_closed_form(albedo_prime: f64, bc: &Boundary) -> f64 {
 /// at α′ = 0 to 1 at α′ = 1.
 ///
 /// # Errors
-/// `InvalidParameter` for α′ outside [0, 1] or η outside [1, [`FRESNEL_MOMENT_MAX_ETA`]].
+/// `InvalidParameter` for α′ outside [0, 1] or η outside [1, [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`]].
 pub fn rd_total(albedo_prime: f64, eta: f64) -> Result<f64> {
     check_albedo(albedo_prime)?;
     Ok(total_closed_form(albedo_prime, &Boundary::new(eta)?))
-}
-
-pub(crate) fn check_albedo(albedo_prime: f64) -> Result<()> {
-    if (0.0..=1.0).contains(&albedo_prime) {
-        Ok(())
-    } else {
-        Err(OpticsError::InvalidParameter {
-            name: "albedo_prime",
-            value: albedo_prime,
-            reason: "the reduced albedo must lie in [0, 1]",
-        })
-    }
 }
 
 /// The reduced albedo α′ whose better-dipole total [`rd_total`] equals `rd` at this η: the closed
@@ -221,46 +175,16 @@ pub(crate) fn check_albedo(albedo_prime: f64) -> Result<()> {
 ///
 /// # Errors
 /// `RdOutOfModelRange` for rd outside (0, 1]; `InvalidParameter` for η outside
-/// [1, [`FRESNEL_MOMENT_MAX_ETA`]].
+/// [1, [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`]].
 pub fn albedo_from_rd(rd: f64, eta: f64) -> Result<f64> {
     let bc = Boundary::new(eta)?;
     invert_total("better dipole", rd, eta, 1.0, |a| total_closed_form(a, &bc))
 }
 
-/// Solves total(α′) = rd for α′ ∈ [0, 1] where total rises from 0 to `max` = total(1), in
-/// u = √(1 − α′); `RdOutOfModelRange` outside (0, max].
-pub(crate) fn invert_total(
-    model: &'static str,
-    rd: f64,
-    eta: f64,
-    max: f64,
-    total: impl Fn(f64) -> f64,
-) -> Result<f64> {
-    if !(rd.is_finite() && rd > 0.0 && rd <= max) {
-        return Err(OpticsError::RdOutOfModelRange {
-            model,
-            rd,
-            eta,
-            max,
-        });
-    }
-    if rd == max {
-        return Ok(1.0);
-    }
-    let f = |u: f64| total(1.0 - u * u) - rd;
-    let u =
-        crate::roots::bracketed_root(f, 0.0, 1.0, 1e-13).ok_or(OpticsError::RdOutOfModelRange {
-            model,
-            rd,
-            eta,
-            max,
-        })?;
-    Ok(1.0 - u * u)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::OpticsError;
 
     fn props(sigma_a: f64, sigma_s_prime: f64, eta: f64) -> OpticalProperties {
         OpticalProperties::new(sigma_s_prime, sigma_a, eta).unwrap()

@@ -1,6 +1,7 @@
 //! Pieces shared by the improved-diffusion models ([`crate::better_dipole`], [`crate::pbd`]): the
-//! exitance of one real/virtual source pair under d'Eon's boundary condition, with its derivatives,
-//! and a Gauss–Legendre quadrature on doubling panels for radial integrals.
+//! boundary constants of d'Eon's boundary condition ([`Boundary`]), the exitance of one
+//! real/virtual source pair with its derivatives, a Gauss–Legendre quadrature on doubling panels for
+//! radial integrals, and the inversion of a total Rd(α′) for α′ ([`invert_total`]).
 //!
 //! The pair term (pbrt-v4 `BeamDiffusionMS` integrand, docs/physics.md §2.1 and §3), with σtr² =
 //! s2:
@@ -15,6 +16,85 @@
 //! ∂[(1 + σd)e^{−σd}]/∂s2 = −d²e^{−σd}/2.
 
 use crate::dual::{Dual, Real};
+use crate::error::{OpticsError, Result, eta_at_least_one};
+use crate::fresnel::{FRESNEL_MOMENT_MAX_ETA, fresnel_moment1, fresnel_moment2};
+
+/// The boundary constants of one η: A, C_φ, C_E.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Boundary {
+    /// A = (1 + 3C₂)/(1 − 2C₁).
+    pub a: f64,
+    /// C_φ = ¼(1 − 2C₁).
+    pub c_phi: f64,
+    /// C_E = ½(1 − 3C₂).
+    pub c_e: f64,
+}
+
+impl Boundary {
+    /// The constants for η, refusing η outside [1, [`FRESNEL_MOMENT_MAX_ETA`]].
+    pub(crate) fn new(eta: f64) -> Result<Self> {
+        eta_at_least_one(eta)?;
+        if eta > FRESNEL_MOMENT_MAX_ETA {
+            return Err(OpticsError::InvalidParameter {
+                name: "eta",
+                value: eta,
+                reason: "the improved-diffusion models (better dipole, photon beam diffusion) use \
+                         pbrt's Fresnel-moment polynomials, which are fitted for 1 ≤ η ≤ 2.5; use the \
+                         classical dipole or the Monte Carlo model for larger η",
+            });
+        }
+        let (c1, c2) = (fresnel_moment1(eta), fresnel_moment2(eta));
+        Ok(Self {
+            a: (1.0 + 3.0 * c2) / (1.0 - 2.0 * c1),
+            c_phi: 0.25 * (1.0 - 2.0 * c1),
+            c_e: 0.5 * (1.0 - 3.0 * c2),
+        })
+    }
+}
+
+/// Refuses a reduced albedo outside [0, 1].
+pub(crate) fn check_albedo(albedo_prime: f64) -> Result<()> {
+    if (0.0..=1.0).contains(&albedo_prime) {
+        Ok(())
+    } else {
+        Err(OpticsError::InvalidParameter {
+            name: "albedo_prime",
+            value: albedo_prime,
+            reason: "the reduced albedo must lie in [0, 1]",
+        })
+    }
+}
+
+/// Solves total(α′) = rd for α′ ∈ [0, 1] where total rises from 0 to `max` = total(1), in
+/// u = √(1 − α′); `RdOutOfModelRange` outside (0, max].
+pub(crate) fn invert_total(
+    model: &'static str,
+    rd: f64,
+    eta: f64,
+    max: f64,
+    total: impl Fn(f64) -> f64,
+) -> Result<f64> {
+    if !(rd.is_finite() && rd > 0.0 && rd <= max) {
+        return Err(OpticsError::RdOutOfModelRange {
+            model,
+            rd,
+            eta,
+            max,
+        });
+    }
+    if rd == max {
+        return Ok(1.0);
+    }
+    let f = |u: f64| total(1.0 - u * u) - rd;
+    let u =
+        crate::roots::bracketed_root(f, 0.0, 1.0, 1e-13).ok_or(OpticsError::RdOutOfModelRange {
+            model,
+            rd,
+            eta,
+            max,
+        })?;
+    Ok(1.0 - u * u)
+}
 
 /// (e^{−σa} − e^{−σb})/σ for σ ≥ 0, computed without cancellation (`expm1`); b − a at σ = 0.
 #[inline(always)]

@@ -12,9 +12,10 @@
 //! Rd(r) = α′/(4π) [zr(σtr dr + 1)e^{−σtr dr}/dr³ + zv(σtr dv + 1)e^{−σtr dv}/dv³]      (Jensen eq. 4)
 //! ```
 
-use serde::Serialize;
+pub use crate::family::ProfileSample;
 
 use crate::error::{OpticsError, Result, eta_at_least_one};
+use crate::family::ProfileModel;
 use crate::properties::OpticalProperties;
 
 /// Diffuse Fresnel reflectance Fdr(η) = −1.440/η² + 0.710/η + 0.668 + 0.0636η, the fit quoted by
@@ -144,17 +145,6 @@ pub fn albedo_from_rd(rd: f64, eta: f64) -> Result<f64> {
         }
     }
     Ok(1.0 - s * s / 3.0)
-}
-
-/// Rd(r) and its partial derivatives in σ′s and σa at one radius.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ProfileSample {
-    /// Radially resolved diffuse reflectance Rd(r) [mm⁻²].
-    pub rd: f64,
-    /// ∂Rd/∂σ′s [mm⁻² / mm⁻¹ = mm⁻¹].
-    pub d_sigma_s_prime: f64,
-    /// ∂Rd/∂σa [mm⁻¹].
-    pub d_sigma_a: f64,
 }
 
 /// The classical dipole for one set of optical properties, with the shared quantities (α′, σtr, zr,
@@ -330,6 +320,19 @@ impl Dipole {
     /// Total diffuse reflectance ∫2πr Rd(r) dr of this dipole ([`rd_total`]).
     pub fn rd_total(&self) -> f64 {
         rd_total(self.albedo_prime, self.props.eta())
+    }
+}
+
+/// The trait delegates to the dipole's own methods (the blocked hot path included).
+impl ProfileModel for Dipole {
+    fn rd(&self, r_mm: f64) -> f64 {
+        Dipole::rd(self, r_mm)
+    }
+    fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {
+        Dipole::profile_with_derivatives_into(self, radii_mm, out);
+    }
+    fn rd_total(&self) -> f64 {
+        Dipole::rd_total(self)
     }
 }
 

@@ -51,9 +51,39 @@ pub enum OpticsError {
         /// Why, and what to do.
         reason: &'static str,
     },
-    /// A forward-model name that is not one of the diffusion models.
-    #[error("unknown forward model {0:?}: expected one of dipole, better-dipole, pbd (or mc)")]
-    UnknownModel(String),
+    /// A name (of a forward model, an albedo model, a method) that is not one of the valid ones.
+    #[error("unknown {what} {given:?}: expected one of {expected}")]
+    UnknownName {
+        /// What was named, e.g. "forward model".
+        what: &'static str,
+        /// The name given.
+        given: String,
+        /// The valid names, comma-separated.
+        expected: &'static str,
+    },
+    /// A parameter outside what a tabulated model (the Monte Carlo tables) covers.
+    #[error("{name} = {value} is outside the table's range [{min}, {max}]")]
+    OutOfTable {
+        /// Which coordinate, e.g. `eta` or `rd_total`.
+        name: &'static str,
+        /// The value asked for.
+        value: f64,
+        /// The tables' lower limit.
+        min: f64,
+        /// The tables' upper limit.
+        max: f64,
+    },
+    /// A Henyey–Greenstein g other than the one the Monte Carlo tables were made for.
+    #[error(
+        "g = {given} but the Monte Carlo tables were made for g = {tables}: build tables for this \
+         g (`scatterfit table --g {given}`) or use g = {tables}"
+    )]
+    AnisotropyMismatch {
+        /// The g asked for.
+        given: f64,
+        /// The tables' g.
+        tables: f64,
+    },
     /// A spectrum that does not cover the range a colour computation needs.
     #[error("spectrum: {0}")]
     Spectrum(String),
@@ -71,6 +101,19 @@ pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64> {
             name,
             value,
             reason: "must be a finite number ≥ 0",
+        })
+    }
+}
+
+/// Checks that the Henyey–Greenstein asymmetry `g` is finite and in (−1, 1).
+pub(crate) fn check_g(g: f64) -> Result<f64> {
+    if g.is_finite() && g.abs() < 1.0 {
+        Ok(g)
+    } else {
+        Err(OpticsError::InvalidParameter {
+            name: "g",
+            value: g,
+            reason: "the Henyey–Greenstein asymmetry must lie in (−1, 1)",
         })
     }
 }

@@ -17,16 +17,24 @@
 //! Modules: [`fresnel`] (exact Fresnel, Schlick, η from a d/8 specular reflectance, pbrt's Fresnel
 //! moments), [`dipole`] (Jensen et al. 2001 classical dipole, its total reflectance and the α′
 //! inversion), [`better_dipole`] (d'Eon 2012), [`pbd`] (photon beam diffusion, Habel et al. 2013 as
-//! pbrt-v4 evaluates it), [`model`] (the [`ProfileModel`] trait every forward model implements, and
-//! [`DiffusionModel`] by name), [`colour`] (spectra → CIE XYZ → L\*a\*b\* / linear sRGB),
-//! [`spectro`] (the spectrophotometer stage).
+//! pbrt-v4 evaluates it), [`model`] (the diffusion models as [`ModelFamily`]s, [`DiffusionModel`]),
+//! [`colour`] (spectra → CIE XYZ → L\*a\*b\* / linear sRGB), [`spectro`] (the spectrophotometer
+//! stage).
+//!
+//! The vocabulary the crates above share: [`Channel`] and [`Rgb`] (a value per linear-sRGB
+//! channel, by name), [`ModelName`], [`AlbedoModel`] and [`Method`] (what a user chooses), and the
+//! forward-model traits [`ProfileModel`] (Rd(r) of one parameter set) and [`ModelFamily`] (a named
+//! model: profiles, its total Rd(α′, η, g) and the α′ inversion).
 
 pub mod better_dipole;
 pub mod colour;
 pub mod dipole;
+pub mod family;
 pub mod fresnel;
 pub mod model;
+pub mod names;
 pub mod pbd;
+pub mod rgb;
 pub mod spectro;
 
 mod diffusion;
@@ -36,5 +44,8 @@ mod properties;
 mod roots;
 
 pub use error::{OpticsError, Result};
-pub use model::{AnyDiffusion, DiffusionModel, ProfileModel, ProfileSample};
+pub use family::{ModelFamily, ProfileModel, ProfileSample};
+pub use model::DiffusionModel;
+pub use names::{AlbedoModel, Method, ModelName};
 pub use properties::OpticalProperties;
+pub use rgb::{Channel, Rgb};

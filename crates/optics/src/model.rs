@@ -1,166 +1,100 @@
-//! One interface for the radial-profile forward models, so that the fit, the study and `measure` can
-//! take any of them: the classical dipole ([`crate::dipole::Dipole`], Jensen et al. 2001), the better
-//! dipole ([`crate::better_dipole::BetterDipole`], d'Eon 2012), photon beam diffusion
-//! ([`crate::pbd::Pbd`], Habel et al. 2013 as pbrt-v4 evaluates it) and, in the `mc` crate, the Monte
-//! Carlo tables (`scatterfit_mc::McProfile`).
+//! The diffusion forward models as [`ModelFamily`]s: the classical dipole
+//! ([`crate::dipole::Dipole`], Jensen et al. 2001), the better dipole
+//! ([`crate::better_dipole::BetterDipole`], d'Eon 2012) and photon beam diffusion ([`crate::pbd::Pbd`],
+//! Habel et al. 2013 as pbrt-v4 evaluates it), each with its own total diffuse reflectance
+//! Rd(α′, η, g) and its inverse α′(Rd, η, g) — the spectrophotometer's albedo "by the same physics".
+//! The Monte Carlo tables are the fourth family, in the `mc` crate (`scatterfit_mc::McTableSet`).
 //!
-//! [`DiffusionModel`] names the three diffusion models and gives each one's total diffuse reflectance
-//! Rd(α′, η) and its inverse α′(Rd, η) — the spectrophotometer's albedo "by the same physics".
+//! The traits themselves are [`crate::family`]'s, re-exported here.
 
-use std::fmt;
-use std::str::FromStr;
+pub use crate::family::{ModelFamily, ProfileModel, ProfileSample};
 
-pub use crate::dipole::ProfileSample;
-use crate::error::{OpticsError, Result};
+use crate::better_dipole::{self, BetterDipole};
+use crate::diffusion::check_albedo;
+use crate::dipole::{self, Dipole};
+use crate::error::{Result, check_g, eta_at_least_one};
+use crate::names::ModelName;
+use crate::pbd::{self, Pbd};
 use crate::properties::OpticalProperties;
-use crate::{better_dipole, dipole, pbd};
 
-/// A radially resolved diffuse reflectance model Rd(r) of a half-space for one set of optical
-/// properties (built per parameter set, like [`crate::dipole::Dipole::new`]).
-pub trait ProfileModel {
-    /// Rd(r) [mm⁻²] at radius `r_mm` ≥ 0 [mm] from the point of incidence.
-    fn rd(&self, r_mm: f64) -> f64;
-    /// Rd and its partial derivatives ∂Rd/∂σ′s, ∂Rd/∂σa at every radius of `radii_mm`, written to
-    /// `out` (the shorter of the two sets the count). Derivatives are analytic (never finite
-    /// differences). The hot path of the fit: one call per Levenberg–Marquardt iteration.
-    fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]);
-    /// Total diffuse reflectance ∫₀^∞ 2πr Rd(r) dr [1] (excluding the specular reflection).
-    fn rd_total(&self) -> f64;
-}
-
-impl ProfileModel for dipole::Dipole {
-    fn rd(&self, r_mm: f64) -> f64 {
-        dipole::Dipole::rd(self, r_mm)
-    }
-    fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {
-        dipole::Dipole::profile_with_derivatives_into(self, radii_mm, out);
-    }
-    fn rd_total(&self) -> f64 {
-        dipole::Dipole::rd_total(self)
-    }
-}
-
-/// The diffusion forward models by name (the `model =` / `--model` values except `mc`, which lives in
-/// the `mc` crate).
+/// The diffusion forward models (the `model =` / `--model` values except `mc`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum DiffusionModel {
-    /// Classical dipole, Jensen et al. 2001 (the paper's model): `dipole`.
+    /// Classical dipole, Jensen et al. 2001 (the paper's model): `dipole`. Depends on σ′s only
+    /// (g is ignored).
     Dipole,
-    /// d'Eon 2012 "A better dipole" (physics.md §3): `better-dipole`.
+    /// d'Eon 2012 "A better dipole" (physics.md §3): `better-dipole`. Depends on σ′s only.
     BetterDipole,
-    /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (physics.md §2), g = 0:
-    /// `pbd`.
+    /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (physics.md §2): `pbd`.
+    /// Its single scattering uses σs = σ′s/(1 − g).
     Pbd,
 }
 
 impl DiffusionModel {
     /// Every diffusion model, in the order of the docs.
     pub const ALL: [DiffusionModel; 3] = [Self::Dipole, Self::BetterDipole, Self::Pbd];
+}
 
-    /// The name used in files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Dipole => "dipole",
-            Self::BetterDipole => "better-dipole",
-            Self::Pbd => "pbd",
+impl From<DiffusionModel> for ModelName {
+    fn from(m: DiffusionModel) -> Self {
+        match m {
+            DiffusionModel::Dipole => ModelName::Dipole,
+            DiffusionModel::BetterDipole => ModelName::BetterDipole,
+            DiffusionModel::Pbd => ModelName::Pbd,
         }
     }
+}
 
-    /// The model for `props`.
-    ///
-    /// # Errors
-    /// `InvalidParameter` where the model does not cover η (better dipole and PBD: η ≤ 2.5).
-    pub fn profile(self, props: &OpticalProperties) -> Result<AnyDiffusion> {
+impl ModelFamily for DiffusionModel {
+    fn name(&self) -> ModelName {
+        (*self).into()
+    }
+
+    fn profile(&self, props: &OpticalProperties) -> Result<Box<dyn ProfileModel>> {
         Ok(match self {
-            Self::Dipole => AnyDiffusion::Dipole(dipole::Dipole::new(props)),
-            Self::BetterDipole => {
-                AnyDiffusion::BetterDipole(better_dipole::BetterDipole::new(props)?)
-            }
-            Self::Pbd => AnyDiffusion::Pbd(Box::new(pbd::Pbd::new(props)?)),
+            Self::Dipole => Box::new(Dipole::new(props)),
+            Self::BetterDipole => Box::new(BetterDipole::new(props)?),
+            Self::Pbd => Box::new(Pbd::new(props)?),
         })
     }
 
-    /// Total diffuse reflectance Rd(α′, η) of this model (closed form for the dipoles, quadrature for
-    /// PBD).
-    ///
-    /// # Errors
-    /// `InvalidParameter` for α′ outside [0, 1] or η outside the model's range.
-    pub fn rd_total(self, albedo_prime: f64, eta: f64) -> Result<f64> {
+    /// Builds the model on the stack (no heap allocation for the dipoles: this is the fit's hot
+    /// path, ~47 µs per channel with the dipole).
+    fn eval(&self, props: &OpticalProperties, radii_mm: &[f64], out: &mut [ProfileSample]) {
+        match self {
+            Self::Dipole => Dipole::new(props).profile_with_derivatives_into(radii_mm, out),
+            Self::BetterDipole => match BetterDipole::new(props) {
+                Ok(m) => ProfileModel::profile_with_derivatives_into(&m, radii_mm, out),
+                Err(_) => out.fill(ProfileSample::NAN),
+            },
+            Self::Pbd => match Pbd::new(props) {
+                Ok(m) => ProfileModel::profile_with_derivatives_into(&m, radii_mm, out),
+                Err(_) => out.fill(ProfileSample::NAN),
+            },
+        }
+    }
+
+    /// Closed form for the dipoles (g ignored), quadrature for PBD.
+    fn rd_total(&self, albedo_prime: f64, eta: f64, g: f64) -> Result<f64> {
+        check_g(g)?;
         match self {
             Self::Dipole => {
-                better_dipole::check_albedo(albedo_prime)?;
-                crate::error::eta_at_least_one(eta)?;
+                check_albedo(albedo_prime)?;
+                eta_at_least_one(eta)?;
                 Ok(dipole::rd_total(albedo_prime, eta))
             }
             Self::BetterDipole => better_dipole::rd_total(albedo_prime, eta),
-            Self::Pbd => pbd::rd_total(albedo_prime, eta),
+            Self::Pbd => pbd::rd_total(albedo_prime, eta, g),
         }
     }
 
-    /// The reduced albedo α′ whose total diffuse reflectance is `rd` at η (the inverse of
-    /// [`DiffusionModel::rd_total`], monotonic for every model).
-    ///
-    /// # Errors
-    /// `RdOutOfRange`/`RdOutOfModelRange` for an Rd the model cannot produce, `InvalidParameter` for
-    /// η outside the model's range.
-    pub fn albedo_from_rd(self, rd: f64, eta: f64) -> Result<f64> {
+    fn albedo_from_rd(&self, rd: f64, eta: f64, g: f64) -> Result<f64> {
+        check_g(g)?;
         match self {
             Self::Dipole => dipole::albedo_from_rd(rd, eta),
             Self::BetterDipole => better_dipole::albedo_from_rd(rd, eta),
-            Self::Pbd => pbd::albedo_from_rd(rd, eta),
-        }
-    }
-}
-
-impl fmt::Display for DiffusionModel {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for DiffusionModel {
-    type Err = OpticsError;
-    fn from_str(s: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| OpticsError::UnknownModel(s.to_owned()))
-    }
-}
-
-/// One of the diffusion models, built for one parameter set ([`DiffusionModel::profile`]).
-#[derive(Debug, Clone)]
-#[non_exhaustive]
-pub enum AnyDiffusion {
-    /// Classical dipole.
-    Dipole(dipole::Dipole),
-    /// Better dipole.
-    BetterDipole(better_dipole::BetterDipole),
-    /// Photon beam diffusion (boxed: it holds its 100 depth samples).
-    Pbd(Box<pbd::Pbd>),
-}
-
-impl ProfileModel for AnyDiffusion {
-    fn rd(&self, r_mm: f64) -> f64 {
-        match self {
-            Self::Dipole(m) => ProfileModel::rd(m, r_mm),
-            Self::BetterDipole(m) => ProfileModel::rd(m, r_mm),
-            Self::Pbd(m) => ProfileModel::rd(m.as_ref(), r_mm),
-        }
-    }
-    fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {
-        match self {
-            Self::Dipole(m) => m.profile_with_derivatives_into(radii_mm, out),
-            Self::BetterDipole(m) => ProfileModel::profile_with_derivatives_into(m, radii_mm, out),
-            Self::Pbd(m) => ProfileModel::profile_with_derivatives_into(m.as_ref(), radii_mm, out),
-        }
-    }
-    fn rd_total(&self) -> f64 {
-        match self {
-            Self::Dipole(m) => ProfileModel::rd_total(m),
-            Self::BetterDipole(m) => ProfileModel::rd_total(m),
-            Self::Pbd(m) => ProfileModel::rd_total(m.as_ref()),
+            Self::Pbd => pbd::albedo_from_rd(rd, eta, g),
         }
     }
 }
@@ -169,36 +103,107 @@ impl ProfileModel for AnyDiffusion {
 mod tests {
     use super::*;
 
+    /// Names: each diffusion model is its `ModelName` (the names of files and `--model`).
     #[test]
-    fn names_round_trip_and_unknown_is_refused() {
+    fn names() {
+        let names: Vec<&str> = DiffusionModel::ALL
+            .iter()
+            .map(|m| m.name().name())
+            .collect();
+        assert_eq!(names, ["dipole", "better-dipole", "pbd"]);
         for m in DiffusionModel::ALL {
-            assert_eq!(m.name().parse::<DiffusionModel>().unwrap(), m);
+            assert_eq!(ModelName::from(m), m.name());
         }
-        let e = "dipol".parse::<DiffusionModel>().unwrap_err().to_string();
-        assert!(e.contains("dipole, better-dipole, pbd"), "{e}");
     }
 
-    /// The trait delegates to the dipole's own methods: same numbers.
+    /// Through the family (the fit's `eval` and the boxed `profile`) the dipole gives exactly its
+    /// own numbers: values and both derivatives at every radius, the total, and the inversion.
     #[test]
     fn dipole_through_trait_is_unchanged() {
         let p = OpticalProperties::new(1.2, 0.03, 1.4).unwrap();
-        let d = dipole::Dipole::new(&p);
-        let any = DiffusionModel::Dipole.profile(&p).unwrap();
-        let radii = [0.1, 1.0, 5.0];
-        let mut out = [ProfileSample {
-            rd: 0.0,
-            d_sigma_s_prime: 0.0,
-            d_sigma_a: 0.0,
-        }; 3];
-        any.profile_with_derivatives_into(&radii, &mut out);
-        for (r, o) in radii.iter().zip(&out) {
-            assert_eq!(any.rd(*r), d.rd(*r));
-            assert_eq!(o.rd, d.rd_with_derivatives(*r).rd);
+        let d = Dipole::new(&p);
+        let family: &dyn ModelFamily = &DiffusionModel::Dipole;
+        let boxed = family.profile(&p).unwrap();
+        let radii = [0.0, 0.1, 1.0, 5.0, 17.0];
+        let mut via_eval = [ProfileSample::ZERO; 5];
+        let mut via_box = [ProfileSample::ZERO; 5];
+        family.eval(&p, &radii, &mut via_eval);
+        boxed.profile_with_derivatives_into(&radii, &mut via_box);
+        for (i, &r) in radii.iter().enumerate() {
+            let want = d.rd_with_derivatives(r);
+            for (what, got) in [("eval", via_eval[i]), ("profile", via_box[i])] {
+                assert_eq!(got.rd, want.rd, "{what} Rd at r = {r}");
+                assert_eq!(
+                    got.d_sigma_s_prime, want.d_sigma_s_prime,
+                    "{what} ∂/∂σ′s at r = {r}"
+                );
+                assert_eq!(got.d_sigma_a, want.d_sigma_a, "{what} ∂/∂σa at r = {r}");
+            }
+            assert_eq!(boxed.rd(r), d.rd(r));
+            // The derivatives are not zero (a comparison of zeros would prove nothing).
+            assert!(want.d_sigma_s_prime != 0.0 && want.d_sigma_a != 0.0);
         }
-        assert_eq!(any.rd_total(), d.rd_total());
+        assert_eq!(boxed.rd_total(), d.rd_total());
         assert_eq!(
-            DiffusionModel::Dipole.rd_total(0.9, 1.4).unwrap(),
+            family.rd_total(0.9, 1.4, 0.0).unwrap(),
             dipole::rd_total(0.9, 1.4)
         );
+        let rd = dipole::rd_total(0.9, 1.4);
+        assert_eq!(
+            family.albedo_from_rd(rd, 1.4, 0.0).unwrap(),
+            dipole::albedo_from_rd(rd, 1.4).unwrap()
+        );
+    }
+
+    /// The improved models through `eval` equal their own `rd_with_derivatives`; a parameter set
+    /// outside a model's range fills NaN, and `profile` refuses it.
+    #[test]
+    fn eval_matches_models_and_fills_nan_outside() {
+        let p = OpticalProperties::new(1.1, 0.05, 1.33).unwrap();
+        let radii = [0.05, 0.5, 3.0];
+        let mut out = [ProfileSample::ZERO; 3];
+        DiffusionModel::BetterDipole.eval(&p, &radii, &mut out);
+        let b = BetterDipole::new(&p).unwrap();
+        for (o, &r) in out.iter().zip(&radii) {
+            assert_eq!(*o, b.rd_with_derivatives(r));
+        }
+        DiffusionModel::Pbd.eval(&p, &radii, &mut out);
+        let m = Pbd::new(&p).unwrap();
+        for (o, &r) in out.iter().zip(&radii) {
+            assert_eq!(*o, m.rd_with_derivatives(r));
+        }
+        let high = OpticalProperties::new(1.1, 0.05, 2.6).unwrap();
+        for m in [DiffusionModel::BetterDipole, DiffusionModel::Pbd] {
+            m.eval(&high, &radii, &mut out);
+            assert!(out.iter().all(|s| s.rd.is_nan() && s.d_sigma_a.is_nan()));
+            assert!(m.profile(&high).is_err());
+        }
+    }
+
+    /// g: the dipoles ignore it (σ′s is all they know), PBD's single scattering uses σs = σ′s/(1 − g)
+    /// (so the total moves), and a g outside (−1, 1) is refused by every model.
+    #[test]
+    fn g_reaches_pbd_only() {
+        let (a, eta) = (0.9, 1.4);
+        for m in [DiffusionModel::Dipole, DiffusionModel::BetterDipole] {
+            assert_eq!(
+                m.rd_total(a, eta, 0.0).unwrap(),
+                m.rd_total(a, eta, 0.7).unwrap()
+            );
+        }
+        let pbd0 = DiffusionModel::Pbd.rd_total(a, eta, 0.0).unwrap();
+        let pbd7 = DiffusionModel::Pbd.rd_total(a, eta, 0.7).unwrap();
+        assert_ne!(pbd0, pbd7);
+        let p = OpticalProperties::new(a, 1.0 - a, eta)
+            .unwrap()
+            .with_g(0.7)
+            .unwrap();
+        assert_eq!(pbd7, DiffusionModel::Pbd.profile(&p).unwrap().rd_total());
+        let back = DiffusionModel::Pbd.albedo_from_rd(pbd7, eta, 0.7).unwrap();
+        assert!((back - a).abs() < 1e-9, "{back}");
+        for m in DiffusionModel::ALL {
+            assert!(m.rd_total(a, eta, 1.0).is_err());
+            assert!(m.albedo_from_rd(0.3, eta, f64::NAN).is_err());
+        }
     }
 }

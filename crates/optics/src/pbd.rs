@@ -39,12 +39,12 @@
 
 use std::f64::consts::PI;
 
-use crate::better_dipole::{Boundary, check_albedo, invert_total};
-use crate::diffusion::{Pair, PairTerm, exp_diff_over_sigma, integrate_doubling};
-use crate::dipole::ProfileSample;
+use crate::diffusion::{
+    Boundary, Pair, PairTerm, check_albedo, exp_diff_over_sigma, integrate_doubling, invert_total,
+};
 use crate::dual::{Dual, Real};
-use crate::error::{OpticsError, Result};
-use crate::model::ProfileModel;
+use crate::error::Result;
+use crate::family::{ProfileModel, ProfileSample};
 use crate::properties::OpticalProperties;
 
 /// Depth samples per sum, pbrt's `nSamples` in both `BeamDiffusionMS` and `BeamDiffusionSS`.
@@ -93,27 +93,14 @@ pub struct Pbd {
 }
 
 impl Pbd {
-    /// PBD for `props` with g = 0 (σs = σ′s), pbrt's default for measured media.
-    ///
-    /// # Errors
-    /// `InvalidParameter` for η > [`FRESNEL_MOMENT_MAX_ETA`].
-    pub fn new(props: &OpticalProperties) -> Result<Self> {
-        Self::with_g(props, 0.0)
-    }
-
-    /// PBD for `props` with Henyey–Greenstein asymmetry `g` (σs = σ′s/(1 − g)); g only changes the
+    /// PBD for `props`, with their Henyey–Greenstein asymmetry g ([`OpticalProperties::g`], 0 —
+    /// pbrt's default for measured media — unless set): σs = σ′s/(1 − g); g only changes the
     /// single-scattering term.
     ///
     /// # Errors
-    /// `InvalidParameter` for g outside (−1, 1) or η > [`FRESNEL_MOMENT_MAX_ETA`].
-    pub fn with_g(props: &OpticalProperties, g: f64) -> Result<Self> {
-        if !(g.is_finite() && g.abs() < 1.0) {
-            return Err(OpticsError::InvalidParameter {
-                name: "g",
-                value: g,
-                reason: "the Henyey–Greenstein asymmetry must lie in (−1, 1)",
-            });
-        }
+    /// `InvalidParameter` for η > [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`].
+    pub fn new(props: &OpticalProperties) -> Result<Self> {
+        let g = props.g();
         let eta = props.eta();
         let bc = Boundary::new(eta)?;
         let sp = Dual::variable(props.sigma_s_prime(), 0);
@@ -164,9 +151,17 @@ impl Pbd {
         &self.props
     }
 
-    /// The Henyey–Greenstein asymmetry g.
+    /// The Henyey–Greenstein asymmetry g (the properties').
     pub fn g(&self) -> f64 {
         self.g
+    }
+
+    /// PBD for `props` with asymmetry `g` instead of theirs: `Pbd::new(&props.with_g(g)?)`.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for g outside (−1, 1) or η > [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`].
+    pub fn with_g(props: &OpticalProperties, g: f64) -> Result<Self> {
+        Self::new(&props.with_g(g)?)
     }
 
     /// The multiple-scattering sum Σᵢ κᵢ E_i (without ρ′²/(4πN)), optionally only its κ-correction
@@ -331,33 +326,35 @@ impl ProfileModel for Pbd {
     }
 }
 
-/// Total diffuse reflectance Rd(α′, η) of PBD with g = 0 (at σ′t = 1; it depends on α′ and η only),
+/// Total diffuse reflectance Rd(α′, η, g) of PBD (at σ′t = 1; it depends on α′, η and g only),
 /// [`Pbd::rd_total`]. 0 at α′ = 0; above 1 near α′ = 1 for most η (PBD is not exactly energy
 /// conserving).
 ///
 /// # Errors
-/// `InvalidParameter` for α′ outside [0, 1] or η outside [1, [`FRESNEL_MOMENT_MAX_ETA`]].
-pub fn rd_total(albedo_prime: f64, eta: f64) -> Result<f64> {
+/// `InvalidParameter` for α′ outside [0, 1], η outside [1, [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`]]
+/// or g outside (−1, 1).
+pub fn rd_total(albedo_prime: f64, eta: f64, g: f64) -> Result<f64> {
     check_albedo(albedo_prime)?;
     Boundary::new(eta)?;
+    crate::error::check_g(g)?;
     if albedo_prime == 0.0 {
         return Ok(0.0);
     }
-    let props = OpticalProperties::new(albedo_prime, 1.0 - albedo_prime, eta)?;
+    let props = OpticalProperties::new(albedo_prime, 1.0 - albedo_prime, eta)?.with_g(g)?;
     Ok(Pbd::new(&props)?.rd_total())
 }
 
-/// The reduced albedo α′ whose PBD total [`rd_total`] equals `rd` at η (g = 0): Rd(α′) rises from 0
+/// The reduced albedo α′ whose PBD total [`rd_total`] equals `rd` at η and g: Rd(α′) rises from 0
 /// to Rd(1) (checked on a grid in the tests), so every rd ∈ (0, Rd(1)] has one α′, found by the
 /// Illinois bracketed root finder in u = √(1 − α′) to |Δu| < 1e-13 (10–30 quadratures, ~10 ms).
 ///
 /// # Errors
 /// `RdOutOfModelRange` for rd outside (0, Rd(1)]; `InvalidParameter` for η outside
-/// [1, [`FRESNEL_MOMENT_MAX_ETA`]].
-pub fn albedo_from_rd(rd: f64, eta: f64) -> Result<f64> {
-    let max = rd_total(1.0, eta)?;
+/// [1, [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`]] or g outside (−1, 1).
+pub fn albedo_from_rd(rd: f64, eta: f64, g: f64) -> Result<f64> {
+    let max = rd_total(1.0, eta, g)?;
     invert_total("photon beam diffusion", rd, eta, max, |a| {
-        rd_total(a, eta).unwrap_or(f64::NAN)
+        rd_total(a, eta, g).unwrap_or(f64::NAN)
     })
 }
 
@@ -473,7 +470,7 @@ mod tests {
                 (p - pbrt).abs() < 1e-6,
                 "pbrt ρ_eff[{i}] = {p}, want {pbrt}"
             );
-            let t = rd_total(a, 1.33).unwrap();
+            let t = rd_total(a, 1.33, 0.0).unwrap();
             assert!((t - exact).abs() < 1e-7, "total[{i}] = {t}, want {exact}");
         }
     }
@@ -492,8 +489,8 @@ mod tests {
         ] {
             // pbrt's Catmull-Rom interpolation between its albedo nodes adds up to ~1e-3.
             assert!((pbrt_rho_eff(rho, 1.33) - kd).abs() < 2e-3, "Kd {kd}");
-            let a = albedo_from_rd(kd, 1.33).unwrap();
-            assert!((rd_total(a, 1.33).unwrap() - kd).abs() < 1e-9);
+            let a = albedo_from_rd(kd, 1.33, 0.0).unwrap();
+            assert!((rd_total(a, 1.33, 0.0).unwrap() - kd).abs() < 1e-9);
             // The exact total is larger than pbrt's truncated one, so the exact α′ is smaller.
             assert!(a <= rho + 1e-6, "Kd {kd}: α′ {a} vs pbrt {rho}");
         }
@@ -508,18 +505,18 @@ mod tests {
             for j in 1..=60 {
                 let t = j as f64 / 60.0;
                 let a = 1.0 - (1.0 - t).powi(3);
-                let rd = rd_total(a, eta).unwrap();
+                let rd = rd_total(a, eta, 0.0).unwrap();
                 assert!(rd > prev, "η = {eta}, α′ = {a}");
                 prev = rd;
             }
         }
-        let max = rd_total(1.0, 1.33).unwrap();
+        let max = rd_total(1.0, 1.33, 0.0).unwrap();
         assert!((max - 1.03262480).abs() < 1e-7);
-        assert_eq!(albedo_from_rd(max, 1.33).unwrap(), 1.0);
-        let err = albedo_from_rd(1.04, 1.33).unwrap_err().to_string();
+        assert_eq!(albedo_from_rd(max, 1.33, 0.0).unwrap(), 1.0);
+        let err = albedo_from_rd(1.04, 1.33, 0.0).unwrap_err().to_string();
         assert!(err.contains("photon beam diffusion"), "{err}");
-        assert!(albedo_from_rd(0.0, 1.33).is_err());
-        assert!(rd_total(0.5, 2.6).is_err());
+        assert!(albedo_from_rd(0.0, 1.33, 0.0).is_err());
+        assert!(rd_total(0.5, 2.6, 0.0).is_err());
     }
 
     /// Analytic derivatives (duals) against central finite differences, g = 0 and g = 0.8.

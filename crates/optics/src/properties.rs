@@ -1,13 +1,20 @@
-//! [`OpticalProperties`]: σ′s, σa and η of one material and one colour channel.
+//! [`OpticalProperties`]: σ′s, σa, η (and the Henyey–Greenstein g) of one material and one colour
+//! channel.
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, eta_at_least_one, non_negative};
+use crate::error::{Result, check_g, eta_at_least_one, non_negative};
 
 /// The optical properties of a homogeneous material in one colour channel.
 ///
-/// Built only through [`OpticalProperties::new`] (or [`OpticalProperties::from_albedo`]); JSON is read
-/// through the same check (`#[serde(try_from)]`), so every value of this type is valid.
+/// Built only through [`OpticalProperties::new`] (or [`OpticalProperties::from_albedo`], and
+/// [`OpticalProperties::with_g`]); JSON is read through the same checks (`#[serde(try_from)]`), so
+/// every value of this type is valid.
+///
+/// g is the Henyey–Greenstein asymmetry of the phase function, 0 (isotropic) unless set. The
+/// measurement gives σ′s = σs(1 − g) only; the diffusion dipoles depend on σ′s alone and ignore g,
+/// photon beam diffusion's single scattering and the Monte Carlo tables use σs = σ′s/(1 − g). JSON
+/// without `g` reads as g = 0, and g = 0 is not written (files stay as they were before g existed).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "RawProperties")]
 pub struct OpticalProperties {
@@ -17,6 +24,13 @@ pub struct OpticalProperties {
     sigma_a: f64,
     /// Relative refractive index η = n_material / n_air [1].
     eta: f64,
+    /// Henyey–Greenstein asymmetry g ∈ (−1, 1) [1].
+    #[serde(skip_serializing_if = "is_isotropic")]
+    g: f64,
+}
+
+fn is_isotropic(g: &f64) -> bool {
+    *g == 0.0
 }
 
 /// The unchecked shape of [`OpticalProperties`] in files.
@@ -25,17 +39,19 @@ struct RawProperties {
     sigma_s_prime: f64,
     sigma_a: f64,
     eta: f64,
+    #[serde(default)]
+    g: f64,
 }
 
 impl TryFrom<RawProperties> for OpticalProperties {
     type Error = crate::OpticsError;
     fn try_from(raw: RawProperties) -> Result<Self> {
-        Self::new(raw.sigma_s_prime, raw.sigma_a, raw.eta)
+        Self::new(raw.sigma_s_prime, raw.sigma_a, raw.eta)?.with_g(raw.g)
     }
 }
 
 impl OpticalProperties {
-    /// Checked constructor: σ′s > 0, σa ≥ 0, both finite, η ≥ 1.
+    /// Checked constructor: σ′s > 0, σa ≥ 0, both finite, η ≥ 1; g = 0.
     ///
     /// # Errors
     /// [`crate::OpticsError::InvalidParameter`] naming the offending quantity.
@@ -54,6 +70,19 @@ impl OpticalProperties {
             sigma_s_prime,
             sigma_a,
             eta,
+            g: 0.0,
+        })
+    }
+
+    /// The same properties with Henyey–Greenstein asymmetry `g` (σ′s, σa and η unchanged: σs =
+    /// σ′s/(1 − g) changes with g).
+    ///
+    /// # Errors
+    /// [`crate::OpticsError::InvalidParameter`] for g outside (−1, 1) or not finite.
+    pub fn with_g(self, g: f64) -> Result<Self> {
+        Ok(Self {
+            g: check_g(g)?,
+            ..self
         })
     }
 
@@ -70,6 +99,17 @@ impl OpticalProperties {
     /// Relative refractive index η = n_material / n_air [1].
     pub fn eta(&self) -> f64 {
         self.eta
+    }
+
+    /// Henyey–Greenstein asymmetry g [1] (0 unless set by [`OpticalProperties::with_g`]).
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+
+    /// Scattering coefficient σs = σ′s/(1 − g) [mm⁻¹] (the similarity relation; Wyman, Patterson &
+    /// Wilson 1989).
+    pub fn sigma_s(&self) -> f64 {
+        self.sigma_s_prime / (1.0 - self.g)
     }
 
     /// Reduced extinction coefficient σ′t = σa + σ′s [mm⁻¹].
@@ -122,11 +162,31 @@ mod tests {
             r#"{"sigma_s_prime":-1,"sigma_a":0.1,"eta":1.3}"#,
             r#"{"sigma_s_prime":1,"sigma_a":-0.1,"eta":1.3}"#,
             r#"{"sigma_s_prime":1,"sigma_a":0.1,"eta":0.5}"#,
+            r#"{"sigma_s_prime":1,"sigma_a":0.1,"eta":1.3,"g":1}"#,
         ] {
             assert!(
                 serde_json::from_str::<OpticalProperties>(bad).is_err(),
                 "{bad}"
             );
         }
+    }
+
+    /// g defaults to 0 (old files read), is written only when set, round-trips, and is checked.
+    #[test]
+    fn g_is_optional_checked_and_round_trips() {
+        let p = OpticalProperties::new(1.2, 0.03, 1.4).unwrap();
+        assert_eq!(p.g(), 0.0);
+        assert_eq!(p.sigma_s(), 1.2);
+        let json = serde_json::to_string(&p).unwrap();
+        assert_eq!(json, r#"{"sigma_s_prime":1.2,"sigma_a":0.03,"eta":1.4}"#);
+        let q = p.with_g(0.5).unwrap();
+        assert_eq!((q.g(), q.sigma_s_prime(), q.sigma_s()), (0.5, 1.2, 2.4));
+        let json = serde_json::to_string(&q).unwrap();
+        assert!(json.contains(r#""g":0.5"#), "{json}");
+        assert_eq!(serde_json::from_str::<OpticalProperties>(&json).unwrap(), q);
+        for bad in [1.0, -1.0, f64::NAN, 2.0] {
+            assert!(p.with_g(bad).is_err(), "{bad}");
+        }
+        assert_eq!(p.with_g(-0.3).unwrap().g(), -0.3);
     }
 }

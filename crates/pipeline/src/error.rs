@@ -61,6 +61,14 @@ pub enum PipelineError {
     Input(String),
 }
 
+/// The forward-model factory's failure (the Monte Carlo tables shipped with scatterfit do not load)
+/// as bad input, as the commands report it.
+impl From<scatterfit_mc::McError> for PipelineError {
+    fn from(e: scatterfit_mc::McError) -> Self {
+        PipelineError::Input(format!("the Monte Carlo tables: {e}"))
+    }
+}
+
 impl PipelineError {
     /// True when the tool ran and the measurement failed (exit 1); false for bad input or usage
     /// (exit 2). Pixel work that fails on valid files — a response that cannot be recovered, a spot

@@ -1,12 +1,8 @@
 //! Stage 4: the fit per channel, and its conversion into the result file's shape.
 
-use scatterfit_fit::{
-    ChannelInput, Diffusion, DipoleModel, FitOptions, FitReport, McModel, Method, PreparedFit,
-    ProfileData, ProfileModel, Spot, Start,
-};
-use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
+use scatterfit_fit::{ChannelInput, FitOptions, FitReport, PreparedFit, ProfileData, Spot, Start};
 use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
-use scatterfit_optics::model::DiffusionModel;
+use scatterfit_optics::{AlbedoModel, Channel, Method, ModelFamily, ModelName};
 use serde::Serialize;
 
 use crate::error::{PipelineError, Result};
@@ -16,11 +12,11 @@ use crate::spectro::SpectroStage;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitSettings {
     /// proposed | existing.
-    pub method: MethodName,
-    /// The forward model.
+    pub method: Method,
+    /// The forward model (`scatterfit_mc::family` makes it).
     pub model: ModelName,
-    /// How α′ comes from the spectrophotometer's Rd.
-    pub albedo_model: AlbedoModelName,
+    /// How α′ comes from the spectrophotometer's Rd (`scatterfit_mc::albedo_family`).
+    pub albedo_model: AlbedoModel,
     /// Radius of the light spot [mm]; the model is convolved with it.
     pub spot_radius_mm: f64,
     /// Innermost fitted radius [mm] (default: the spot's diameter).
@@ -36,10 +32,7 @@ impl FitSettings {
     /// [`PipelineError::Input`] for a spot radius or r_min the ring selection refuses (the
     /// manifest and the commands check both before).
     pub fn options(&self) -> Result<FitOptions> {
-        let mut o = FitOptions::new(match self.method {
-            MethodName::Proposed => Method::Proposed,
-            MethodName::Existing => Method::Existing,
-        });
+        let mut o = FitOptions::new(self.method);
         o.spot = Spot::Disk {
             radius_mm: self.spot_radius_mm,
         };
@@ -56,40 +49,6 @@ impl FitSettings {
     /// The innermost fitted radius [mm]: the given one, else the spot's diameter.
     pub fn r_min_mm(&self) -> f64 {
         self.r_min_mm.unwrap_or(2.0 * self.spot_radius_mm)
-    }
-}
-
-/// The forward model for `name`: the dipole (Jensen et al. 2001), the better dipole (d'Eon 2012),
-/// photon beam diffusion (Habel et al. 2013) or the Monte Carlo tables shipped with scatterfit.
-///
-/// # Errors
-/// [`PipelineError::Input`] when the Monte Carlo tables cannot be loaded.
-pub fn model_for(name: ModelName) -> Result<&'static dyn ProfileModel> {
-    static BETTER: Diffusion = Diffusion(DiffusionModel::BetterDipole);
-    static PBD: Diffusion = Diffusion(DiffusionModel::Pbd);
-    Ok(match name {
-        ModelName::Dipole => &DipoleModel,
-        ModelName::BetterDipole => &BETTER,
-        ModelName::Pbd => &PBD,
-        ModelName::Mc => McModel::bundled()
-            .map_err(|e| PipelineError::Input(format!("the Monte Carlo tables: {e}")))?,
-    })
-}
-
-/// The model whose total Rd(α′, η) is inverted for α′: the profile model's own for `diffusion`
-/// (the dipole's closed form — the paper's eq. 1 — when the profile model is `mc`), the Monte Carlo
-/// tables' for `mc`.
-///
-/// # Errors
-/// As [`model_for`].
-pub fn albedo_model_for(
-    albedo: AlbedoModelName,
-    model: ModelName,
-) -> Result<&'static dyn ProfileModel> {
-    match (albedo, model) {
-        (AlbedoModelName::Mc, _) => model_for(ModelName::Mc),
-        (AlbedoModelName::Diffusion, ModelName::Mc) => model_for(ModelName::Dipole),
-        (AlbedoModelName::Diffusion, m) => model_for(m),
     }
 }
 
@@ -127,7 +86,7 @@ pub fn fit_stage(
     profiles: &[ProfileData],
     spectro: &SpectroStage,
     settings: &FitSettings,
-    model: &dyn ProfileModel,
+    model: &dyn ModelFamily,
 ) -> Vec<ChannelOutcome> {
     let opts = match settings.options() {
         Ok(o) => o,
@@ -140,20 +99,21 @@ pub fn fit_stage(
                 .collect();
         }
     };
-    let names = ["R", "G", "B"];
     profiles
         .iter()
         .enumerate()
         .map(|(c, data)| {
             let albedo = spectro.albedo_prime.get(c).copied().flatten();
-            if settings.method == MethodName::Proposed && albedo.is_none() {
+            if settings.method == Method::Proposed && albedo.is_none() {
                 return ChannelOutcome::NotFitted {
                     problem: spectro
                         .problems
                         .get(c)
                         .cloned()
                         .flatten()
-                        .unwrap_or_else(|| format!("channel {}: no reduced albedo", names[c])),
+                        .unwrap_or_else(|| {
+                            format!("channel {}: no reduced albedo", channel_name(c))
+                        }),
                 };
             }
             let input = ChannelInput {
@@ -164,11 +124,16 @@ pub fn fit_stage(
             match scatterfit_fit::fit_channel(data, &input, model, &opts) {
                 Ok(r) => ChannelOutcome::Fitted(Box::new(r)),
                 Err(e) => ChannelOutcome::NotFitted {
-                    problem: format!("channel {}: {e}", names.get(c).unwrap_or(&"?")),
+                    problem: format!("channel {}: {e}", channel_name(c)),
                 },
             }
         })
         .collect()
+}
+
+/// "R", "G", "B" for 0, 1, 2 ("?" beyond).
+fn channel_name(c: usize) -> &'static str {
+    Channel::ALL.get(c).map_or("?", |ch| ch.name())
 }
 
 /// The part of a channel's uncertainty that the spectrophotometer contributes [mm⁻¹].
@@ -192,14 +157,14 @@ pub fn propagate_spectro(
     profiles: &[ProfileData],
     spectro: &SpectroStage,
     settings: &FitSettings,
-    model: &dyn ProfileModel,
+    model: &dyn ModelFamily,
     fits: &[ChannelOutcome],
 ) -> Vec<Option<SpectroErrors>> {
     let Ok(opts) = settings.options() else {
         return vec![None; fits.len()];
     };
     let u = &spectro.uncertainty;
-    let proposed = settings.method == MethodName::Proposed;
+    let proposed = settings.method == Method::Proposed;
     fits.iter()
         .zip(profiles)
         .enumerate()

@@ -22,3 +22,7 @@ pub mod spectro;
 
 pub use error::{PipelineError, Result};
 pub use measure::{Measurement, Overrides, Stage, Timings, measure_sample, sample_dirs};
+/// The one name → forward model factory (the Monte Carlo tables live in `scatterfit_mc`).
+pub use scatterfit_mc::{albedo_family, family};
+/// The vocabulary a program using the pipeline needs: what to fit with, and per-channel values.
+pub use scatterfit_optics::{AlbedoModel, Channel, Method, ModelFamily, ModelName, Rgb};

@@ -5,17 +5,16 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use scatterfit_fit::ProfileData;
-use scatterfit_io::manifest::{
-    AlbedoModelName, MethodName, ModelName, SampleManifest, read_manifest,
-};
+use scatterfit_io::manifest::{SampleManifest, read_manifest};
 use scatterfit_io::result_json::{Channels, FileRef, Inputs, MeasurementResult};
+use scatterfit_mc::{albedo_family, family};
+use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
 use crate::fit::{
-    ChannelOutcome, FitSettings, SpectroErrors, albedo_model_for, channel_result, fit_stage,
-    model_for, propagate_spectro,
+    ChannelOutcome, FitSettings, SpectroErrors, channel_result, fit_stage, propagate_spectro,
 };
 use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
 use crate::profile::{ProfileSettings, ProfileStage, profile_stage};
@@ -25,11 +24,11 @@ use crate::spectro::{SpectroStage, spectro_stage};
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Overrides {
     /// proposed | existing.
-    pub method: Option<MethodName>,
+    pub method: Option<Method>,
     /// The forward model.
     pub model: Option<ModelName>,
     /// How α′ comes from the spectrophotometer.
-    pub albedo_model: Option<AlbedoModelName>,
+    pub albedo_model: Option<AlbedoModel>,
     /// η instead of the measured one.
     pub eta: Option<f64>,
     /// Fix the scale by the spectrophotometer.
@@ -98,20 +97,16 @@ pub struct Timings {
 pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSettings> {
     let method = o.method.or(manifest.fit.method).unwrap_or_default();
     let model = o.model.or(manifest.fit.model).unwrap_or_default();
-    model_for(model)?;
-    let albedo_model =
-        o.albedo_model
-            .or(manifest.fit.albedo_model)
-            .unwrap_or(if model == ModelName::Mc {
-                AlbedoModelName::Mc
-            } else {
-                AlbedoModelName::Diffusion
-            });
+    family(model)?;
+    let albedo_model = o
+        .albedo_model
+        .or(manifest.fit.albedo_model)
+        .unwrap_or(AlbedoModel::default_for(model));
     let normalise = o
         .normalise_with_spectro
         .or(manifest.fit.normalise_with_spectro)
         .unwrap_or(false);
-    if normalise && method == MethodName::Existing {
+    if normalise && method == Method::Existing {
         return Err(PipelineError::Input(
             "normalising with the spectrophotometer applies to the proposed method only".into(),
         ));
@@ -140,9 +135,9 @@ pub fn measure_sample(
     let t0 = Instant::now();
     let manifest = read_manifest(dir)?;
     let settings = fit_settings(&manifest, overrides)?;
-    let model = model_for(settings.model)?;
+    let model = family(settings.model)?;
     progress(Stage::Spectro);
-    let albedo = albedo_model_for(settings.albedo_model, settings.model)?;
+    let albedo = albedo_family(settings.albedo_model, settings.model)?;
     let spectro = spectro_stage(&manifest, overrides.eta, albedo)?;
     let spectro_s = t0.elapsed().as_secs_f64();
     let hdr = match &manifest.camera.hdr {
@@ -231,10 +226,10 @@ impl Measurement {
     ///
     /// # Errors
     /// [`PipelineError::Input`] as [`fit_settings`].
-    pub fn refit(&self, method: MethodName) -> Result<Measurement> {
+    pub fn refit(&self, method: Method) -> Result<Measurement> {
         let mut settings = self.settings;
         settings.method = method;
-        if method == MethodName::Existing {
+        if method == Method::Existing {
             settings.normalise_with_spectro = false;
         }
         self.refit_with(settings)
@@ -261,8 +256,8 @@ impl Measurement {
     }
 
     fn refit_inner(&self, settings: FitSettings, propagate: bool) -> Result<Measurement> {
-        let model = model_for(settings.model)?;
-        let albedo = albedo_model_for(settings.albedo_model, settings.model)?;
+        let model = family(settings.model)?;
+        let albedo = albedo_family(settings.albedo_model, settings.model)?;
         let spectro = self.spectro.with_albedo_model(albedo);
         let t = Instant::now();
         let data: Vec<ProfileData> = (0..3)
@@ -333,9 +328,9 @@ impl Measurement {
             eta_source: self.spectro.eta_source.into(),
             eta_stderr: self.spectro.uncertainty.eta_stderr,
             spectro_repeatability: Some(self.spectro.uncertainty.repeatability),
-            method: self.settings.method.as_str().into(),
-            model: self.settings.model.as_str().into(),
-            albedo_model: self.settings.albedo_model.as_str().into(),
+            method: self.settings.method.name().into(),
+            model: self.settings.model.name().into(),
+            albedo_model: self.settings.albedo_model.name().into(),
             channels,
             inputs: Inputs {
                 sample_dir: m.dir.to_string_lossy().into_owned(),
@@ -348,9 +343,9 @@ impl Measurement {
                 spot_radius_mm: Some(self.settings.spot_radius_mm),
                 center_px: Some(self.profile.center.xy()),
                 options: serde_json::json!({
-                    "method": self.settings.method.as_str(),
-                    "model": self.settings.model.as_str(),
-                    "albedo_model": self.settings.albedo_model.as_str(),
+                    "method": self.settings.method.name(),
+                    "model": self.settings.model.name(),
+                    "albedo_model": self.settings.albedo_model.name(),
                     "normalise_with_spectro": self.settings.normalise_with_spectro,
                     "r_min_mm": self.settings.r_min_mm(),
                     "r_max_px": m.fit.r_max_px.unwrap_or(300.0),

@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use scatterfit_fit::ProfileModel;
 use scatterfit_io::manifest::SampleManifest;
 use scatterfit_optics::colour::{Lab, Observer};
 use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
+use scatterfit_optics::{Channel, ModelFamily};
 use serde::Serialize;
 
 use crate::error::{PipelineError, Result};
@@ -74,7 +74,7 @@ impl SpectroUncertainty {
 
 impl SpectroStage {
     /// The same reading with α′ from another model's total Rd(α′, η).
-    pub fn with_albedo_model(&self, albedo: &dyn ProfileModel) -> SpectroStage {
+    pub fn with_albedo_model(&self, albedo: &dyn ModelFamily) -> SpectroStage {
         from_rd(
             Reading {
                 file: self.file.clone(),
@@ -130,7 +130,7 @@ fn eta_pm(analysis: &SpectroAnalysis, repeatability: f64) -> [f64; 2] {
 pub fn spectro_stage(
     manifest: &SampleManifest,
     eta: Option<f64>,
-    albedo: &dyn ProfileModel,
+    albedo: &dyn ModelFamily,
 ) -> Result<SpectroStage> {
     let eta = eta.or(manifest.spectro.eta);
     let lab = manifest.spectro.lab.map(|[l, a, b]| {
@@ -186,7 +186,7 @@ pub fn from_reading(
     lab: Option<(Lab, Observer)>,
     eta: Option<f64>,
     repeatability: f64,
-    albedo: &dyn ProfileModel,
+    albedo: &dyn ModelFamily,
 ) -> Result<SpectroStage> {
     if let Some(e) = eta
         && !(e.is_finite() && e >= 1.0)
@@ -224,7 +224,11 @@ pub fn from_reading(
     ))
 }
 
-fn from_rd(reading: Reading, albedo: &dyn ProfileModel) -> SpectroStage {
+/// The Henyey–Greenstein g α′ is inverted at: 0, an isotropic medium with σs = σ′s (what the
+/// measurement assumes; the diffusion dipoles do not depend on it).
+const ISOTROPIC: f64 = 0.0;
+
+fn from_rd(reading: Reading, albedo: &dyn ModelFamily) -> SpectroStage {
     let Reading {
         file,
         analysis,
@@ -235,18 +239,17 @@ fn from_rd(reading: Reading, albedo: &dyn ProfileModel) -> SpectroStage {
         repeatability,
         eta_pm,
     } = reading;
-    let names = ["R", "G", "B"];
     let mut albedo_prime = [None; 3];
     let mut problems: [Option<String>; 3] = Default::default();
     for c in 0..3 {
         // The paper's eq. (1) (the dipole's total diffuse reflectance, inverted) or the same
         // inversion with another model's total.
-        match albedo.albedo_from_rd(rd[c], eta) {
+        match albedo.albedo_from_rd(rd[c], eta, ISOTROPIC) {
             Ok(a) => albedo_prime[c] = Some(a),
             Err(e) => {
                 problems[c] = Some(format!(
                     "channel {}: α′ from Rd = {:.4} by the {} total: {e}",
-                    names[c],
+                    Channel::ALL[c].name(),
                     rd[c],
                     albedo.name()
                 ));
@@ -256,7 +259,11 @@ fn from_rd(reading: Reading, albedo: &dyn ProfileModel) -> SpectroStage {
     let rd_pm: [[f64; 2]; 3] =
         std::array::from_fn(|c| [rd[c] * (1.0 - repeatability), rd[c] * (1.0 + repeatability)]);
     let albedo_pm: [[Option<f64>; 2]; 3] = std::array::from_fn(|c| {
-        std::array::from_fn(|k| albedo.albedo_from_rd(rd_pm[c][k], eta_pm[k]).ok())
+        std::array::from_fn(|k| {
+            albedo
+                .albedo_from_rd(rd_pm[c][k], eta_pm[k], ISOTROPIC)
+                .ok()
+        })
     });
     let albedo_prime_stderr = std::array::from_fn(|c| match albedo_pm[c] {
         [Some(a0), Some(a1)] => Some(0.5 * (a1 - a0).abs()),

@@ -4,9 +4,9 @@
 //! within 5 % and σa within 12 % (median over channels with α′ in [0.9, 0.9995] and η ≤ 1.6), η
 //! within 0.005 — on the quick rig (256² px at 0.1 mm/px, a tenth of the photons; fixed seeds).
 
-use scatterfit_io::manifest::MethodName;
 use scatterfit_io::result_json::{ChannelStatus, parse_result_json};
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
+use scatterfit_optics::Method;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
@@ -77,7 +77,7 @@ fn proposed_method_meets_the_targets_on_twin_samples() {
             sa_err.push((ch.sigma_a.unwrap() / m.sigma_a[c] - 1.0).abs());
         }
         // The existing method runs on the same profile without failing outright.
-        let existing = meas.refit(MethodName::Existing).unwrap();
+        let existing = meas.refit(Method::Existing).unwrap();
         assert_eq!(existing.fits.len(), 3);
     }
     assert!(sp_err.len() >= 9, "{} channels in range", sp_err.len());

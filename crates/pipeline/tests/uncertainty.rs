@@ -10,11 +10,11 @@ use std::path::Path;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use scatterfit_fit::{DipoleModel, ProfileData, Ring};
-use scatterfit_io::manifest::{AlbedoModelName, MethodName, ModelName};
+use scatterfit_fit::{ProfileData, Ring};
 use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
 use scatterfit_optics::spectro::SpectroReading;
+use scatterfit_optics::{AlbedoModel, DiffusionModel, Method, ModelName};
 use scatterfit_pipeline::fit::{FitSettings, fit_stage, propagate_spectro};
 use scatterfit_pipeline::spectro::{SpectroStage, from_reading};
 
@@ -40,7 +40,7 @@ fn stage(f: f64, repeatability: f64) -> SpectroStage {
         None,
         None,
         repeatability,
-        &DipoleModel,
+        &DiffusionModel::Dipole,
     )
     .unwrap()
 }
@@ -131,21 +131,21 @@ fn profiles(s: &SpectroStage) -> Vec<ProfileData> {
 #[test]
 fn sigma_errors_match_refits_of_repeated_readings() {
     let settings = FitSettings {
-        method: MethodName::Proposed,
+        method: Method::Proposed,
         model: ModelName::Dipole,
-        albedo_model: AlbedoModelName::Diffusion,
+        albedo_model: AlbedoModel::Diffusion,
         spot_radius_mm: 0.5,
         r_min_mm: Some(1.0),
         normalise_with_spectro: false,
     };
     let nominal = stage(1.0, EPS);
     let data = profiles(&nominal);
-    let fits = fit_stage(&data, &nominal, &settings, &DipoleModel);
-    let errors = propagate_spectro(&data, &nominal, &settings, &DipoleModel, &fits);
+    let fits = fit_stage(&data, &nominal, &settings, &DiffusionModel::Dipole);
+    let errors = propagate_spectro(&data, &nominal, &settings, &DiffusionModel::Dipole, &fits);
     let (mut sp, mut sa) = (vec![Vec::new(); 3], vec![Vec::new(); 3]);
     for f in draws() {
         let s = stage(f, 0.0);
-        for (c, outcome) in fit_stage(&data, &s, &settings, &DipoleModel)
+        for (c, outcome) in fit_stage(&data, &s, &settings, &DiffusionModel::Dipole)
             .iter()
             .enumerate()
         {

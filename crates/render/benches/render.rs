@@ -3,6 +3,7 @@
 //! Run: `cargo bench -p scatterfit-render --bench render`.
 
 use divan::{Bencher, black_box};
+use scatterfit_optics::Rgb;
 use scatterfit_render::{
     Material, Method, RenderOptions, Scene, Shape, render, studio, studio_lights,
 };
@@ -15,7 +16,7 @@ const SIZE: usize = 512;
 
 fn material() -> Material {
     Material::dipole(
-        [(1.979, 0.000792), (1.893, 0.0496), (1.992, 0.0227)],
+        Rgb::from_array([(1.979, 0.000792), (1.893, 0.0496), (1.992, 0.0227)]),
         1.2886,
     )
     .unwrap()

@@ -21,6 +21,25 @@ pub enum RenderError {
     /// Optical properties refused by `scatterfit-optics`.
     #[error(transparent)]
     Optics(#[from] scatterfit_optics::OpticsError),
+    /// A channel's parameters outside what the chosen profile model covers.
+    #[error(
+        "the {model} model cannot take channel {channel} (σ′s = {sigma_s_prime}, σa = {sigma_a} \
+         mm⁻¹, η = {eta}): {source}"
+    )]
+    Profile {
+        /// The profile model.
+        model: scatterfit_optics::ModelName,
+        /// The channel.
+        channel: scatterfit_optics::Channel,
+        /// σ′s [mm⁻¹].
+        sigma_s_prime: f64,
+        /// σa [mm⁻¹].
+        sigma_a: f64,
+        /// η.
+        eta: f64,
+        /// Why.
+        source: scatterfit_optics::OpticsError,
+    },
     /// An image could not be built (zero size).
     #[error("image: {0}")]
     Image(#[from] scatterfit_imaging::ShapeError),

@@ -8,8 +8,9 @@
 //!   diffuse, translucent and anisotropic specular terms.
 //! - **Texture-space dipole method** ([`texture_space`], §4.2, eq. 6): the dipole BSSRDF integrated
 //!   over irradiance sampled on the surface, evaluated hierarchically (Jensen & Buhler 2002).
-//! - **Profile model** ([`RadialProfile`]): the forward model Rd(r) per channel; the classical
-//!   dipole now, any other model later, without touching the renderer.
+//! - **Profile model** ([`Material`]): the forward model Rd(r) per channel, a
+//!   `scatterfit_optics::ProfileModel` from any `ModelFamily` (the classical dipole, the better
+//!   dipole, photon beam diffusion, the Monte Carlo tables), without touching the renderer.
 //! - **Radiance** in relative units: an irradiance of 1 on a white Lambertian surface facing the
 //!   light gives 1/π. Linear sRGB, D65; [`tonemap`] makes an 8-bit sRGB picture of it.
 //!
@@ -36,7 +37,7 @@ pub mod validation;
 
 pub use error::{RenderError, Result};
 pub use mesh::Mesh;
-pub use profile::{Material, RadialProfile, RdTable};
+pub use profile::{Material, RdTable};
 pub use render::{Method, RenderOptions, RenderStats, Rendered, Timings, render};
 pub use scene::{Camera, Light, Projection, Scene};
 pub use scenes::{Shape, studio, studio_lights};

@@ -1,47 +1,30 @@
-//! The forward model as a parameter: a per-channel radial profile Rd(r), and the material the
-//! renderer shades with.
-//!
-//! Any profile model the fit offers (classical dipole now; better dipole, photon beam diffusion or a
-//! Monte Carlo table later) plugs in through [`RadialProfile`] without touching the renderer.
+//! The forward model as a parameter: the material the renderer shades with holds one radial
+//! profile Rd(r) per channel, a [`ProfileModel`] built by any [`ModelFamily`] (the classical dipole,
+//! the better dipole, photon beam diffusion, the Monte Carlo tables: the caller chooses, e.g. with
+//! `scatterfit_mc::family`), without touching the renderer.
 
-use scatterfit_optics::OpticalProperties;
-use scatterfit_optics::dipole::Dipole;
+use scatterfit_optics::{
+    Channel, DiffusionModel, ModelFamily, ModelName, OpticalProperties, ProfileModel, Rgb,
+};
 
-use crate::error::{Result, invalid};
-
-/// A radially resolved diffuse reflectance profile of a semi-infinite medium lit by a pencil beam at
-/// normal incidence.
-pub trait RadialProfile: Send + Sync {
-    /// Rd(r) [mm⁻²] at distance `r_mm` from the point of incidence; finite and ≥ 0.
-    fn rd(&self, r_mm: f64) -> f64;
-    /// Total diffuse reflectance ∫₀^∞ 2πr Rd(r) dr (dimensionless).
-    fn rd_total(&self) -> f64;
-}
-
-/// The classical dipole of Jensen et al. 2001, eq. (4) (`scatterfit_optics::dipole`).
-impl RadialProfile for Dipole {
-    fn rd(&self, r_mm: f64) -> f64 {
-        Dipole::rd(self, r_mm)
-    }
-
-    fn rd_total(&self) -> f64 {
-        Dipole::rd_total(self)
-    }
-}
+use crate::error::{RenderError, Result};
 
 /// What the renderer shades with: η, σ′s and σa per linear-sRGB channel (the subsurface colour
-/// method uses them directly) and a radial profile per channel (the texture-space method).
+/// method uses them directly) and a radial profile per channel (the texture-space method), built by
+/// one model family.
 pub struct Material {
     eta: f64,
-    coefficients: [(f64, f64); 3],
-    profiles: [Box<dyn RadialProfile>; 3],
-    model: String,
+    g: f64,
+    coefficients: Rgb<(f64, f64)>,
+    profiles: Rgb<Box<dyn ProfileModel>>,
+    model: ModelName,
 }
 
 impl std::fmt::Debug for Material {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Material")
             .field("eta", &self.eta)
+            .field("g", &self.g)
             .field("coefficients", &self.coefficients)
             .field("model", &self.model)
             .finish()
@@ -49,57 +32,51 @@ impl std::fmt::Debug for Material {
 }
 
 impl Material {
-    /// The material with the classical dipole as its profile model. `coefficients` are (σ′s, σa)
-    /// [mm⁻¹] per R, G, B channel.
+    /// The material with `family`'s profile per channel: `coefficients` are (σ′s, σa) [mm⁻¹] per
+    /// channel, η the relative refractive index, g the Henyey–Greenstein asymmetry (0 for measured
+    /// parameters; the dipoles ignore it).
     ///
     /// # Errors
-    /// The optics crate's refusal of a coefficient (σ′s ≤ 0, σa < 0, η < 1, non-finite).
-    pub fn dipole(coefficients: [(f64, f64); 3], eta: f64) -> Result<Self> {
-        let mut profiles: Vec<Box<dyn RadialProfile>> = Vec::with_capacity(3);
-        for &(sp, sa) in &coefficients {
-            let props = OpticalProperties::new(sp, sa, eta)?;
-            profiles.push(Box::new(Dipole::new(&props)));
-        }
-        let profiles: [Box<dyn RadialProfile>; 3] = match profiles.try_into() {
-            Ok(p) => p,
-            Err(_) => unreachable!("three channels"),
-        };
+    /// [`RenderError::Optics`] for a coefficient, η or g the optics crate refuses (σ′s ≤ 0, σa < 0,
+    /// η < 1, |g| ≥ 1, non-finite); [`RenderError::Profile`] naming the channel when the model does
+    /// not cover its parameters (η > 2.5 for the improved diffusion models, outside the Monte Carlo
+    /// tables).
+    pub fn new(
+        family: &dyn ModelFamily,
+        coefficients: Rgb<(f64, f64)>,
+        eta: f64,
+        g: f64,
+    ) -> Result<Self> {
+        let props = coefficients
+            .map(|(sp, sa)| OpticalProperties::new(sp, sa, eta).and_then(|p| p.with_g(g)))
+            .transpose()?;
+        let profiles = props
+            .map_with_channel(|channel, p| {
+                family.profile(&p).map_err(|source| RenderError::Profile {
+                    model: family.name(),
+                    channel,
+                    sigma_s_prime: p.sigma_s_prime(),
+                    sigma_a: p.sigma_a(),
+                    eta,
+                    source,
+                })
+            })
+            .transpose()?;
         Ok(Self {
             eta,
+            g,
             coefficients,
             profiles,
-            model: "dipole".into(),
+            model: family.name(),
         })
     }
 
-    /// A material with any profile model (`model` names it in reports).
+    /// The material with the classical dipole (Jensen et al. 2001) as its profile model, g = 0.
     ///
     /// # Errors
-    /// [`crate::RenderError::InvalidOption`] for η < 1 or a coefficient out of domain.
-    pub fn with_profiles(
-        coefficients: [(f64, f64); 3],
-        eta: f64,
-        profiles: [Box<dyn RadialProfile>; 3],
-        model: &str,
-    ) -> Result<Self> {
-        if !(eta.is_finite() && eta >= 1.0) {
-            return Err(invalid("eta", eta, "must be ≥ 1"));
-        }
-        for &(sp, sa) in &coefficients {
-            if !(sp.is_finite() && sp > 0.0 && sa.is_finite() && sa >= 0.0) {
-                return Err(invalid(
-                    "coefficients",
-                    format!("({sp}, {sa})"),
-                    "need σ′s > 0 and σa ≥ 0 [mm⁻¹]",
-                ));
-            }
-        }
-        Ok(Self {
-            eta,
-            coefficients,
-            profiles,
-            model: model.into(),
-        })
+    /// As [`Material::new`].
+    pub fn dipole(coefficients: Rgb<(f64, f64)>, eta: f64) -> Result<Self> {
+        Self::new(&DiffusionModel::Dipole, coefficients, eta, 0.0)
     }
 
     /// Relative refractive index η.
@@ -107,20 +84,36 @@ impl Material {
         self.eta
     }
 
+    /// Henyey–Greenstein asymmetry g the profiles were built with.
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+
     /// (σ′s, σa) [mm⁻¹] per channel.
-    pub fn coefficients(&self) -> [(f64, f64); 3] {
+    pub fn coefficients(&self) -> Rgb<(f64, f64)> {
         self.coefficients
     }
 
-    /// The profile of channel `c` (0 = R, 1 = G, 2 = B).
-    pub fn profile(&self, c: usize) -> &dyn RadialProfile {
+    /// The profile of channel `c`.
+    pub fn profile(&self, c: Channel) -> &dyn ProfileModel {
         self.profiles[c].as_ref()
     }
 
-    /// The profile model's name, e.g. `dipole`.
-    pub fn model(&self) -> &str {
-        &self.model
+    /// Rd(r) [mm⁻²] of channel `c`, negative values (a model's rounding far out) taken as 0.
+    pub fn rd(&self, c: Channel, r_mm: f64) -> f64 {
+        nonnegative_rd(self.profile(c), r_mm)
     }
+
+    /// The profile model's name.
+    pub fn model(&self) -> ModelName {
+        self.model
+    }
+}
+
+/// Rd(r) ≥ 0: the renderer adds light, never removes it.
+#[inline]
+fn nonnegative_rd(profile: &dyn ProfileModel, r_mm: f64) -> f64 {
+    profile.rd(r_mm).max(0.0)
 }
 
 /// Rd(r) tabulated for fast lookups, linear in q = √r, on [0, r_cut]; 0 beyond r_cut, the radius
@@ -147,21 +140,21 @@ pub struct RdTable {
 const MAX_DQ: f64 = 0.003;
 
 impl RdTable {
-    /// Tabulates `profile` out to at most `r_limit` [mm] (distances beyond never occur).
-    pub fn new(profile: &dyn RadialProfile, r_limit: f64) -> Self {
-        let peak = (0..=100)
-            .map(|i| profile.rd(0.01 * i as f64))
-            .fold(0.0, f64::max);
+    /// Tabulates `profile` (negative values taken as 0) out to at most `r_limit` [mm] (distances
+    /// beyond never occur).
+    pub fn new(profile: &dyn ProfileModel, r_limit: f64) -> Self {
+        let rd = |r: f64| nonnegative_rd(profile, r);
+        let peak = (0..=100).map(|i| rd(0.01 * i as f64)).fold(0.0, f64::max);
         // Find where Rd falls below 1e-9 of the peak (doubling, then bisection).
         let floor = 1e-9 * peak;
         let mut hi = 1.0;
-        while hi < 1000.0 && profile.rd(hi) > floor {
+        while hi < 1000.0 && rd(hi) > floor {
             hi *= 2.0;
         }
         let mut lo = 0.5 * hi;
         for _ in 0..40 {
             let mid = 0.5 * (lo + hi);
-            if profile.rd(mid) > floor {
+            if rd(mid) > floor {
                 lo = mid;
             } else {
                 hi = mid;
@@ -172,7 +165,7 @@ impl RdTable {
         let (mut lo_h, mut hi_h) = (0.0, r_cut);
         for _ in 0..60 {
             let mid = 0.5 * (lo_h + hi_h);
-            if profile.rd(mid) > 0.5 * peak {
+            if rd(mid) > 0.5 * peak {
                 lo_h = mid;
             } else {
                 hi_h = mid;
@@ -185,12 +178,12 @@ impl RdTable {
             .map(|i| {
                 let q = q_max * i as f64 / nodes as f64;
                 let r = q * q;
-                let f = profile.rd(r).max(0.0);
+                let f = rd(r);
                 // Central differences; step 1e-3 of the radius (≥ 5e-5 mm) keeps truncation and
                 // rounding errors near 1e-6 relative. Rd is even in r, so at r = 0 Rd′/r = Rd″.
                 let h = 1e-3 * r.max(0.05);
-                let (fp, fm) = (profile.rd(r + h), profile.rd((r - h).abs()));
-                let d2 = (fp - 2.0 * profile.rd(r) + fm) / (h * h);
+                let (fp, fm) = (rd(r + h), rd((r - h).abs()));
+                let d2 = (fp - 2.0 * rd(r) + fm) / (h * h);
                 let d1_over_r = if r > 0.0 {
                     (fp - fm) / (2.0 * h * r)
                 } else {
@@ -258,6 +251,7 @@ impl RdTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use scatterfit_optics::dipole::Dipole;
 
     /// The table reproduces the dipole to 1e-4 (relative) wherever Rd > 1e-6·Rd(0), for every
     /// material of the paper's Table 1 and the extremes of Jensen's table.

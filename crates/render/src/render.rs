@@ -6,6 +6,7 @@ use std::time::Instant;
 use glam::DVec3;
 use rayon::prelude::*;
 use scatterfit_imaging::ImageBuf;
+use scatterfit_optics::Channel;
 use scatterfit_optics::fresnel::fresnel_dielectric;
 
 use crate::bvh::Ray;
@@ -168,7 +169,8 @@ pub fn render(
         Method::Colour => Shader::Colour {
             layers: material
                 .coefficients()
-                .map(|(sp, sa)| Layer::new(sp, sa, eta, opts.colour.g)),
+                .map(|(sp, sa)| Layer::new(sp, sa, eta, opts.colour.g))
+                .into_array(),
             rho_s: rho_s(&opts.colour, eta),
             params: opts.colour,
         },
@@ -176,7 +178,7 @@ pub fn render(
             let t0 = Instant::now();
             // Distances between surface points never exceed the mesh's bounding-box diagonal.
             let diameter = scene.bvh().bounds().extent().length();
-            let tables = [0, 1, 2].map(|c| RdTable::new(material.profile(c), diameter));
+            let tables = Channel::ALL.map(|c| RdTable::new(material.profile(c), diameter));
             let tables_s = t0.elapsed().as_secs_f64();
             let rays = opts
                 .dipole

@@ -29,6 +29,7 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
+use scatterfit_optics::Channel;
 use scatterfit_optics::fresnel::fresnel_dielectric;
 
 use crate::bvh::Ray;
@@ -306,7 +307,7 @@ impl PointCloud {
     pub fn new(points: Vec<IrradiancePoint>, material: &Material) -> Self {
         Self::with_tables(
             points,
-            [0, 1, 2].map(|c| RdTable::new(material.profile(c), f64::INFINITY)),
+            Channel::ALL.map(|c| RdTable::new(material.profile(c), f64::INFINITY)),
         )
     }
 
@@ -346,7 +347,7 @@ impl PointCloud {
         for p in &self.points {
             let r = (p.p - x).length();
             for (c, a) in acc.iter_mut().enumerate() {
-                *a += p.power[c] * material.profile(c).rd(r);
+                *a += p.power[c] * material.rd(Channel::ALL[c], r);
             }
         }
         acc
@@ -510,6 +511,7 @@ mod tests {
     use super::*;
     use crate::mesh::Mesh;
     use crate::scene::{Camera, Projection};
+    use scatterfit_optics::Rgb;
 
     fn plane_scene(lights: Vec<Light>) -> Scene {
         let mesh = Mesh::slab(400.0, 400.0, 10.0).unwrap();
@@ -531,7 +533,8 @@ mod tests {
     #[test]
     fn uniform_plane_gives_ft_e_rd_over_pi() {
         let eta = 1.3;
-        let material = Material::dipole([(1.0, 0.1), (2.0, 0.05), (0.7, 0.2)], eta).unwrap();
+        let material =
+            Material::dipole(Rgb::from_array([(1.0, 0.1), (2.0, 0.05), (0.7, 0.2)]), eta).unwrap();
         let ft_n = 1.0 - fresnel_dielectric(1.0, eta);
         let e = 2.5;
         let mesh = Mesh::slab(100.0, 100.0, 10.0).unwrap();
@@ -557,7 +560,8 @@ mod tests {
             .collect();
         let to_l = |b: f64| ft_o * b / std::f64::consts::PI;
         for c in 0..3 {
-            let expected = ft_o * e * material.profile(c).rd_total() / std::f64::consts::PI;
+            let expected =
+                ft_o * e * material.profile(Channel::ALL[c]).rd_total() / std::f64::consts::PI;
             for hierarchical in [false, true] {
                 let l: Vec<f64> = positions
                     .iter()
@@ -586,8 +590,11 @@ mod tests {
     #[test]
     fn hierarchy_matches_direct_sum() {
         let eta = 1.2886;
-        let material =
-            Material::dipole([(1.979, 0.000792), (1.893, 0.0496), (1.992, 0.0227)], eta).unwrap();
+        let material = Material::dipole(
+            Rgb::from_array([(1.979, 0.000792), (1.893, 0.0496), (1.992, 0.0227)]),
+            eta,
+        )
+        .unwrap();
         let scene = plane_scene(vec![Light::Spot {
             center: DVec3::ZERO,
             direction: DVec3::Y,

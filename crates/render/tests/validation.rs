@@ -4,8 +4,8 @@
 //! averaged over the light spot by a polar midpoint quadrature, then averaged over the pixels of
 //! each ring exactly as `radial_profile` groups them.
 
-use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
+use scatterfit_optics::{OpticalProperties, Rgb};
 use scatterfit_render::validation::{SpotSetup, render_spot_profile};
 use scatterfit_render::{Material, Method, RenderOptions, Shape, render, studio, studio_lights};
 
@@ -34,7 +34,7 @@ fn spot_averaged(d: &Dipole, a: f64, r: f64) -> f64 {
 fn spot_on_slab_matches_the_model() {
     let coefficients = [(1.979, 0.000792), (1.893, 0.0496), (1.992, 0.0227)];
     let eta = 1.2886;
-    let material = Material::dipole(coefficients, eta).unwrap();
+    let material = Material::dipole(Rgb::from_array(coefficients), eta).unwrap();
     let setup = SpotSetup {
         mm_per_pixel: 0.1,
         r_max_mm: 6.0,
@@ -120,7 +120,7 @@ fn spot_on_slab_matches_the_model() {
 #[test]
 fn deterministic_finite_and_non_negative() {
     let material = Material::dipole(
-        [(1.189, 1.189), (1.742, 0.090597), (1.865, 0.016372)],
+        Rgb::from_array([(1.189, 1.189), (1.742, 0.090597), (1.865, 0.016372)]),
         1.9432,
     )
     .unwrap();
@@ -167,7 +167,7 @@ fn colour_method_on_a_slab_follows_eqs_3_and_4() {
     use scatterfit_render::colour::ColourParams;
     use scatterfit_render::{Camera, Light, Mesh, Projection, Scene};
     let (sp, sa, eta) = (1.2, 0.3, 1.4);
-    let material = Material::dipole([(sp, sa); 3], eta).unwrap();
+    let material = Material::dipole(Rgb::from_array([(sp, sa); 3]), eta).unwrap();
     let fdr = -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta;
     let camera = Camera {
         eye: DVec3::new(0.0, 50.0, 0.0),

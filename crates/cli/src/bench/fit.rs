@@ -3,8 +3,8 @@
 use std::time::Instant;
 
 use anyhow::Context;
-use scatterfit_fit::{ChannelInput, DipoleModel, FitOptions, PreparedFit, Spot};
-use scatterfit_io::manifest::MethodName;
+use scatterfit_fit::{ChannelInput, FitOptions, Method, PreparedFit, Spot};
+use scatterfit_optics::DiffusionModel;
 use scatterfit_pipeline::measure_sample;
 use scatterfit_synth::materials::by_name;
 
@@ -52,26 +52,23 @@ pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
     let cases = [
         (
             "proposed, spot disk convolved (default)",
-            MethodName::Proposed,
+            Method::Proposed,
             true,
         ),
-        ("proposed, point spot", MethodName::Proposed, false),
+        ("proposed, point spot", Method::Proposed, false),
         (
             "existing (σ′s, σa), spot disk convolved",
-            MethodName::Existing,
+            Method::Existing,
             true,
         ),
     ];
     for (label, method, disk) in cases {
-        let mut opts = FitOptions::new(match method {
-            MethodName::Proposed => scatterfit_fit::Method::Proposed,
-            MethodName::Existing => scatterfit_fit::Method::Existing,
-        });
+        let mut opts = FitOptions::new(method);
         if !disk {
             opts.spot = Spot::Point;
         }
-        let prepared = PreparedFit::new(&data, &input, &DipoleModel, &opts)?;
-        let n = if method == MethodName::Existing {
+        let prepared = PreparedFit::new(&data, &input, &DiffusionModel::Dipole, &opts)?;
+        let n = if method == Method::Existing {
             reps / 10
         } else {
             reps

@@ -18,7 +18,7 @@ pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
     let threads = rayon::current_num_threads();
     let m = &scatterfit_synth::materials::CHOI_2014[0];
     let material = Material::dipole(
-        std::array::from_fn(|c| (m.sigma_s_prime[c], m.sigma_a[c])),
+        scatterfit_optics::Rgb::from_fn(|c| (m.sigma_s_prime[c.index()], m.sigma_a[c.index()])),
         m.eta,
     )?;
     let mut figures = Vec::new();
