@@ -9,8 +9,9 @@
 //! file atomically.
 //!
 //! Text: `plotters` runs without font-kit (no FreeType or fontconfig, which a fresh machine may lack);
-//! DejaVu Sans is compiled into the binary and registered with plotters' `ab_glyph` font table as
-//! `sans-serif`, so the PNG always shows its labels and the SVG's text metrics match.
+//! the DejaVu Sans embedded in `scatterfit_imaging::text` is registered with plotters' `ab_glyph`
+//! font table as `sans-serif`, so the SVG's text metrics match, and the PNG's glyphs are drawn by
+//! that module's rasteriser.
 //!
 //! Log axes are drawn in log10 space with our own decade ticks (labels `10⁻⁴ … 10⁰`); values that
 //! cannot be shown (non-finite, or ≤ 0 on a log axis) are skipped, and curves are clipped to the
@@ -113,8 +114,6 @@ const FIGURE_HEIGHT: u32 = 520;
 const TITLE_HEIGHT: u32 = 40;
 /// Font family under which the embedded font is registered.
 const FONT: &str = "sans-serif";
-/// DejaVu Sans (Bitstream Vera licence, assets/DejaVuSans-LICENSE.txt).
-static DEJAVU_SANS: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 const TITLE_SIZE: f64 = 22.0;
 const PANEL_TITLE_SIZE: f64 = 18.0;
@@ -186,21 +185,21 @@ mod glyph_text {
     use plotters_backend::{
         BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingErrorKind,
     };
+    use scatterfit_imaging::text::Font;
 
-    use super::DEJAVU_SANS;
-
-    /// A bitmap backend whose text is rasterised here with `ab_glyph`, glyph by glyph at its pen
-    /// position, side bearing and kerning. plotters 0.3.7's `ab_glyph` text drops each glyph's left side
-    /// bearing, so letters crowd unevenly ("excluded" reads "exduded" at 14 px). Layout (text extents,
-    /// hence label and legend placement) stays plotters' own, which measures advances correctly.
+    /// A bitmap backend whose text is rasterised by `scatterfit_imaging::text`, glyph by glyph at
+    /// its pen position, side bearing and kerning. plotters 0.3.7's `ab_glyph` text drops each
+    /// glyph's left side bearing, so letters crowd unevenly ("excluded" reads "exduded" at 14 px).
+    /// Layout (text extents, hence label and legend placement) stays plotters' own, which measures
+    /// advances correctly.
     pub(super) struct GlyphTextBackend<'a> {
         inner: BitMapBackend<'a>,
-        font: ab_glyph::FontRef<'static>,
+        font: &'static Font,
     }
 
     impl<'a> GlyphTextBackend<'a> {
         pub(super) fn new(inner: BitMapBackend<'a>) -> Result<Self> {
-            let font = ab_glyph::FontRef::try_from_slice(DEJAVU_SANS).map_err(|e| {
+            let font = Font::dejavu_sans().map_err(|e| {
                 anyhow!("the embedded plot font (DejaVu Sans) could not be loaded: {e}")
             })?;
             Ok(Self { inner, font })
@@ -283,8 +282,6 @@ mod glyph_text {
             style: &S,
             pos: BackendCoord,
         ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
-            use ab_glyph::{Font, ScaleFont};
-
             let colour = style.color();
             if colour.alpha == 0.0 {
                 return Ok(());
@@ -304,30 +301,12 @@ mod glyph_text {
                 VPos::Bottom => -height,
             };
             let transform = style.transform();
-            let font = self.font.clone();
-            let scaled = font.as_scaled(style.size() as f32);
-            let cap_height = scaled
-                .outline_glyph(scaled.scaled_glyph('H'))
-                .map_or(0.63 * scaled.height(), |g| -g.px_bounds().min.y);
-            let baseline = (height as f32 + cap_height) / 2.0;
+            let px = style.size() as f32;
+            let baseline = (height as f32 + self.font.cap_height(px)) / 2.0;
             let mut coverage: Vec<(i32, i32, f32)> = Vec::new();
-            let mut pen = 0.0f32;
-            let mut previous = None;
-            for c in text.chars() {
-                let id = scaled.glyph_id(c);
-                if let Some(p) = previous {
-                    pen += scaled.kern(p, id);
-                }
-                let glyph =
-                    id.with_scale_and_position(scaled.scale(), ab_glyph::point(pen, baseline));
-                if let Some(outline) = font.outline_glyph(glyph) {
-                    let bounds = outline.px_bounds();
-                    let (x0, y0) = (bounds.min.x as i32, bounds.min.y as i32);
-                    outline.draw(|x, y, c| coverage.push((x0 + x as i32, y0 + y as i32, c)));
-                }
-                pen += scaled.h_advance(id);
-                previous = Some(id);
-            }
+            self.font
+                .layout(text, px)
+                .coverage((0.0, baseline), |x, y, c| coverage.push((x, y, c)));
             for (x, y, c) in coverage {
                 let (x, y) = transform.transform(x + dx - min_x, y + dy - min_y);
                 let alpha = colour.alpha * f64::from(c.clamp(0.0, 1.0));
@@ -348,7 +327,12 @@ mod glyph_text {
 fn register_font() -> Result<()> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, DEJAVU_SANS).is_ok()
+        plotters::style::register_font(
+            FONT,
+            FontStyle::Normal,
+            scatterfit_imaging::text::DEJAVU_SANS,
+        )
+        .is_ok()
     });
     ensure!(
         ok,
