@@ -101,18 +101,18 @@ impl Font {
         }
     }
 
-    /// Height of the font's ascender above the baseline at `px` [px].
+    /// Height of the font's ascender above the baseline at `px` \[px\].
     pub fn ascent(&self, px: f32) -> f32 {
         self.face.as_scaled(PxScale::from(px)).ascent()
     }
 
-    /// Distance from one baseline to the next at `px` [px]: ascent − descent + line gap.
+    /// Distance from one baseline to the next at `px` \[px\]: ascent − descent + line gap.
     pub fn line_height(&self, px: f32) -> f32 {
         let scaled = self.face.as_scaled(PxScale::from(px));
         scaled.height() + scaled.line_gap()
     }
 
-    /// Height of a capital letter above the baseline at `px` [px]: the top of "H"'s pixel bounds
+    /// Height of a capital letter above the baseline at `px` \[px\]: the top of "H"'s pixel bounds
     /// (whole pixels), or 0.63 of the font height for a font without an "H" outline.
     pub fn cap_height(&self, px: f32) -> f32 {
         let scaled = self.face.as_scaled(PxScale::from(px));
@@ -122,7 +122,7 @@ impl Font {
     }
 }
 
-/// A glyph of a [`Line`] and its pen position [px from the line's start].
+/// A glyph of a [`Line`] and its pen position \[px from the line's start\].
 #[derive(Debug, Clone, Copy)]
 struct PlacedGlyph {
     id: GlyphId,
@@ -139,12 +139,12 @@ pub struct Line<'f> {
 }
 
 impl Line<'_> {
-    /// The advance width of the whole line [px]: where the pen stops after the last glyph.
+    /// The advance width of the whole line \[px\]: where the pen stops after the last glyph.
     pub fn width(&self) -> f32 {
         self.width
     }
 
-    /// Rasterises the line with its pen starting at `origin` (x, baseline y) [px] and calls
+    /// Rasterises the line with its pen starting at `origin` (x, baseline y) \[px\] and calls
     /// `pixel(x, y, coverage)` for every pixel a glyph touches, glyph after glyph, coverage in
     /// 0…1 (anti-aliased; clamp before blending, `ab_glyph` may overshoot slightly). Pixels may lie
     /// outside any image: the caller clips.
@@ -160,7 +160,7 @@ impl Line<'_> {
         }
     }
 
-    /// Draws the line into `image` with its pen starting at `origin` (x, baseline y) [px] in the
+    /// Draws the line into `image` with its pen starting at `origin` (x, baseline y) \[px\] in the
     /// colour `ink`: each touched pixel becomes `(1 − c)·pixel + c·ink`, rounded, per channel in
     /// the buffer's own (sRGB) values, as text renderers blend. The first three channels are
     /// blended (the first only, for a grey image); pixels outside the image are skipped.
