@@ -74,6 +74,8 @@ fn wrap_note<DB: DrawingBackend>(
     Ok(lines)
 }
 
+/// Draws `fig` on `root` (either backend): the series' error counts are checked before anything is
+/// drawn, then the title strip and the panels side by side on shared axes.
 pub(super) fn draw_figure<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     fig: &Figure,
@@ -136,6 +138,8 @@ where
     Ok(())
 }
 
+/// One panel: its title and note lines in a header `header` px tall, then the chart with the mesh,
+/// the series in order, the legend, and "no data to show" when nothing can be drawn.
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     fig: &Figure,
