@@ -55,10 +55,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         args.quiet || args.json,
         &|dir, r| {
             if let Ok(m) = r
-                && let Err(e) = crate::report::write_measurement(dir, m)
+                && let Err(e) = scatterfit_report::write_measurement(dir, m)
                 && let Ok(mut w) = write_errors.lock()
             {
-                w.push((dir.to_path_buf(), crate::common::error_text(&e)));
+                w.push((dir.to_path_buf(), crate::common::error_text(&e.into())));
             }
         },
     )?;
@@ -95,7 +95,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         crate::output::print_json(&results)?;
     } else {
         for r in &results {
-            out!("{}", crate::report::summary_text(r))?;
+            out!("{}", scatterfit_report::summary_text(r))?;
         }
         outln!(
             "\n{} of {} samples measured completely; summary: {} and {}",

@@ -181,7 +181,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&result)?;
     } else {
-        out!("{}", crate::report::summary_text(&result))?;
+        out!("{}", scatterfit_report::summary_text(&result))?;
     }
     Ok(if fits.iter().all(ChannelOutcome::is_measurement) {
         ExitCode::SUCCESS

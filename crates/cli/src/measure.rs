@@ -62,11 +62,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for p in &m.hdr.dropped_alpha {
         errln!("note: {}: alpha channel ignored", p.display());
     }
-    let (result, written) = crate::report::write_measurement(&out, &m)?;
+    let scatterfit_report::WrittenReport {
+        result,
+        files: written,
+    } = scatterfit_report::write_measurement(&out, &m)?;
     if args.json {
         crate::output::print_json(&result)?;
     } else {
-        out!("{}", crate::report::summary_text(&result))?;
+        out!("{}", scatterfit_report::summary_text(&result))?;
         let t = &m.timings;
         outln!(
             "  time: {:.3} s (spectro {:.3}, read {:.3}, merge {:.3}, profile {:.3}, fits {:.4})",

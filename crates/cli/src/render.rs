@@ -35,9 +35,6 @@ use scatterfit_render::{
 };
 use serde::Serialize;
 
-/// DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`) for captions.
-const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-
 /// The built-in models.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum ShapeArg {
@@ -733,7 +730,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 title,
                 ..FigureStyle::default()
             };
-            write_png(out, &compose(&panels, &style, FONT)?)?;
+            write_png(out, &compose(&panels, &style)?)?;
         }
     }
     let summary = Summary {

@@ -195,16 +195,18 @@ pub fn compare_dirs_exact(
                 continue;
             }
         };
-        if write_results && let Err(e) = crate::report::write_measurement(&o.dir, &proposed) {
+        if write_results && let Err(e) = scatterfit_report::write_measurement(&o.dir, &proposed) {
+            let e = anyhow::Error::from(e);
             failed.push((o.dir.clone(), format!("writing the results: {e:#}")));
         }
         let name = proposed.manifest.display_name();
-        let fig = crate::figures::compare_figure(&existing, &proposed, &name);
-        if let Err(e) = crate::plot::write_figure(
+        let fig = scatterfit_report::compare_figure(&existing, &proposed, &name);
+        if let Err(e) = scatterfit_report::write_figure(
             &fig,
             Some(&o.dir.join("compare.svg")),
             Some(&o.dir.join("compare.png")),
         ) {
+            let e = anyhow::Error::from(e);
             failed.push((o.dir.clone(), format!("writing the plot: {e:#}")));
         }
         if exact {

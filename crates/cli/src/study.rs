@@ -17,11 +17,11 @@ use rayon::prelude::*;
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_pipeline::fit::FitSettings;
 use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
+use scatterfit_report::{Figure, Panel, Series, SeriesStyle};
 use serde::Serialize;
 
 use crate::common::cache_dir;
 use crate::output::{errln, out, outln};
-use crate::plot::{Figure, Panel, Series, SeriesStyle};
 use crate::twin::{Material, synthesize, write_sample};
 
 /// Arguments of `scatterfit study`.
@@ -273,7 +273,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
     }
-    crate::plot::write_figure(
+    scatterfit_report::write_figure(
         &figure(&rows, &combos),
         Some(&out.join("study.svg")),
         Some(&out.join("study.png")),

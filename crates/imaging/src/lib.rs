@@ -11,6 +11,9 @@
 //! 3. [`find_spot_center`] (or [`SpotCenter::given`]) — the spot centre, sub-pixel;
 //! 4. [`radial_profile`] — per-ring mean, standard error and count, radius in pixels and mm.
 //!
+//! Beside the pipeline, [`text`] draws a line of text onto a buffer (the workspace's one glyph
+//! rasteriser, with the embedded DejaVu Sans), for plot labels and figure captions.
+//!
 //! Pixel coordinates: pixel (x, y) has its centre at (x, y).
 
 pub mod buffer;
@@ -19,6 +22,7 @@ pub mod error;
 pub mod merge;
 pub mod profile;
 pub mod response;
+pub mod text;
 
 pub use buffer::{ImageBuf, ShapeError};
 pub use center::{CenterOptions, SpotCenter, find_spot_center};

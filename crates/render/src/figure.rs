@@ -1,11 +1,11 @@
 //! Figures: panels side by side with captions under them (the shape of the paper's Figure 5), as
 //! 8-bit sRGB with text, or as a linear grid (no text) for EXR.
 //!
-//! Text is rasterised with `ab_glyph` from font bytes the caller passes (the CLI embeds DejaVu Sans),
-//! so captions render on a machine with no system fonts.
+//! Captions are drawn by `scatterfit_imaging::text` (the workspace's one glyph rasteriser) in the
+//! DejaVu Sans embedded there, so they render on a machine with no system fonts.
 
-use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 use scatterfit_imaging::ImageBuf;
+use scatterfit_imaging::text::Font;
 
 use crate::error::{RenderError, Result, invalid};
 
@@ -48,13 +48,14 @@ impl Default for FigureStyle {
     }
 }
 
-/// Composes panels (all the same size) into a grid with captions.
+/// Composes panels (all the same size) into a grid with captions in the embedded DejaVu Sans.
 ///
 /// # Errors
-/// [`RenderError::Font`] if `font` is not a TrueType/OpenType font; [`RenderError::InvalidOption`]
-/// for no panel, zero columns, or panels of different sizes or channel counts other than 3.
-pub fn compose(panels: &[Panel], style: &FigureStyle, font: &[u8]) -> Result<ImageBuf<u8>> {
-    let font = FontRef::try_from_slice(font).map_err(|e| RenderError::Font(e.to_string()))?;
+/// [`RenderError::InvalidOption`] for no panel, zero columns, or panels of different sizes or
+/// channel counts other than 3; [`RenderError::Font`] if the embedded font does not load (a broken
+/// build).
+pub fn compose(panels: &[Panel], style: &FigureStyle) -> Result<ImageBuf<u8>> {
+    let font = Font::dejavu_sans().map_err(|e| RenderError::Font(e.reason))?;
     let first = panels
         .first()
         .ok_or_else(|| invalid("panels", 0, "need at least one"))?;
@@ -72,8 +73,7 @@ pub fn compose(panels: &[Panel], style: &FigureStyle, font: &[u8]) -> Result<Ima
             "must all be RGB images of the same size",
         ));
     }
-    let scaled = font.as_scaled(PxScale::from(style.text_px));
-    let line_h = (scaled.height() + scaled.line_gap()).ceil() as usize + 2;
+    let line_h = font.line_height(style.text_px).ceil() as usize + 2;
     let lines = panels.iter().map(|p| p.caption.len()).max().unwrap_or(0);
     let cols = style.columns.min(panels.len());
     let rows = panels.len().div_ceil(cols);
@@ -86,14 +86,11 @@ pub fn compose(panels: &[Panel], style: &FigureStyle, font: &[u8]) -> Result<Ima
     let cell_h = ph + lines * line_h + g / 2;
     let w = cols * pw + (cols + 1) * g;
     let h = title_h + rows * cell_h + (rows + 1) * g;
-    let mut canvas = Canvas {
-        w,
-        h,
-        data: style.background.repeat(w * h),
-    };
+    let mut canvas = ImageBuf::new(w, h, 3, style.background.repeat(w * h))?;
     if let Some(title) = &style.title {
-        canvas.text(
-            &font,
+        centred_text(
+            &mut canvas,
+            font,
             style.text_px,
             title,
             w as f32 / 2.0,
@@ -108,15 +105,15 @@ pub fn compose(panels: &[Panel], style: &FigureStyle, font: &[u8]) -> Result<Ima
         for y in 0..ph {
             let src = &p.image.data()[y * pw * 3..(y + 1) * pw * 3];
             let dst = ((y0 + y) * w + x0) * 3;
-            canvas.data[dst..dst + pw * 3].copy_from_slice(src);
+            canvas.data_mut()[dst..dst + pw * 3].copy_from_slice(src);
         }
         for (i, line) in p.caption.iter().enumerate() {
             let cx = x0 as f32 + pw as f32 / 2.0;
             let ty = (y0 + ph + g / 2 + i * line_h) as f32;
-            canvas.text(&font, style.text_px, line, cx, ty, style.ink);
+            centred_text(&mut canvas, font, style.text_px, line, cx, ty, style.ink);
         }
     }
-    Ok(ImageBuf::new(w, h, 3, canvas.data)?)
+    Ok(canvas)
 }
 
 /// Linear panels (1 or 3 channels, same size) side by side with `gap` pixels of 0 between them, in
@@ -160,48 +157,17 @@ pub fn compose_linear(
     Ok(ImageBuf::new(w, h, ch, data)?)
 }
 
-struct Canvas {
-    w: usize,
-    h: usize,
-    data: Vec<u8>,
-}
-
-impl Canvas {
-    /// Draws `text` centred on `cx`, its line box starting at `top`; coverage blended in sRGB
-    /// (as text renderers do).
-    fn text(&mut self, font: &FontRef<'_>, px: f32, text: &str, cx: f32, top: f32, ink: [u8; 3]) {
-        let scale = PxScale::from(px);
-        let sf = font.as_scaled(scale);
-        let mut glyphs = Vec::new();
-        let mut x = 0.0f32;
-        let mut prev = None;
-        for ch in text.chars() {
-            let id = sf.glyph_id(ch);
-            if let Some(p) = prev {
-                x += sf.kern(p, id);
-            }
-            glyphs.push(id.with_scale_and_position(scale, point(x, top + sf.ascent())));
-            x += sf.h_advance(id);
-            prev = Some(id);
-        }
-        let x0 = (cx - x / 2.0).max(0.0);
-        for mut gl in glyphs {
-            gl.position.x += x0;
-            let Some(outline) = font.outline_glyph(gl) else {
-                continue;
-            };
-            let b = outline.px_bounds();
-            outline.draw(|gx, gy, c| {
-                let (px, py) = (b.min.x as i64 + gx as i64, b.min.y as i64 + gy as i64);
-                if px < 0 || py < 0 || px as usize >= self.w || py as usize >= self.h {
-                    return;
-                }
-                let i = (py as usize * self.w + px as usize) * 3;
-                let c = c.clamp(0.0, 1.0);
-                for (d, &k) in self.data[i..i + 3].iter_mut().zip(&ink) {
-                    *d = (*d as f32 * (1.0 - c) + k as f32 * c).round() as u8;
-                }
-            });
-        }
-    }
+/// Draws `text` centred on `cx` (never starting left of the image), its line box starting at `top`.
+fn centred_text(
+    canvas: &mut ImageBuf<u8>,
+    font: &Font,
+    px: f32,
+    text: &str,
+    cx: f32,
+    top: f32,
+    ink: [u8; 3],
+) {
+    let line = font.layout(text, px);
+    let x0 = (cx - line.width() / 2.0).max(0.0);
+    line.draw(canvas, (x0, top + font.ascent(px)), ink);
 }

@@ -34,7 +34,7 @@ pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
     for _ in 0..3 {
         let t0 = Instant::now();
         let meas = measure_sample(&dir, &overrides, &|_| {})?;
-        crate::report::write_measurement(&dir, &meas)?;
+        scatterfit_report::write_measurement(&dir, &meas)?;
         totals.push(t0.elapsed().as_secs_f64());
         last = Some(meas);
     }

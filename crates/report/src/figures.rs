@@ -65,7 +65,7 @@ fn model_series(
     label: &str,
     style: SeriesStyle,
 ) -> Option<Series> {
-    let model = scatterfit_mc::family(m.settings.model).ok()?;
+    let model = scatterfit_pipeline::family(m.settings.model).ok()?;
     let props =
         OpticalProperties::new(report.sigma_s_prime.value, report.sigma_a.value, report.eta)
             .ok()?;

@@ -1,25 +1,39 @@
 //! Writing and printing a measurement: result.json, result.csv and result.md (Table 1's shape),
-//! profile.csv, and the fit plot (fit.svg, fit.png; Figure 4's shape). Shared by `measure`,
-//! `batch` and `demo`.
+//! profile.csv, and the fit plot (fit.svg, fit.png; Figure 4's shape). The CLI's `measure`, `batch`,
+//! `compare` and `demo` write through here.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use scatterfit_io::result_json::{MeasurementResult, write_result_json};
 use scatterfit_io::result_table::{errors_note, sig4, sigma_cells, table1_csv, table1_markdown};
 use scatterfit_pipeline::Measurement;
 
-/// Writes every result file of `m` into `dir` (created if missing); returns the result and the
-/// paths written.
+use crate::error::{ReportError, Result};
+
+/// What [`write_measurement`] wrote.
+#[derive(Debug, Clone)]
+pub struct WrittenReport {
+    /// The measurement's result, as written to result.json.
+    pub result: MeasurementResult,
+    /// The files written, in order: profile.csv, result.json, result.csv, result.md, fit.svg,
+    /// fit.png.
+    pub files: Vec<PathBuf>,
+}
+
+/// Writes every result file of `m` into `dir` (created if missing): profile.csv, result.json,
+/// result.csv, result.md, fit.svg and fit.png. Each file is written atomically; files of an earlier
+/// run are replaced.
 ///
 /// # Errors
-/// The first file that cannot be written.
-pub fn write_measurement(
-    dir: &Path,
-    m: &Measurement,
-) -> anyhow::Result<(MeasurementResult, Vec<PathBuf>)> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+/// The first file that cannot be written, named in the error: [`ReportError::CreateDir`],
+/// [`ReportError::ProfileCsv`], [`ReportError::ResultJson`], [`ReportError::Write`],
+/// [`ReportError::WritePlot`].
+pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let mut written = Vec::new();
     let profile = dir.join("profile.csv");
     scatterfit_io::profile_csv::write_profile_csv(&profile, &m.profile.to_table())?;
@@ -33,8 +47,12 @@ pub fn write_measurement(
         ("result.md", table1_markdown(std::slice::from_ref(&result))),
     ] {
         let p = dir.join(name);
-        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
-            .with_context(|| format!("writing {}", p.display()))?;
+        scatterfit_io::atomic::write_atomic(&p, text.as_bytes()).map_err(|source| {
+            ReportError::Write {
+                path: p.clone(),
+                source,
+            }
+        })?;
         written.push(p);
     }
     let (svg, png) = (dir.join("fit.svg"), dir.join("fit.png"));
@@ -44,10 +62,14 @@ pub fn write_measurement(
         Some(&png),
     )?;
     written.extend([svg, png]);
-    Ok((result, written))
+    Ok(WrittenReport {
+        result,
+        files: written,
+    })
 }
 
-/// A human summary of one result: η and, per channel, σ′s ± error, σa ± error, α′, MSE, time.
+/// A human summary of one result, as `scatterfit measure` prints it: η and, per channel,
+/// σ′s ± error, σa ± error, α′, MSE, fit time and rings used.
 pub fn summary_text(r: &MeasurementResult) -> String {
     let mut t = String::new();
     let eta = match r.eta_stderr {
