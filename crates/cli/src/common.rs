@@ -88,16 +88,12 @@ pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::
     Ok(())
 }
 
-/// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default. Its
-/// temporary files are swept on Ctrl-C (the mc and synth crates write them without `io::atomic`).
+/// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default. (Its
+/// writes go through `scatterfit-safefs` like every other, so Ctrl-C removes their temporaries.)
 pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
-    let dir = given
+    given
         .map(Path::to_path_buf)
-        .or_else(scatterfit_mc::table::default_cache_dir);
-    if let Some(d) = &dir {
-        scatterfit_io::atomic::sweep_on_interrupt(d);
-    }
-    dir
+        .or_else(scatterfit_mc::table::default_cache_dir)
 }
 
 /// `1/600` for short times that are whole fractions, else 4 significant digits.

@@ -561,10 +561,7 @@ pub fn read_bracket_within(
     let decoded: Vec<Result<BracketFrame, BracketError>> = plan
         .par_iter()
         .map(|(path, time)| {
-            let bytes = std::fs::read(path).map_err(|source| ImageFileError::Read {
-                path: path.clone(),
-                source,
-            })?;
+            let bytes = crate::image_files::read_image_bytes(path, budget)?;
             let time_s = match time {
                 TimeOf::Known { time_s, .. } => *time_s,
                 TimeOf::Exif => exif_exposure_time(&bytes, path)?,
@@ -593,8 +590,10 @@ pub fn decoded_size<'a>(paths: impl IntoIterator<Item = &'a Path>) -> (u64, u64,
     let mut largest = 0u64;
     let mut shape = String::new();
     for path in paths {
-        let Ok(reader) = image::ImageReader::open(path).and_then(|r| r.with_guessed_format())
-        else {
+        // A regular file only: `ImageReader::open` on a FIFO would block for ever.
+        let Ok(reader) = scatterfit_safefs::read::open_regular(path).and_then(|(f, _)| {
+            image::ImageReader::new(std::io::BufReader::new(f)).with_guessed_format()
+        }) else {
             continue;
         };
         let Ok(decoder) = reader.into_decoder() else {

@@ -103,11 +103,18 @@ fn invalid(path: &Path, detail: String) -> MeshError {
     }
 }
 
+/// A mesh file's bytes: a regular file only, within the memory budget ([`crate::budget`]).
+fn read_mesh_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
+    scatterfit_safefs::read::read_limited(path, crate::budget::memory_budget_bytes()).map_err(
+        |error| MeshError::Read {
+            path: path.to_path_buf(),
+            error,
+        },
+    )
+}
+
 fn read_obj(path: &Path) -> Result<Parsed, MeshError> {
-    let text = std::fs::read(path).map_err(|error| MeshError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let text = read_mesh_bytes(path)?;
     let opts = tobj::LoadOptions {
         triangulate: false,
         single_index: true,
@@ -160,10 +167,7 @@ fn read_obj(path: &Path) -> Result<Parsed, MeshError> {
 fn read_ply(path: &Path) -> Result<Parsed, MeshError> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let bytes = std::fs::read(path).map_err(|error| MeshError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes = read_mesh_bytes(path)?;
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut std::io::Cursor::new(bytes))
         .map_err(|e| invalid(path, format!("not a readable PLY file ({e})")))?;

@@ -1,7 +1,6 @@
 //! Table files: JSON read and written atomically, and the cache rule shared by every table type —
 //! reuse a file only when it was made with the same spec (and format), else simulate and save.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -17,10 +16,12 @@ pub(crate) fn read_with<T>(
     path: &Path,
     parse: impl FnOnce(&str) -> std::result::Result<T, String>,
 ) -> Result<T> {
-    let text = std::fs::read_to_string(path).map_err(|source| McError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let text =
+        scatterfit_safefs::read::read_to_string_limited(path, scatterfit_safefs::MAX_TEXT_BYTES)
+            .map_err(|source| McError::Io {
+                path: path.to_owned(),
+                source,
+            })?;
     parse(&text).map_err(|message| McError::Format {
         path: path.to_owned(),
         message,
@@ -61,9 +62,11 @@ pub(crate) fn load_or_build<T>(
     Ok((table, CacheStatus::Built, path))
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same folder (created if missing),
-/// synced, then renamed over the target. (mc does not depend on io, whose `write_atomic` does the same;
-/// synth's profile cache uses this one.)
+/// Writes `bytes` to `path` atomically, creating its folder if missing: through
+/// `scatterfit_safefs::write::write_atomic` (an exclusively created temporary with an unpredictable
+/// name, registered for Ctrl-C, renamed over a regular file or nothing — never through a link). mc
+/// does not depend on io, whose `write_atomic` is the same function; synth's profile cache uses this
+/// one.
 ///
 /// # Errors
 /// `Io` on any file-system error (the target is then untouched).
@@ -77,19 +80,5 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(io)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
+    scatterfit_safefs::write::write_atomic(path, bytes).map_err(io)
 }

@@ -356,8 +356,10 @@ impl McProfile {
             return Ok((Self::simulate(spec, progress)?, false));
         };
         let path = dir.join(format!("synth-profile-{}.json", spec.fingerprint()));
-        if let Ok(text) = std::fs::read_to_string(&path)
-            && let Ok(p) = serde_json::from_str::<Self>(&text)
+        if let Ok(text) = scatterfit_safefs::read::read_to_string_limited(
+            &path,
+            scatterfit_safefs::MAX_TEXT_BYTES,
+        ) && let Ok(p) = serde_json::from_str::<Self>(&text)
             && p.format == PROFILE_FORMAT
             && p.spec == *spec
             && p.value.len() + 1 == spec.edges.len()
