@@ -60,8 +60,9 @@ pub enum BracketError {
     },
     /// An exposure time is zero, negative or not finite.
     #[error(
-        "{where_}: exposure time {time_s} s is not positive; every frame needs its shutter time in \
-         seconds (> 0)"
+        "{where_}: exposure time {} s is not positive; every frame needs its shutter time in \
+         seconds (> 0)",
+        crate::escape::number(*time_s)
     )]
     NonPositiveTime {
         /// Where the time came from (`exposures.csv, line 3` or `img.jpg (EXIF ExposureTime)`).
@@ -211,11 +212,10 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
         .clone();
     let column = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
     let (Some(file_col), Some(time_col)) = (column("file"), column("time_s")) else {
-        let found = headers.iter().collect::<Vec<_>>().join(",");
-        return Err(header_err(if found.is_empty() {
+        return Err(header_err(if headers.is_empty() {
             "an empty file".into()
         } else {
-            found
+            crate::text::header_for_message(headers.iter(), &["file", "time_s"])
         }));
     };
     let mut entries = Vec::new();
@@ -251,7 +251,8 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
             return Err(line_err(
                 line,
                 format!(
-                    "no `time_s` for {file}; give its shutter time in seconds, e.g. 0.01 or 1/100"
+                    "no `time_s` for {}; give its shutter time in seconds, e.g. 0.01 or 1/100",
+                    crate::escape::token(file)
                 ),
             ));
         };
@@ -259,14 +260,20 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
             line_err(
                 line,
                 format!(
-                    "`time_s` = {time_text:?} for {file} is not a number; write seconds as a decimal \
-                     (0.0016667) or a fraction (1/600)"
+                    "`time_s` = {} for {} is not a number; write seconds as a decimal \
+                     (0.0016667) or a fraction (1/600)",
+                    crate::text::cell_for_message(time_text),
+                    crate::escape::token(file)
                 ),
             )
         })?;
         if !(time_s > 0.0 && time_s.is_finite()) {
             return Err(BracketError::NonPositiveTime {
-                where_: format!("{}, line {line} ({file})", path.display()),
+                where_: format!(
+                    "{}, line {line} ({})",
+                    path.display(),
+                    crate::escape::token(file)
+                ),
                 time_s,
             });
         }

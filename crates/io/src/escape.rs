@@ -75,7 +75,7 @@ pub fn token(text: &str) -> String {
 /// A message of another library (a parser's) with every quoted segment — `` `…` `` or `"…"` — made a
 /// [`token`]: shortened and escaped.
 pub fn shorten_quotes(message: &str) -> String {
-    map_quotes(message, |q| token(q))
+    map_quotes(message, token)
 }
 
 /// A message of another library with its quoted segments removed unless `keep` accepts them
@@ -146,7 +146,7 @@ pub fn number(v: f64) -> String {
     }
     let a = v.abs();
     let exp = a.log10().floor() as i32;
-    let text = if (-4..7).contains(&exp) {
+    let text = if (-4..6).contains(&exp) {
         let decimals = (5 - exp).max(0) as usize;
         trim_zeros(format!("{v:.decimals$}"))
     } else {

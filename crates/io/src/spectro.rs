@@ -71,7 +71,7 @@ pub enum SpectroCsvError {
         found: String,
     },
     /// A cell that is not a finite number, or a reflectance outside its range.
-    #[error("{path}: line {line}, column `{column}`: {value:?} {reason}")]
+    #[error("{path}: line {line}, column `{column}`: {value} {reason}")]
     BadValue {
         /// The file.
         path: PathBuf,
@@ -79,7 +79,8 @@ pub enum SpectroCsvError {
         line: u64,
         /// The column's name.
         column: String,
-        /// The text of the cell.
+        /// The text of the cell, quoted for the message (`"…"`, shortened and escaped:
+        /// [`crate::text::cell_for_message`]).
         value: String,
         /// What is wrong with it and what is expected.
         reason: String,
@@ -184,7 +185,10 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
         .map(|h| h.to_ascii_lowercase())
         .collect();
     let find = |name: &str| header.iter().position(|h| h == name);
-    let found = header.join(",");
+    let found = crate::text::header_for_message(
+        header.iter().map(String::as_str),
+        &["wavelength_nm", "sci", "sce", "sci_pct", "sce_pct"],
+    );
     let wl_col = find("wavelength_nm").ok_or_else(|| SpectroCsvError::MissingColumn {
         path: p(),
         column: "wavelength_nm",
@@ -227,7 +231,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 path: p(),
                 line,
                 column: name.to_owned(),
-                value: text.to_owned(),
+                value: crate::text::cell_for_message(text),
                 reason,
             };
             let v: f64 = dialect.parse_f64(text).ok_or_else(|| {
@@ -252,7 +256,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 path: p(),
                 line,
                 column: "wavelength_nm".into(),
-                value: record.get(wl_col).unwrap_or("").to_owned(),
+                value: crate::text::cell_for_message(record.get(wl_col).unwrap_or("")),
                 reason: "is not a wavelength in nanometres (expected about 360–780)".into(),
             });
         }
@@ -263,7 +267,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                     path: p(),
                     line,
                     column: name.to_owned(),
-                    value: record.get(col).unwrap_or("").to_owned(),
+                    value: crate::text::cell_for_message(record.get(col).unwrap_or("")),
                     reason: format!(
                         "is outside 0..{max}{}",
                         if scale == 1.0 && v > 1.0 && v <= 100.0 {

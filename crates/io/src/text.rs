@@ -266,6 +266,36 @@ fn windows_1252(b: u8) -> char {
     }
 }
 
+/// A CSV header for a message, under the content rule (RELIABILITY.md, "Inputs"): its column names
+/// as short escaped tokens when at least one of `ours` is among them (a CSV of the expected kind with
+/// a column misnamed or missing), else nothing of the file's content — only how many fields its first
+/// line has (a file named by mistake, or on purpose: `/etc/shadow`, must not be echoed).
+pub fn header_for_message<'a>(header: impl IntoIterator<Item = &'a str>, ours: &[&str]) -> String {
+    let names: Vec<&str> = header.into_iter().collect();
+    let recognised = names
+        .iter()
+        .any(|h| ours.iter().any(|o| h.trim().eq_ignore_ascii_case(o)));
+    if recognised {
+        names
+            .iter()
+            .map(|n| crate::escape::token(n))
+            .collect::<Vec<_>>()
+            .join(",")
+    } else {
+        format!(
+            "a first line of {} field(s), none of them a column read here; the file's content is \
+             not shown — is this the right file?",
+            names.len()
+        )
+    }
+}
+
+/// A cell of a recognised CSV file for a message: `"…"`, a short escaped token
+/// ([`crate::escape::token`]).
+pub fn cell_for_message(cell: &str) -> String {
+    format!("\"{}\"", crate::escape::token(cell))
+}
+
 /// How a CSV file separates columns, and whether its numbers may use a decimal comma.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CsvDialect {

@@ -3,7 +3,6 @@
 //! removes, and nothing a reader could mistake for the new file.
 
 use std::fs;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
