@@ -57,7 +57,10 @@ pub fn summary_text(r: &MeasurementResult) -> String {
     let _ = writeln!(
         t,
         "{}: η = {eta} ({}), method {}, model {}",
-        r.name, r.eta_source, r.method, r.model
+        scatterfit_io::escape::one_line(&r.name),
+        scatterfit_io::escape::one_line(&r.eta_source),
+        scatterfit_io::escape::one_line(&r.method),
+        scatterfit_io::escape::one_line(&r.model)
     );
     let _ = writeln!(
         t,
@@ -75,7 +78,7 @@ pub fn summary_text(r: &MeasurementResult) -> String {
             c.rings_used
         );
         if let Some(p) = &c.problem {
-            let _ = writeln!(t, "      note: {p}");
+            let _ = writeln!(t, "      note: {}", scatterfit_io::escape::one_line(p));
         }
     }
     let errors = errors_note(std::slice::from_ref(r));

@@ -217,11 +217,30 @@ pub fn xml_text(text: &str) -> String {
             '"' => out.push_str("&quot;"),
             '\'' => out.push_str("&apos;"),
             '\t' | '\n' | '\r' => out.push(c),
-            '\u{0}'..='\u{1f}' | '\u{fffe}' | '\u{ffff}' => out.push('\u{fffd}'),
+            c if xml_forbidden(c) => out.push('\u{fffd}'),
             _ => out.push(c),
         }
     }
     out
+}
+
+/// `text` with the characters XML 1.0 forbids (C0 controls but tab, newline and CR; U+FFFE,
+/// U+FFFF) replaced by U+FFFD: for text handed to an XML writer that escapes `&`, `<`, `>`, `"`
+/// and `'` itself (plotters' SVG backend), or for a finished document.
+pub fn xml_chars(text: &str) -> Cow<'_, str> {
+    if !text.chars().any(xml_forbidden) {
+        return Cow::Borrowed(text);
+    }
+    Cow::Owned(
+        text.chars()
+            .map(|c| if xml_forbidden(c) { '\u{fffd}' } else { c })
+            .collect(),
+    )
+}
+
+/// A character XML 1.0 does not allow in a document.
+fn xml_forbidden(c: char) -> bool {
+    matches!(c, '\u{0}'..='\u{8}' | '\u{b}' | '\u{c}' | '\u{e}'..='\u{1f}' | '\u{fffe}' | '\u{ffff}')
 }
 
 /// A list of names for a message, each a [`token`], joined by `, `.
