@@ -20,6 +20,9 @@ pub fn write_measurement(
     m: &Measurement,
 ) -> anyhow::Result<(MeasurementResult, Vec<PathBuf>)> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    // The set manifest goes first and comes back last: a folder without one is incomplete
+    // (`scatterfit_io::result_set`).
+    scatterfit_io::result_set::begin(dir)?;
     let mut written = Vec::new();
     let profile = dir.join("profile.csv");
     scatterfit_io::profile_csv::write_profile_csv(&profile, &m.profile.to_table())?;
@@ -44,6 +47,13 @@ pub fn write_measurement(
         Some(&png),
     )?;
     written.extend([svg, png]);
+    let names: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    scatterfit_io::result_set::finish(dir, &names, &result.name, &m.manifest.dir)?;
+    written.push(dir.join(scatterfit_io::result_set::SET_FILE));
     Ok((result, written))
 }
 

@@ -47,7 +47,7 @@ pub enum ManifestError {
         /// The I/O error.
         source: std::io::Error,
         /// What to do.
-        hint: &'static str,
+        hint: String,
     },
     /// Not valid TOML, an unknown key, or a value of the wrong type.
     #[error("{}: {message}", path.display())]
@@ -270,10 +270,9 @@ pub fn read_manifest(path_or_dir: &Path) -> Result<SampleManifest, ManifestError
         .map_err(|e| match e {
             crate::text::TextError::Io { path, source } => ManifestError::Read {
                 hint: if source.kind() == std::io::ErrorKind::NotFound {
-                    " — a sample folder holds a sample.toml naming its spectro file and bracket \
-                     (see `scatterfit synth` for a complete example folder)"
+                    not_found_hint(&path)
                 } else {
-                    ""
+                    String::new()
                 },
                 path,
                 source,
@@ -287,6 +286,32 @@ pub fn read_manifest(path_or_dir: &Path) -> Result<SampleManifest, ManifestError
         .unwrap_or(Path::new("."))
         .to_path_buf();
     parse_manifest(&text, &path, dir)
+}
+
+/// What to say when the manifest is not there: a file that looks like a misspelt one
+/// (`Sample.toml`, `sample.TOML`, `sample.toml.txt`) is named; else what a sample folder holds.
+fn not_found_hint(path: &Path) -> String {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let misspelt = std::fs::read_dir(dir).ok().and_then(|entries| {
+        entries.flatten().map(|e| e.file_name()).find(|n| {
+            let l = n.to_string_lossy().to_lowercase();
+            n != MANIFEST_NAME
+                && (l.starts_with("sample.toml")
+                    || (l.starts_with("sample") && (l.ends_with(".toml") || l.ends_with(".tml"))))
+        })
+    });
+    match misspelt {
+        Some(n) => format!(
+            " — the folder holds {}: rename it to exactly sample.toml (names are case-sensitive)",
+            crate::escape::token(&n.to_string_lossy())
+        ),
+        None => " — a sample folder holds a sample.toml naming its spectro file and bracket (see \
+                 `scatterfit synth` for a complete example folder)"
+            .into(),
+    }
 }
 
 /// Parses and checks manifest text; `path` names it in messages, `dir` resolves its paths.

@@ -21,4 +21,7 @@ pub mod profile;
 pub mod spectro;
 
 pub use error::{PipelineError, Result};
-pub use measure::{Measurement, Overrides, Stage, Timings, measure_sample, sample_dirs};
+pub use measure::{
+    Measurement, Overrides, SampleDirs, SampleInputs, Stage, Timings, measure_sample,
+    misspelt_manifest, sample_dirs, sample_inputs,
+};
