@@ -213,7 +213,10 @@ impl FitArgs {
         if let Some(e) = self.eta
             && !(e.is_finite() && (1.0..=3.0).contains(&e))
         {
-            anyhow::bail!("--eta {e}: the relative refractive index must lie in [1, 3]");
+            anyhow::bail!(
+                "--eta {}: the relative refractive index must lie in [1, 3]",
+                crate::numeric::show(e)
+            );
         }
         Ok(Overrides {
             method: self.method.map(Into::into),

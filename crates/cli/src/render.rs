@@ -594,7 +594,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if !(args.mesh_scale.is_finite() && args.mesh_scale > 0.0) {
         bail!(
             "--mesh-scale {} must be a positive number (mm per file unit)",
-            args.mesh_scale
+            crate::numeric::show(args.mesh_scale)
         );
     }
     if !(1000..=10_000_000).contains(&args.triangles) {

@@ -63,7 +63,7 @@ fn spec_from(args: &Args) -> anyhow::Result<TableSpec> {
     if args.eta < 1.0 && !args.allow_eta_below_one {
         bail!(
             "--eta {}: below 1 is unusual for a solid; pass --allow-eta-below-one if you mean it",
-            args.eta
+            crate::numeric::show(args.eta)
         );
     }
     if !(args.g > -1.0 && args.g < 1.0) {

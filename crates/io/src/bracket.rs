@@ -80,10 +80,11 @@ pub enum BracketError {
     },
     /// Two images have the same exposure time (a bracket needs distinct times).
     #[error(
-        "{} and {} have the same exposure time {time_s} s; a bracket needs a different shutter time \
+        "{} and {} have the same exposure time {} s; a bracket needs a different shutter time \
          for every frame (remove the duplicate or correct its time)",
         first.display(),
-        second.display()
+        second.display(),
+        crate::escape::number(*time_s)
     )]
     DuplicateTime {
         /// The first image.

@@ -87,8 +87,10 @@ pub enum SpectroCsvError {
     },
     /// Wavelengths not strictly increasing.
     #[error(
-        "{path}: line {line}: wavelength {wavelength} nm does not follow {previous} nm; wavelengths \
-         must increase strictly (sort the rows and remove duplicates)"
+        "{path}: line {line}: wavelength {} nm does not follow {} nm; wavelengths must increase \
+         strictly (sort the rows and remove duplicates)",
+        crate::escape::number(*wavelength),
+        crate::escape::number(*previous)
     )]
     Order {
         /// The file.
@@ -110,9 +112,12 @@ pub enum SpectroCsvError {
     },
     /// SCI below SCE beyond measurement noise.
     #[error(
-        "{path}: line {line}: SCI {sci} is below SCE {sce} at {wavelength} nm by more than the noise \
-         tolerance {tolerance}; SCI includes the specular component and cannot be smaller — are the \
-         columns swapped?"
+        "{path}: line {line}: SCI {} is below SCE {} at {} nm by more than the noise tolerance \
+         {}; SCI includes the specular component and cannot be smaller — are the columns swapped?",
+        crate::escape::number(*sci),
+        crate::escape::number(*sce),
+        crate::escape::number(*wavelength),
+        crate::escape::number(*tolerance)
     )]
     SciBelowSce {
         /// The file.

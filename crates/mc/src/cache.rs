@@ -57,9 +57,31 @@ pub(crate) fn load_or_build<T>(
     {
         return Ok((table, CacheStatus::Loaded, path));
     }
+    // A cache that cannot take the file fails now, not after the Monte Carlo work.
+    prepare_write(&path)?;
     let table = build()?;
     save(&table, &path)?;
     Ok((table, CacheStatus::Built, path))
+}
+
+/// Checks, before a cache file is computed, that it can be written at `path`: its folder exists (it
+/// is created) and takes a new file, and what is at `path` (if anything) is a regular file, not a
+/// link, a folder or a device. A corrupt file is no obstacle: it is replaced.
+///
+/// # Errors
+/// [`McError::Cache`] naming the file.
+pub fn prepare_write(path: &Path) -> Result<()> {
+    let cache = |source| McError::Cache {
+        path: path.to_owned(),
+        source,
+    };
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(cache)?;
+    scatterfit_safefs::write::check_destination(path).map_err(cache)?;
+    scatterfit_safefs::write::check_can_write_in(dir).map_err(cache)
 }
 
 /// Writes `bytes` to `path` atomically, creating its folder if missing: through
@@ -69,7 +91,8 @@ pub(crate) fn load_or_build<T>(
 /// one.
 ///
 /// # Errors
-/// `Io` on any file-system error (the target is then untouched).
+/// `Io` when the folder cannot be created, `Cache` when the file cannot be written (the target is
+/// then untouched).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io = |source| McError::Io {
         path: path.to_owned(),
@@ -80,5 +103,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(io)?;
-    scatterfit_safefs::write::write_atomic(path, bytes).map_err(io)
+    scatterfit_safefs::write::write_atomic(path, bytes).map_err(|source| McError::Cache {
+        path: path.to_owned(),
+        source,
+    })
 }

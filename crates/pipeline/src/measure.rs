@@ -394,8 +394,8 @@ pub struct SampleInputs {
 /// `measure_sample` starts with, and what the CLI checks its outputs against before any work.
 ///
 /// # Errors
-/// [`PipelineError::InputPath`] for a file outside the folder; the manifest's and the exposures
-/// CSV's errors.
+/// [`PipelineError::InputPath`] for a file outside the folder; the manifest's errors. (An exposures
+/// CSV that cannot be read lists no frame; the measurement reports it.)
 pub fn sample_inputs(dir: &Path, allow_outside: bool) -> Result<SampleInputs> {
     let manifest_path = if dir.is_dir() {
         dir.join(scatterfit_io::manifest::MANIFEST_NAME)
@@ -435,7 +435,10 @@ pub fn sample_inputs(dir: &Path, allow_outside: bool) -> Result<SampleInputs> {
         && let Some(csv) = &m.camera.exposures
     {
         let csv = m.resolve(csv);
-        for e in scatterfit_io::bracket::read_exposures_csv(&csv)? {
+        // An exposures CSV that cannot be read names no frame that could be read; the bracket
+        // stage reports it in its turn (after the spectrophotometer's errors, as before).
+        let listed = scatterfit_io::bracket::read_exposures_csv(&csv).unwrap_or_default();
+        for e in listed {
             let key = format!(
                 "the frame on line {} of {}",
                 e.line,

@@ -78,15 +78,15 @@ pub fn is_temporary_name(name: &OsStr) -> bool {
 }
 
 /// Refuses a destination that is a symbolic link or exists and is not a regular file (looked at
-/// without following links). A missing destination is fine.
+/// without following links). A missing destination is fine, and so is one that cannot be looked at
+/// (a folder in its path that is a file, no permission): creating the temporary reports that.
 ///
 /// # Errors
 /// [`UnsafeFile::SymlinkDestination`] or [`UnsafeFile::DestinationNotRegular`] inside an
-/// `io::Error`, or the error of `lstat` other than "not found".
+/// `io::Error`.
 pub fn check_destination(path: &Path) -> io::Result<()> {
     match fs::symlink_metadata(path) {
-        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(e),
+        Err(_) => Ok(()),
         Ok(m) if m.file_type().is_symlink() => Err(UnsafeFile::SymlinkDestination.into_io()),
         Ok(m) if m.is_file() => Ok(()),
         Ok(m) => Err(UnsafeFile::DestinationNotRegular {
