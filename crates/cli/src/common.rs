@@ -349,6 +349,9 @@ pub fn refuse_foreign_results(sample_dir: &Path, out: &Path, force: bool) -> any
     )
 }
 
+/// Samples that were not measured, with the reason: `(folder, why)`.
+pub type Failures = Vec<(PathBuf, String)>;
+
 /// The sample folders of a command over many samples (`batch`, `compare`), found and checked before
 /// any work: each folder once (other spellings of it — `a`, `./a`, `a/`, a link — noted on stderr
 /// unless `quiet`), folders whose manifest is misspelt returned as failures to report, and every
@@ -364,7 +367,7 @@ pub fn samples_for(
     shared: &[PathBuf],
     allow_outside: bool,
     quiet: bool,
-) -> anyhow::Result<(Vec<PathBuf>, Vec<(PathBuf, String)>)> {
+) -> anyhow::Result<(Vec<PathBuf>, Failures)> {
     let found = scatterfit_pipeline::sample_dirs(dirs);
     if !quiet {
         for (path, kept) in &found.duplicates {

@@ -316,7 +316,9 @@ fn study_sample(
     combos: &[Combo],
 ) -> anyhow::Result<Vec<Row>> {
     let truth: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("truth.json")).context("reading truth.json")?,
+        &scatterfit_io::text::read_text_file(&dir.join("truth.json"))
+            .context("reading truth.json")?
+            .text,
     )?;
     // At η = 1 there is no specular reflection to measure η from (SCI = SCE): the study gives it.
     let overrides = Overrides {
