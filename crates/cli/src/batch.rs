@@ -8,7 +8,6 @@ use std::sync::Mutex;
 
 use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_io::result_table::{table1_csv, table1_markdown};
-use scatterfit_pipeline::sample_dirs;
 
 use crate::common::FitArgs;
 use crate::output::{errln, out, outln};
@@ -46,7 +45,18 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let dirs = sample_dirs(&args.dirs);
+    let shared: Vec<PathBuf> = ["summary.csv", "summary.md"]
+        .iter()
+        .map(|f| args.output_dir.join(f))
+        .collect();
+    let (dirs, misspelt) = crate::common::samples_for(
+        "batch",
+        &args.dirs,
+        &crate::common::RESULT_FILES,
+        &shared,
+        overrides.allow_outside_paths,
+        args.quiet || args.json,
+    )?;
     let write_errors = Mutex::new(Vec::<(PathBuf, String)>::new());
     let outcomes = crate::runner::measure_many(
         &dirs,
@@ -64,6 +74,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )?;
     let mut results: Vec<MeasurementResult> = Vec::new();
     let mut failed: Vec<(PathBuf, String)> = write_errors.into_inner().unwrap_or_default();
+    let samples = dirs.len() + misspelt.len();
+    failed.extend(misspelt);
     for o in &outcomes {
         match &o.result {
             Ok(m) => {
@@ -99,8 +111,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
         outln!(
             "\n{} of {} samples measured completely; summary: {} and {}",
-            dirs.len() - failed.len(),
-            dirs.len(),
+            samples - failed.len(),
+            samples,
             args.output_dir.join("summary.csv").display(),
             args.output_dir.join("summary.md").display()
         )?;

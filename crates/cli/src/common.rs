@@ -4,7 +4,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use anyhow::bail;
+use anyhow::{Context, bail};
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_pipeline::Overrides;
 
@@ -70,11 +70,15 @@ pub fn bar(len: u64, template: &str, quiet: bool) -> indicatif::ProgressBar {
     bar
 }
 
-/// Refuses to write into `dir` when any of `files` already exists there, unless `force`.
+/// Refuses to write into `dir` when any of `files` already exists there, unless `force`; a link or a
+/// non-file at one of their names always.
 ///
 /// # Errors
 /// Names the first existing file and says how to proceed.
 pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::Result<()> {
+    for f in files {
+        check_destination(&dir.join(f), "-o")?;
+    }
     if force {
         return Ok(());
     }
@@ -88,16 +92,12 @@ pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::
     Ok(())
 }
 
-/// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default. Its
-/// temporary files are swept on Ctrl-C (the mc and synth crates write them without `io::atomic`).
+/// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default. (Its
+/// writes go through `scatterfit-safefs` like every other, so Ctrl-C removes their temporaries.)
 pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
-    let dir = given
+    given
         .map(Path::to_path_buf)
-        .or_else(scatterfit_mc::cache::default_cache_dir);
-    if let Some(d) = &dir {
-        scatterfit_io::atomic::sweep_on_interrupt(d);
-    }
-    dir
+        .or_else(scatterfit_mc::cache::default_cache_dir)
 }
 
 /// `1/600` for short times that are whole fractions, else 4 significant digits.
@@ -197,6 +197,11 @@ pub struct FitArgs {
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd instead of fitting it.
     #[arg(long)]
     pub normalise_with_spectro: bool,
+    /// Let a manifest name files outside its sample folder (`../dark.png`, an absolute path, a
+    /// link that leaves the folder). Without it they are refused before any work: whoever can
+    /// write a manifest could otherwise make scatterfit read any file you can.
+    #[arg(long)]
+    pub allow_outside_paths: bool,
 }
 
 impl FitArgs {
@@ -208,7 +213,10 @@ impl FitArgs {
         if let Some(e) = self.eta
             && !(e.is_finite() && (1.0..=3.0).contains(&e))
         {
-            anyhow::bail!("--eta {e}: the relative refractive index must lie in [1, 3]");
+            anyhow::bail!(
+                "--eta {}: the relative refractive index must lie in [1, 3]",
+                crate::numeric::show(e)
+            );
         }
         Ok(Overrides {
             method: self.method.map(Into::into),
@@ -216,6 +224,7 @@ impl FitArgs {
             albedo_model: self.albedo_model.map(Into::into),
             eta: self.eta,
             normalise_with_spectro: self.normalise_with_spectro.then_some(true),
+            allow_outside_paths: self.allow_outside_paths,
         })
     }
 }
@@ -235,10 +244,178 @@ pub fn identity(path: &Path) -> PathBuf {
     }
 }
 
+/// True when `a` and `b` are the same file: the same resolved path ([`identity`]), or, for files
+/// that exist, the same device and inode (a hard link is the same file under another name).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    if identity(a) == identity(b) {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return x.dev() == y.dev() && x.ino() == y.ino();
+        }
+    }
+    false
+}
+
+/// The files `measure` (and `batch`, `compare`'s and `demo`'s measurements) write into a sample's
+/// output folder; the set manifest last.
+pub const RESULT_FILES: [&str; 7] = [
+    "profile.csv",
+    "result.json",
+    "result.csv",
+    "result.md",
+    "fit.svg",
+    "fit.png",
+    scatterfit_io::result_set::SET_FILE,
+];
+
+/// Refuses, before any work, to let `command` write any of `outputs` over one of the sample's
+/// `inputs` (compared by [`same_file`]): a spectro file called `result.csv`, a frame called
+/// `fit.png` would be destroyed by the run that reads them.
+///
+/// # Errors
+/// Names the output, the input and where the input is named, and what to do.
+pub fn refuse_outputs_that_are_inputs(
+    command: &str,
+    outputs: &[PathBuf],
+    inputs: &[(String, PathBuf)],
+) -> anyhow::Result<()> {
+    for out in outputs {
+        if let Some((key, input)) = inputs.iter().find(|(_, i)| same_file(i, out)) {
+            bail!(
+                "{} would be written by `{command}`, but it is an input of the sample ({key}: \
+                 {}); inputs are never overwritten and nothing was written — rename the input (and \
+                 where it is named) or write the results elsewhere with -o DIR",
+                out.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `measure A -o B`: refuses, unless `force`, to write into a folder `out` that is not the sample's
+/// own (`sample_dir`) when it is another sample's folder (it holds a `sample.toml`) or holds result
+/// files that are not this sample's (their `result-files.json` names another sample, or there is
+/// none to tell). This sample's earlier results there are replaced.
+///
+/// # Errors
+/// Says what is there and how to proceed.
+pub fn refuse_foreign_results(sample_dir: &Path, out: &Path, force: bool) -> anyhow::Result<()> {
+    if force || !out.is_dir() || same_file(out, sample_dir) {
+        return Ok(());
+    }
+    let manifest = out.join(scatterfit_io::manifest::MANIFEST_NAME);
+    if std::fs::symlink_metadata(&manifest).is_ok() {
+        bail!(
+            "-o {}: this is the folder of another sample (it holds {}); its result files would be \
+             replaced by this sample's and nothing was written — choose another folder, or pass \
+             --force if you mean it",
+            out.display(),
+            scatterfit_io::manifest::MANIFEST_NAME
+        );
+    }
+    let present: Vec<&str> = RESULT_FILES
+        .iter()
+        .copied()
+        .filter(|f| std::fs::symlink_metadata(out.join(f)).is_ok())
+        .collect();
+    if present.is_empty() {
+        return Ok(());
+    }
+    let what = match scatterfit_io::result_set::read(out) {
+        Ok(Some(set)) if same_file(Path::new(&set.sample_dir), sample_dir) => return Ok(()),
+        Ok(Some(set)) => format!(
+            "the results of the sample {} (measured from {}, run {})",
+            scatterfit_io::escape::token(&set.sample),
+            scatterfit_io::escape::one_line(&set.sample_dir),
+            scatterfit_io::escape::token(&set.run_id)
+        ),
+        Ok(None) => format!(
+            "result files that cannot be tied to this sample (no {}: written by another sample, an \
+             older scatterfit or an interrupted run)",
+            scatterfit_io::result_set::SET_FILE
+        ),
+        Err(e) => format!("result files with an unreadable set manifest ({e})"),
+    };
+    bail!(
+        "-o {} holds {what}: {}; nothing was written — pass --force to replace them, or choose \
+         another folder",
+        out.display(),
+        present.join(", ")
+    )
+}
+
+/// Samples that were not measured, with the reason: `(folder, why)`.
+pub type Failures = Vec<(PathBuf, String)>;
+
+/// The sample folders of a command over many samples (`batch`, `compare`), found and checked before
+/// any work: each folder once (other spellings of it — `a`, `./a`, `a/`, a link — noted on stderr
+/// unless `quiet`), folders whose manifest is misspelt returned as failures to report, and every
+/// sample's `per_sample` outputs (in its own folder) and the command's `shared` outputs checked
+/// against every sample's inputs (refused, exit 2, when one would overwrite an input).
+///
+/// # Errors
+/// An output that is an input, or a link at an output's name.
+pub fn samples_for(
+    command: &str,
+    dirs: &[PathBuf],
+    per_sample: &[&str],
+    shared: &[PathBuf],
+    allow_outside: bool,
+    quiet: bool,
+) -> anyhow::Result<(Vec<PathBuf>, Failures)> {
+    let found = scatterfit_pipeline::sample_dirs(dirs);
+    if !quiet {
+        for (path, kept) in &found.duplicates {
+            crate::output::errln!(
+                "note: {} is the same folder as {}; measured once",
+                path.display(),
+                kept.display()
+            );
+        }
+    }
+    let misspelt: Vec<(PathBuf, String)> = found
+        .misspelt
+        .iter()
+        .map(|(dir, file)| {
+            (
+                dir.clone(),
+                format!(
+                    "no sample.toml, but {} — rename it to exactly sample.toml (names are \
+                     case-sensitive); not measured",
+                    scatterfit_io::escape::token(
+                        &file.file_name().unwrap_or_default().to_string_lossy()
+                    )
+                ),
+            )
+        })
+        .collect();
+    for o in shared {
+        check_destination(o, "-o")?;
+    }
+    for dir in &found.dirs {
+        // A sample whose manifest cannot be read fails later with its own error, like any other.
+        let Ok(inputs) = scatterfit_pipeline::sample_inputs(dir, allow_outside) else {
+            continue;
+        };
+        let mut outputs: Vec<PathBuf> = per_sample.iter().map(|f| dir.join(f)).collect();
+        for o in &outputs {
+            check_destination(o, "-o")?;
+        }
+        outputs.extend(shared.iter().cloned());
+        refuse_outputs_that_are_inputs(command, &outputs, &inputs.files)
+            .with_context(|| format!("sample {}", dir.display()))?;
+    }
+    Ok((found.dirs, misspelt))
+}
+
 /// Refuses to write `output` over any of `inputs`.
 pub fn refuse_overwrite(output: &Path, what: &str, inputs: &[&Path]) -> anyhow::Result<()> {
-    let out = identity(output);
-    if let Some(input) = inputs.iter().find(|i| identity(i) == out) {
+    if let Some(input) = inputs.iter().find(|i| same_file(i, output)) {
         bail!(
             "{what} {} is also an input ({}); inputs are never overwritten — choose another output file",
             output.display(),
@@ -288,6 +465,7 @@ pub fn check_output_file(
     if path.is_dir() {
         bail!("{flag} {}: is a folder; name a file", path.display());
     }
+    check_destination(path, flag)?;
     if path.exists() && !force {
         bail!(
             "{flag} {}: the file exists; nothing was done — pass --force to replace it, or choose \
@@ -296,6 +474,17 @@ pub fn check_output_file(
         );
     }
     check_output_folder(path, flag)
+}
+
+/// Refuses an output path that is a symbolic link (even a dangling one) or exists and is not a
+/// regular file: writes never go through a link (`scatterfit_io::atomic`), and saying so before the
+/// work saves it.
+///
+/// # Errors
+/// Names `flag`, the path and what it is.
+pub fn check_destination(path: &Path, flag: &str) -> anyhow::Result<()> {
+    scatterfit_io::atomic::check_destination(path)
+        .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
 }
 
 /// Checks that the folder of the output file `path` exists and is writable (a probe file is

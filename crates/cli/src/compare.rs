@@ -7,7 +7,6 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use scatterfit_io::result_table::{table2_csv, table2_markdown};
-use scatterfit_pipeline::sample_dirs;
 
 use crate::common::FitArgs;
 use crate::output::{errln, out, outln};
@@ -43,16 +42,28 @@ pub struct Args {
 
 /// Runs `scatterfit compare`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    args.fit.overrides()?;
+    let overrides = args.fit.overrides()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let dirs = sample_dirs(&args.dirs);
-    let (pairs, failed) = crate::runner::compare_dirs(
+    let shared: Vec<PathBuf> = ["compare.csv", "compare.md"]
+        .iter()
+        .map(|f| args.output_dir.join(f))
+        .collect();
+    let (dirs, misspelt) = crate::common::samples_for(
+        "compare",
+        &args.dirs,
+        &["compare.svg", "compare.png"],
+        &shared,
+        overrides.allow_outside_paths,
+        args.quiet || args.json,
+    )?;
+    let (pairs, mut failed) = crate::runner::compare_dirs(
         &dirs,
         &args.fit,
         args.jobs.unwrap_or(0),
         args.quiet || args.json,
         false,
     )?;
+    failed.extend(misspelt);
     std::fs::create_dir_all(&args.output_dir)?;
     for (name, text) in [
         ("compare.csv", table2_csv(&pairs)),

@@ -162,6 +162,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         albedo_model: None,
         eta: None,
         normalise_with_spectro: false,
+        allow_outside_paths: false,
     };
     let (pairs, exacts, failed) =
         crate::runner::compare_dirs_exact(&dirs, &fit, args.jobs.unwrap_or(0), quiet, true, true)?;

@@ -143,12 +143,10 @@ fn check_output(out: &Path, format: Format, input: &Path, force: bool) -> anyhow
             out.with_extension(want).display()
         );
     }
+    crate::common::check_destination(out, "output")?;
     if out.exists() {
-        let same = match (out.canonicalize(), input.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        };
-        if same {
+        // The same file by resolved path, or by device and inode (a hard link).
+        if crate::common::same_file(out, input) {
             bail!(
                 "output {} is the input result; write the export to another file",
                 out.display()

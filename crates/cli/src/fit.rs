@@ -65,13 +65,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if !(args.eta.is_finite() && (1.0..=3.0).contains(&args.eta)) {
         bail!(
             "--eta {}: the relative refractive index must lie in [1, 3]",
-            args.eta
+            crate::numeric::show(args.eta)
         );
     }
     if !(args.spot_diameter_mm > 0.0 && args.spot_diameter_mm <= 20.0) {
         bail!(
             "--spot-diameter-mm {}: must lie in (0, 20] mm",
-            args.spot_diameter_mm
+            crate::numeric::show(args.spot_diameter_mm)
         );
     }
     let method: Method = args.method.into();
@@ -84,12 +84,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(a) = args.albedo
         && let Some(bad) = a.iter().find(|v| !(**v > 0.0 && **v <= 1.0))
     {
-        bail!("--albedo: {bad} is outside (0, 1] (a reduced albedo σ′s/σ′t)");
+        bail!(
+            "--albedo: {} is outside (0, 1] (a reduced albedo σ′s/σ′t)",
+            crate::numeric::show(*bad)
+        );
     }
     if let Some(rd) = args.rd
         && let Some(bad) = rd.iter().find(|v| !(**v > 0.0 && **v <= 1.0))
     {
-        bail!("--rd: {bad} is outside (0, 1] (a diffuse reflectance, a fraction)");
+        bail!(
+            "--rd: {} is outside (0, 1] (a diffuse reflectance, a fraction)",
+            crate::numeric::show(*bad)
+        );
     }
     if let Some(r) = args.r_min_mm {
         crate::numeric::ensure(

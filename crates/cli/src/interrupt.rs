@@ -1,8 +1,10 @@
 //! Ctrl-C (SIGINT; also SIGTERM and SIGHUP, `ctrlc`'s `termination` feature, as a scheduler sends): the
-//! temporary files of writes in flight are removed (`scatterfit_io::atomic::remove_in_flight`, which
-//! also stops later writes and sweeps the Monte Carlo cache folders registered by
-//! `common::cache_dir`), then the process exits with 130, the shell's code for an interrupted
-//! command. A result file is either complete or absent; an interrupted run leaves no `.tmp-` file.
+//! temporary files of writes in flight are removed (`scatterfit_io::atomic::remove_in_flight`: one
+//! registry for every writer, the Monte Carlo and synth caches included; it also stops later
+//! writes), then the process exits with 130, the shell's code for an interrupted command. A result
+//! file is either complete or absent; an interrupted run leaves no `.scatterfit-tmp-` file. (A run
+//! killed without a chance to clean up — SIGKILL, a power cut — leaves its temporaries; the next run
+//! that writes into that folder removes them once they are stale: `scatterfit_safefs::write`.)
 
 use crate::output::errln;
 

@@ -16,10 +16,15 @@ use crate::output::{errln, out, outln};
 pub struct Args {
     /// The sample folder (holding sample.toml).
     pub dir: PathBuf,
-    /// Where to write result.json, result.csv, result.md, profile.csv, fit.svg and fit.png
-    /// (default: the sample folder; these files are the command's own and are replaced).
+    /// Where to write result.json, result.csv, result.md, profile.csv, fit.svg, fit.png and, last,
+    /// result-files.json (default: the sample folder; these files are the command's own and are
+    /// replaced). A folder holding another sample's results, or another sample's folder, is refused
+    /// without --force.
     #[arg(short = 'o', long = "output-dir", value_name = "DIR")]
     pub output_dir: Option<PathBuf>,
+    /// Write into an -o folder that holds another sample's results (or is another sample's folder).
+    #[arg(long)]
+    pub force: bool,
     #[command(flatten)]
     pub fit: FitArgs,
     /// Print result.json on stdout instead of the summary.
@@ -39,8 +44,20 @@ struct Timing {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     let out = args.output_dir.clone().unwrap_or_else(|| args.dir.clone());
-    // Where the result files go is checked before the measurement (milliseconds, not minutes).
+    // Where the result files go is checked before the measurement (milliseconds, not minutes):
+    // writable, not another sample's, and no result file over one of the sample's inputs.
     crate::common::check_output_dir(&out, "-o")?;
+    let inputs = scatterfit_pipeline::sample_inputs(&args.dir, overrides.allow_outside_paths)
+        .with_context(|| format!("measuring {}", args.dir.display()))?;
+    crate::common::refuse_foreign_results(&inputs.manifest.dir, &out, args.force)?;
+    let outputs: Vec<PathBuf> = crate::common::RESULT_FILES
+        .iter()
+        .map(|f| out.join(f))
+        .collect();
+    crate::common::refuse_outputs_that_are_inputs("measure", &outputs, &inputs.files)?;
+    for o in &outputs {
+        crate::common::check_destination(o, "-o")?;
+    }
     let bar = bar(5, "{msg} {bar:30} {elapsed}", args.quiet || args.json);
     let m = measure_sample(&args.dir, &overrides, &|stage| {
         let msg = match stage {

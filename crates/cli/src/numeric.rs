@@ -35,15 +35,11 @@ pub fn ensure(
     }
 }
 
-/// A number for messages: as written for ordinary magnitudes, in scientific notation otherwise
-/// (`1e-300`, not three hundred zeros).
+/// A number for messages: at most 6 significant digits, in scientific notation beyond ordinary
+/// magnitudes (`1e-300`, not three hundred zeros; `0.3`, not `0.30000000000000004`):
+/// `scatterfit_io::escape::number`.
 pub fn show(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 || (1e-4..1e7).contains(&a) || !a.is_finite() {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
+    scatterfit_io::escape::number(v)
 }
 
 /// Parses a count: `1000000`, `1e6`, `2.5e5` or `1_000_000`; a whole number ≥ 0 that fits in u64

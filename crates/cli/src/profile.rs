@@ -101,8 +101,9 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
         && let Some(bad) = l.iter().find(|v| !(v.is_finite() && **v >= 0.0))
     {
         anyhow::bail!(
-            "--detection-limit: {bad} is not a radiance ≥ 0 (relative units, as `scatterfit merge` \
-             prints it)"
+            "--detection-limit: {} is not a radiance ≥ 0 (relative units, as `scatterfit merge` \
+             prints it)",
+            crate::numeric::show(*bad)
         );
     }
     crate::numeric::check_memory(

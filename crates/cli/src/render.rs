@@ -180,6 +180,10 @@ pub struct Args {
     /// The measured profile CSV for --profile, instead of the result's `inputs.profile`.
     #[arg(long, value_name = "CSV", requires = "profile")]
     pub measured_profile: Option<PathBuf>,
+    /// With --profile: follow a result's `inputs.profile` even when it leads outside the result's
+    /// folder (`../x.csv`, an absolute path, a link that leaves it); refused otherwise.
+    #[arg(long, requires = "profile")]
+    pub allow_outside_paths: bool,
     /// Light-spot radius for --profile [mm], in (0, 10] (default: the result's
     /// `inputs.spot_radius_mm`).
     #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
@@ -380,7 +384,7 @@ fn load_params(spec: &str, model: Option<ModelName>) -> anyhow::Result<Params> {
             None => bail!(
                 "{spec}: the parameters were fitted with a model render does not know (`{}`); \
                  pass --model dipole|better-dipole|pbd|mc",
-                result.model.trim().to_ascii_lowercase()
+                scatterfit_io::escape::token(result.model.trim())
             ),
         },
     };
@@ -492,6 +496,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(m) = &args.mesh {
         inputs.push(m.clone());
     }
+    if let Some(m) = &args.measured_profile {
+        inputs.push(m.clone());
+    }
     for out in &args.output {
         let ext = out
             .extension()
@@ -511,6 +518,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 if args.profile { " or .csv" } else { "" }
             ),
         }
+        crate::common::check_destination(out, "-o")?;
         if out.exists() && !args.force {
             bail!(
                 "-o {}: the file exists; nothing was done — pass --force to replace it, or choose \
@@ -538,7 +546,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if !(args.mesh_scale.is_finite() && args.mesh_scale > 0.0) {
         bail!(
             "--mesh-scale {} must be a positive number (mm per file unit)",
-            args.mesh_scale
+            crate::numeric::show(args.mesh_scale)
         );
     }
     if !(1000..=10_000_000).contains(&args.triangles) {
@@ -942,6 +950,35 @@ fn write_png(path: &Path, img: &ImageBuf<u8>) -> anyhow::Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// The result `json` and the profile `csv` it names, when they share a folder: listed in the
+/// folder's result set with the hashes they have now (one run's files), else refused; a folder
+/// without a set (an older scatterfit, an interrupted run) is noted on stderr.
+fn check_one_run(json: &Path, csv: &Path, quiet: bool) -> anyhow::Result<()> {
+    let folder = json.parent().unwrap_or(Path::new(""));
+    let folder = if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    };
+    let (Some(j), Some(c)) = (json.file_name(), csv.file_name()) else {
+        return Ok(());
+    };
+    if !crate::common::same_file(csv.parent().unwrap_or(Path::new(".")), folder) {
+        return Ok(());
+    }
+    let (j, c) = (j.to_string_lossy(), c.to_string_lossy());
+    match scatterfit_io::result_set::verify(folder, &[&j, &c])? {
+        scatterfit_io::result_set::SetStatus::Unknown if !quiet => errln!(
+            "note: {} has no {}: {j} and {c} cannot be checked to come from one run (results of an \
+             older scatterfit, or of a run that was interrupted — then measure again)",
+            folder.display(),
+            scatterfit_io::result_set::SET_FILE
+        ),
+        _ => {}
+    }
+    Ok(())
+}
+
 /// `--profile`: the measurement's slab and spot rendered by the texture-space method, compared ring
 /// by ring with the measured profile divided by the fitted scale k (Table 2's MSE, §4.4).
 fn run_profile(
@@ -960,14 +997,29 @@ fn run_profile(
     };
     let csv = match given {
         Some(path) => path.clone(),
-        None => match &result.inputs.profile {
-            Some(rel) => folder.join(rel),
-            None => bail!(
-                "{}: no `inputs.profile`; give the measured profile with --measured-profile FILE.csv",
-                p.source
-            ),
-        },
+        None => {
+            match &result.inputs.profile {
+                Some(rel) => {
+                    let csv = folder.join(rel);
+                    // A result names files inside its folder (the input path policy), and the result
+                    // and the profile it names must come from one run (the folder's result set).
+                    scatterfit_io::inputs::InputPolicy::new(folder, args.allow_outside_paths)?
+                        .check(Path::new(&p.source), "`inputs.profile`", &csv)?;
+                    check_one_run(Path::new(&p.source), &csv, args.quiet)?;
+                    csv
+                }
+                None => bail!(
+                    "{}: no `inputs.profile`; give the measured profile with --measured-profile FILE.csv",
+                    p.source
+                ),
+            }
+        }
     };
+    // The profile is an input too: no output may replace it (with --force it could).
+    let refs = [csv.as_path()];
+    for out in &args.output {
+        crate::common::refuse_overwrite(out, "-o", &refs)?;
+    }
     let table = read_profile_csv(&csv)?;
     let column = |name: &str| {
         table

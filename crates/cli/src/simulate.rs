@@ -157,7 +157,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
         bail!(
             "--eta {}: below 1 means the material is optically thinner than air, which is unusual for \
              a solid; pass --allow-eta-below-one if you mean it",
-            args.eta
+            crate::numeric::show(args.eta)
         );
     }
     range(

@@ -94,7 +94,12 @@ fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
                 bail!("--lab takes three numbers: L* a* b*")
             };
             if !(0.0..=100.0).contains(&l) || !a.is_finite() || !b.is_finite() {
-                bail!("--lab {l} {a} {b}: L* must lie in 0..100 and a*, b* be finite numbers");
+                bail!(
+                    "--lab {} {} {}: L* must lie in 0..100 and a*, b* be finite numbers",
+                    crate::numeric::show(l),
+                    crate::numeric::show(a),
+                    crate::numeric::show(b)
+                );
             }
             let observer = Observer::from_degrees(args.observer)
                 .with_context(|| format!("--observer {}: use 2 or 10", args.observer))?;
@@ -104,7 +109,10 @@ fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
     if let Some(eta) = args.eta
         && !(1.0..=3.0).contains(&eta)
     {
-        bail!("--eta {eta}: the relative refractive index must lie in [1, 3]");
+        bail!(
+            "--eta {}: the relative refractive index must lie in [1, 3]",
+            crate::numeric::show(eta)
+        );
     }
     Ok(SpectroOptions { lab, eta: args.eta })
 }

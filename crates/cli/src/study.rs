@@ -145,15 +145,21 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
         bail!("give at least one η and one α′");
     }
     if let Some(e) = args.etas.iter().find(|e| !(1.0..=2.5).contains(*e)) {
-        bail!("--etas: {e} is outside [1, 2.5], the range of the Monte Carlo tables");
+        bail!(
+            "--etas: {} is outside [1, 2.5], the range of the Monte Carlo tables",
+            crate::numeric::show(*e)
+        );
     }
     if let Some(a) = args.albedos.iter().find(|a| !(0.3..=0.9999).contains(*a)) {
-        bail!("--albedos: {a} is outside [0.3, 0.9999]");
+        bail!(
+            "--albedos: {} is outside [0.3, 0.9999]",
+            crate::numeric::show(*a)
+        );
     }
     if !(0.2..=20.0).contains(&args.sigma_t_prime) {
         bail!(
             "--sigma-t-prime {}: must lie in [0.2, 20] mm⁻¹",
-            args.sigma_t_prime
+            crate::numeric::show(args.sigma_t_prime)
         );
     }
     let dir = &args.output_dir;
@@ -306,7 +312,9 @@ fn study_sample(
     combos: &[Combo],
 ) -> anyhow::Result<Vec<Row>> {
     let truth: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("truth.json")).context("reading truth.json")?,
+        &scatterfit_io::text::read_text_file(&dir.join("truth.json"))
+            .context("reading truth.json")?
+            .text,
     )?;
     // At η = 1 there is no specular reflection to measure η from (SCI = SCE): the study gives it.
     let overrides = Overrides {

@@ -99,7 +99,10 @@ fn material_from(args: &Args) -> anyhow::Result<Material> {
         ("--sigma-a", m.sigma_a),
     ] {
         if let Some(x) = v.iter().find(|x| !(**x > 0.0 && **x <= 100.0)) {
-            bail!("{what}: {x} is outside (0, 100] mm⁻¹");
+            bail!(
+                "{what}: {} is outside (0, 100] mm⁻¹",
+                crate::numeric::show(*x)
+            );
         }
     }
     if !(1.0..=3.0).contains(&m.eta) {

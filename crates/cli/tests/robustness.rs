@@ -369,7 +369,7 @@ fn simulate_outputs_and_exit_classes() {
     let left: Vec<String> = std::fs::read_dir(d)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.contains(".tmp-"))
+        .filter(|n| n.contains(".tmp-") || n.starts_with(".scatterfit-tmp-"))
         .collect();
     assert!(left.is_empty(), "{left:?}");
 }

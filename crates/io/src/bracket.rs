@@ -60,8 +60,9 @@ pub enum BracketError {
     },
     /// An exposure time is zero, negative or not finite.
     #[error(
-        "{where_}: exposure time {time_s} s is not positive; every frame needs its shutter time in \
-         seconds (> 0)"
+        "{where_}: exposure time {} s is not positive; every frame needs its shutter time in \
+         seconds (> 0)",
+        crate::escape::number(*time_s)
     )]
     NonPositiveTime {
         /// Where the time came from (`exposures.csv, line 3` or `img.jpg (EXIF ExposureTime)`).
@@ -79,10 +80,11 @@ pub enum BracketError {
     },
     /// Two images have the same exposure time (a bracket needs distinct times).
     #[error(
-        "{} and {} have the same exposure time {time_s} s; a bracket needs a different shutter time \
+        "{} and {} have the same exposure time {} s; a bracket needs a different shutter time \
          for every frame (remove the duplicate or correct its time)",
         first.display(),
-        second.display()
+        second.display(),
+        crate::escape::number(*time_s)
     )]
     DuplicateTime {
         /// The first image.
@@ -211,11 +213,10 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
         .clone();
     let column = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
     let (Some(file_col), Some(time_col)) = (column("file"), column("time_s")) else {
-        let found = headers.iter().collect::<Vec<_>>().join(",");
-        return Err(header_err(if found.is_empty() {
+        return Err(header_err(if headers.is_empty() {
             "an empty file".into()
         } else {
-            found
+            crate::text::header_for_message(headers.iter(), &["file", "time_s"])
         }));
     };
     let mut entries = Vec::new();
@@ -251,7 +252,8 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
             return Err(line_err(
                 line,
                 format!(
-                    "no `time_s` for {file}; give its shutter time in seconds, e.g. 0.01 or 1/100"
+                    "no `time_s` for {}; give its shutter time in seconds, e.g. 0.01 or 1/100",
+                    crate::escape::token(file)
                 ),
             ));
         };
@@ -259,14 +261,20 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
             line_err(
                 line,
                 format!(
-                    "`time_s` = {time_text:?} for {file} is not a number; write seconds as a decimal \
-                     (0.0016667) or a fraction (1/600)"
+                    "`time_s` = {} for {} is not a number; write seconds as a decimal \
+                     (0.0016667) or a fraction (1/600)",
+                    crate::text::cell_for_message(time_text),
+                    crate::escape::token(file)
                 ),
             )
         })?;
         if !(time_s > 0.0 && time_s.is_finite()) {
             return Err(BracketError::NonPositiveTime {
-                where_: format!("{}, line {line} ({file})", path.display()),
+                where_: format!(
+                    "{}, line {line} ({})",
+                    path.display(),
+                    crate::escape::token(file)
+                ),
                 time_s,
             });
         }
@@ -561,10 +569,7 @@ pub fn read_bracket_within(
     let decoded: Vec<Result<BracketFrame, BracketError>> = plan
         .par_iter()
         .map(|(path, time)| {
-            let bytes = std::fs::read(path).map_err(|source| ImageFileError::Read {
-                path: path.clone(),
-                source,
-            })?;
+            let bytes = crate::image_files::read_image_bytes(path, budget)?;
             let time_s = match time {
                 TimeOf::Known { time_s, .. } => *time_s,
                 TimeOf::Exif => exif_exposure_time(&bytes, path)?,
@@ -593,8 +598,10 @@ pub fn decoded_size<'a>(paths: impl IntoIterator<Item = &'a Path>) -> (u64, u64,
     let mut largest = 0u64;
     let mut shape = String::new();
     for path in paths {
-        let Ok(reader) = image::ImageReader::open(path).and_then(|r| r.with_guessed_format())
-        else {
+        // A regular file only: `ImageReader::open` on a FIFO would block for ever.
+        let Ok(reader) = scatterfit_safefs::read::open_regular(path).and_then(|(f, _)| {
+            image::ImageReader::new(std::io::BufReader::new(f)).with_guessed_format()
+        }) else {
             continue;
         };
         let Ok(decoder) = reader.into_decoder() else {

@@ -269,7 +269,17 @@ fn drop_alpha<T: Copy>(data: &[T], stride: usize) -> Vec<T> {
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageFileError> {
-    std::fs::read(path).map_err(|source| ImageFileError::Read {
+    read_image_bytes(path, crate::budget::memory_budget_bytes())
+}
+
+/// The bytes of an image file: a regular file only (a FIFO or a device is refused at once) of at
+/// most `budget` bytes (a compressed image is never larger than what it decodes to, which the
+/// budget bounds too).
+///
+/// # Errors
+/// [`ImageFileError::Read`] naming the file.
+pub fn read_image_bytes(path: &Path, budget: u64) -> Result<Vec<u8>, ImageFileError> {
+    scatterfit_safefs::read::read_limited(path, budget).map_err(|source| ImageFileError::Read {
         path: path.to_path_buf(),
         source,
     })
@@ -482,7 +492,7 @@ pub fn read_radiance(path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
 /// # Errors
 /// As [`read_radiance`], and [`ImageFileError::TooLarge`].
 pub fn read_radiance_within(path: &Path, budget: u64) -> Result<ImageBuf<f32>, ImageFileError> {
-    let bytes = read_bytes(path)?;
+    let bytes = read_image_bytes(path, budget)?;
     decode_radiance(&bytes, path, budget)
 }
 

@@ -9,13 +9,16 @@
 pub mod atomic;
 pub mod bracket;
 pub mod budget;
+pub mod escape;
 pub mod export;
 pub mod image_files;
+pub mod inputs;
 pub mod manifest;
 pub mod mesh;
 pub mod profile_csv;
 pub mod response_csv;
 pub mod result_json;
+pub mod result_set;
 pub mod result_table;
 pub mod sample_folder;
 pub mod spectro;

@@ -47,7 +47,7 @@ pub enum ManifestError {
         /// The I/O error.
         source: std::io::Error,
         /// What to do.
-        hint: &'static str,
+        hint: String,
     },
     /// Not valid TOML, an unknown key, or a value of the wrong type.
     #[error("{}: {message}", path.display())]
@@ -67,6 +67,9 @@ pub enum ManifestError {
         /// What is wrong and what to do.
         problem: String,
     },
+    /// The file is not text we read (binary data, UTF-16 without a byte-order mark, too large).
+    #[error(transparent)]
+    Text(crate::text::TextError),
     /// The manifest could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Write {
@@ -197,22 +200,54 @@ pub fn read_manifest(path_or_dir: &Path) -> Result<SampleManifest, ManifestError
     } else {
         path_or_dir.to_path_buf()
     };
-    let text = std::fs::read_to_string(&path).map_err(|source| ManifestError::Read {
-        hint: if source.kind() == std::io::ErrorKind::NotFound {
-            " — a sample folder holds a sample.toml naming its spectro file and bracket (see \
-             `scatterfit synth` for a complete example folder)"
-        } else {
-            ""
-        },
-        path: path.clone(),
-        source,
-    })?;
+    // Through the text reader every text file uses: a regular file of at most 64 MiB, UTF-8 (with or
+    // without BOM), UTF-16 with BOM, or Windows-1252.
+    let text = crate::text::read_text_file(&path)
+        .map_err(|e| match e {
+            crate::text::TextError::Io { path, source } => ManifestError::Read {
+                hint: if source.kind() == std::io::ErrorKind::NotFound {
+                    not_found_hint(&path)
+                } else {
+                    String::new()
+                },
+                path,
+                source,
+            },
+            other => ManifestError::Text(other),
+        })?
+        .text;
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."))
         .to_path_buf();
     parse_manifest(&text, &path, dir)
+}
+
+/// What to say when the manifest is not there: a file that looks like a misspelt one
+/// (`Sample.toml`, `sample.TOML`, `sample.toml.txt`) is named; else what a sample folder holds.
+fn not_found_hint(path: &Path) -> String {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let misspelt = std::fs::read_dir(dir).ok().and_then(|entries| {
+        entries.flatten().map(|e| e.file_name()).find(|n| {
+            let l = n.to_string_lossy().to_lowercase();
+            n != MANIFEST_NAME
+                && (l.starts_with("sample.toml")
+                    || (l.starts_with("sample") && (l.ends_with(".toml") || l.ends_with(".tml"))))
+        })
+    });
+    match misspelt {
+        Some(n) => format!(
+            " — the folder holds {}: rename it to exactly sample.toml (names are case-sensitive)",
+            crate::escape::token(&n.to_string_lossy())
+        ),
+        None => " — a sample folder holds a sample.toml naming its spectro file and bracket (see \
+                 `scatterfit synth` for a complete example folder)"
+            .into(),
+    }
 }
 
 /// Parses and checks manifest text; `path` names it in messages, `dir` resolves its paths.
@@ -224,9 +259,9 @@ pub fn parse_manifest(
     path: &Path,
     dir: PathBuf,
 ) -> Result<SampleManifest, ManifestError> {
-    let mut m: SampleManifest = toml::from_str(text).map_err(|e| ManifestError::Syntax {
+    let mut m = parse_toml(text).map_err(|message| ManifestError::Syntax {
         path: path.to_path_buf(),
-        message: e.to_string().trim_end().replace('\n', "\n  "),
+        message,
     })?;
     m.dir = dir;
     let invalid = |key: &'static str, problem: String| ManifestError::Invalid {
@@ -253,7 +288,12 @@ pub fn parse_manifest(
     {
         return Err(invalid(
             "spectro.lab",
-            format!("= [{l}, {a}, {b}]: L* must lie in 0..100 and a*, b* be finite"),
+            format!(
+                "= [{}, {}, {}]: L* must lie in 0..100 and a*, b* be finite",
+                num(l),
+                num(a),
+                num(b)
+            ),
         ));
     }
     if let Some(o) = m.spectro.lab_observer
@@ -270,7 +310,10 @@ pub fn parse_manifest(
     {
         return Err(invalid(
             "spectro.eta",
-            format!("= {eta}: the relative refractive index must lie in [1, 3]"),
+            format!(
+                "= {}: the relative refractive index must lie in [1, 3]",
+                num(eta)
+            ),
         ));
     }
     if let Some(r) = m.spectro.repeatability
@@ -279,8 +322,9 @@ pub fn parse_manifest(
         return Err(invalid(
             "spectro.repeatability",
             format!(
-                "= {r}: the relative standard deviation of a reading must lie in [0, 0.2] \
-                 (0.005 is 0.5 %; 0 ignores the spectrophotometer's uncertainty)"
+                "= {}: the relative standard deviation of a reading must lie in [0, 0.2] \
+                 (0.005 is 0.5 %; 0 ignores the spectrophotometer's uncertainty)",
+                num(r)
             ),
         ));
     }
@@ -296,7 +340,7 @@ pub fn parse_manifest(
         Some(v) if !(v.is_finite() && v > 0.0 && v < 100.0) => {
             return Err(invalid(
                 "camera.mm_per_pixel",
-                format!("= {v}: must be a number in (0, 100) mm per pixel"),
+                format!("= {}: must be a number in (0, 100) mm per pixel", num(v)),
             ));
         }
         Some(_) => {}
@@ -323,7 +367,7 @@ pub fn parse_manifest(
     {
         return Err(invalid(
             "camera.spot_diameter_mm",
-            format!("= {d}: must be a number in (0, 20] mm"),
+            format!("= {}: must be a number in (0, 20] mm", num(d)),
         ));
     }
     if let Some([x, y]) = m.camera.center_px
@@ -339,13 +383,16 @@ pub fn parse_manifest(
     {
         return Err(invalid(
             "fit.r_max_px",
-            format!("= {r}: must be a number of pixels in [2, 100000]"),
+            format!("= {}: must be a number of pixels in [2, 100000]", num(r)),
         ));
     }
     if let Some(r) = m.fit.r_min_mm
         && !(r.is_finite() && r >= 0.0)
     {
-        return Err(invalid("fit.r_min_mm", format!("= {r}: must be ≥ 0 mm")));
+        return Err(invalid(
+            "fit.r_min_mm",
+            format!("= {}: must be ≥ 0 mm", num(r)),
+        ));
     }
     if m.fit.normalise_with_spectro == Some(true) && m.fit.method == Some(Method::Existing) {
         return Err(invalid(
@@ -354,6 +401,97 @@ pub fn parse_manifest(
         ));
     }
     Ok(m)
+}
+
+use crate::escape::number as num;
+
+/// The top-level keys of a manifest: a TOML file whose top-level keys are all among these is
+/// recognised as a manifest, and only then may a message quote a piece of it.
+const TOP_LEVEL_KEYS: [&str; 4] = ["name", "spectro", "camera", "fit"];
+
+/// Parses manifest text, with messages that follow the content rule (RELIABILITY.md, "Inputs"):
+/// line and column always; before the file is recognised as a manifest (it parses as TOML and its
+/// top-level keys are ours) nothing of its content; after, single keys and values as short escaped
+/// tokens. Never toml's snippet of the line.
+fn parse_toml(text: &str) -> Result<SampleManifest, String> {
+    let at = |e: &toml::de::Error| {
+        e.span()
+            .map(|s| {
+                let (line, column) = line_column(text, s.start);
+                format!("line {line}, column {column}: ")
+            })
+            .unwrap_or_default()
+    };
+    let table: toml::Table = match toml::from_str(text) {
+        Ok(t) => t,
+        Err(e) => {
+            let what =
+                crate::escape::redact_quotes(e.message().trim(), |q| TOP_LEVEL_KEYS.contains(&q));
+            return Err(format!(
+                "{}not valid TOML ({what}); the file's content is not shown — is this a sample \
+                 manifest?",
+                at(&e)
+            ));
+        }
+    };
+    let recognised = table.keys().all(|k| TOP_LEVEL_KEYS.contains(&k.as_str()));
+    match toml::from_str::<SampleManifest>(text) {
+        Ok(m) => Ok(m),
+        Err(e) if !recognised => Err(format!(
+            "{}a top-level key that is not `name`, `[spectro]`, `[camera]` or `[fit]`: this is not \
+             a scatterfit sample manifest (its content is not shown; `scatterfit synth` writes a \
+             complete example)",
+            at(&e)
+        )),
+        Err(e) => {
+            let key = e
+                .span()
+                .and_then(|s| key_at(text, s.start))
+                .map(|k| format!("`{k}`: "))
+                .unwrap_or_default();
+            Err(format!(
+                "{}{key}{}",
+                at(&e),
+                crate::escape::shorten_quotes(e.message().trim())
+            ))
+        }
+    }
+}
+
+/// 1-based line and column (in characters) of byte `offset` of `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let mut start = offset;
+    while !text.is_char_boundary(start) {
+        start -= 1;
+    }
+    let before = &text[..start];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+    (line, column)
+}
+
+/// The dotted key (`camera.mm_per_pixel`) of the line holding byte `offset`, as a short escaped
+/// token: the last `[table]` header above it and the key before `=` on its line.
+fn key_at(text: &str, offset: usize) -> Option<String> {
+    let (line, _) = line_column(text, offset);
+    let lines: Vec<&str> = text.lines().collect();
+    let here = lines.get(line - 1)?;
+    let (key, _) = here.split_once('=')?;
+    let key = key.trim().trim_matches('"');
+    if key.is_empty() || key.starts_with('[') {
+        return None;
+    }
+    let table = lines[..line - 1]
+        .iter()
+        .rev()
+        .map(|l| l.trim())
+        .find(|l| l.starts_with('[') && !l.starts_with("[["))
+        .map(|l| l.trim_matches(['[', ']']).trim());
+    Some(crate::escape::token(&match table {
+        Some(t) => format!("{t}.{key}"),
+        None => key.to_string(),
+    }))
 }
 
 fn toml_string(s: &str) -> String {
@@ -579,5 +717,81 @@ r_max_px = 300
             assert!(err.contains(key), "{key}: {err}");
             assert!(err.contains("sample.toml"), "{err}");
         }
+    }
+
+    /// The content rule: a file that is not a manifest (a password file, a TOML file of another
+    /// program) is named with a line and column, and nothing of its content is shown.
+    #[test]
+    fn content_of_a_file_that_is_not_a_manifest_is_never_shown() {
+        for (text, line) in [
+            ("root:$6$SECRETHASH:19000:0:99999:7:::\nbin:*:1\n", 1),
+            ("name = \"x\"\ntoken = \"SECRETVALUE\"\n", 2),
+            ("[registry]\ntoken = \"SECRETVALUE\"\n", 1),
+            ("SECRETKEY = 1\n", 1),
+            ("a = \"SECRET\nVALUE\"\n", 2),
+            ("\"SECRET\" = [1, 2\n", 1),
+        ] {
+            let err = parse(text).unwrap_err().to_string();
+            assert!(!err.contains("SECRET"), "{text:?}: {err}");
+            assert!(!err.contains("token") && !err.contains("registry"), "{err}");
+            assert!(err.contains(&format!("line {line}, column")), "{err}");
+            assert!(err.contains("s/sample.toml"), "{err}");
+        }
+    }
+
+    /// A recognised manifest's mistakes quote the key and value, shortened and escaped.
+    #[test]
+    fn recognised_mistakes_quote_short_escaped_tokens() {
+        let long = "d".repeat(200);
+        let err = parse(&GOOD.replace("model = \"dipole\"", &format!("model = \"{long}\"")))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(&format!("`{}…`", "d".repeat(40))), "{err}");
+        assert!(!err.contains(&"d".repeat(41)), "{err}");
+        assert!(err.contains("fit.model"), "{err}");
+        let err = parse(&GOOD.replace("model = \"dipole\"", "model = \"\\u001b[31mred\""))
+            .unwrap_err()
+            .to_string();
+        assert!(!err.contains('\u{1b}'), "{err:?}");
+        // A number from the file is shown with at most 6 significant digits.
+        let err = parse(&GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = 1e300"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("= 1e300:"), "{err}");
+        let err = parse(
+            &GOOD
+                .replace("eta", "x")
+                .replace("[spectro]", "[spectro]\neta = 3.14159265358979"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("= 3.14159:"), "{err}");
+    }
+
+    /// `sample.toml` in UTF-16 (with BOM) or Windows-1252 reads like every other text file.
+    #[test]
+    fn utf16_and_windows_1252_manifests_are_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = GOOD.replace("pink plastic", "Probe grün, 23 °C");
+        let mut utf16 = vec![0xFF, 0xFE];
+        for u in text.encode_utf16() {
+            utf16.extend(u.to_le_bytes());
+        }
+        let latin1: Vec<u8> = text.chars().map(|c| c as u32 as u8).collect();
+        for bytes in [utf16, latin1, text.as_bytes().to_vec()] {
+            std::fs::write(dir.path().join(MANIFEST_NAME), &bytes).unwrap();
+            let m = read_manifest(dir.path()).unwrap();
+            assert_eq!(m.name.as_deref(), Some("Probe grün, 23 °C"));
+        }
+    }
+
+    /// A manifest that is a FIFO or a device is refused at once, naming it.
+    #[cfg(unix)]
+    #[test]
+    fn special_files_are_refused() {
+        let e = read_manifest(Path::new("/dev/zero"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("character device"), "{e}");
     }
 }

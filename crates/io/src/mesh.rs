@@ -103,11 +103,18 @@ fn invalid(path: &Path, detail: String) -> MeshError {
     }
 }
 
+/// A mesh file's bytes: a regular file only, within the memory budget ([`crate::budget`]).
+fn read_mesh_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
+    scatterfit_safefs::read::read_limited(path, crate::budget::memory_budget_bytes()).map_err(
+        |error| MeshError::Read {
+            path: path.to_path_buf(),
+            error,
+        },
+    )
+}
+
 fn read_obj(path: &Path) -> Result<Parsed, MeshError> {
-    let text = std::fs::read(path).map_err(|error| MeshError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let text = read_mesh_bytes(path)?;
     let opts = tobj::LoadOptions {
         triangulate: false,
         single_index: true,
@@ -160,13 +167,31 @@ fn read_obj(path: &Path) -> Result<Parsed, MeshError> {
 fn read_ply(path: &Path) -> Result<Parsed, MeshError> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let bytes = std::fs::read(path).map_err(|error| MeshError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes = read_mesh_bytes(path)?;
+    // The content rule (RELIABILITY.md, "Inputs"): the parser's messages quote whole lines, so a
+    // file that does not start with PLY's magic line is refused without them, and a PLY file's
+    // error keeps the parser's first line with its quotes shortened.
+    if !(bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")) {
+        return Err(invalid(
+            path,
+            "not a PLY file (it does not start with the line `ply`); the file's content is not \
+             shown"
+                .into(),
+        ));
+    }
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut std::io::Cursor::new(bytes))
-        .map_err(|e| invalid(path, format!("not a readable PLY file ({e})")))?;
+        .map_err(|e| {
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("");
+            invalid(
+                path,
+                format!(
+                    "not a readable PLY file ({})",
+                    crate::escape::shorten_quotes(&first.replace('\'', "`"))
+                ),
+            )
+        })?;
     let scalar = |p: &Property| -> Option<f64> {
         Some(match *p {
             Property::Char(v) => v as f64,
@@ -505,6 +530,40 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("refers to vertex 8"), "{err}");
+    }
+
+    /// The content rule: a file that is not a mesh is refused without its content; a PLY file's
+    /// parse error shows at most a short token; a special file is refused at once.
+    #[test]
+    fn mesh_errors_do_not_echo_content() {
+        let dir = tempfile::tempdir().unwrap();
+        let secret = "root:$6$SECRETHASH:19000:0:99999:7:::\n";
+        for name in ["shadow.ply", "shadow.obj"] {
+            let err = read_mesh(&write(dir.path(), name, secret.as_bytes()))
+                .unwrap_err()
+                .to_string();
+            assert!(!err.contains("SECRET"), "{err}");
+            assert!(err.contains(name), "{err}");
+        }
+        let ply = format!(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n{}\n",
+            "SECRET".repeat(20)
+        );
+        let err = read_mesh(&write(dir.path(), "long.ply", ply.as_bytes()))
+            .unwrap_err()
+            .to_string();
+        assert!(!err.contains(&"SECRET".repeat(8)), "{err}");
+        #[cfg(unix)]
+        {
+            let e = read_mesh(Path::new("/dev/zero.obj"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("zero.obj"), "{e}");
+            let link = dir.path().join("zero.obj");
+            std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+            let e = read_mesh(&link).unwrap_err().to_string();
+            assert!(e.contains("character device"), "{e}");
+        }
     }
 
     #[test]

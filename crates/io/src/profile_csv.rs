@@ -179,7 +179,10 @@ pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, Profil
     let r_mm_col = find("r_mm").ok_or_else(|| {
         invalid(format!(
             "the header has no `r_mm` column (found `{}`)",
-            names.join(",")
+            crate::text::header_for_message(
+                names.iter().copied(),
+                &["r_mm", "r_px", "value_r", "value_g", "value_b", "value_y"]
+            )
         ))
     })?;
     let r_px_col = find("r_px");
@@ -191,6 +194,7 @@ pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, Profil
                 find(&format!("stderr_{name}")),
                 find(&format!("count_{name}")),
             ) else {
+                let name = crate::escape::token(name);
                 return Err(invalid(format!(
                     "channel `{name}` needs columns value_{name}, stderr_{name} and count_{name}"
                 )));
@@ -238,8 +242,9 @@ pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, Profil
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
                     invalid(format!(
-                        "line {line}: `{}` = {field:?} is not a finite number",
-                        names[col]
+                        "line {line}: `{}` = {} is not a finite number",
+                        crate::escape::token(names[col]),
+                        crate::text::cell_for_message(field)
                     ))
                 })
         };
@@ -257,8 +262,9 @@ pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, Profil
             let field = record.get(*n).unwrap_or("");
             column.count.push(field.parse::<u64>().map_err(|_| {
                 invalid(format!(
-                    "line {line}: `{}` = {field:?} is not a pixel count",
-                    names[*n]
+                    "line {line}: `{}` = {} is not a pixel count",
+                    crate::escape::token(names[*n]),
+                    crate::text::cell_for_message(field)
                 ))
             })?);
         }

@@ -198,7 +198,13 @@ pub fn parse_response_csv(text: &str, path: &Path) -> Result<ResponseTable, Resp
         .clone();
     let names: Vec<String> = headers.iter().map(str::to_ascii_lowercase).collect();
     let find = |n: &str| names.iter().position(|h| h == n);
-    let z_col = find("z").ok_or_else(|| header_err(names.join(",")))?;
+    let shown = || {
+        crate::text::header_for_message(
+            names.iter().map(String::as_str),
+            &["z", "g", "g_y", "g_r", "g_g", "g_b"],
+        )
+    };
+    let z_col = find("z").ok_or_else(|| header_err(shown()))?;
     let value_cols: Vec<usize> = match (
         find("g_r"),
         find("g_g"),
@@ -207,7 +213,7 @@ pub fn parse_response_csv(text: &str, path: &Path) -> Result<ResponseTable, Resp
     ) {
         (Some(r), Some(g), Some(b), _) => vec![r, g, b],
         (None, None, None, Some(y)) => vec![y],
-        _ => return Err(header_err(names.join(","))),
+        _ => return Err(header_err(shown())),
     };
     let mut g = vec![Vec::new(); value_cols.len()];
     let mut lines = LineCounter::new(text);
@@ -253,7 +259,11 @@ pub fn parse_response_csv(text: &str, path: &Path) -> Result<ResponseTable, Resp
                 .ok_or_else(|| {
                     line_err(
                         line,
-                        format!("`{}` = {field:?} is not a finite number", names[col]),
+                        format!(
+                            "`{}` = {} is not a finite number",
+                            crate::escape::token(&names[col]),
+                            crate::text::cell_for_message(field)
+                        ),
                     )
                 })?;
             g[c].push(value);

@@ -305,6 +305,15 @@ fn text_error(e: crate::text::TextError) -> ResultJsonError {
     }
 }
 
+/// What a JSON syntax error is, without its position (given separately) and without content.
+fn classify_json(e: &serde_json::Error) -> String {
+    let text = e.to_string();
+    match text.rfind(" at line ") {
+        Some(i) => text[..i].to_string(),
+        None => text,
+    }
+}
+
 /// [`read_result_json`] on text already read; `path` names it in errors.
 ///
 /// # Errors
@@ -314,16 +323,35 @@ pub fn parse_result_json(text: &str, path: &Path) -> Result<MeasurementResult, R
         path: path.to_path_buf(),
         detail,
     };
+    // The content rule (RELIABILITY.md, "Inputs"): until the file is recognised as a result (JSON
+    // whose top level is an object with `channels`), a message shows nothing of its content.
+    const EXPECTED: &str = "expected the JSON that `scatterfit measure` writes (name, eta, method, \
+                            model, channels.r/g/b)";
+    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+        invalid(format!(
+            "not a scatterfit result: not valid JSON at line {}, column {} ({}); the file's \
+             content is not shown; {EXPECTED}",
+            e.line(),
+            e.column(),
+            crate::escape::redact_quotes(&classify_json(&e), |_| false)
+        ))
+    })?;
+    if value.get("channels").is_none() {
+        return Err(invalid(format!(
+            "not a scatterfit result: no `channels` at the top level; the file's content is not \
+             shown; {EXPECTED}"
+        )));
+    }
     let result: MeasurementResult = serde_json::from_str(text).map_err(|e| {
         invalid(format!(
-            "not a scatterfit result ({e}); expected the JSON that `scatterfit measure` writes \
-             (name, eta, method, model, channels.r/g/b)"
+            "not a scatterfit result ({}); {EXPECTED}",
+            crate::escape::shorten_quotes(&e.to_string())
         ))
     })?;
     if !(result.eta.is_finite() && result.eta >= 1.0) {
         return Err(invalid(format!(
             "`eta` = {} must be a number ≥ 1 (relative refractive index)",
-            result.eta
+            crate::escape::number(result.eta)
         )));
     }
     for (name, c) in ["r", "g", "b"].iter().zip(result.channels.as_array()) {
@@ -338,7 +366,8 @@ pub fn parse_result_json(text: &str, path: &Path) -> Result<MeasurementResult, R
                 && !(v.is_finite() && v >= 0.0)
             {
                 return Err(invalid(format!(
-                    "`channels.{name}.{field}` = {v} must be a finite number ≥ 0 [mm⁻¹]"
+                    "`channels.{name}.{field}` = {} must be a finite number ≥ 0 [mm⁻¹]",
+                    crate::escape::number(v)
                 )));
             }
         }
@@ -351,7 +380,8 @@ pub fn parse_result_json(text: &str, path: &Path) -> Result<MeasurementResult, R
             && !(a.is_finite() && a > 0.0 && a <= 1.0)
         {
             return Err(invalid(format!(
-                "`channels.{name}.albedo_prime` = {a} must lie in (0, 1]"
+                "`channels.{name}.albedo_prime` = {} must lie in (0, 1]",
+                crate::escape::number(a)
             )));
         }
     }
@@ -461,5 +491,41 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("not a scatterfit result"), "{err}");
+    }
+
+    /// The content rule: a file that is not a result (a secret, a JSON file of another program)
+    /// is refused without a word of its content; a result's wrong value is shown shortened and
+    /// with at most 6 significant digits.
+    #[test]
+    fn content_is_shown_only_for_a_recognised_result() {
+        for text in [
+            "root:$6$SECRETHASH:19000:0:99999:7:::",
+            r#"{"token": "SECRETVALUE"}"#,
+            r#"{"eta": "SECRETVALUE"}"#,
+            r#"["SECRETVALUE"]"#,
+            "\"SECRETVALUE",
+        ] {
+            let err = parse_result_json(text, Path::new("r.json"))
+                .unwrap_err()
+                .to_string();
+            assert!(!err.contains("SECRET"), "{text}: {err}");
+            assert!(
+                err.contains("r.json") && err.contains("not a scatterfit result"),
+                "{err}"
+            );
+        }
+        let mut v = serde_json::to_value(result()).unwrap();
+        v["method"] = serde_json::json!(7);
+        v["name"] = serde_json::json!(format!("{}\u{1b}[2J", "n".repeat(100)));
+        let err = parse_result_json(&v.to_string(), Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("invalid type"), "{err}");
+        let mut r = result();
+        r.eta = 1e-300;
+        let err = parse_result_json(&serde_json::to_string(&r).unwrap(), Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("= 1e-300 "), "{err}");
     }
 }

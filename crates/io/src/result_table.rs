@@ -136,8 +136,8 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 num(c.albedo_prime, 6),
                 num(c.rd_total, 6),
                 num(Some(r.eta), 4),
-                r.method,
-                r.model,
+                csv_text(&r.method),
+                csv_text(&r.model),
                 num(Some(c.fit_time_s), 7),
                 c.iterations,
                 num(c.mse, 8),
@@ -157,12 +157,10 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
     t
 }
 
+/// A text cell: quoted where needed, and never a spreadsheet formula ([`crate::escape::csv_cell`]:
+/// a name starting with `=`, `+`, `-` or `@` gets a leading `'`).
 fn csv_text(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\"").replace('\n', " "))
-    } else {
-        s.to_string()
-    }
+    crate::escape::csv_cell(s)
 }
 
 /// Table 1 as Markdown: Material | Color | σ′s | σa | η | fitting time, as the paper prints it,
@@ -174,7 +172,12 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
     );
     for r in results {
         for (k, (name, c)) in CHANNELS.iter().zip(r.channels.as_array()).enumerate() {
-            let material = if k == 0 { r.name.as_str() } else { "" };
+            // The name is the user's text: `|`, line breaks and raw HTML must not break the table.
+            let material = if k == 0 {
+                crate::escape::markdown_cell(&r.name)
+            } else {
+                String::new()
+            };
             let eta = match (k, r.eta_stderr) {
                 (1, Some(e)) => format!("{:.4} ± {}", r.eta, sig4(e)),
                 (1, None) => format!("{:.4}", r.eta),
@@ -205,7 +208,13 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
                 .iter()
                 .zip(r.channels.as_array())
                 .filter_map(move |(n, c)| {
-                    c.problem.as_ref().map(|p| format!("- {} {n}: {p}", r.name))
+                    c.problem.as_ref().map(|p| {
+                        format!(
+                            "- {} {n}: {}",
+                            crate::escape::markdown_cell(&r.name),
+                            crate::escape::markdown_cell(p)
+                        )
+                    })
                 })
         })
         .collect();
@@ -235,7 +244,11 @@ pub fn table2_markdown(pairs: &[(MeasurementResult, MeasurementResult)]) -> Stri
                 existing.channels.as_array()[k],
                 proposed.channels.as_array()[k],
             );
-            let material = if k == 0 { existing.name.as_str() } else { "" };
+            let material = if k == 0 {
+                crate::escape::markdown_cell(&existing.name)
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 t,
                 "| {material} | {name} | {} | {} | {} | {:.0} | {} | {} | {} | {:.0} |",
@@ -304,5 +317,41 @@ mod tests {
     fn csv_quotes_problems() {
         assert_eq!(csv_text("a, b"), "\"a, b\"");
         assert_eq!(csv_text("plain"), "plain");
+    }
+
+    /// A hostile sample name cannot make a formula in result.csv, break a row of result.md or
+    /// inject HTML into it; the tables keep their shape.
+    #[test]
+    fn hostile_names_stay_cells() {
+        let json = r#"{ "name": "n", "eta": 1.3, "method": "proposed", "model": "dipole",
+          "channels": {
+            "r": { "status": "ok", "sigma_s_prime": 1.0, "sigma_a": 0.01, "albedo_prime": 0.99 },
+            "g": { "status": "ok", "sigma_s_prime": 1.0, "sigma_a": 0.02, "albedo_prime": 0.98 },
+            "b": { "status": "ok", "sigma_s_prime": 1.0, "sigma_a": 0.03, "albedo_prime": 0.97 } },
+          "version": "0.1.0" }"#;
+        let mut r =
+            crate::result_json::parse_result_json(json, std::path::Path::new("r.json")).unwrap();
+        for name in [
+            "=HYPERLINK(\"http://evil\",\"x\")",
+            "+cmd|' /C calc'!A0",
+            "@SUM(1)",
+            "a|b\n| x | y |<img src=x onerror=alert(1)>",
+        ] {
+            r.name = name.into();
+            r.channels.g.problem = Some(format!("{name} problem"));
+            let csv = table1_csv(std::slice::from_ref(&r));
+            let mut rows = csv::Reader::from_reader(csv.as_bytes());
+            for row in rows.records() {
+                let row = row.unwrap();
+                assert_eq!(row.len(), 25, "{csv}");
+                assert!(!row[0].starts_with(['=', '+', '-', '@']), "{csv}");
+            }
+            let md = table1_markdown(std::slice::from_ref(&r));
+            for line in md.lines().filter(|l| l.starts_with('|')) {
+                let cells = line.replace("\\|", "").matches('|').count();
+                assert_eq!(cells, 9, "{line}");
+            }
+            assert!(!md.contains("<img"), "{md}");
+        }
     }
 }

@@ -71,7 +71,7 @@ pub enum SpectroCsvError {
         found: String,
     },
     /// A cell that is not a finite number, or a reflectance outside its range.
-    #[error("{path}: line {line}, column `{column}`: {value:?} {reason}")]
+    #[error("{path}: line {line}, column `{column}`: {value} {reason}")]
     BadValue {
         /// The file.
         path: PathBuf,
@@ -79,15 +79,18 @@ pub enum SpectroCsvError {
         line: u64,
         /// The column's name.
         column: String,
-        /// The text of the cell.
+        /// The text of the cell, quoted for the message (`"…"`, shortened and escaped:
+        /// [`crate::text::cell_for_message`]).
         value: String,
         /// What is wrong with it and what is expected.
         reason: String,
     },
     /// Wavelengths not strictly increasing.
     #[error(
-        "{path}: line {line}: wavelength {wavelength} nm does not follow {previous} nm; wavelengths \
-         must increase strictly (sort the rows and remove duplicates)"
+        "{path}: line {line}: wavelength {} nm does not follow {} nm; wavelengths must increase \
+         strictly (sort the rows and remove duplicates)",
+        crate::escape::number(*wavelength),
+        crate::escape::number(*previous)
     )]
     Order {
         /// The file.
@@ -109,9 +112,12 @@ pub enum SpectroCsvError {
     },
     /// SCI below SCE beyond measurement noise.
     #[error(
-        "{path}: line {line}: SCI {sci} is below SCE {sce} at {wavelength} nm by more than the noise \
-         tolerance {tolerance}; SCI includes the specular component and cannot be smaller — are the \
-         columns swapped?"
+        "{path}: line {line}: SCI {} is below SCE {} at {} nm by more than the noise tolerance \
+         {}; SCI includes the specular component and cannot be smaller — are the columns swapped?",
+        crate::escape::number(*sci),
+        crate::escape::number(*sce),
+        crate::escape::number(*wavelength),
+        crate::escape::number(*tolerance)
     )]
     SciBelowSce {
         /// The file.
@@ -184,7 +190,10 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
         .map(|h| h.to_ascii_lowercase())
         .collect();
     let find = |name: &str| header.iter().position(|h| h == name);
-    let found = header.join(",");
+    let found = crate::text::header_for_message(
+        header.iter().map(String::as_str),
+        &["wavelength_nm", "sci", "sce", "sci_pct", "sce_pct"],
+    );
     let wl_col = find("wavelength_nm").ok_or_else(|| SpectroCsvError::MissingColumn {
         path: p(),
         column: "wavelength_nm",
@@ -227,7 +236,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 path: p(),
                 line,
                 column: name.to_owned(),
-                value: text.to_owned(),
+                value: crate::text::cell_for_message(text),
                 reason,
             };
             let v: f64 = dialect.parse_f64(text).ok_or_else(|| {
@@ -252,7 +261,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 path: p(),
                 line,
                 column: "wavelength_nm".into(),
-                value: record.get(wl_col).unwrap_or("").to_owned(),
+                value: crate::text::cell_for_message(record.get(wl_col).unwrap_or("")),
                 reason: "is not a wavelength in nanometres (expected about 360–780)".into(),
             });
         }
@@ -263,7 +272,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                     path: p(),
                     line,
                     column: name.to_owned(),
-                    value: record.get(col).unwrap_or("").to_owned(),
+                    value: crate::text::cell_for_message(record.get(col).unwrap_or("")),
                     reason: format!(
                         "is outside 0..{max}{}",
                         if scale == 1.0 && v > 1.0 && v <= 100.0 {

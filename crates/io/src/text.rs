@@ -20,13 +20,12 @@
 //! UTF-16 (in `std`) and Windows-1252 (a 32-entry table below), so a dependency would add build time
 //! for nothing.
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Largest text input read, in bytes (64 MiB). Every text file of a measurement is a few kilobytes
 /// (a 24-MP profile CSV with 1-px rings to the image corner is under 2 MB); anything larger is not
 /// one of ours and is refused before it is read into memory.
-pub const MAX_TEXT_FILE_BYTES: u64 = 64 << 20;
+pub const MAX_TEXT_FILE_BYTES: u64 = scatterfit_safefs::MAX_TEXT_BYTES;
 
 /// How the bytes of a text file were decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,35 +99,29 @@ pub enum TextError {
 pub const RESAVE_ADVICE: &str = "save it from the spreadsheet or editor as \"CSV UTF-8\" (or plain \
      text, UTF-8), with a comma or semicolon between columns";
 
-/// Reads a text file of at most [`MAX_TEXT_FILE_BYTES`] and decodes it ([`decode_text`]).
+/// Reads a text file of at most [`MAX_TEXT_FILE_BYTES`] and decodes it ([`decode_text`]). Only a
+/// regular file is read: a FIFO, a device (`/dev/zero`), a folder or a socket is refused at once
+/// (`scatterfit_safefs::read`).
 ///
 /// # Errors
 /// [`TextError`] naming the file.
 pub fn read_text_file(path: &Path) -> Result<DecodedText, TextError> {
-    let io = |source| TextError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let too_large = |bytes| TextError::TooLarge {
-        path: path.to_path_buf(),
-        bytes,
-        limit: MAX_TEXT_FILE_BYTES,
-    };
-    if let Ok(meta) = file.metadata()
-        && meta.len() > MAX_TEXT_FILE_BYTES
-    {
-        return Err(too_large(meta.len()));
-    }
-    // The size may change between the check and the read (or be unknown, for a pipe): read at most
-    // one byte beyond the limit.
-    let mut bytes = Vec::new();
-    file.take(MAX_TEXT_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
-    if bytes.len() as u64 > MAX_TEXT_FILE_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
+    let bytes =
+        scatterfit_safefs::read::read_limited(path, MAX_TEXT_FILE_BYTES).map_err(|source| {
+            match scatterfit_safefs::UnsafeFile::of(&source) {
+                Some(&scatterfit_safefs::UnsafeFile::TooLarge { bytes, limit }) => {
+                    TextError::TooLarge {
+                        path: path.to_path_buf(),
+                        bytes,
+                        limit,
+                    }
+                }
+                _ => TextError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                },
+            }
+        })?;
     decode_text(&bytes, path)
 }
 
@@ -271,6 +264,36 @@ fn windows_1252(b: u8) -> char {
         0x80..=0x9F => HIGH[usize::from(b - 0x80)],
         _ => char::from(b),
     }
+}
+
+/// A CSV header for a message, under the content rule (RELIABILITY.md, "Inputs"): its column names
+/// as short escaped tokens when at least one of `ours` is among them (a CSV of the expected kind with
+/// a column misnamed or missing), else nothing of the file's content — only how many fields its first
+/// line has (a file named by mistake, or on purpose: `/etc/shadow`, must not be echoed).
+pub fn header_for_message<'a>(header: impl IntoIterator<Item = &'a str>, ours: &[&str]) -> String {
+    let names: Vec<&str> = header.into_iter().collect();
+    let recognised = names
+        .iter()
+        .any(|h| ours.iter().any(|o| h.trim().eq_ignore_ascii_case(o)));
+    if recognised {
+        names
+            .iter()
+            .map(|n| crate::escape::token(n))
+            .collect::<Vec<_>>()
+            .join(",")
+    } else {
+        format!(
+            "a first line of {} field(s), none of them a column read here; the file's content is \
+             not shown — is this the right file?",
+            names.len()
+        )
+    }
+}
+
+/// A cell of a recognised CSV file for a message: `"…"`, a short escaped token
+/// ([`crate::escape::token`]).
+pub fn cell_for_message(cell: &str) -> String {
+    format!("\"{}\"", crate::escape::token(cell))
 }
 
 /// How a CSV file separates columns, and whether its numbers may use a decimal comma.

@@ -2,29 +2,34 @@
 //! tool's interrupt handler before it exits). A file of its own: the interruption is process-wide and
 //! stops every later write, so no other test may share this process.
 
+use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 
 use scatterfit_io::atomic::{
-    in_flight, remove_in_flight, sweep_on_interrupt, temporary_path, write_atomic,
-    write_atomic_with,
+    TEMP_PREFIX, in_flight, is_temporary_name, remove_in_flight, write_atomic, write_atomic_with,
 };
 
+fn temporaries(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .filter(|e| is_temporary_name(&e.file_name()))
+        .map(|e| e.path())
+        .collect()
+}
+
 /// A large write is interrupted half-way: its temporary file is removed at once (the writer's later
-/// bytes go to the unlinked file and its rename fails), the target is never created, this process's
-/// temporaries in a swept cache folder are removed (another process's are not), and no write after
-/// the interruption creates a file.
+/// bytes go to the unlinked file and its rename fails), the target is never created, another
+/// process's temporary (a concurrent run's) is not touched, and no write after the interruption
+/// creates a file.
 #[test]
 fn interruption_removes_temporaries_and_stops_writes() {
     let dir = tempfile::tempdir().unwrap();
     let target = dir.path().join("big.exr");
-    let tmp = temporary_path(&target).unwrap();
-    let cache = dir.path().join("cache");
-    std::fs::create_dir(&cache).unwrap();
-    let ours = cache.join(format!(".mc-table.json.tmp-{}", std::process::id()));
-    let theirs = cache.join(".mc-table.json.tmp-1");
-    std::fs::write(&ours, b"partial").unwrap();
+    let theirs = dir
+        .path()
+        .join(format!("{TEMP_PREFIX}000000000000-mc-table.json"));
     std::fs::write(&theirs, b"another process").unwrap();
-    sweep_on_interrupt(&cache);
 
     let (started, wait_started) = mpsc::channel();
     let (resume, wait_resume) = mpsc::channel::<()>();
@@ -41,13 +46,17 @@ fn interruption_removes_temporaries_and_stops_writes() {
         })
     };
     wait_started.recv().unwrap();
-    assert!(tmp.exists(), "the temporary file is being written");
+    let tmp: Vec<PathBuf> = temporaries(dir.path())
+        .into_iter()
+        .filter(|p| *p != theirs)
+        .collect();
+    assert_eq!(tmp.len(), 1, "the temporary file is being written");
+    let tmp = tmp[0].clone();
     assert_eq!(in_flight(), vec![tmp.clone()]);
 
     let removed = remove_in_flight();
-    assert!(removed.contains(&tmp), "{removed:?}");
-    assert!(removed.contains(&ours), "{removed:?}");
-    assert!(!tmp.exists() && !ours.exists());
+    assert_eq!(removed, vec![tmp.clone()]);
+    assert!(!tmp.exists());
     assert!(
         theirs.exists(),
         "another process's temporary is not ours to remove"
@@ -62,11 +71,6 @@ fn interruption_removes_temporaries_and_stops_writes() {
     let later = dir.path().join("later.csv");
     let err = write_atomic(&later, b"x").unwrap_err();
     assert_eq!(err.kind(), std::io::ErrorKind::Interrupted);
-    assert!(!later.exists() && !temporary_path(&later).unwrap().exists());
-    let mut left: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    left.sort();
-    assert_eq!(left, ["cache"]);
+    assert!(!later.exists());
+    assert_eq!(temporaries(dir.path()), vec![theirs]);
 }

@@ -327,11 +327,15 @@ fn every_bracket_refusal_names_the_culprit() {
     );
     let e = bracket_error("file,time_s\nf0.png,0.01\nf1.png,fast\n", |_| {});
     assert!(e.contains("line 3") && e.contains("not a number"), "{e}");
+    // A header without any of our columns is not echoed (the content rule: the file may not be an
+    // exposures CSV at all); one with some of them is.
     let e = bracket_error("name,seconds\nf0.png,0.01\n", |_| {});
     assert!(
-        e.contains("`file` and `time_s`") && e.contains("name,seconds"),
+        e.contains("`file` and `time_s`") && e.contains("2 field(s)") && !e.contains("seconds"),
         "{e}"
     );
+    let e = bracket_error("file,seconds\nf0.png,0.01\n", |_| {});
+    assert!(e.contains("file,seconds"), "{e}");
     let e = bracket_error(
         "file,time_s\nf0.png,0.01\nf1.png,0.02\nf2.png,0.01\n",
         |_| {},

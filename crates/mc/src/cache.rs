@@ -2,7 +2,6 @@
 //! cache rule — reuse a file only when it was made with the same spec (and format), else simulate
 //! and save ([`CacheStatus`] says which happened).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -40,10 +39,12 @@ pub(crate) fn read_with<T>(
     path: &Path,
     parse: impl FnOnce(&str) -> std::result::Result<T, String>,
 ) -> Result<T> {
-    let text = std::fs::read_to_string(path).map_err(|source| McError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let text =
+        scatterfit_safefs::read::read_to_string_limited(path, scatterfit_safefs::MAX_TEXT_BYTES)
+            .map_err(|source| McError::Io {
+                path: path.to_owned(),
+                source,
+            })?;
     parse(&text).map_err(|message| McError::Format {
         path: path.to_owned(),
         message,
@@ -79,17 +80,42 @@ pub(crate) fn load_or_build<T>(
     {
         return Ok((table, CacheStatus::Loaded, path));
     }
+    // A cache that cannot take the file fails now, not after the Monte Carlo work.
+    prepare_write(&path)?;
     let table = build()?;
     save(&table, &path)?;
     Ok((table, CacheStatus::Built, path))
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same folder (created if missing),
-/// synced, then renamed over the target. (mc does not depend on io, whose `write_atomic` does the same;
-/// synth's profile cache uses this one.)
+/// Checks, before a cache file is computed, that it can be written at `path`: its folder exists (it
+/// is created) and takes a new file, and what is at `path` (if anything) is a regular file, not a
+/// link, a folder or a device. A corrupt file is no obstacle: it is replaced.
 ///
 /// # Errors
-/// `Io` on any file-system error (the target is then untouched).
+/// [`McError::Cache`] naming the file.
+pub fn prepare_write(path: &Path) -> Result<()> {
+    let cache = |source| McError::Cache {
+        path: path.to_owned(),
+        source,
+    };
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(cache)?;
+    scatterfit_safefs::write::check_destination(path).map_err(cache)?;
+    scatterfit_safefs::write::check_can_write_in(dir).map_err(cache)
+}
+
+/// Writes `bytes` to `path` atomically, creating its folder if missing: through
+/// `scatterfit_safefs::write::write_atomic` (an exclusively created temporary with an unpredictable
+/// name, registered for Ctrl-C, renamed over a regular file or nothing — never through a link). mc
+/// does not depend on io, whose `write_atomic` is the same function; synth's profile cache uses this
+/// one.
+///
+/// # Errors
+/// `Io` when the folder cannot be created, `Cache` when the file cannot be written (the target is
+/// then untouched).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io = |source| McError::Io {
         path: path.to_owned(),
@@ -100,19 +126,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(io)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
+    scatterfit_safefs::write::write_atomic(path, bytes).map_err(|source| McError::Cache {
+        path: path.to_owned(),
+        source,
+    })
 }

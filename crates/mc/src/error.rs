@@ -53,6 +53,19 @@ pub enum McError {
         #[source]
         source: std::io::Error,
     },
+    /// The cache cannot take a new file (found before the Monte Carlo work, or when saving).
+    #[error(
+        "cannot write the cache file {}: {source}; choose a writable cache folder (--cache-dir or \
+         SCATTERFIT_CACHE), or remove what is at that name",
+        path.display()
+    )]
+    Cache {
+        /// The cache file.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
     /// A cache file could not be parsed or serialised.
     #[error("{path}: not a valid table file: {message}")]
     Format {

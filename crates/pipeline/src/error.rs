@@ -56,6 +56,10 @@ pub enum PipelineError {
         /// The imaging error.
         source: ImagingError,
     },
+    /// A file named by the manifest (or by the exposures CSV) resolves outside the sample folder
+    /// (the input path policy, `scatterfit_io::inputs`).
+    #[error(transparent)]
+    InputPath(#[from] scatterfit_io::inputs::InputPathError),
     /// An option or a combination of inputs the pipeline cannot use.
     #[error("{0}")]
     Input(String),

@@ -21,7 +21,10 @@ pub mod profile;
 pub mod spectro;
 
 pub use error::{PipelineError, Result};
-pub use measure::{Measurement, Overrides, Stage, Timings, measure_sample, sample_dirs};
+pub use measure::{
+    Measurement, Overrides, SampleDirs, SampleInputs, Stage, Timings, measure_sample,
+    misspelt_manifest, sample_dirs, sample_inputs,
+};
 /// The one name → forward model factory (the Monte Carlo tables live in `scatterfit_mc`).
 pub use scatterfit_mc::{albedo_family, family};
 /// The vocabulary a program using the pipeline needs: what to fit with, and per-channel values.

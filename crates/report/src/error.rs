@@ -77,6 +77,9 @@ pub enum ReportError {
     /// profile.csv could not be written (the error names the file).
     #[error(transparent)]
     ProfileCsv(#[from] ProfileCsvError),
+    /// The result set's manifest (`result-files.json`) could not be removed or written.
+    #[error(transparent)]
+    ResultSet(#[from] scatterfit_io::result_set::ResultSetError),
 }
 
 /// `Result` with [`ReportError`].

@@ -34,6 +34,9 @@ pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
         path: dir.to_path_buf(),
         source,
     })?;
+    // The set manifest goes first and comes back last: a folder without one is incomplete
+    // (`scatterfit_io::result_set`).
+    scatterfit_io::result_set::begin(dir)?;
     let mut written = Vec::new();
     let profile = dir.join("profile.csv");
     scatterfit_io::profile_csv::write_profile_csv(&profile, &m.profile.to_table())?;
@@ -62,6 +65,13 @@ pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
         Some(&png),
     )?;
     written.extend([svg, png]);
+    let names: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    scatterfit_io::result_set::finish(dir, &names, &result.name, &m.manifest.dir)?;
+    written.push(dir.join(scatterfit_io::result_set::SET_FILE));
     Ok(WrittenReport {
         result,
         files: written,
@@ -79,7 +89,10 @@ pub fn summary_text(r: &MeasurementResult) -> String {
     let _ = writeln!(
         t,
         "{}: η = {eta} ({}), method {}, model {}",
-        r.name, r.eta_source, r.method, r.model
+        scatterfit_io::escape::one_line(&r.name),
+        scatterfit_io::escape::one_line(&r.eta_source),
+        scatterfit_io::escape::one_line(&r.method),
+        scatterfit_io::escape::one_line(&r.model)
     );
     let _ = writeln!(
         t,
@@ -97,7 +110,7 @@ pub fn summary_text(r: &MeasurementResult) -> String {
             c.rings_used
         );
         if let Some(p) = &c.problem {
-            let _ = writeln!(t, "      note: {p}");
+            let _ = writeln!(t, "      note: {}", scatterfit_io::escape::one_line(p));
         }
     }
     let errors = errors_note(std::slice::from_ref(r));

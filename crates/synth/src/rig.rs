@@ -356,17 +356,40 @@ impl McProfile {
             return Ok((Self::simulate(spec, progress)?, false));
         };
         let path = dir.join(format!("synth-profile-{}.json", spec.fingerprint()));
-        if let Ok(text) = std::fs::read_to_string(&path)
-            && let Ok(p) = serde_json::from_str::<Self>(&text)
+        if let Ok(text) = scatterfit_safefs::read::read_to_string_limited(
+            &path,
+            scatterfit_safefs::MAX_TEXT_BYTES,
+        ) && let Ok(p) = serde_json::from_str::<Self>(&text)
             && p.format == PROFILE_FORMAT
             && p.spec == *spec
             && p.value.len() + 1 == spec.edges.len()
+            && p.is_usable()
         {
             return Ok((p, true));
         }
+        // A corrupt file (unreadable, or numbers no simulation gives) is simulated again and
+        // replaced; a cache that cannot take the file fails now, before the Monte Carlo work, and
+        // is blamed by name.
+        scatterfit_mc::cache::prepare_write(&path)?;
         let p = Self::simulate(spec, progress)?;
         scatterfit_mc::cache::write_atomic(&path, &serde_json::to_vec(&p).unwrap_or_default())?;
         Ok((p, false))
+    }
+
+    /// True when the numbers are ones a simulation gives: finite, non-negative, increasing bin
+    /// centres, Rd within [0, 1], and smooth enough to render ([`SmoothProfile::new`]). What a
+    /// cached profile must be to be reused.
+    fn is_usable(&self) -> bool {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x >= 0.0);
+        self.value.len() == self.stderr.len()
+            && self.value.len() == self.centers.len()
+            && finite(&self.value)
+            && finite(&self.stderr)
+            && finite(&self.centers)
+            && self.centers.windows(2).all(|w| w[0] < w[1])
+            && (0.0..=1.0).contains(&self.rd_total.value)
+            && self.rd_total.stderr.is_finite()
+            && SmoothProfile::new(self).is_ok()
     }
 }
 

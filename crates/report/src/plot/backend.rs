@@ -35,7 +35,9 @@ pub fn render_svg(fig: &Figure) -> error::Result<String> {
         root.present()
             .map_err(|e| draw_error("rendering the SVG plot", e))?;
     }
-    Ok(text)
+    // plotters escapes `<`, `>`, `&` and quotes but not the control characters XML forbids, which
+    // a sample's name may hold: the document must stay well-formed for any name.
+    Ok(scatterfit_io::escape::xml_chars(&text).into_owned())
 }
 
 /// The figure as PNG bytes (8-bit RGB).
