@@ -17,13 +17,14 @@ pub struct WrittenReport {
     /// The measurement's result, as written to result.json.
     pub result: MeasurementResult,
     /// The files written, in order: profile.csv, result.json, result.csv, result.md, fit.svg,
-    /// fit.png.
+    /// fit.png and last the set's manifest, result-files.json (`scatterfit_io::result_set`).
     pub files: Vec<PathBuf>,
 }
 
 /// Writes every result file of `m` into `dir` (created if missing): profile.csv, result.json,
-/// result.csv, result.md, fit.svg and fit.png. Each file is written atomically; files of an earlier
-/// run are replaced.
+/// result.csv, result.md, fit.svg and fit.png, then result-files.json, which lists them with their
+/// hashes (a folder without it holds an incomplete set). Each file is written atomically; files of
+/// an earlier run are replaced.
 ///
 /// # Errors
 /// The first file that cannot be written, named in the error: [`ReportError::CreateDir`],

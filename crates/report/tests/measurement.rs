@@ -84,7 +84,8 @@ fn a_measured_sample_gets_its_report_files() {
             "result.csv",
             "result.md",
             "fit.svg",
-            "fit.png"
+            "fit.png",
+            "result-files.json"
         ]
     );
     for f in &written.files {
