@@ -27,6 +27,7 @@ pub mod dipole;
 pub mod fresnel;
 pub mod model;
 pub mod pbd;
+pub mod port;
 pub mod spectro;
 
 mod diffusion;
