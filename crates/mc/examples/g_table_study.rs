@@ -14,7 +14,9 @@
 //!   above. With three (g₀ < g_mid < g₁, one η): the error of interpolating in g (linear in g between
 //!   g₀ and g₁ at fixed α′, ρ′, on ln R′) against the g_mid table, and of the totals (the same
 //!   for a ratio to the g = 0 table, which does not depend on g). With three tables of one g at
-//!   η₀ < η_mid < η₁: the error of interpolating in η likewise. With one table: the size of the
+//!   η₀ < η_mid < η₁: the error of interpolating in η likewise. With five (four g nodes, then a
+//!   table between the middle two): the error of Catmull-Rom in g (pbrt's non-uniform weights) on
+//!   ln R′ and on the totals. With one table: the size of the
 //!   g-correction, R′_g/R′₀ − 1 against the shipped g = 0 table at the same η, by ρ′ window (RMS),
 //!   and of the totals.
 
@@ -72,8 +74,10 @@ fn main() {
                 ratio(&sets[0]);
             } else if sets.len() == 2 {
                 noise(&sets[0], &sets[1]);
-            } else {
+            } else if sets.len() == 3 {
                 interpolation(&sets[0], &sets[1], &sets[2]);
+            } else {
+                catmull_rom_in_g(&sets[..4], &sets[4]);
             }
         }
         _ => eprintln!("usage: g_table_study cost|noise|compare …"),
@@ -219,5 +223,39 @@ fn ratio(set: &McTableSet) {
         );
         line += &windows(|rho| (m.rd(rho), m.rd(rho) / z.rd(rho) - 1.0), 1.0);
         println!("{line}");
+    }
+}
+
+/// Catmull-Rom in g over four tables (g₀ < g₁ < g₂ < g₃, one η) against a table at g₁ < g < g₂.
+fn catmull_rom_in_g(nodes: &[McTableSet], mid: &McTableSet) {
+    let x: Vec<f64> = nodes.iter().map(McTableSet::g).collect();
+    let g = mid.g();
+    // pbrt-v4 CatmullRomWeights for non-uniform nodes.
+    let t = (g - x[1]) / (x[2] - x[1]);
+    let (t2, t3) = (t * t, t * t * t);
+    let mut w = [0.0, 2.0 * t3 - 3.0 * t2 + 1.0, -2.0 * t3 + 3.0 * t2, 0.0];
+    let w0 = (t3 - 2.0 * t2 + t) * (x[2] - x[1]) / (x[2] - x[0]);
+    w[0] = -w0;
+    w[2] += w0;
+    let w3 = (t3 - t2) * (x[2] - x[1]) / (x[3] - x[1]);
+    w[1] -= w3;
+    w[3] = w3;
+    println!("Catmull-Rom in g over {x:?} at g = {g}: weights {w:?}");
+    for ap in ALBEDOS {
+        let ms: Option<Vec<McProfile>> = nodes.iter().map(|s| model(s, ap)).collect();
+        let (Some(ms), Some(mm)) = (ms, model(mid, ap)) else {
+            println!("α′ {ap}: outside the tables");
+            continue;
+        };
+        let tot: f64 = ms.iter().zip(w).map(|(m, wk)| wk * m.rd_total()).sum();
+        let cr = |rho: f64| {
+            let v: f64 = ms.iter().zip(w).map(|(m, wk)| wk * m.rd(rho).ln()).sum();
+            (mm.rd(rho), v.exp() / mm.rd(rho) - 1.0)
+        };
+        println!(
+            "α′ {ap:<7} total: {:+.1e} | profile:{}",
+            tot - mm.rd_total(),
+            windows(cr, 1.0)
+        );
     }
 }
