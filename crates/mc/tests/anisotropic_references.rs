@@ -125,3 +125,86 @@ fn white_run_totals_match_adding_doubling() {
         }
     }
 }
+
+/// MCML's reflected weight per radial window for one case: (window edges [mm], Σ Rd·area over the
+/// window's bins, MCML's photons, MCML's total Rd).
+fn mcml_windows(g: f64, eta: f64, ap: f64, windows: &[f64]) -> (Vec<f64>, u64, f64) {
+    let mut w = vec![0.0; windows.len() - 1];
+    let (mut photons, mut total) = (0, 0.0);
+    for line in include_str!("../../../data/reference/mcml_profiles_g.csv").lines() {
+        if line.starts_with('#') || line.starts_with('g') {
+            continue;
+        }
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        if (v[0], v[1], v[2]) != (g, eta, ap) {
+            continue;
+        }
+        photons = v[3] as u64;
+        total = v[4];
+        let (lo, hi, rd) = (v[6], v[7], v[8]);
+        let area = std::f64::consts::PI * (hi * hi - lo * lo);
+        if let Some(k) =
+            (0..w.len()).find(|&k| lo >= windows[k] - 1e-9 && hi <= windows[k + 1] + 1e-9)
+        {
+            w[k] += rd * area;
+        }
+    }
+    assert!(photons > 0, "no MCML profile for g {g} η {eta} α′ {ap}");
+    (w, photons, total)
+}
+
+/// The engine's reflected fraction per radial window (0–0.5–1–2–5–10–19.75 mm at σ′t = 1 mm⁻¹) and
+/// its total against MCML's at g = 0.5–0.95. Both codes score the same estimator (implicit capture,
+/// the same roulette), so MCML's standard error is ours × √(N_ours/N_MCML); windows with more than
+/// 20 % relative error are skipped. Within 4 combined standard errors.
+#[test]
+fn engine_profiles_match_mcml() {
+    let windows = [0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 19.75];
+    let cases = [
+        (0.9, 1.4, 0.5, 100_000),
+        (0.9, 1.4, 0.9, 20_000),
+        (0.9, 1.0, 0.9, 20_000),
+        (0.95, 1.4, 0.9, 10_000),
+        (0.8, 2.0, 0.9, 20_000),
+        (0.5, 1.4, 0.99, 8_000),
+        (0.5, 1.0, 0.5, 100_000),
+    ];
+    for (g, eta, ap, photons) in cases {
+        let (mcml, n_mcml, mcml_total) = mcml_windows(g, eta, ap, &windows);
+        let r = Simulation::new(
+            half_space(g, eta, ap),
+            Beam::pencil(),
+            RadialGrid::from_edges(windows.to_vec()).unwrap(),
+            photons,
+            23,
+        )
+        .unwrap()
+        .run();
+        let scale = (photons as f64 / n_mcml as f64).sqrt();
+        for k in 0..windows.len() - 1 {
+            let area = r.grid.area(k);
+            let (ours, se) = (r.rd_profile[k].value * area, r.rd_profile[k].stderr * area);
+            let se_all = se * (1.0 + scale * scale).sqrt();
+            if ours <= 0.0 || se_all > 0.2 * ours {
+                continue;
+            }
+            eprintln!(
+                "g {g} η {eta} α′ {ap} [{}, {}) mm: ours {ours:.5} ± {se:.5}, MCML {:.5}",
+                windows[k],
+                windows[k + 1],
+                mcml[k]
+            );
+            assert!(
+                (ours - mcml[k]).abs() < 4.0 * se_all,
+                "g {g} η {eta} α′ {ap} window {k}: {ours} ± {se_all} vs MCML {}",
+                mcml[k]
+            );
+        }
+        let se_t = r.rd_total.stderr * (1.0 + scale * scale).sqrt();
+        assert!(
+            (r.rd_total.value - mcml_total).abs() < 4.0 * se_t,
+            "g {g} η {eta} α′ {ap}: total {:?} vs MCML {mcml_total}",
+            r.rd_total
+        );
+    }
+}
