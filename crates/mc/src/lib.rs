@@ -39,6 +39,7 @@ mod fresnel;
 mod grid;
 pub mod model;
 mod phase;
+pub mod port;
 mod rng;
 mod sample;
 pub mod smooth;

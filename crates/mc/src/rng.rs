@@ -55,6 +55,12 @@ impl PhotonRng {
         }
     }
 
+    /// 64 random bits.
+    #[inline(always)]
+    pub(crate) fn bits(&mut self) -> u64 {
+        self.0.next_u64()
+    }
+
     /// Uniform in (0, 1]: safe for `ln` (MCML rejects ξ = 0 for the step length).
     #[inline(always)]
     pub(crate) fn uniform_open0(&mut self) -> f64 {

@@ -25,10 +25,11 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::engine::{CHUNK_PHOTONS, spin};
+use crate::engine::{CHUNK_PHOTONS, spin_isotropic};
 use crate::error::{Result, check};
 use crate::fresnel::fresnel_mcml;
 use crate::grid::RadialGrid;
+use crate::phase::{HgSampler, scatter_hg};
 use crate::rng::{PhotonRng, stream};
 
 /// Survival probability of the interaction-count roulette.
@@ -269,6 +270,7 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
         let tracer = Tracer {
             eta: spec.eta,
             g: spec.g,
+            hg: HgSampler::new(spec.g),
             cos_crit,
             min_n,
             max_n: stratum.max_interactions,
@@ -293,8 +295,14 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
                     let mut acc = Accum::new(k, bins);
                     let mut rng = stream(seed, c);
                     let mut w = vec![0.0; k];
-                    for _ in 0..count {
-                        tracer.trace(&mut rng, &mut acc, &mut w);
+                    if tracer.g == 0.0 {
+                        for _ in 0..count {
+                            tracer.trace::<false>(&mut rng, &mut acc, &mut w);
+                        }
+                    } else {
+                        for _ in 0..count {
+                            tracer.trace::<true>(&mut rng, &mut acc, &mut w);
+                        }
                     }
                     acc
                 })
@@ -350,6 +358,8 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
 struct Tracer<'a> {
     eta: f64,
     g: f64,
+    /// Henyey–Greenstein sampling constants of `g`.
+    hg: HgSampler,
     cos_crit: f64,
     min_n: u64,
     max_n: u64,
@@ -362,9 +372,9 @@ struct Tracer<'a> {
 impl Tracer<'_> {
     /// Traces one non-absorbing photon from a normally incident pencil beam at the origin until it
     /// leaves through the surface z = 0 (scored if it had at least `min_n` interactions) or reaches
-    /// `max_n` interactions.
+    /// `max_n` interactions. `ANISO`: g ≠ 0.
     #[inline]
-    fn trace(&self, rng: &mut PhotonRng, acc: &mut Accum, w: &mut [f64]) {
+    fn trace<const ANISO: bool>(&self, rng: &mut PhotonRng, acc: &mut Accum, w: &mut [f64]) {
         let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
         let (mut ux, mut uy, mut uz) = (0.0f64, 0.0f64, 1.0f64);
         let mut n: u64 = 0;
@@ -415,7 +425,11 @@ impl Tracer<'_> {
                 }
                 weight /= ROULETTE_SURVIVAL;
             }
-            (ux, uy, uz) = spin(self.g, ux, uy, uz, rng);
+            if ANISO {
+                [ux, uy, uz] = scatter_hg([ux, uy, uz], &self.hg, rng);
+            } else {
+                (ux, uy, uz) = spin_isotropic(rng);
+            }
         }
     }
 

@@ -34,6 +34,7 @@ pub mod fresnel;
 pub mod model;
 pub mod names;
 pub mod pbd;
+pub mod port;
 pub mod rgb;
 pub mod spectro;
 

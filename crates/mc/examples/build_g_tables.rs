@@ -1,0 +1,89 @@
+//! Builds the anisotropic (g ≠ 0) `mc` tables of issue 15 with the layout of
+//! `common/g_tables_layout.rs` (albedo nodes over α′ 0.2–0.99995, strata at 64/(1 − g) and
+//! 1024/(1 − g) interactions) and writes each in compact form as
+//! `OUT/mc-white-eta<η>-g<g>.json` (η and g to two decimals). Tables already in OUT are skipped, so
+//! an interrupted build resumes; each line of the log (stdout) gives the table, its build time,
+//! interactions and the smoothing χ².
+//!
+//! ```text
+//! cargo run --release -p scatterfit-mc --example build_g_tables -- --out DIR \
+//!     [--photons P] [--seed S] [--g G,G,…] [--eta E,E,…]
+//! ```
+//! Defaults: P = 1e6 full-length photons (16 P and 4 P in the shorter strata), seed 1, and the
+//! chosen grid in the order most needed first: g = 0.9 and 0.8 over the η grid, then g = 0.5,
+//! 0.95, 0.7 (BENCHMARKS.md, "Anisotropic white tables", says why and what it costs). The η grid
+//! for g ≠ 0 is 1.0, 1.1, …, 2.4 (0.1 apart; 15 tables), built 0.2 apart first (1.0, 1.2, …, 2.4,
+//! then 1.1, 1.3, …, 2.3) so that a coarse set is complete early.
+
+#[path = "common/g_tables_layout.rs"]
+mod layout;
+
+use scatterfit_mc::model::McTable;
+use scatterfit_mc::white::simulate;
+
+/// The g grid, most needed first.
+const G_GRID: [f64; 5] = [0.9, 0.8, 0.5, 0.95, 0.7];
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let value = |flag: &str| -> Option<&str> {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .map(String::as_str)
+    };
+    let list = |s: &str| -> Vec<f64> {
+        s.split(',')
+            .map(|x| x.trim().parse::<f64>().expect("a number"))
+            .collect()
+    };
+    let Some(out) = value("--out").map(std::path::PathBuf::from) else {
+        eprintln!("usage: build_g_tables --out DIR [--photons P] [--seed S] [--g G,…] [--eta E,…]");
+        std::process::exit(2);
+    };
+    let photons = value("--photons").map_or(1e6, |p| p.parse::<f64>().expect("photons")) as u64;
+    let seed: u64 = value("--seed").map_or(1, |s| s.parse().expect("seed"));
+    let gs = value("--g").map_or(G_GRID.to_vec(), list);
+    let etas = value("--eta").map_or(
+        (0..8)
+            .map(|i| 1.0 + 0.2 * i as f64)
+            .chain((0..7).map(|i| 1.1 + 0.2 * i as f64))
+            .collect(),
+        list,
+    );
+    std::fs::create_dir_all(&out).expect("output folder");
+    for &g in &gs {
+        for &eta in &etas {
+            let path = out.join(format!("mc-white-eta{eta:.2}-g{g:.2}.json"));
+            if path.exists() {
+                continue;
+            }
+            let mut spec = layout::g_spec(eta, g, photons);
+            spec.seed = seed;
+            let t0 = std::time::Instant::now();
+            let tally = simulate(&spec.white().expect("white spec"), &|_| {}).expect("simulate");
+            let secs = t0.elapsed().as_secs_f64();
+            let table = match McTable::from_tally(&spec, &tally) {
+                Ok(t) => t.compact(),
+                Err(e) => {
+                    // Logged, and the next table built: a failed one is rebuilt (with more photons)
+                    // on the next run, since its file is missing.
+                    println!("FAILED g {g:.2} η {eta:.2} ({photons} photons): {e}");
+                    continue;
+                }
+            };
+            table.save(&path).expect("write");
+            let chi = table.chi2_per_bin();
+            println!(
+                "{} g {g:.2} η {eta:.2}: {secs:.0} s wall, {:.3e} interactions, χ²/bin {:.2}–{:.2}, {} bytes",
+                std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map_or(0, |d| d.as_secs()),
+                tally.interactions as f64,
+                chi.iter().cloned().fold(f64::INFINITY, f64::min),
+                chi.iter().cloned().fold(0.0, f64::max),
+                std::fs::metadata(&path).map_or(0, |m| m.len())
+            );
+        }
+    }
+}
