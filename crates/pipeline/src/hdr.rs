@@ -21,6 +21,9 @@ use serde::Serialize;
 
 use crate::error::{PipelineError, Result};
 
+/// How the bracket became radiance (the name `result.json` records).
+pub use scatterfit_io::result_json::ResponseKind;
+
 /// The 8-bit code at which a pixel counts as detected in the longest exposure. Below it the tone
 /// curve's toe, where the recovered response is least certain, and quantisation bias the merged
 /// radiance: on the rig twin's steep profiles (α′ = 0.3–0.7, η = 2.4, exact forward model) a
@@ -114,8 +117,8 @@ pub struct HdrStage {
     pub hdr: HdrImage,
     /// The response used (8-bit), `None` for a linear 16-bit merge or a given radiance map.
     pub response: Option<ResponseCurve>,
-    /// `recovered`, `given`, `linear` or `merged` (a radiance map from the manifest).
-    pub response_kind: &'static str,
+    /// Recovered, given, linear or merged (a radiance map from the manifest).
+    pub response_kind: ResponseKind,
     /// RMS residual of the response recovery per channel (recovered responses only).
     pub rms: Vec<f64>,
     /// The frames, shortest first.
@@ -275,7 +278,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             })
             .collect();
         let (response, kind, rms) = match &inputs.response {
-            Some(path) => (load_response(path)?, "given", Vec::new()),
+            Some(path) => (load_response(path)?, ResponseKind::Given, Vec::new()),
             None => {
                 let samples = inputs
                     .samples
@@ -286,7 +289,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                     imaging("recovering the camera response (or give a known one: --response for merge, camera.response in sample.toml for measure)"),
                 )?;
                 let rms = cal.solutions.iter().map(|s| s.rms_residual).collect();
-                (cal.response, "recovered", rms)
+                (cal.response, ResponseKind::Recovered, rms)
             }
         };
         let dark = dark.and_then(|d| match d {
@@ -345,7 +348,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
         HdrStage {
             hdr,
             response: None,
-            response_kind: "linear",
+            response_kind: ResponseKind::Linear,
             rms: Vec::new(),
             frames,
             image,
@@ -377,7 +380,7 @@ pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
             clipped_count: 0,
         },
         response: None,
-        response_kind: "merged",
+        response_kind: ResponseKind::Merged,
         rms: Vec::new(),
         frames: Vec::new(),
         image: format!("{w}×{h} {}", if ch == 1 { "grey" } else { "RGB" }),

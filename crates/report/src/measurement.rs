@@ -91,16 +91,17 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         t,
         "{}: η = {eta} ({}), method {}, model {}",
         scatterfit_io::escape::one_line(&r.name),
-        scatterfit_io::escape::one_line(&r.eta_source),
-        scatterfit_io::escape::one_line(&r.method),
-        scatterfit_io::escape::one_line(&r.model)
+        r.eta_source.map_or("", |s| s.name()),
+        r.method,
+        r.model
     );
     let _ = writeln!(
         t,
         "  ch  {:<30} {:<32} {:<8} {:<10} {:>9} {:>6}",
         "σ′s [mm⁻¹]", "σa [mm⁻¹]", "α′", "MSE", "fit [µs]", "rings"
     );
-    for (name, c) in ["R", "G", "B"].iter().zip(r.channels.as_array()) {
+    for (ch, c) in r.channels.iter_channels() {
+        let name = ch.name();
         let [sp, sa] = sigma_cells(c);
         let _ = writeln!(
             t,

@@ -256,7 +256,7 @@ impl RendererParameters {
         unit: SceneUnit,
     ) -> Result<(Self, Vec<String>), ExportError> {
         let mut warnings = Vec::new();
-        let channels = result.channels.as_array();
+        let channels = result.channels.as_ref().into_array();
         for (name, c) in CHANNEL_NAMES.iter().zip(channels) {
             let missing = c.sigma_s_prime.is_none() || c.sigma_a.is_none();
             if c.status == ChannelStatus::Failed || missing {
@@ -318,10 +318,10 @@ impl RendererParameters {
                 b: channel(b),
             },
             source: Provenance {
-                method: result.method.clone(),
-                model: result.model.clone(),
-                albedo_model: result.albedo_model.clone(),
-                eta_source: result.eta_source.clone(),
+                method: result.method.to_string(),
+                model: result.model.to_string(),
+                albedo_model: result.albedo_model.map_or_else(String::new, |a| a.to_string()),
+                eta_source: result.eta_source.map_or_else(String::new, |e| e.to_string()),
                 measured_with: result.version.clone(),
             },
             conventions: format!(
@@ -519,12 +519,12 @@ mod fixtures {
         MeasurementResult {
             name: "marble".into(),
             eta: 1.5,
-            eta_source: "given".into(),
+            eta_source: Some(crate::result_json::EtaSource::Given),
             eta_stderr: None,
             spectro_repeatability: None,
-            method: "proposed".into(),
-            model: "dipole".into(),
-            albedo_model: "diffusion".into(),
+            method: scatterfit_optics::Method::Proposed,
+            model: scatterfit_optics::ModelName::Dipole,
+            albedo_model: Some(scatterfit_optics::AlbedoModel::Diffusion.into()),
             channels: Channels::from_array([
                 channel(2.19, 0.0021, 0.8302),
                 channel(2.62, 0.0041, 0.7910),
