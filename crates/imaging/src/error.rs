@@ -149,6 +149,35 @@ pub enum ImagingError {
         /// downward).
         span: f64,
     },
+    /// The frames do not brighten with their exposure times: a frame with a longer time is darker
+    /// than (or the same as) one with a shorter time — times reversed or shuffled, or one frame
+    /// listed twice. Seen directly in the frames, before any response is recovered
+    /// ([`crate::check_bracket_order`]).
+    #[error(
+        "the frames do not brighten with their exposure times: {what} (frame {longer} at {t_longer} s \
+         against frame {shorter} at {t_shorter} s, counting frames in the order given from 0; of the \
+         {compared} pixel values that are unclipped in either and differ, {darker} got darker and \
+         {brighter} brighter with the longer time) — are the exposure times in the right order, each \
+         with its own frame? (check the exposures CSV or the files' EXIF times)"
+    )]
+    BracketOutOfOrder {
+        /// What was seen: "the longer exposure is darker", "the two frames are identical", …
+        what: &'static str,
+        /// Index (as given) of the frame with the shorter time.
+        shorter: usize,
+        /// Index (as given) of the frame with the longer time.
+        longer: usize,
+        /// Its time [s].
+        t_shorter: f64,
+        /// Its time [s].
+        t_longer: f64,
+        /// Pixel values compared (not clipped at the same end in both frames).
+        compared: usize,
+        /// Of those, how many are lower in the longer exposure.
+        darker: usize,
+        /// And how many higher.
+        brighter: usize,
+    },
     /// The dark frame is at or above the signal: fewer than [`crate::MIN_VALID_FRACTION`] of a
     /// channel's pixels rise above it even in the longest exposure.
     #[error(
@@ -228,6 +257,7 @@ impl ImagingError {
             Self::NotEnoughSamples { .. }
                 | Self::SolveFailed { .. }
                 | Self::ResponseNotIncreasing { .. }
+                | Self::BracketOutOfOrder { .. }
                 | Self::NoValidRadiance { .. }
                 | Self::NoSpot { .. }
         )

@@ -14,6 +14,7 @@ pub mod image_files;
 pub mod manifest;
 pub mod mesh;
 pub mod profile_csv;
+pub mod raw;
 pub mod response_csv;
 pub mod result_json;
 pub mod result_table;
