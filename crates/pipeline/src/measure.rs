@@ -6,7 +6,8 @@ use std::time::Instant;
 
 use scatterfit_fit::ProfileData;
 use scatterfit_io::manifest::{
-    AlbedoModelName, MethodName, ModelName, SampleManifest, read_manifest,
+    AlbedoModelName, AutoOrNone, BlackLevelSetting, MethodName, ModelName, SampleManifest,
+    read_manifest,
 };
 use scatterfit_io::result_json::{Channels, FileRef, Inputs, MeasurementResult};
 use serde::Serialize;
@@ -14,11 +15,12 @@ use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
 use crate::fit::{
-    ChannelOutcome, FitSettings, SpectroErrors, albedo_model_for, channel_result, fit_stage,
+    ChannelOutcome, FitSettings, SpotShape, SpectroErrors, albedo_model_for, channel_result, fit_stage,
     model_for, propagate_spectro,
 };
 use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
-use crate::profile::{ProfileSettings, ProfileStage, profile_stage};
+use crate::hdr::BlackLevel;
+use crate::profile::{ProfileSettings, ProfileStage, profile_stage_with};
 use crate::spectro::{SpectroStage, spectro_stage};
 
 /// Options that override the manifest's `[fit]` (from the command line).
@@ -116,11 +118,23 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
             "normalising with the spectrophotometer applies to the proposed method only".into(),
         ));
     }
+    // The spot: a disk (the paper's), or a Gaussian of that 1/e² diameter (issue 16); a spot
+    // image replaces this once the bracket is merged (measure_sample).
+    let diameter = manifest.camera.spot_diameter_mm.unwrap_or(1.0);
+    let (spot, spot_radius_mm) = match manifest.camera.spot_profile {
+        Some(scatterfit_io::manifest::SpotProfileName::Gaussian) => {
+            let s = scatterfit_fit::RadialSpot::gaussian(0.5 * diameter)
+                .map_err(|e| PipelineError::Input(format!("camera.spot_profile: {e}")))?;
+            (SpotShape::Radial(s), s.radius_enclosing(0.99))
+        }
+        _ => (SpotShape::Disk, 0.5 * diameter),
+    };
     Ok(FitSettings {
         method,
         model,
         albedo_model,
-        spot_radius_mm: 0.5 * manifest.camera.spot_diameter_mm.unwrap_or(1.0),
+        spot,
+        spot_radius_mm,
         r_min_mm: manifest.fit.r_min_mm,
         normalise_with_spectro: normalise,
     })
@@ -168,6 +182,15 @@ pub fn measure_sample(
                 .as_ref()
                 .map(|p| manifest.resolve(p));
             inputs.dark = manifest.camera.dark.as_ref().map(|p| manifest.resolve(p));
+            // A real camera (issue 16): black level, shutter times, flat frame.
+            inputs.flat = manifest.camera.flat.as_ref().map(|p| manifest.resolve(p));
+            inputs.exposure_correction = manifest.camera.exposure_correction.unwrap_or_default();
+            inputs.black_level = match manifest.camera.black_level {
+                None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
+                Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
+                Some(BlackLevelSetting::One(v)) => BlackLevel::Given(vec![v]),
+                Some(BlackLevelSetting::PerChannel(v)) => BlackLevel::Given(v.to_vec()),
+            };
             // Pixels dark in every frame are evidence of radiance below the first code: keep them
             // as 0 so far rings are not averaged over their brighter pixels only; pixels saturated
             // everywhere are masked out by the profile stage.
@@ -179,7 +202,7 @@ pub fn measure_sample(
     };
     let t_profile = Instant::now();
     progress(Stage::Profile);
-    let profile = profile_stage(
+    let profile = profile_stage_with(
         &hdr.hdr.radiance,
         Some(&hdr.hdr.clipped),
         &hdr.detection_limit,
@@ -189,7 +212,18 @@ pub fn measure_sample(
             ring_width_px: 1.0,
             center_px: manifest.camera.center_px,
         },
+        manifest.camera.background.unwrap_or_default(),
     )?;
+    let mut settings = settings;
+    if let Some(p) = &manifest.camera.spot_image {
+        let s = crate::hdr::spot_kernel_from_image(
+            &manifest.resolve(p),
+            &hdr,
+            manifest.camera.mm_per_pixel.unwrap_or(f64::NAN),
+        )?;
+        settings.spot = SpotShape::Radial(s);
+        settings.spot_radius_mm = s.radius_enclosing(0.99);
+    }
     let profile_s = t_profile.elapsed().as_secs_f64();
     let channels = profile.profile.channels();
     if channels != 3 {
