@@ -15,7 +15,9 @@ pub const MIN_RATIO_FOR_BRIGHTENING: f64 = 1.25;
 
 /// Checks that the frames of a bracket brighten with their exposure times: for each pair of frames
 /// adjacent in time, over the pixel values that are not clipped at the same end in both (`0` and
-/// `max` are the clip codes) and that differ, the count that got darker (d) and brighter (b) with
+/// `max` are the clip codes), that carry signal in one of them (at least 1/32 of the way from the
+/// bracket's floor, its 1st percentile, to `max`: values near the floor are noise that moves
+/// either way) and that differ, the count that got darker (d) and brighter (b) with
 /// the longer time. Refused when d − b > 3√(b + d) (the longer frame is clearly darker: times
 /// reversed or shuffled), when the two frames are identical while more than half of their values
 /// are unclipped (one frame listed twice), or, for times ≥ [`MIN_RATIO_FOR_BRIGHTENING`] apart,
@@ -30,7 +32,7 @@ pub const MIN_RATIO_FOR_BRIGHTENING: f64 = 1.25;
 /// Bracket errors, [`ImagingError::BracketOutOfOrder`].
 pub fn check_bracket_order<T>(frames: &[ImageBuf<T>], times_s: &[f64], max: T) -> Result<()>
 where
-    T: Copy + PartialOrd + PartialEq + Default + Sync,
+    T: Copy + PartialOrd + PartialEq + Default + Sync + Into<f64>,
 {
     check_bracket(frames, times_s)?;
     let mut order: Vec<usize> = (0..frames.len()).collect();
@@ -38,6 +40,17 @@ where
     let n = frames[0].data().len();
     let step = (n / 200_000).max(1);
     let zero = T::default();
+    // Values near the sensor's floor are noise that moves either way (a dark sample's short
+    // frames are mostly read noise about code 0 or the black level): only values that reach a
+    // 32nd of the way from the bracket's floor (its 1st percentile) to the clip count.
+    let mut sample: Vec<f64> = frames
+        .iter()
+        .flat_map(|f| f.data().iter().step_by(step * 7 + 1).map(|&v| v.into()))
+        .collect();
+    sample.sort_by(f64::total_cmp);
+    let floor = sample.get(sample.len() / 100).copied().unwrap_or(0.0);
+    let top: f64 = max.into();
+    let signal = floor + (top - floor) / 32.0;
     for pair in order.windows(2) {
         let (s, l) = (pair[0], pair[1]);
         let (a, b) = (frames[s].data(), frames[l].data());
@@ -48,7 +61,8 @@ where
             seen += 1;
             let low = x == zero && y == zero;
             let high = x == max && y == max;
-            if !low && !high {
+            let weak = x.into() < signal && y.into() < signal;
+            if !low && !high && !weak {
                 unclipped += 1;
                 if y < x {
                     darker += 1;
@@ -67,7 +81,7 @@ where
         } else if compared == 0 && unclipped * 2 > seen {
             Some("the two frames are identical (one frame listed twice?)")
         } else if ratio >= MIN_RATIO_FOR_BRIGHTENING
-            && compared > 0
+            && compared >= 100
             && (brighter as f64 - darker as f64) < margin
         {
             Some("the longer exposure is no brighter")
