@@ -19,8 +19,8 @@ pub const MIN_RATIO_FOR_BRIGHTENING: f64 = 1.25;
 /// bracket's floor, its 1st percentile, to `max`: values near the floor are noise that moves
 /// either way) and that differ, the count that got darker (d) and brighter (b) with
 /// the longer time. Refused when d − b > 3√(b + d) (the longer frame is clearly darker: times
-/// reversed or shuffled), when the two frames are identical while more than half of their values
-/// are unclipped (one frame listed twice), or, for times ≥ [`MIN_RATIO_FOR_BRIGHTENING`] apart,
+/// reversed or shuffled), when the two frames are identical value for value and some value carries
+/// signal (one frame listed twice), or, for times ≥ [`MIN_RATIO_FOR_BRIGHTENING`] apart,
 /// when b − d < 3√(b + d) (a longer exposure that is not clearly brighter). Noise alone moves
 /// b − d by about √(b + d), so a good bracket passes with a wide margin (on the twin's brackets,
 /// b/d > 50 for every pair).
@@ -33,6 +33,7 @@ pub const MIN_RATIO_FOR_BRIGHTENING: f64 = 1.25;
 pub fn check_bracket_order<T>(frames: &[ImageBuf<T>], times_s: &[f64], max: T) -> Result<()>
 where
     T: Copy + PartialOrd + PartialEq + Default + Sync + Into<f64>,
+    [T]: PartialEq,
 {
     check_bracket(frames, times_s)?;
     let mut order: Vec<usize> = (0..frames.len()).collect();
@@ -54,11 +55,10 @@ where
     for pair in order.windows(2) {
         let (s, l) = (pair[0], pair[1]);
         let (a, b) = (frames[s].data(), frames[l].data());
-        let (mut darker, mut brighter, mut compared, mut unclipped, mut seen) = (0, 0, 0, 0, 0);
+        let (mut darker, mut brighter, mut compared, mut unclipped) = (0, 0, 0, 0);
         let mut k = 0;
         while k < n {
             let (x, y) = (a[k], b[k]);
-            seen += 1;
             let low = x == zero && y == zero;
             let high = x == max && y == max;
             let weak = x.into() < signal && y.into() < signal;
@@ -78,7 +78,7 @@ where
         let ratio = times_s[l] / times_s[s];
         let what = if darker as f64 - brighter as f64 > margin {
             Some("the longer exposure is darker")
-        } else if compared == 0 && unclipped * 2 > seen {
+        } else if a == b && unclipped > 0 {
             Some("the two frames are identical (one frame listed twice?)")
         } else if ratio >= MIN_RATIO_FOR_BRIGHTENING
             && compared >= 100
