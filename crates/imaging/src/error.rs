@@ -178,6 +178,24 @@ pub enum ImagingError {
         /// And how many higher.
         brighter: usize,
     },
+    /// A frame holds far more or less light than its exposure time says, measured against its
+    /// neighbours on the pixels well exposed in both: more than a shutter's error.
+    #[error(
+        "frame {frame} (at {time_s} s, counting frames by time from 0) holds {factor:.3} × the \
+         light its exposure time says, measured against its neighbours on the pixels well exposed \
+         in both — more than a shutter's error ({limit:.0} %): is it the right file for that time \
+         (one frame listed twice, a frame of another bracket, the light changed)?"
+    )]
+    ExposureMismatch {
+        /// Index of the frame, by time.
+        frame: usize,
+        /// Its nominal time [s].
+        time_s: f64,
+        /// Its estimated exposure over the nominal one.
+        factor: f64,
+        /// The largest deviation taken for a shutter's [%].
+        limit: f64,
+    },
     /// The dark frame is at or above the signal: fewer than [`crate::MIN_VALID_FRACTION`] of a
     /// channel's pixels rise above it even in the longest exposure.
     #[error(
@@ -258,6 +276,7 @@ impl ImagingError {
                 | Self::SolveFailed { .. }
                 | Self::ResponseNotIncreasing { .. }
                 | Self::BracketOutOfOrder { .. }
+                | Self::ExposureMismatch { .. }
                 | Self::NoValidRadiance { .. }
                 | Self::NoSpot { .. }
         )

@@ -28,7 +28,7 @@ pub use merge::{
     CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MIN_VALID_FRACTION,
     MergeOptions, Weighting, merge, merge_linear_black, merge_linear_u16,
 };
-pub use order::{MIN_RATIO_FOR_BRIGHTENING, check_bracket_order};
+pub use order::check_bracket_order;
 pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{
     CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,

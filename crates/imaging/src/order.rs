@@ -8,22 +8,16 @@
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result, check_bracket};
 
-/// Pairs of frames whose times differ by at least this factor must brighten more pixel values than
-/// they darken by a clear margin (a repeated frame under another time brightens none); pairs closer
-/// in time are only refused when they clearly darken.
-pub const MIN_RATIO_FOR_BRIGHTENING: f64 = 1.25;
-
 /// Checks that the frames of a bracket brighten with their exposure times: for each pair of frames
 /// adjacent in time, over the pixel values that are not clipped at the same end in both (`0` and
-/// `max` are the clip codes), that carry signal in one of them (at least 1/32 of the way from the
-/// bracket's floor, its 1st percentile, to `max`: values near the floor are noise that moves
-/// either way) and that differ, the count that got darker (d) and brighter (b) with
-/// the longer time. Refused when d − b > 3√(b + d) (the longer frame is clearly darker: times
-/// reversed or shuffled), when the two frames are identical value for value and some value carries
-/// signal (one frame listed twice), or, for times ≥ [`MIN_RATIO_FOR_BRIGHTENING`] apart,
-/// when b − d < 3√(b + d) (a longer exposure that is not clearly brighter). Noise alone moves
-/// b − d by about √(b + d), so a good bracket passes with a wide margin (on the twin's brackets,
-/// b/d > 50 for every pair).
+/// `max` are the clip codes), the summed change Σ(y − x) from the shorter frame x to the longer y
+/// in units of its noise, z = Σ(y − x)/√Σ(y − x)² (noise moves a value either way, so over values
+/// without signal z stays within a few units of 0, whatever the noise; values with signal add to
+/// it). Refused when z < −3 (the longer frame is clearly darker: times reversed or shuffled), when
+/// the two frames are identical value for value (one frame listed twice). A frame shot twice and
+/// listed under two times differs from its twin by noise only and is not refused here (a pair of
+/// short frames of a dark sample looks the same); the HDR stage's exposure estimate finds it
+/// (`ImagingError::ExposureMismatch`). The message gives how many values got darker and brighter.
 ///
 /// `max` is the clip value (255 for 8-bit, the saturation for linear data). At most about 200 000
 /// values per pair are compared (a regular subsample).
@@ -41,29 +35,21 @@ where
     let n = frames[0].data().len();
     let step = (n / 200_000).max(1);
     let zero = T::default();
-    // Values near the sensor's floor are noise that moves either way (a dark sample's short
-    // frames are mostly read noise about code 0 or the black level): only values that reach a
-    // 32nd of the way from the bracket's floor (its 1st percentile) to the clip count.
-    let mut sample: Vec<f64> = frames
-        .iter()
-        .flat_map(|f| f.data().iter().step_by(step * 7 + 1).map(|&v| v.into()))
-        .collect();
-    sample.sort_by(f64::total_cmp);
-    let floor = sample.get(sample.len() / 100).copied().unwrap_or(0.0);
-    let top: f64 = max.into();
-    let signal = floor + (top - floor) / 32.0;
     for pair in order.windows(2) {
         let (s, l) = (pair[0], pair[1]);
         let (a, b) = (frames[s].data(), frames[l].data());
         let (mut darker, mut brighter, mut compared, mut unclipped) = (0, 0, 0, 0);
+        let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         let mut k = 0;
         while k < n {
             let (x, y) = (a[k], b[k]);
             let low = x == zero && y == zero;
             let high = x == max && y == max;
-            let weak = x.into() < signal && y.into() < signal;
-            if !low && !high && !weak {
+            if !low && !high {
                 unclipped += 1;
+                let d = y.into() - x.into();
+                sum += d;
+                sum2 += d * d;
                 if y < x {
                     darker += 1;
                     compared += 1;
@@ -74,17 +60,12 @@ where
             }
             k += step;
         }
-        let margin = 3.0 * ((darker + brighter) as f64).sqrt();
-        let ratio = times_s[l] / times_s[s];
-        let what = if darker as f64 - brighter as f64 > margin {
+        // z: the summed change in units of its noise (noise moves each value either way).
+        let z = if sum2 > 0.0 { sum / sum2.sqrt() } else { 0.0 };
+        let what = if z < -3.0 {
             Some("the longer exposure is darker")
         } else if a == b && unclipped > 0 {
             Some("the two frames are identical (one frame listed twice?)")
-        } else if ratio >= MIN_RATIO_FOR_BRIGHTENING
-            && compared >= 100
-            && (brighter as f64 - darker as f64) < margin
-        {
-            Some("the longer exposure is no brighter")
         } else {
             None
         };

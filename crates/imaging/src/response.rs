@@ -748,3 +748,4 @@ pub fn select_samples(
         })
         .collect())
 }
+

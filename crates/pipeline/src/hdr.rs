@@ -28,6 +28,32 @@ use crate::error::{PipelineError, Result};
 /// shutter's scatter and the estimate's own (about 0.1 % on the twin) stay below it.
 pub const EXPOSURE_AUTO_THRESHOLD: f64 = 0.01;
 
+/// A frame whose estimated exposure differs from its nominal time by more than this (25 %) is
+/// refused ([`scatterfit_imaging::ImagingError::ExposureMismatch`]): no shutter errs so much; the
+/// file does not belong to its time.
+pub const EXPOSURE_MISMATCH_LIMIT: f64 = 0.25;
+
+/// Refuses an exposure estimate that moves a frame by more than [`EXPOSURE_MISMATCH_LIMIT`].
+fn check_exposure(est: &ExposureEstimate, times: &[f64]) -> Result<()> {
+    if let Some((frame, f)) = est
+        .factor
+        .iter()
+        .enumerate()
+        .find(|(_, f)| (*f - 1.0).abs() > EXPOSURE_MISMATCH_LIMIT)
+    {
+        return Err(PipelineError::Imaging {
+            context: "estimating the exposures from the frames".into(),
+            source: scatterfit_imaging::ImagingError::ExposureMismatch {
+                frame,
+                time_s: times[frame],
+                factor: *f,
+                limit: 100.0 * EXPOSURE_MISMATCH_LIMIT,
+            },
+        });
+    }
+    Ok(())
+}
+
 /// The black level of linear frames.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum BlackLevel {
@@ -403,6 +429,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                     || (round == 0 && est.max_correction > EXPOSURE_AUTO_THRESHOLD)
                     || (round > 0 && corrections.exposure_applied);
                 if round == 0 {
+                    check_exposure(&est, &times)?;
                     corrections.exposure = Some(est.clone());
                 }
                 if !apply {
@@ -540,6 +567,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                 },
                 false,
             );
+            check_exposure(&est, &times)?;
             let apply = inputs.exposure_correction == ExposureCorrection::Always
                 || est.max_correction > EXPOSURE_AUTO_THRESHOLD;
             if apply {
