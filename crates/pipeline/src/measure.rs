@@ -391,6 +391,10 @@ impl Measurement {
                     "spot_radius_mm": self.settings.spot_radius_mm,
                     "response": self.hdr.response_kind,
                     "detection_limit": self.profile.detection_limit,
+                    "camera": {
+                        "corrections": self.hdr.corrections,
+                        "background": self.profile.background,
+                    },
                 }),
             },
             version: env!("CARGO_PKG_VERSION").into(),
