@@ -177,7 +177,8 @@ fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
         gaussian_spot: args.gaussian_spot,
         spot_image: args.spot_image,
     };
-    rig.validate().map_err(|e| anyhow::anyhow!("{e} (check --glare, --vignetting, --exposure-error)"))?;
+    rig.validate()
+        .map_err(|e| anyhow::anyhow!("{e} (check --glare, --vignetting, --exposure-error)"))?;
     Ok(rig)
 }
 
@@ -208,7 +209,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     check_output_files(&args.output_dir, &names, args.force)?;
     let cache = cache_dir(args.cache_dir.as_deref());
-    let sample = synthesize_on(&m, &rig, args.seed, cache.as_deref(), args.quiet || args.json)?;
+    let sample = synthesize_on(
+        &m,
+        &rig,
+        args.seed,
+        cache.as_deref(),
+        args.quiet || args.json,
+    )?;
     write_sample_with(
         &args.output_dir,
         &sample,

@@ -107,7 +107,8 @@ pub fn write_sample_with(
         },
         flat: s.bracket.flat.as_ref().map(frame),
         spot_image: s.bracket.spot_image.as_ref().map(frame),
-        spot_profile: (rig.effects.gaussian_spot && s.bracket.spot_image.is_none()).then_some(scatterfit_io::manifest::SpotProfileName::Gaussian),
+        spot_profile: (rig.effects.gaussian_spot && s.bracket.spot_image.is_none())
+            .then_some(scatterfit_io::manifest::SpotProfileName::Gaussian),
     };
     write_sample_folder_with(
         dir,

@@ -41,7 +41,11 @@ impl RadialSpot {
                 "need one intensity per annulus (edges = intensities + 1)",
             );
         }
-        if edges_mm[0] != 0.0 || edges_mm.windows(2).any(|w| !(w[1] > w[0] && w[1].is_finite())) {
+        if edges_mm[0] != 0.0
+            || edges_mm
+                .windows(2)
+                .any(|w| !(w[1] > w[0] && w[1].is_finite()))
+        {
             return bad(
                 "spot profile edges [mm]",
                 edges_mm[0],
@@ -76,7 +80,13 @@ impl RadialSpot {
             }
         }
         let level: Vec<f64> = (0..n)
-            .map(|i| if area[i] > 0.0 { power[i] / area[i] } else { 0.0 })
+            .map(|i| {
+                if area[i] > 0.0 {
+                    power[i] / area[i]
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let total: f64 = power.iter().sum();
         if !(total > 0.0 && total.is_finite()) {
@@ -228,7 +238,9 @@ mod tests {
                 norm += g;
                 for b in 0..nphi {
                     let phi = std::f64::consts::PI * (b as f64 + 0.5) / nphi as f64;
-                    let d = (r * r + rho * rho - 2.0 * r * rho * phi.cos()).max(0.0).sqrt();
+                    let d = (r * r + rho * rho - 2.0 * r * rho * phi.cos())
+                        .max(0.0)
+                        .sqrt();
                     sum += g * f(d) / nphi as f64;
                 }
             }

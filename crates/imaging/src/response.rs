@@ -748,4 +748,3 @@ pub fn select_samples(
         })
         .collect())
 }
-

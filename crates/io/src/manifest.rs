@@ -477,11 +477,14 @@ pub fn parse_manifest(
         Some(BlackLevelSetting::One(v)) if !(v.is_finite() && (0.0..65535.0).contains(&v)) => {
             return Err(invalid(
                 "camera.black_level",
-                format!("= {v}: a black level is a raw value in [0, 65535) DN, or \"auto\"/\"none\""),
+                format!(
+                    "= {v}: a black level is a raw value in [0, 65535) DN, or \"auto\"/\"none\""
+                ),
             ));
         }
         Some(BlackLevelSetting::PerChannel(v))
-            if v.iter().any(|v| !(v.is_finite() && (0.0..65535.0).contains(v))) =>
+            if v.iter()
+                .any(|v| !(v.is_finite() && (0.0..65535.0).contains(v))) =>
         {
             return Err(invalid(
                 "camera.black_level",
@@ -627,7 +630,11 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     if let Some(b) = m.camera.background {
         t.push_str(&format!(
             "background = \"{}\"\n",
-            if b == AutoOrNone::Auto { "auto" } else { "none" }
+            if b == AutoOrNone::Auto {
+                "auto"
+            } else {
+                "none"
+            }
         ));
     }
     if let Some(e) = m.camera.exposure_correction {

@@ -88,14 +88,19 @@ pub fn decode_raw(bytes: &[u8], path: &Path) -> Result<RawFrame, ImageFileError>
         rawler::RawImageData::Float(_) => {
             return Err(unsupported(
                 path,
-                format!("its raw data are floating point, which this reader does not take; {advice}"),
+                format!(
+                    "its raw data are floating point, which this reader does not take; {advice}"
+                ),
             ));
         }
     };
     if w == 0 || h == 0 || data.len() < w * h * cpp {
         return Err(unsupported(
             path,
-            format!("the decoder returned {w}×{h}×{cpp} samples but {}", data.len()),
+            format!(
+                "the decoder returned {w}×{h}×{cpp} samples but {}",
+                data.len()
+            ),
         ));
     }
     let whites = &raw.whitelevel.0;
@@ -125,7 +130,10 @@ pub fn decode_raw(bytes: &[u8], path: &Path) -> Result<RawFrame, ImageFileError>
             if (0..2).any(|r| (0..2).any(|c| colour(r, c) > 2)) {
                 return Err(unsupported(
                     path,
-                    format!("its mosaic {} has colours other than R, G, B; {advice}", cfa.name),
+                    format!(
+                        "its mosaic {} has colours other than R, G, B; {advice}",
+                        cfa.name
+                    ),
                 ));
             }
             let mut black = [0.0f64; 3];
@@ -166,7 +174,9 @@ pub fn decode_raw(bytes: &[u8], path: &Path) -> Result<RawFrame, ImageFileError>
         }
         (p, n) => Err(unsupported(
             path,
-            format!("its data are {n} sample(s) per pixel ({p:?}), neither a 2 × 2 mosaic nor linear RGB; {advice}"),
+            format!(
+                "its data are {n} sample(s) per pixel ({p:?}), neither a 2 × 2 mosaic nor linear RGB; {advice}"
+            ),
         )),
     }
 }
@@ -199,10 +209,8 @@ fn demosaic_bilinear(
             for c in 0..3 {
                 out[(y * w + x) * 3 + c] = if c == own {
                     data[y * w + x]
-                } else if n[c] > 0 {
-                    ((sum[c] + n[c] / 2) / n[c]) as u16
                 } else {
-                    0
+                    (sum[c] + n[c] / 2).checked_div(n[c]).unwrap_or(0) as u16
                 };
             }
         }
@@ -233,7 +241,10 @@ pub fn write_dng(path: &Path, rgb: &ImageBuf<u16>, info: &DngInfo) -> Result<(),
     use tiff::encoder::{Rational, SRational, TiffEncoder, colortype};
     use tiff::tags::Tag;
     if rgb.channels() != 3 {
-        return Err(unsupported(path, "a DNG is written from an RGB frame".into()));
+        return Err(unsupported(
+            path,
+            "a DNG is written from an RGB frame".into(),
+        ));
     }
     let (w, h) = (rgb.width(), rgb.height());
     // RGGB: (even row, even col) R, (even, odd) G, (odd, even) G, (odd, odd) B.
@@ -273,7 +284,8 @@ pub fn write_dng(path: &Path, rgb: &ImageBuf<u16>, info: &DngInfo) -> Result<(),
             .map_err(err)?;
         e.write_tag(Tag::Make, "scatterfit").map_err(err)?;
         e.write_tag(Tag::Model, "rig twin").map_err(err)?;
-        e.write_tag(Tag::Unknown(33421), &[2u16, 2][..]).map_err(err)?; // CFARepeatPatternDim
+        e.write_tag(Tag::Unknown(33421), &[2u16, 2][..])
+            .map_err(err)?; // CFARepeatPatternDim
         e.write_tag(Tag::Unknown(33422), &[0u8, 1, 1, 2][..])
             .map_err(err)?; // CFAPattern RGGB
         e.write_tag(Tag::Unknown(33434), Rational { n, d })
@@ -287,7 +299,8 @@ pub fn write_dng(path: &Path, rgb: &ImageBuf<u16>, info: &DngInfo) -> Result<(),
         e.write_tag(Tag::Unknown(50710), &[0u8, 1, 2][..])
             .map_err(err)?; // CFAPlaneColor
         e.write_tag(Tag::Unknown(50711), 1u16).map_err(err)?; // CFALayout: rectangular
-        e.write_tag(Tag::Unknown(50713), &[2u16, 2][..]).map_err(err)?; // BlackLevelRepeatDim
+        e.write_tag(Tag::Unknown(50713), &[2u16, 2][..])
+            .map_err(err)?; // BlackLevelRepeatDim
         e.write_tag(Tag::Unknown(50714), &[b[0], b[1], b[1], b[2]][..])
             .map_err(err)?; // BlackLevel
         e.write_tag(Tag::Unknown(50717), info.white_level)

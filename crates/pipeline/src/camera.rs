@@ -189,7 +189,7 @@ pub fn flat_divisor(linear: &ImageBuf<f32>) -> Option<ImageBuf<f32>> {
     }
     sorted.sort_by(f32::total_cmp);
     let median = sorted[sorted.len() / 2];
-    if !(median > 0.0) {
+    if median.is_nan() || median <= 0.0 {
         return None;
     }
     data.iter_mut().for_each(|v| *v /= median);
@@ -302,11 +302,9 @@ pub fn spot_from_image(
     linear: &ImageBuf<f32>,
     mm_per_pixel: f64,
 ) -> std::result::Result<scatterfit_fit::RadialSpot, String> {
-    let center = scatterfit_imaging::find_spot_center(
-        linear,
-        &scatterfit_imaging::CenterOptions::default(),
-    )
-    .map_err(|e| format!("no spot found in it ({e})"))?;
+    let center =
+        scatterfit_imaging::find_spot_center(linear, &scatterfit_imaging::CenterOptions::default())
+            .map_err(|e| format!("no spot found in it ({e})"))?;
     let [cx, cy] = center.xy();
     let (w, h, ch) = (linear.width(), linear.height(), linear.channels());
     // Grey: the mean of the channels.
@@ -338,10 +336,16 @@ pub fn spot_from_image(
         }
     }
     let mean: Vec<f64> = (0..nbin)
-        .map(|k| if cnt[k] > 0 { sum[k] / cnt[k] as f64 } else { 0.0 })
+        .map(|k| {
+            if cnt[k] > 0 {
+                sum[k] / cnt[k] as f64
+            } else {
+                0.0
+            }
+        })
         .collect();
     let peak = mean.iter().copied().fold(0.0f64, f64::max);
-    if !(peak > 0.0) {
+    if peak.is_nan() || peak <= 0.0 {
         return Err("it holds no light above its corners".into());
     }
     let half = mean.iter().position(|&v| v < 0.5 * peak).unwrap_or(nbin);

@@ -34,6 +34,8 @@ pub struct FitSettings {
 }
 
 /// The light spot's shape in [`FitSettings`].
+// Inline disks keep the settings `Copy` (see `scatterfit_fit::Spot`).
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum SpotShape {
     /// A uniform disk of [`FitSettings::spot_radius_mm`] (the paper's).

@@ -362,13 +362,17 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             .map(|(k, f)| {
                 format!(
                     "{k} = {}",
-                    f.file
-                        .file_name()
-                        .map_or_else(|| f.file.display().to_string(), |n| n.to_string_lossy().into_owned())
+                    f.file.file_name().map_or_else(
+                        || f.file.display().to_string(),
+                        |n| n.to_string_lossy().into_owned()
+                    )
                 )
             })
             .collect();
-        format!("checking the bracket's order (frames by time: {})", names.join(", "))
+        format!(
+            "checking the bracket's order (frames by time: {})",
+            names.join(", ")
+        )
     };
     let mut corrections = Corrections::default();
     let depth = bracket.frames()[0].frame.bit_depth();
@@ -474,7 +478,11 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                 .enumerate()
                 .map(|(i, &z)| {
                     let g = &tables[if tables.len() == 1 { 0 } else { i % ch }];
-                    if z == 0 { 0.0 } else { g[usize::from(z)].exp() as f32 }
+                    if z == 0 {
+                        0.0
+                    } else {
+                        g[usize::from(z)].exp() as f32
+                    }
                 })
                 .collect();
             corrections.flat = Some(divide_flat(&mut hdr, path, f.width(), f.height(), ch, lin)?);
@@ -534,7 +542,9 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             match &inputs.black_level {
                 BlackLevel::None => None,
                 BlackLevel::Given(v) => Some((
-                    (0..ch).map(|c| v[if v.len() == 1 { 0 } else { c.min(v.len() - 1) }]).collect(),
+                    (0..ch)
+                        .map(|c| v[if v.len() == 1 { 0 } else { c.min(v.len() - 1) }])
+                        .collect(),
                     "given",
                 )),
                 BlackLevel::Auto => match raw {
@@ -600,7 +610,9 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                 .iter()
                 .enumerate()
                 .map(|(i, &v)| {
-                    let d = dark.as_ref().map_or(black_of(i % ch), |d| f64::from(d.data()[i]));
+                    let d = dark
+                        .as_ref()
+                        .map_or(black_of(i % ch), |d| f64::from(d.data()[i]));
                     (f64::from(v) - d) as f32
                 })
                 .collect();
@@ -670,7 +682,7 @@ fn divide_flat(
             v / d.max(floor)
         })
         .collect();
-    if !(lo > 0.0) {
+    if lo.is_nan() || lo <= 0.0 {
         return Err(bad());
     }
     hdr.radiance = ImageBuf::new(w, h, ch, data).map_err(|_| bad())?;
@@ -695,7 +707,9 @@ pub fn spot_kernel_from_image(
             path.display()
         ))
     };
-    let frame = read_camera_frame(path).map_err(|e| bad(e.to_string()))?.frame;
+    let frame = read_camera_frame(path)
+        .map_err(|e| bad(e.to_string()))?
+        .frame;
     let linear: Vec<f32> = match (&frame, &stage.response) {
         (CameraFrame::U8(f), Some(r)) => {
             let tables = r.tables();
@@ -705,7 +719,11 @@ pub fn spot_kernel_from_image(
                 .enumerate()
                 .map(|(i, &z)| {
                     let g = &tables[if tables.len() == 1 { 0 } else { i % ch }];
-                    if z == 0 { 0.0 } else { g[usize::from(z)].exp() as f32 }
+                    if z == 0 {
+                        0.0
+                    } else {
+                        g[usize::from(z)].exp() as f32
+                    }
                 })
                 .collect()
         }
@@ -717,8 +735,7 @@ pub fn spot_kernel_from_image(
                 .iter()
                 .enumerate()
                 .map(|(i, &v)| {
-                    (f64::from(v) - black.map_or(0.0, |(b, _)| b[(i % ch).min(b.len() - 1)]))
-                        as f32
+                    (f64::from(v) - black.map_or(0.0, |(b, _)| b[(i % ch).min(b.len() - 1)])) as f32
                 })
                 .collect()
         }

@@ -15,11 +15,11 @@ use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
 use crate::fit::{
-    ChannelOutcome, FitSettings, SpotShape, SpectroErrors, albedo_model_for, channel_result, fit_stage,
-    model_for, propagate_spectro,
+    ChannelOutcome, FitSettings, SpectroErrors, SpotShape, albedo_model_for, channel_result,
+    fit_stage, model_for, propagate_spectro,
 };
-use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
 use crate::hdr::BlackLevel;
+use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
 use crate::profile::{ProfileSettings, ProfileStage, profile_stage_with};
 use crate::spectro::{SpectroStage, spectro_stage};
 

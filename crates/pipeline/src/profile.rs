@@ -188,22 +188,26 @@ pub fn estimate_background(
 ) -> Result<Vec<Background>> {
     let (w, h) = (radiance.width() as f64, radiance.height() as f64);
     let [cx, cy] = center;
-    let far = [(0.0, 0.0), (w - 1.0, 0.0), (0.0, h - 1.0), (w - 1.0, h - 1.0)]
-        .iter()
-        .map(|(x, y)| (x - cx).hypot(y - cy))
-        .fold(0.0f64, f64::max);
-    let opts = ProfileOptions::new(2.0, far.max(4.0)).map_err(|source| {
-        PipelineError::Imaging {
-            context: "the background's rings".into(),
-            source,
-        }
+    let far = [
+        (0.0, 0.0),
+        (w - 1.0, 0.0),
+        (0.0, h - 1.0),
+        (w - 1.0, h - 1.0),
+    ]
+    .iter()
+    .map(|(x, y)| (x - cx).hypot(y - cy))
+    .fold(0.0f64, f64::max);
+    let opts = ProfileOptions::new(2.0, far.max(4.0)).map_err(|source| PipelineError::Imaging {
+        context: "the background's rings".into(),
+        source,
     })?;
-    let rings = radial_profile(radiance, center, saturated, mm_per_pixel, &opts).map_err(
-        |source| PipelineError::Imaging {
-            context: "the background's rings".into(),
-            source,
-        },
-    )?;
+    let rings =
+        radial_profile(radiance, center, saturated, mm_per_pixel, &opts).map_err(|source| {
+            PipelineError::Imaging {
+                context: "the background's rings".into(),
+                source,
+            }
+        })?;
     let peak: Vec<f64> = (0..profile.channels())
         .map(|c| {
             profile
@@ -225,8 +229,11 @@ pub fn estimate_background(
                 .filter_map(|(k, r)| {
                     let ch = &r.channels[c];
                     let r_mm = rings.r_mm(k)?;
-                    (ch.mean.is_finite() && ch.std_err.is_finite() && r_mm > 0.0)
-                        .then_some((r_mm, ch.mean, ch.std_err.max(1e-30)))
+                    (ch.mean.is_finite() && ch.std_err.is_finite() && r_mm > 0.0).then_some((
+                        r_mm,
+                        ch.mean,
+                        ch.std_err.max(1e-30),
+                    ))
                 })
                 .collect();
             let (level, stderr) =
@@ -236,7 +243,11 @@ pub fn estimate_background(
             Background {
                 level,
                 stderr,
-                relative_to_peak: if peak[c] > 0.0 { level / peak[c] } else { f64::NAN },
+                relative_to_peak: if peak[c] > 0.0 {
+                    level / peak[c]
+                } else {
+                    f64::NAN
+                },
                 subtracted,
             }
         })

@@ -156,6 +156,7 @@ fn shape_errors(
     )
     .unwrap();
     let mut worst = [0.0; 3];
+    #[allow(clippy::needless_range_loop)]
     for c in 0..3 {
         let ratios: Vec<f64> = prof
             .profile
@@ -175,9 +176,15 @@ fn shape_errors(
         let mut sorted = ratios.clone();
         sorted.sort_by(f64::total_cmp);
         let k = sorted[sorted.len() / 2];
-        worst[c] = ratios.iter().map(|r| (r / k - 1.0).abs()).fold(0.0, f64::max);
+        worst[c] = ratios
+            .iter()
+            .map(|r| (r / k - 1.0).abs())
+            .fold(0.0, f64::max);
         if std::env::var("CAMERA_DEBUG").is_ok() && worst[c] > 0.01 {
-            let v: Vec<String> = ratios.iter().map(|r| format!("{:+.3}", r / k - 1.0)).collect();
+            let v: Vec<String> = ratios
+                .iter()
+                .map(|r| format!("{:+.3}", r / k - 1.0))
+                .collect();
             eprintln!("  channel {c}: {}", v.join(" "));
         }
     }
@@ -251,7 +258,11 @@ fn no_good_bracket_is_refused_and_shapes_hold() {
         }
     }
     all.sort_by(f64::total_cmp);
-    let q = |p: f64| all.get(((all.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(0.0);
+    let q = |p: f64| {
+        all.get(((all.len() as f64 - 1.0) * p) as usize)
+            .copied()
+            .unwrap_or(0.0)
+    };
     eprintln!(
         "shape error over the sweep: median {:.4}, 90 % {:.4}, worst {worst:.4}; within 1 %: {} of \
          {measured} channels measured ({unmeasurable} with nothing measurable beyond 0.5 mm)",
@@ -284,8 +295,13 @@ fn a_wrong_order_is_refused_saying_what_was_seen() {
     let rig = RigSpec::quick();
     let f = dipole(0.9, 1.3);
     let b = render_bracket_fn(&|_, r| f(r), Some([1.0, 0.8, 0.6]), &rig, 3).unwrap();
-    let cases: Vec<(&str, Vec<f64>, Vec<ImageBuf<u8>>)> = vec![
-        ("reversed", b.times_s.iter().rev().copied().collect(), b.frames.clone()),
+    type Case = (&'static str, Vec<f64>, Vec<ImageBuf<u8>>);
+    let cases: Vec<Case> = vec![
+        (
+            "reversed",
+            b.times_s.iter().rev().copied().collect(),
+            b.frames.clone(),
+        ),
         (
             "shuffled",
             {
@@ -398,7 +414,12 @@ fn effect(
         let mut sorted = ratios.clone();
         sorted.sort_by(f64::total_cmp);
         let k = sorted[sorted.len() / 2];
-        worst = worst.max(ratios.iter().map(|r| (r / k - 1.0).abs()).fold(0.0, f64::max));
+        worst = worst.max(
+            ratios
+                .iter()
+                .map(|r| (r / k - 1.0).abs())
+                .fold(0.0, f64::max),
+        );
     }
     worst
 }
@@ -409,8 +430,18 @@ fn effect(
 fn glare_is_estimated_and_subtracted() {
     let mut rig = RigSpec::quick();
     rig.effects.glare = 3e-4;
-    let on = effect(rig.clone(), &|_, _| {}, scatterfit_io::manifest::AutoOrNone::Auto, true);
-    let off = effect(rig, &|_, _| {}, scatterfit_io::manifest::AutoOrNone::Auto, false);
+    let on = effect(
+        rig.clone(),
+        &|_, _| {},
+        scatterfit_io::manifest::AutoOrNone::Auto,
+        true,
+    );
+    let off = effect(
+        rig,
+        &|_, _| {},
+        scatterfit_io::manifest::AutoOrNone::Auto,
+        false,
+    );
     eprintln!("glare: shape error {on:.4} handled, {off:.4} not");
     assert!(on < 0.08 && off > 3.0 * on, "{on} vs {off}");
 }
@@ -421,8 +452,18 @@ fn glare_is_estimated_and_subtracted() {
 fn black_level_is_found_in_the_corners() {
     let mut rig = RigSpec::quick();
     rig.camera = CameraModel::named("linear16").unwrap();
-    let on = effect(rig.clone(), &|_, _| {}, scatterfit_io::manifest::AutoOrNone::None, true);
-    let off = effect(rig, &|_, _| {}, scatterfit_io::manifest::AutoOrNone::None, false);
+    let on = effect(
+        rig.clone(),
+        &|_, _| {},
+        scatterfit_io::manifest::AutoOrNone::None,
+        true,
+    );
+    let off = effect(
+        rig,
+        &|_, _| {},
+        scatterfit_io::manifest::AutoOrNone::None,
+        false,
+    );
     eprintln!("black level: shape error {on:.4} handled, {off:.4} not");
     assert!(on < 0.03 && off > 3.0 * on, "{on} vs {off}");
 }
@@ -438,7 +479,12 @@ fn the_flat_frame_removes_vignetting() {
         scatterfit_io::manifest::AutoOrNone::None,
         true,
     );
-    let off = effect(rig, &|_, _| {}, scatterfit_io::manifest::AutoOrNone::None, false);
+    let off = effect(
+        rig,
+        &|_, _| {},
+        scatterfit_io::manifest::AutoOrNone::None,
+        false,
+    );
     eprintln!("vignetting: shape error {on:.4} handled, {off:.4} not");
     assert!(on < 0.03 && off > 2.0 * on, "{on} vs {off}");
 }
@@ -449,8 +495,18 @@ fn the_flat_frame_removes_vignetting() {
 fn exposure_times_are_estimated_from_the_frames() {
     let mut rig = RigSpec::quick();
     rig.effects.exposure_error = 0.03;
-    let on = effect(rig.clone(), &|_, _| {}, scatterfit_io::manifest::AutoOrNone::None, true);
-    let off = effect(rig, &|_, _| {}, scatterfit_io::manifest::AutoOrNone::None, false);
+    let on = effect(
+        rig.clone(),
+        &|_, _| {},
+        scatterfit_io::manifest::AutoOrNone::None,
+        true,
+    );
+    let off = effect(
+        rig,
+        &|_, _| {},
+        scatterfit_io::manifest::AutoOrNone::None,
+        false,
+    );
     eprintln!("exposure error: shape error {on:.4} handled, {off:.4} not");
     assert!(off > 1.5 * on, "{on} vs {off}");
 }

@@ -405,7 +405,11 @@ impl RigSpec {
         }
         let e = &self.effects;
         if !(0.0..=0.1).contains(&e.glare) {
-            return bad("glare", e.glare, "must lie in [0, 0.1] of the spot's radiance");
+            return bad(
+                "glare",
+                e.glare,
+                "must lie in [0, 0.1] of the spot's radiance",
+            );
         }
         if !(0.0..=0.9).contains(&e.vignetting) {
             return bad("vignetting", e.vignetting, "must lie in [0, 0.9]");
@@ -832,7 +836,9 @@ pub fn render_bracket_fn(
     // Relative gains of a white LED through an RGB sensor, perturbed so the tool cannot know them.
     let drawn = [0.75, 1.0, 0.6].map(|g: f64| g * rng.random_range(0.8..1.2));
     let rel = relative_gains.unwrap_or(drawn);
-    let peak = (0..3).map(|c| rel[c] * rd_at(c, 0.0)).fold(0.0f64, f64::max);
+    let peak = (0..3)
+        .map(|c| rel[c] * rd_at(c, 0.0))
+        .fold(0.0f64, f64::max);
     let scale = rig.peak_fill * rig.camera.full_well_e / (peak * rig.times_s[0]);
     let gains = rel.map(|g| g * scale);
     let fx = &rig.effects;
@@ -869,7 +875,7 @@ pub fn render_bracket_fn(
     let expose = |j: usize, t: f64, rate: &(dyn Fn(usize, usize, usize) -> f64 + Sync)| -> Frame {
         let electrons = |y: usize, k: usize, rng: &mut Xoshiro256PlusPlus| {
             let mut e = shot(rate(k / 3, y, k % 3) * t, rng);
-            if let Some(n) = Normal::new(0.0, camera.read_noise_e.max(1e-12)).ok() {
+            if let Ok(n) = Normal::new(0.0, camera.read_noise_e.max(1e-12)) {
                 e += n.sample(rng);
             }
             e
@@ -890,12 +896,15 @@ pub fn render_bracket_fn(
             Frame::U16(ImageBuf::new(w, h, 3, raw).expect("w × h × 3 samples"))
         } else {
             let mut codes = vec![0u8; w * h * 3];
-            codes.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
-                let mut rng = stream(y);
-                for (k, out) in row.iter_mut().enumerate() {
-                    *out = camera.code(electrons(y, k, &mut rng));
-                }
-            });
+            codes
+                .par_chunks_mut(w * 3)
+                .enumerate()
+                .for_each(|(y, row)| {
+                    let mut rng = stream(y);
+                    for (k, out) in row.iter_mut().enumerate() {
+                        *out = camera.code(electrons(y, k, &mut rng));
+                    }
+                });
             Frame::U8(ImageBuf::new(w, h, 3, codes).expect("w × h × 3 samples"))
         }
     };
