@@ -236,8 +236,7 @@ pub struct Background {
     pub stderr: f64,
     /// The level over the profile's peak (the glare's size as a lens maker gives it).
     pub relative_to_peak: f64,
-    /// True when it was subtracted (significant: above 3 standard errors and a tenth of the
-    /// detection limit).
+    /// True when it was subtracted (significant: above 3 standard errors and the detection limit).
     pub subtracted: bool,
 }
 
