@@ -594,8 +594,7 @@ fn a_raw_bracket_agrees_with_the_8_bit_one() {
                 .collect::<Vec<_>>(),
         );
     }
-    for c in 0..3 {
-        let ((s8, a8), (sr, ar)) = (results[0][c], results[1][c]);
+    for (c, (&(s8, a8), &(sr, ar))) in results[0].iter().zip(&results[1]).enumerate() {
         assert!(
             (sr / s8 - 1.0).abs() < 0.03,
             "channel {c}: σ′s {sr} vs {s8}"
