@@ -11,8 +11,8 @@ use std::process::ExitCode;
 
 use crate::output::errln;
 use anyhow::{Context, bail};
-use scatterfit_io::export::{ExportError, Format, SceneUnit, export};
-use scatterfit_io::result_json::read_result_json;
+use scatterfit_io::export::{ExportError, ExportOptions, Format, SceneUnit, export_with};
+use scatterfit_io::result_json::{MeasurementResult, read_result_json};
 
 /// Arguments of `scatterfit export`.
 #[derive(Debug, clap::Args)]
@@ -92,7 +92,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     // The error's message already includes its cause; flatten it so `{:#}` does not repeat it.
     let result = read_result_json(&args.result).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let exported = match export(&result, format, unit) {
+    let options = ExportOptions {
+        unit,
+        exact_rd: exact_transport_rd(&result),
+    };
+    let exported = match export_with(&result, format, &options) {
         Ok(e) => e,
         Err(err @ ExportError::FailedChannel { .. }) => {
             return Err(crate::common::MeasurementFailed(format!(
@@ -101,7 +105,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             ))
             .into());
         }
-        Err(err) => return Err(err).context(format!("exporting {}", args.result.display())),
+        Err(err) => return Err(anyhow::anyhow!("{}: {err}", args.result.display())),
     };
     if !args.quiet {
         for w in &exported.warnings {
@@ -126,6 +130,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => crate::output::write_stdout_bytes(exported.text.as_bytes())?,
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Exact transport's total diffuse reflectance Rd_exact(α′, η) of each channel's exported medium (a
+/// half-space with the result's σ′s, σa, g = 0 and η), from the Monte Carlo tables shipped with
+/// scatterfit: what Mitsuba's and pbrt's volumetric path tracers render, which the export's header
+/// compares with the measured Rd. `None` when the tables do not cover the result (η outside 1.0–2.5)
+/// or a channel has no coefficients (the export then refuses it anyway).
+fn exact_transport_rd(result: &MeasurementResult) -> Option<[f64; 3]> {
+    let mc = scatterfit_pipeline::fit::model_for(scatterfit_io::manifest::ModelName::Mc).ok()?;
+    let [r, g, b] = result.coefficients().ok()?.map(|(sp, sa)| {
+        let rd = mc.rd_total(sp / (sp + sa), result.eta);
+        (rd.is_finite() && (0.0..=1.0).contains(&rd)).then_some(rd)
+    });
+    Some([r?, g?, b?])
 }
 
 /// Refuses an output whose extension does not match the format, an existing file without `--force`,

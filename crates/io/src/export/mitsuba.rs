@@ -2,7 +2,8 @@
 //! `dielectric` boundary and a `homogeneous` medium.
 
 use super::{
-    RendererParameters, channel_table_comment, identifier, joined, largest, num, provenance_line,
+    MaterialNames, Renderer, RendererParameters, channel_table_comment, joined, largest,
+    model_header, num, provenance_line, xml_comment,
 };
 
 /// A Mitsuba 3 XML scene fragment: a `<scene>` holding a `dielectric` BSDF (`int_ior` = η, `ext_ior` = 1)
@@ -17,7 +18,8 @@ use super::{
 /// documentation recommends it for subsurface scattering). The usage comment names the `rr_depth` the
 /// integrator needs for this albedo ([`roulette_depth`]).
 pub fn mitsuba_fragment(params: &RendererParameters) -> String {
-    let id = identifier(&params.name);
+    let names = MaterialNames::new(&params.name);
+    let id = &names.id;
     let u = params.unit.symbol();
     let chans = params.channels.as_array();
     let scale = largest(chans.map(|c| c.sigma_t));
@@ -25,11 +27,16 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     let sigma_t_rgb = rgb(chans.map(|c| c.sigma_t / scale));
     let albedo_rgb = rgb(chans.map(|c| c.albedo));
     let rr = roulette_depth(largest(chans.map(|c| c.albedo)));
-    let mfp = num(chans.iter().map(|c| c.mfp).fold(f64::INFINITY, f64::min));
+    let min_mfp = chans.iter().map(|c| c.mfp).fold(f64::INFINITY, f64::min);
+    let mfp = num(min_mfp);
+    // Mitsuba's spawn offset: (1 + max |p_i|) · 1500 · 2⁻²⁴ scene units (`math::RayEpsilon`) — for an
+    // object 1 scene unit from the origin, about 1.8e-4 scene units.
+    let offset = 2.0 * RAY_EPSILON;
+    let offset_fraction = offset / min_mfp;
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
-    s.push_str(&xml_comment(&format!(
-        "  scatterfit export for Mitsuba 3: \"{}\"\n\
-         \x20 {}\n\
+    let mut header = format!(
+        "  scatterfit export for Mitsuba 3: \"{display}\"\n\
+         \x20 {provenance}\n\
          \x20 Scene unit: 1 scene unit = 1 {u}. The medium's extinction is sigma_t = scale * rgb(sigma_t) per\n\
          \x20 {u}: the colour is normalised to a largest component of 1 (RGB values must lie in [0, 1] in\n\
          \x20 spectral variants) and its magnitude is `scale`. For a scene in another unit multiply `scale` by\n\
@@ -38,22 +45,52 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20 and an isotropic phase function (g = 0): the measurement gives sigma_s' = sigma_s (1 - g) only,\n\
          \x20 and a diffusive material looks the same for every (sigma_s, g) with that sigma_s'.\n\
          \x20 Channels are linear sRGB. eta is relative to air; the boundary is smooth.\n\n",
-        params.name,
-        provenance_line(params),
-    )));
+        display = names.display,
+        provenance = provenance_line(params),
+    );
+    for line in model_header(params, &[Renderer::MitsubaVolpath]) {
+        header.push_str("  ");
+        header.push_str(&line);
+        header.push('\n');
+    }
+    header.push('\n');
+    s.push_str(&xml_comment(&header));
     s.push_str(&xml_comment(&channel_table_comment(params, "  ")));
     s.push_str(&xml_comment(&format!(
-        "\n  Use with the volpath integrator, max_depth -1 and rr_depth {rr} (Russian roulette only once\n\
-         \x20 the albedo has taken the throughput below 1e-3: Mitsuba's roulette survival is capped at\n\
-         \x20 0.95 per scattering, which at albedos near 1 leaves the long paths carrying much of the\n\
-         \x20 diffuse reflectance to rare, heavy samples and makes short renders too dark). Mitsuba\n\
-         \x20 offsets rays leaving a surface by about 1e-4 (1 + |p|) scene units: keep that well below\n\
-         \x20 the mean free path 1/sigma_t ({mfp} {u} here) or low-albedo renders come out dark.\n\
+        "\n  HOW TO USE. Include this file in a scene (its ids are unique to this material's name, so\n\
+         \x20 several materials' fragments can be included in one scene) and give a shape both refs:\n\
          \x20   <include filename=\"this-file.xml\"/>\n\
          \x20   <shape type=\"...\">\n\
          \x20       <ref id=\"{id}_boundary\"/>\n\
          \x20       <ref name=\"interior\" id=\"{id}_medium\"/>\n\
-         \x20   </shape>\n"
+         \x20   </shape>\n\
+         \x20 Integrator: volpath with max_depth -1 and rr_depth {rr}:\n\
+         \x20   <integrator type=\"volpath\"><integer name=\"max_depth\" value=\"-1\"/>\n\
+         \x20       <integer name=\"rr_depth\" value=\"{rr}\"/></integrator>\n\
+         \x20 (Russian roulette only once the albedo has taken the throughput below 1e-3: Mitsuba's\n\
+         \x20 roulette survival is capped at 0.95 per scattering, which at albedos near 1 leaves the long\n\
+         \x20 paths carrying much of the diffuse reflectance to rare, heavy samples: short renders too dark.)\n\
+         \x20 LIGHTS: the medium renders BLACK under point, spot and directional emitters: they are delta\n\
+         \x20 lights, and no path through the smooth dielectric boundary can connect to them (the medium's\n\
+         \x20 sample_emitters is off for the same reason). Light it with area emitters or an environment\n\
+         \x20 (constant, envmap); Mitsuba 3 has no BSSRDF material to fall back on.\n\
+         \x20 SCENE UNIT AND RAY OFFSETS: Mitsuba offsets every ray leaving a surface by about\n\
+         \x20 1e-4 (1 + |p|) scene units (float32 `RayEpsilon`), which shifts the first scattering deeper\n\
+         \x20 and darkens the material. Here the shortest mean free path 1/sigma_t is {mfp} {u}; for an\n\
+         \x20 object about 1 scene unit from the origin the offset is {pct} of it{verdict}. Metre scenes\n\
+         \x20 rendered materials with sub-millimetre mean free paths 1-8 % dark (BENCHMARKS.md): export\n\
+         \x20 in millimetres (the default scale) and build the scene in millimetres when you can.\n\
+         \x20 SPECTRAL VARIANTS (scalar_spectral, llvm_spectral, ...) turn each RGB into a smooth spectrum;\n\
+         \x20 a medium's reflectance is not linear in its coefficients, so a strongly coloured material\n\
+         \x20 renders shifted in colour (up to {shift} per channel for the demo's materials, BENCHMARKS.md);\n\
+         \x20 the RGB variants (scalar_rgb, llvm_rgb) render the channels exactly.\n",
+        pct = format_percent(offset_fraction),
+        verdict = if offset_fraction > 0.01 {
+            ": ABOVE 1 %, expect a visibly dark render; use a millimetre scene"
+        } else {
+            " (negligible)"
+        },
+        shift = MITSUBA_SPECTRAL_SHIFT,
     )));
     s.push_str("-->\n");
     s.push_str(&format!(
@@ -78,6 +115,26 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     s
 }
 
+/// Mitsuba 3's ray-spawn epsilon for float32 variants, `math::RayEpsilon` = 1500 · 2⁻²⁴ (drjit
+/// `Epsilon` for float is 2⁻²⁴): rays leaving a surface at p start (1 + max |p_i|) · this further.
+pub const RAY_EPSILON: f64 = 1500.0 / 16_777_216.0;
+
+/// What the header says of Mitsuba's spectral shift (measured on the demo's materials,
+/// BENCHMARKS.md "exports").
+const MITSUBA_SPECTRAL_SHIFT: &str = "-20 %";
+
+/// A fraction as a short percentage (`0.03 %`, `12 %`).
+fn format_percent(x: f64) -> String {
+    let p = 100.0 * x;
+    if p >= 10.0 {
+        format!("{p:.0} %")
+    } else {
+        // Two significant digits.
+        let digits = (1 - p.log10().floor() as i32).max(0) as usize;
+        format!("{p:.digits$} %")
+    }
+}
+
 /// The number of scatterings after which the throughput of a path in a medium of single-scattering
 /// albedo `albedo` is below 10⁻³, ⌈ln 10⁻³ / ln α⌉ (at least 5, Mitsuba's default `rr_depth`): from
 /// there on Russian roulette costs little variance. 100 000 for α = 1 (no absorption).
@@ -87,18 +144,6 @@ pub fn roulette_depth(albedo: f64) -> u64 {
     }
     // Bounded: 1e5 covers α up to 1 − 7e-5.
     ((1e-3_f64.ln() / albedo.ln()).ceil()).clamp(5.0, 100_000.0) as u64
-}
-
-/// Text safe inside an XML comment: no `--` (forbidden there) and no control characters but newlines.
-fn xml_comment(text: &str) -> String {
-    let mut s: String = text
-        .chars()
-        .map(|c| if c.is_control() && c != '\n' { ' ' } else { c })
-        .collect();
-    while s.contains("--") {
-        s = s.replace("--", "- -");
-    }
-    s
 }
 
 #[cfg(test)]
@@ -111,6 +156,7 @@ mod tests {
     #[test]
     fn mitsuba_medium_reproduces_the_coefficients() {
         let r = marble();
+        let id = super::super::identifier("marble");
         for (unit, k) in [(SceneUnit::Millimetre, 1.0), (SceneUnit::Metre, 1000.0)] {
             let text = export(&r, Format::Mitsuba, unit).unwrap().text;
             let doc = roxmltree::Document::parse(&text).expect("well-formed XML");
@@ -119,7 +165,10 @@ mod tests {
                 .find(|n| n.has_tag_name("medium"))
                 .unwrap();
             assert_eq!(medium.attribute("type"), Some("homogeneous"));
-            assert_eq!(medium.attribute("id"), Some("marble_medium"));
+            assert_eq!(
+                medium.attribute("id"),
+                Some(format!("{id}_medium").as_str())
+            );
             let value = |tag: &str, name: &str| -> Vec<f64> {
                 medium
                     .descendants()
@@ -142,7 +191,10 @@ mod tests {
             assert_eq!(value("float", "g"), vec![0.0]);
             let bsdf = doc.descendants().find(|n| n.has_tag_name("bsdf")).unwrap();
             assert_eq!(bsdf.attribute("type"), Some("dielectric"));
-            assert_eq!(bsdf.attribute("id"), Some("marble_boundary"));
+            assert_eq!(
+                bsdf.attribute("id"),
+                Some(format!("{id}_boundary").as_str())
+            );
             let ior = |name: &str| {
                 bsdf.children()
                     .find(|n| n.attribute("name") == Some(name))
