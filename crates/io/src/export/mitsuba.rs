@@ -27,12 +27,8 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     let sigma_t_rgb = rgb(chans.map(|c| c.sigma_t / scale));
     let albedo_rgb = rgb(chans.map(|c| c.albedo));
     let rr = roulette_depth(largest(chans.map(|c| c.albedo)));
-    let min_mfp = chans.iter().map(|c| c.mfp).fold(f64::INFINITY, f64::min);
-    let mfp = num(min_mfp);
-    // Mitsuba's spawn offset: (1 + max |p_i|) · 1500 · 2⁻²⁴ scene units (`math::RayEpsilon`) — for an
-    // object 1 scene unit from the origin, about 1.8e-4 scene units.
-    let offset = 2.0 * RAY_EPSILON;
-    let offset_fraction = offset / min_mfp;
+    let mfp = num(shortest_mfp(params));
+    let offset_fraction = ray_offset_fraction(params);
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
     let mut header = format!(
         "  scatterfit export for Mitsuba 3: \"{display}\"\n\
@@ -77,8 +73,8 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20 SCENE UNIT AND RAY OFFSETS: Mitsuba offsets every ray leaving a surface by about\n\
          \x20 1e-4 (1 + |p|) scene units (float32 `RayEpsilon`), which shifts the first scattering deeper\n\
          \x20 and darkens the material. Here the shortest mean free path 1/sigma_t is {mfp} {u}; for an\n\
-         \x20 object about 1 scene unit from the origin the offset is {pct} of it{verdict}. Metre scenes\n\
-         \x20 rendered materials with sub-millimetre mean free paths 1-8 % dark (BENCHMARKS.md): export\n\
+         \x20 object about 1 scene unit from the origin the offset is {pct} of it{verdict}. In metre\n\
+         \x20 scenes a 0.2 mm mean free path rendered 17-23 % dark (BENCHMARKS.md): export\n\
          \x20 in millimetres (the default scale) and build the scene in millimetres when you can.\n\
          \x20 SPECTRAL VARIANTS (scalar_spectral, llvm_spectral, ...) turn each RGB into a smooth spectrum;\n\
          \x20 a medium's reflectance is not linear in its coefficients, so a strongly coloured material\n\
@@ -113,6 +109,41 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
         scale = num(scale),
     ));
     s
+}
+
+/// The shortest mean free path 1/σt of the channels [scene units].
+fn shortest_mfp(params: &RendererParameters) -> f64 {
+    params
+        .per_channel(|c| c.mfp)
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Mitsuba's ray-spawn offset for an object about 1 scene unit from the origin, (1 + 1) ·
+/// [`RAY_EPSILON`] scene units, as a fraction of the shortest mean free path. Measured (BENCHMARKS.md):
+/// a half-space of mean free path 0.2 mm rendered 17–23 % dark in a metre scene (offset 0.45 mean
+/// free paths at the origin) and right in a millimetre one.
+pub fn ray_offset_fraction(params: &RendererParameters) -> f64 {
+    2.0 * RAY_EPSILON / shortest_mfp(params)
+}
+
+/// A warning when Mitsuba's ray offset is above 1 % of the shortest mean free path (metre scenes of
+/// materials with sub-millimetre mean free paths).
+pub(super) fn ray_offset_warning(params: &RendererParameters) -> Option<String> {
+    let f = ray_offset_fraction(params);
+    (f > 0.01).then(|| {
+        format!(
+            "in a {} scene Mitsuba offsets rays leaving a surface by about {} {u} (an object 1 {u} \
+             from the origin), {} of this material's shortest mean free path ({} {u}): it will render \
+             dark (a 0.2 mm mean free path rendered 17-23 % dark in metres); export with --scale mm \
+             and build the scene in millimetres",
+            params.unit.word(),
+            num(2.0 * RAY_EPSILON),
+            format_percent(f),
+            num(shortest_mfp(params)),
+            u = params.unit.symbol(),
+        )
+    })
 }
 
 /// Mitsuba 3's ray-spawn epsilon for float32 variants, `math::RayEpsilon` = 1500 · 2⁻²⁴ (drjit

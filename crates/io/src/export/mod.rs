@@ -72,7 +72,7 @@ mod pbrt;
 
 pub use blender::{BLENDER_MAX_ALBEDO, BlenderValues, blender_script};
 pub use json::{JSON_FORMAT_TAG, JSON_FORMAT_VERSION, json};
-pub use mitsuba::{mitsuba_fragment, roulette_depth};
+pub use mitsuba::{RAY_EPSILON, mitsuba_fragment, ray_offset_fraction, roulette_depth};
 pub use pbrt::{pbrt_material, pbrt_max_depth};
 
 /// Channel keys as `result.json` writes them (and messages name them).
@@ -578,7 +578,10 @@ pub fn export_with(
     }
     let text = match format {
         Format::Pbrt => pbrt_material(&params),
-        Format::Mitsuba => mitsuba_fragment(&params),
+        Format::Mitsuba => {
+            warnings.extend(mitsuba::ray_offset_warning(&params));
+            mitsuba_fragment(&params)
+        }
         Format::Blender => {
             warnings.extend(blender::base_colour_warnings(&params));
             blender_script(&params, &BlenderValues::new(&params))
