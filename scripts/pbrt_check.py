@@ -11,7 +11,9 @@ ROUTE is one of the export's three (see its header):
 - subsurface:   NamedMaterial "<id>" (pbrt's BSSRDF from the measured reflectance and mfp),
 - coefficients: NamedMaterial "<id>-coefficients" (the BSSRDF from sigma_a, sigma_s),
 - medium:       MediumInterface "<id>-medium" "" + NamedMaterial "<id>-boundary" (exact transport with
-                the volpath integrator).
+                the volpath integrator);
+- medium-spectral: the same with "<id>-medium-spectral" (written when the result has its measured
+                spectrum: the albedo per wavelength inverted from it).
 
 The scene (as crates/cli/tests/mitsuba_slab.py's): the export is `Include`d after WorldBegin, as its header
 says; a closed box W wide and T thick (scene units), its top face at z = 0, gets the route's material;
@@ -80,7 +82,11 @@ def read_pfm(path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("export")
-    ap.add_argument("--route", choices=["subsurface", "coefficients", "medium"], required=True)
+    ap.add_argument(
+        "--route",
+        choices=["subsurface", "coefficients", "medium", "medium-spectral"],
+        required=True,
+    )
     ap.add_argument("--light", choices=["uniform", "point", "distant"], default="uniform")
     ap.add_argument("--width", type=float, default=2000.0)
     ap.add_argument("--thickness", type=float, default=400.0)
@@ -103,8 +109,8 @@ def main():
 
     w, t = args.width, args.thickness
     s = w / 1000
-    if args.route == "medium":
-        material = f'MediumInterface "{mid}-medium" ""\n    NamedMaterial "{mid}-boundary"'
+    if args.route.startswith("medium"):
+        material = f'MediumInterface "{mid}-{args.route}" ""\n    NamedMaterial "{mid}-boundary"'
     elif args.route == "coefficients":
         material = f'NamedMaterial "{mid}-coefficients"'
     else:

@@ -95,6 +95,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let options = ExportOptions {
         unit,
         exact_rd: exact_transport_rd(&result),
+        spectral_albedo: spectral_albedo(&result),
     };
     let exported = match export_with(&result, format, &options) {
         Ok(e) => e,
@@ -144,6 +145,18 @@ fn exact_transport_rd(result: &MeasurementResult) -> Option<[f64; 3]> {
         (rd.is_finite() && (0.0..=1.0).contains(&rd)).then_some(rd)
     });
     Some([r?, g?, b?])
+}
+
+/// The single-scattering albedo whose exact-transport total Rd is the measured Rd(λ), at each
+/// wavelength of the result's spectrum (the Monte Carlo tables' inversion): the spectral medium's
+/// albedo. `None` without a spectrum or where a wavelength's Rd cannot be inverted.
+fn spectral_albedo(result: &MeasurementResult) -> Option<Vec<f64>> {
+    let spec = result.rd_spectrum.as_ref()?;
+    let mc = scatterfit_pipeline::fit::model_for(scatterfit_io::manifest::ModelName::Mc).ok()?;
+    spec.rd
+        .iter()
+        .map(|&rd| mc.albedo_from_rd(rd, result.eta).ok())
+        .collect()
 }
 
 /// Refuses an output whose extension does not match the format, an existing file without `--force`,

@@ -29,7 +29,7 @@ delta light: the medium behind its dielectric boundary must render black, as the
 --extra includes a second exported fragment in the same scene and gives its materials to a second box
 beside the first, out of view (two materials' ids in one scene must not clash, and each shape must get
 its own material). --variant picks Mitsuba's variant (scalar_rgb by default; scalar_spectral uplifts
-the RGB coefficients to spectra).
+the RGB coefficients to spectra); --spectral-medium uses the fragment's per-wavelength medium.
 
 Prints one JSON object: per channel (R, G, B) the mean over pixels and its standard error (pixel-to-pixel
 spread / sqrt(pixels)), the pixel count, spp, seconds, and the Mitsuba version.
@@ -56,24 +56,32 @@ def main():
     ap.add_argument("--light", choices=["constant", "directional"], default="constant")
     ap.add_argument("--extra", help="a second fragment, given to a box out of view")
     ap.add_argument("--variant", default="scalar_rgb")
+    ap.add_argument(
+        "--spectral-medium", action="store_true", help="use the fragment's <id>_medium_spectral"
+    )
     args = ap.parse_args()
 
     import mitsuba as mi
 
     mi.set_variant(args.variant)
 
+    suffix = "_medium_spectral" if args.spectral_medium else "_medium"
+
     def ids(path):
         root = ET.parse(path).getroot()
         bsdf = [e for e in root if e.tag == "bsdf"]
-        medium = [e for e in root if e.tag == "medium"]
+        medium = [e for e in root if e.tag == "medium" and e.get("id", "").endswith(suffix)]
         if len(bsdf) != 1 or len(medium) != 1:
-            sys.exit(f"{path}: expected one <bsdf> and one <medium> at the top level")
+            sys.exit(f"{path}: expected one <bsdf> and one <medium> with an id ending {suffix}")
         return bsdf[0].get("id"), medium[0].get("id"), medium[0]
 
     fragment = os.path.abspath(args.fragment)
     bsdf_id, medium_id, medium = ids(fragment)
-    albedo = [e for e in medium if e.tag == "rgb" and e.get("name") == "albedo"]
-    alpha = max(float(x) for x in albedo[0].get("value").split(",")) if albedo else 0.99
+    albedo = [e for e in medium if e.tag in ("rgb", "spectrum") and e.get("name") == "albedo"]
+    # "a, b, c" (rgb) or "λ:a, λ:b, …" (spectrum): the largest value.
+    alpha = (
+        max(float(x.split(":")[-1]) for x in albedo[0].get("value").split(",")) if albedo else 0.99
+    )
     # Russian roulette only once every channel's throughput is below 1e-3: Mitsuba's volpath
     # survives a roulette with q = min(max throughput, 0.95), so at albedos above 0.95 early
     # roulette leaves the long paths that carry much of Rd (α' = 0.999: hundreds of scatterings)

@@ -79,7 +79,16 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20 SPECTRAL VARIANTS (scalar_spectral, llvm_spectral, ...) turn each RGB into a smooth spectrum;\n\
          \x20 a medium's reflectance is not linear in its coefficients, so a strongly coloured material\n\
          \x20 renders shifted in colour (up to {shift} per channel for the demo's materials, BENCHMARKS.md);\n\
-         \x20 the RGB variants (scalar_rgb, llvm_rgb) render the channels exactly.\n",
+         \x20 the RGB variants (scalar_rgb, llvm_rgb) render the channels exactly.{spectral_note}\n",
+        spectral_note = if params.spectral_medium.is_some() {
+            format!(
+                "\n\x20 In a spectral variant give the shape <ref name=\"interior\" id=\"{id}_medium_spectral\"/>\n\
+                 \x20 instead: the medium per wavelength, its albedo inverted from the MEASURED reflectance\n\
+                 \x20 spectrum with exact transport, sigma_t' interpolated between the channels."
+            )
+        } else {
+            String::new()
+        },
         pct = format_percent(offset_fraction),
         verdict = if offset_fraction > 0.01 {
             ": ABOVE 1 %, expect a visibly dark render; use a millimetre scene"
@@ -103,12 +112,45 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20       <phase type=\"hg\">\n\
          \x20           <float name=\"g\" value=\"0\"/>\n\
          \x20       </phase>\n\
-         \x20   </medium>\n\
+         \x20   </medium>\n{spectral}\
          </scene>\n",
         eta = num(params.eta),
         scale = num(scale),
+        spectral = spectral_medium(params, id),
     ));
     s
+}
+
+/// The `<id>_medium_spectral` element for spectral variants, when the parameters have a spectral
+/// medium: σt and albedo as wavelength:value spectra (σt normalised like the RGB one, its magnitude in
+/// `scale`).
+fn spectral_medium(params: &RendererParameters, id: &str) -> String {
+    let Some(m) = &params.spectral_medium else {
+        return String::new();
+    };
+    let scale = m.sigma_t.iter().copied().fold(0.0_f64, f64::max);
+    let pairs = |v: &[f64], k: f64| -> String {
+        m.wavelength_nm
+            .iter()
+            .zip(v)
+            .map(|(l, x)| format!("{}:{}", num(*l), num(x / k)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    format!(
+        "\x20   <medium type=\"homogeneous\" id=\"{id}_medium_spectral\">\n\
+         \x20       <spectrum name=\"sigma_t\" value=\"{}\"/>\n\
+         \x20       <float name=\"scale\" value=\"{}\"/>\n\
+         \x20       <spectrum name=\"albedo\" value=\"{}\"/>\n\
+         \x20       <boolean name=\"sample_emitters\" value=\"false\"/>\n\
+         \x20       <phase type=\"hg\">\n\
+         \x20           <float name=\"g\" value=\"0\"/>\n\
+         \x20       </phase>\n\
+         \x20   </medium>\n",
+        pairs(&m.sigma_t, scale),
+        num(scale),
+        pairs(&m.albedo, 1.0),
+    )
 }
 
 /// The shortest mean free path 1/σt of the channels [scene units].

@@ -74,6 +74,31 @@ pub use blender::{BLENDER_MAX_ALBEDO, BlenderValues, blender_script};
 pub use json::{JSON_FORMAT_TAG, JSON_FORMAT_VERSION, json};
 pub use mitsuba::{RAY_EPSILON, mitsuba_fragment, ray_offset_fraction, roulette_depth};
 pub use pbrt::{pbrt_material, pbrt_max_depth};
+pub use result_spectrum::extended_reflectance;
+
+/// The measured reflectance spectrum as written for renderers.
+mod result_spectrum {
+    use super::{ReflectanceSpectrum, SPECTRAL_RANGE};
+
+    /// `spec` extended to [`SPECTRAL_RANGE`] with its end values (pbrt's piecewise-linear spectra are
+    /// zero outside their points; renderers sample 360–830 nm).
+    pub fn extended_reflectance(spec: &ReflectanceSpectrum) -> ReflectanceSpectrum {
+        let mut s = spec.clone();
+        if let (Some(&first), Some(&r0)) = (s.wavelength_nm.first(), s.rd.first())
+            && first > SPECTRAL_RANGE.0
+        {
+            s.wavelength_nm.insert(0, SPECTRAL_RANGE.0);
+            s.rd.insert(0, r0);
+        }
+        if let (Some(&last), Some(&r1)) = (s.wavelength_nm.last(), s.rd.last())
+            && last < SPECTRAL_RANGE.1
+        {
+            s.wavelength_nm.push(SPECTRAL_RANGE.1);
+            s.rd.push(r1);
+        }
+        s
+    }
+}
 
 /// Channel keys as `result.json` writes them (and messages name them).
 const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
@@ -210,7 +235,7 @@ pub struct Export {
 }
 
 /// What the caller knows beyond the result: the scene unit, and exact transport's total Rd.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ExportOptions {
     /// The scene's length unit.
     pub unit: SceneUnit,
@@ -219,6 +244,11 @@ pub struct ExportOptions {
     /// from the Monte Carlo tables (`scatterfit_mc`), which this crate does not depend on. `None`
     /// when unknown (then the headers quote the benchmark's figures instead of this material's).
     pub exact_rd: Option<[f64; 3]>,
+    /// At each wavelength of the result's `rd_spectrum`, the single-scattering albedo whose exact
+    /// transport total Rd(α′, η) is the measured Rd(λ) (the Monte Carlo tables' inversion, from the
+    /// caller): the spectral medium's albedo. `None` without a spectrum (or where the tables do not
+    /// reach); then no spectral medium is written.
+    pub spectral_albedo: Option<Vec<f64>>,
 }
 
 impl ExportOptions {
@@ -227,9 +257,31 @@ impl ExportOptions {
         Self {
             unit,
             exact_rd: None,
+            spectral_albedo: None,
         }
     }
 }
+
+/// A medium given per wavelength for spectral renderers ([`RendererParameters::spectral_medium`]):
+/// at the measured spectrum's wavelengths, extended to [`SPECTRAL_RANGE`] with the end values.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpectralMedium {
+    /// Wavelengths [nm], increasing.
+    pub wavelength_nm: Vec<f64>,
+    /// Single-scattering albedo σs/σt (g = 0) whose exact-transport Rd is the measured Rd(λ).
+    pub albedo: Vec<f64>,
+    /// Extinction σt(λ) [1/L]: the channels' σ′t interpolated linearly in wavelength between the
+    /// channels' wavelengths ([`CHANNEL_WAVELENGTHS`]), constant beyond them.
+    pub sigma_t: Vec<f64>,
+}
+
+/// The wavelengths [nm] at which the spectral medium takes each channel's σ′t (R, G, B): near the
+/// dominant wavelengths of the sRGB primaries (611, 549, 464 nm, CIE 1931, D65 white).
+pub const CHANNEL_WAVELENGTHS: [f64; 3] = [611.0, 549.0, 464.0];
+
+/// The span [nm] spectral exports cover: renderers sample 360–830 nm, and a piecewise-linear spectrum
+/// is zero outside its points in pbrt, so the measured spectrum is extended with its end values.
+pub const SPECTRAL_RANGE: (f64, f64) = (360.0, 830.0);
 
 /// One channel of [`RendererParameters`], in the scene's unit (`L` below).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -326,6 +378,10 @@ pub struct RendererParameters {
     /// The spectrophotometer's diffuse reflectance spectrum, when the result carries it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rd_spectrum: Option<ReflectanceSpectrum>,
+    /// The medium per wavelength for spectral renderers, when the result has a spectrum and the
+    /// caller gave its exact-transport albedos ([`ExportOptions::spectral_albedo`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectral_medium: Option<SpectralMedium>,
     /// The measurement the numbers come from.
     pub source: Provenance,
     /// The conventions, in words, for a reader without this documentation.
@@ -471,6 +527,22 @@ impl RendererParameters {
             }
         }
         let rd_spectrum = checked_spectrum(result)?;
+        let spectral_albedo = match (&rd_spectrum, &options.spectral_albedo) {
+            (Some(spec), Some(a)) => {
+                if a.len() != spec.rd.len() {
+                    return Err(ExportError::OutOfRange {
+                        field: "spectral_albedo".into(),
+                        value: format!("{} values", a.len()),
+                        range: format!("(one per wavelength of rd_spectrum: {})", spec.rd.len()),
+                    });
+                }
+                for (k, &v) in a.iter().enumerate() {
+                    in_range(format!("spectral_albedo[{k}]"), v, (0.0, 1.0), "")?;
+                }
+                Some(a.clone())
+            }
+            _ => None,
+        };
         let k = unit.mm_per_unit();
         let channel = |j: usize| {
             let (sp, sa, rd) = checked[j];
@@ -504,6 +576,13 @@ impl RendererParameters {
                 g: channel(1),
                 b: channel(2),
             },
+            spectral_medium: rd_spectrum
+                .as_ref()
+                .zip(spectral_albedo)
+                .map(|(spec, albedo)| {
+                    let sigma_t = checked.map(|(sp, sa, _)| (sp + sa) * k);
+                    spectral_medium(spec, &albedo, sigma_t)
+                }),
             rd_spectrum,
             source: Provenance {
                 method: result.method.to_string(),
@@ -528,6 +607,53 @@ impl RendererParameters {
     /// The channels' three values of `f`, R, G, B.
     fn per_channel(&self, f: impl Fn(&ChannelParameters) -> f64) -> [f64; 3] {
         self.channels.as_array().map(f)
+    }
+}
+
+/// The spectral medium of a measured spectrum, its albedos and the channels' σ′t (R, G, B), extended
+/// to [`SPECTRAL_RANGE`].
+fn spectral_medium(
+    spec: &ReflectanceSpectrum,
+    albedo: &[f64],
+    sigma_t: [f64; 3],
+) -> SpectralMedium {
+    // σ′t at the channels' wavelengths, ascending in λ (B, G, R); linear between, constant beyond.
+    let knots = [
+        (CHANNEL_WAVELENGTHS[2], sigma_t[2]),
+        (CHANNEL_WAVELENGTHS[1], sigma_t[1]),
+        (CHANNEL_WAVELENGTHS[0], sigma_t[0]),
+    ];
+    let at = |wl: f64| -> f64 {
+        if wl <= knots[0].0 {
+            return knots[0].1;
+        }
+        for w in knots.windows(2) {
+            let ((l0, v0), (l1, v1)) = (w[0], w[1]);
+            if wl <= l1 {
+                return v0 + (v1 - v0) * (wl - l0) / (l1 - l0);
+            }
+        }
+        knots[2].1
+    };
+    let mut wavelength_nm = spec.wavelength_nm.clone();
+    let mut albedo = albedo.to_vec();
+    if let (Some(&first), Some(&a0)) = (wavelength_nm.first(), albedo.first())
+        && first > SPECTRAL_RANGE.0
+    {
+        wavelength_nm.insert(0, SPECTRAL_RANGE.0);
+        albedo.insert(0, a0);
+    }
+    if let (Some(&last), Some(&a1)) = (wavelength_nm.last(), albedo.last())
+        && last < SPECTRAL_RANGE.1
+    {
+        wavelength_nm.push(SPECTRAL_RANGE.1);
+        albedo.push(a1);
+    }
+    let sigma_t = wavelength_nm.iter().map(|&wl| at(wl)).collect();
+    SpectralMedium {
+        wavelength_nm,
+        albedo,
+        sigma_t,
     }
 }
 
@@ -636,7 +762,7 @@ fn albedo_source(model: &str, albedo_model: &str) -> String {
         ("mc", _) => "mc".into(),
         ("diffusion", "mc") => "dipole".into(),
         ("diffusion", m) => m.into(),
-        (a, _) if a.is_empty() => "unknown".into(),
+        ("", _) => "unknown".into(),
         (a, _) => a.into(),
     }
 }
@@ -1173,7 +1299,7 @@ mod fixtures {
 
 #[cfg(test)]
 mod tests {
-    use super::fixtures::marble;
+    use super::fixtures::{SA, SP, marble};
     use super::*;
 
     #[test]
@@ -1542,6 +1668,7 @@ mod tests {
         let options = ExportOptions {
             unit: SceneUnit::Millimetre,
             exact_rd: Some([0.8302 * 0.56, 0.7910, 0.7526 * 1.1]),
+            spectral_albedo: None,
         };
         let e = export_with(&r, Format::Mitsuba, &options).unwrap();
         assert_eq!(e.warnings.len(), 1, "{:?}", e.warnings);
@@ -1585,6 +1712,62 @@ mod tests {
         );
     }
 
+    /// With the exact-transport albedos of the spectrum, pbrt and Mitsuba get a medium per
+    /// wavelength: σt interpolated between the channels' σ′t, extended to 360–830 nm.
+    #[test]
+    fn spectral_medium_is_written() {
+        let mut r = marble();
+        r.rd_spectrum = Some(crate::result_json::RdSpectrum {
+            wavelength_nm: vec![400.0, 549.0, 700.0],
+            rd: vec![0.75, 0.79, 0.83],
+        });
+        let options = ExportOptions {
+            unit: SceneUnit::Millimetre,
+            exact_rd: None,
+            spectral_albedo: Some(vec![0.99, 0.995, 0.999]),
+        };
+        let (p, _) = RendererParameters::from_result_with(&r, &options).unwrap();
+        let m = p.spectral_medium.as_ref().unwrap();
+        assert_eq!(m.wavelength_nm, vec![360.0, 400.0, 549.0, 700.0, 830.0]);
+        assert_eq!(m.albedo, vec![0.99, 0.99, 0.995, 0.999, 0.999]);
+        // Below 464 nm the B channel's σ′t, at 549 nm G's, beyond 611 nm R's.
+        let st = SP.iter().zip(SA).map(|(s, a)| s + a).collect::<Vec<_>>();
+        assert!(fixtures::close(m.sigma_t[0], st[2], 1e-12));
+        assert!(fixtures::close(m.sigma_t[2], st[1], 1e-12));
+        assert!(fixtures::close(m.sigma_t[4], st[0], 1e-12));
+        let pbrt = export_with(&r, Format::Pbrt, &options).unwrap().text;
+        let directives = pbrt::tests::parse(&pbrt).unwrap();
+        let spectral = directives
+            .iter()
+            .find(|d| d.1.ends_with("-medium-spectral"))
+            .expect("spectral medium");
+        assert_eq!(spectral.2[1].0, "sigma_a");
+        assert_eq!(spectral.2[1].1.len(), 10);
+        let xml = export_with(&r, Format::Mitsuba, &options).unwrap().text;
+        let doc = roxmltree::Document::parse(&xml).unwrap();
+        let id = format!("{}_medium_spectral", identifier("marble"));
+        let medium = doc
+            .descendants()
+            .find(|n| n.attribute("id") == Some(id.as_str()))
+            .unwrap();
+        let albedo = medium
+            .children()
+            .find(|n| n.attribute("name") == Some("albedo"))
+            .unwrap();
+        assert!(
+            albedo
+                .attribute("value")
+                .unwrap()
+                .starts_with("360:0.99, 400:0.99")
+        );
+        // A wrong count of albedos is refused.
+        let bad = ExportOptions {
+            spectral_albedo: Some(vec![0.5]),
+            ..options
+        };
+        assert!(export_with(&r, Format::Pbrt, &bad).is_err());
+    }
+
     /// A result's spectrum is checked and goes into pbrt's reflectance as λ/value pairs.
     #[test]
     fn spectrum_is_checked_and_exported() {
@@ -1597,7 +1780,9 @@ mod tests {
             .unwrap()
             .text;
         assert!(
-            text.contains("\"spectrum reflectance\" [ 400 0.75 550 0.79 700 0.83 ]"),
+            text.contains(
+                "\"spectrum reflectance\" [ 360 0.75 400 0.75 550 0.79 700 0.83 830 0.83 ]"
+            ),
             "{text}"
         );
         pbrt::tests::parse(&text).unwrap();

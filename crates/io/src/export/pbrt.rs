@@ -74,6 +74,7 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
          \x20      NamedMaterial \"{id}-boundary\"\n\
          \x20      Shape ...\n\
          \x20    AttributeEnd\n\
+         {spectral_route}\
          \x20  The medium renders BLACK under point, spot and distant lights: they are delta lights, and\n\
          \x20  no path through the smooth dielectric boundary can connect to them. Light it with area\n\
          \x20  lights or an infinite (environment) light, or use route 1.\n\
@@ -83,6 +84,16 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
          renders shifted in colour: up to {shift} per channel for the demo's materials (BENCHMARKS.md).\n\
          Route 1 uplifts the reflectance itself (a bounded colour pbrt reproduces){spectrum_note}.\n\
          \n",
+        spectral_route = if params.spectral_medium.is_some() {
+            format!(
+                "\x20  For the right colour use MediumInterface \"{id}-medium-spectral\" \"\" instead: the\n\
+                 \x20  same medium per wavelength, its albedo inverted from the MEASURED reflectance spectrum\n\
+                 \x20  with exact transport (so pbrt renders the material's own spectrum), sigma_t' interpolated\n\
+                 \x20  between the channels.\n"
+            )
+        } else {
+            String::new()
+        },
         display = names.display,
         provenance = provenance_line(params),
         shift = PBRT_SPECTRAL_SHIFT,
@@ -139,6 +150,35 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
              \"float eta\" [ {eta} ]\n    \"float g\" [ 0 ]\n\n"
         ));
     }
+    if let Some(m) = &params.spectral_medium {
+        let pairs = |v: &[f64]| -> String {
+            m.wavelength_nm
+                .iter()
+                .zip(v)
+                .map(|(l, x)| format!("{} {}", num(*l), num(*x)))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        let sa: Vec<f64> = m
+            .sigma_t
+            .iter()
+            .zip(&m.albedo)
+            .map(|(t, a)| t * (1.0 - a))
+            .collect();
+        let ss: Vec<f64> = m
+            .sigma_t
+            .iter()
+            .zip(&m.albedo)
+            .map(|(t, a)| t * a)
+            .collect();
+        s.push_str(&format!(
+            "MakeNamedMedium \"{id}-medium-spectral\"\n    \"string type\" [ \"homogeneous\" ]\n    \
+             \"spectrum sigma_a\" [ {} ]\n    \"spectrum sigma_s\" [ {} ]\n    \
+             \"float scale\" [ 1 ]\n    \"float g\" [ 0 ]\n\n",
+            pairs(&sa),
+            pairs(&ss)
+        ));
+    }
     s.push_str(&format!(
         "MakeNamedMedium \"{id}-medium\"\n    \"string type\" [ \"homogeneous\" ]\n    \
          \"rgb sigma_a\" {sigma_a}\n    \"rgb sigma_s\" {sigma_s}\n    \"float scale\" [ 1 ]\n    \
@@ -158,6 +198,7 @@ const PBRT_SPECTRAL_SHIFT: &str = "-20 %";
 /// either.
 fn reflectance_parameter(params: &RendererParameters) -> Option<String> {
     if let Some(spec) = &params.rd_spectrum {
+        let spec = super::extended_reflectance(spec);
         let pairs: Vec<String> = spec
             .wavelength_nm
             .iter()
