@@ -11,9 +11,8 @@ ROUTE is one of the export's three (see its header):
 - subsurface:   NamedMaterial "<id>" (pbrt's BSSRDF from the measured reflectance and mfp),
 - coefficients: NamedMaterial "<id>-coefficients" (the BSSRDF from sigma_a, sigma_s),
 - medium:       MediumInterface "<id>-medium" "" + NamedMaterial "<id>-boundary" (exact transport with
-                the volpath integrator);
-- medium-spectral: the same with "<id>-medium-spectral" (written when the result has its measured
-                spectrum: the albedo per wavelength inverted from it).
+                the volpath integrator; per wavelength when the result has its measured spectrum);
+- medium-rgb:   the same with "<id>-medium-rgb", the RGB medium (written beside the spectral one).
 
 The scene (as crates/cli/tests/mitsuba_slab.py's): the export is `Include`d after WorldBegin, as its header
 says; a closed box W wide and T thick (scene units), its top face at z = 0, gets the route's material;
@@ -84,7 +83,7 @@ def main():
     ap.add_argument("export")
     ap.add_argument(
         "--route",
-        choices=["subsurface", "coefficients", "medium", "medium-spectral"],
+        choices=["subsurface", "coefficients", "medium", "medium-rgb"],
         required=True,
     )
     ap.add_argument("--light", choices=["uniform", "point", "distant"], default="uniform")

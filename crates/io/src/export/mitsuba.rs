@@ -78,7 +78,7 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20 in millimetres (the default scale) and build the scene in millimetres when you can.\n\
          \x20 SPECTRAL VARIANTS (scalar_spectral, llvm_spectral, ...) turn each RGB into a smooth spectrum;\n\
          \x20 a medium's reflectance is not linear in its coefficients, so a strongly coloured material\n\
-         \x20 renders shifted in colour (up to {shift} per channel for the demo's materials, BENCHMARKS.md);\n\
+         \x20 renders shifted in colour ({shift} per channel for the demo's materials, BENCHMARKS.md);\n\
          \x20 the RGB variants (scalar_rgb, llvm_rgb) render the channels exactly.{spectral_note}\n",
         spectral_note = if params.spectral_medium.is_some() {
             format!(
@@ -194,7 +194,7 @@ pub const RAY_EPSILON: f64 = 1500.0 / 16_777_216.0;
 
 /// What the header says of Mitsuba's spectral shift (measured on the demo's materials,
 /// BENCHMARKS.md "exports").
-const MITSUBA_SPECTRAL_SHIFT: &str = "-20 %";
+const MITSUBA_SPECTRAL_SHIFT: &str = "+13 % to -42 %";
 
 /// A fraction as a short percentage (`0.03 %`, `12 %`).
 fn format_percent(x: f64) -> String {

@@ -1739,8 +1739,9 @@ mod tests {
         let directives = pbrt::tests::parse(&pbrt).unwrap();
         let spectral = directives
             .iter()
-            .find(|d| d.1.ends_with("-medium-spectral"))
+            .find(|d| d.1.ends_with("-medium"))
             .expect("spectral medium");
+        assert!(directives.iter().any(|d| d.1.ends_with("-medium-rgb")));
         assert_eq!(spectral.2[1].0, "sigma_a");
         assert_eq!(spectral.2[1].1.len(), 10);
         let xml = export_with(&r, Format::Mitsuba, &options).unwrap().text;

@@ -80,16 +80,17 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
          \x20  lights or an infinite (environment) light, or use route 1.\n\
          \n\
          SPECTRAL RENDERING. pbrt renders spectrally: it turns each RGB into a smooth spectrum, and a\n\
-         medium's reflectance is not linear in sigma, so a strongly coloured medium (routes 2 and 3)\n\
-         renders shifted in colour: up to {shift} per channel for the demo's materials (BENCHMARKS.md).\n\
+         medium's reflectance is not linear in sigma, so a strongly coloured material given by RGB\n\
+         coefficients (route 2, and route 3's RGB medium) renders shifted in colour: {shift} per\n\
+         channel for the demo's materials (BENCHMARKS.md).{spectral_fix}\n\
          Route 1 uplifts the reflectance itself (a bounded colour pbrt reproduces){spectrum_note}.\n\
          \n",
         spectral_route = if params.spectral_medium.is_some() {
             format!(
-                "\x20  For the right colour use MediumInterface \"{id}-medium-spectral\" \"\" instead: the\n\
-                 \x20  same medium per wavelength, its albedo inverted from the MEASURED reflectance spectrum\n\
-                 \x20  with exact transport (so pbrt renders the material's own spectrum), sigma_t' interpolated\n\
-                 \x20  between the channels.\n"
+                "\x20  \"{id}-medium\" is the medium per wavelength: its albedo inverted from the MEASURED\n\
+                 \x20  reflectance spectrum with exact transport, so pbrt renders the material's own spectrum\n\
+                 \x20  (within 1 % of the measured colour for the demo's materials); sigma_t' interpolated\n\
+                 \x20  between the channels. \"{id}-medium-rgb\" is the RGB one (shifted in colour, below).\n"
             )
         } else {
             String::new()
@@ -97,6 +98,11 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
         display = names.display,
         provenance = provenance_line(params),
         shift = PBRT_SPECTRAL_SHIFT,
+        spectral_fix = if params.spectral_medium.is_some() {
+            " Route 3's medium here is given per wavelength\nfrom the measured spectrum and does not shift."
+        } else {
+            " A result with its measured spectrum (rd_spectrum,\nwritten by `scatterfit measure`) gets a medium per wavelength that does not shift."
+        },
         spectrum_note = if params.rd_spectrum.is_some() {
             "; here it is the measured spectrum, so pbrt renders the material's own spectrum"
         } else {
@@ -172,15 +178,20 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
             .map(|(t, a)| t * a)
             .collect();
         s.push_str(&format!(
-            "MakeNamedMedium \"{id}-medium-spectral\"\n    \"string type\" [ \"homogeneous\" ]\n    \
+            "MakeNamedMedium \"{id}-medium\"\n    \"string type\" [ \"homogeneous\" ]\n    \
              \"spectrum sigma_a\" [ {} ]\n    \"spectrum sigma_s\" [ {} ]\n    \
              \"float scale\" [ 1 ]\n    \"float g\" [ 0 ]\n\n",
             pairs(&sa),
             pairs(&ss)
         ));
     }
+    let rgb_medium = if params.spectral_medium.is_some() {
+        format!("{id}-medium-rgb")
+    } else {
+        format!("{id}-medium")
+    };
     s.push_str(&format!(
-        "MakeNamedMedium \"{id}-medium\"\n    \"string type\" [ \"homogeneous\" ]\n    \
+        "MakeNamedMedium \"{rgb_medium}\"\n    \"string type\" [ \"homogeneous\" ]\n    \
          \"rgb sigma_a\" {sigma_a}\n    \"rgb sigma_s\" {sigma_s}\n    \"float scale\" [ 1 ]\n    \
          \"float g\" [ 0 ]\n\
          MakeNamedMaterial \"{id}-boundary\"\n    \"string type\" [ \"dielectric\" ]\n    \
@@ -190,8 +201,8 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
 }
 
 /// What the header says of pbrt's spectral shift of the coefficient routes (measured on the demo's
-/// seven materials, BENCHMARKS.md "exports").
-const PBRT_SPECTRAL_SHIFT: &str = "-20 %";
+/// seven materials measured with the mc model, BENCHMARKS.md "exports").
+const PBRT_SPECTRAL_SHIFT: &str = "from +4 % to -40 % (red aluminium's red)";
 
 /// Route 1's reflectance parameter: the measured spectrum when the result has it (pbrt reads
 /// `"spectrum reflectance" [ λ v λ v … ]`, λ in nm), else the channels' Rd as RGB; `None` without
