@@ -138,9 +138,11 @@ Subsurface IOR (Jensen et al. 2001); the radius is chosen so that this gives sca
 is the measured diffuse reflectance Rd.
 Approximate: Cycles derives the walk's single-scattering albedo from Base Color with its own fit
 (Chiang, Kutz & Burley 2016), lower than exact transport behind a Fresnel boundary needs; measured with
-Blender 4.2 and 5.0, renders come out 6-9 % darker in total reflectance at eta 1.4 and 11 % darker at
-eta 1.94, and less translucent (the glow beyond a shadow edge decays 1.25-1.7x faster) than the
-measured material. For exact transport use the Mitsuba or pbrt volumetric export.
+Blender 4.2 and 5.0, renders come out 6-9 % darker in total reflectance at eta 1.4 (albedos 0.8-0.95),
+1-13 % darker for the demo's seven materials (11-13 % at eta 1.9-2.4), and less translucent (the glow
+beyond a shadow edge decays 1.25-1.7x faster) than the measured material. Base Color carries the
+colour, so this holds whatever model the result was measured with. For exact transport use the
+Mitsuba or pbrt volumetric export.
 {model_notes}"""
 
 import bpy
