@@ -11,7 +11,9 @@ use std::process::ExitCode;
 
 use crate::output::errln;
 use anyhow::{Context, bail};
-use scatterfit_io::export::{ExportError, ExportOptions, Format, SceneUnit, export_with};
+use scatterfit_io::export::{
+    ExportError, ExportOptions, Format, MitsubaVariant, SceneUnit, export_with,
+};
 use scatterfit_io::result_json::{MeasurementResult, read_result_json};
 
 /// Arguments of `scatterfit export`.
@@ -32,6 +34,13 @@ pub struct Args {
     /// instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Mitsuba only: the kind of Mitsuba variant the fragment is for. `rgb` (scalar_rgb, llvm_ad_rgb,
+    /// …) writes the channels' coefficients; `spectral` (scalar_spectral, …) a medium per wavelength
+    /// from the result's measured reflectance spectrum, which spectral variants render in the
+    /// measured colour (their uplift of RGB coefficients shifts strongly coloured materials by tens
+    /// of per cent).
+    #[arg(long, value_enum, default_value = "rgb", value_name = "KIND")]
+    pub mitsuba_variant: VariantArg,
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
@@ -62,6 +71,15 @@ impl From<FormatArg> for Format {
             FormatArg::Json => Format::Json,
         }
     }
+}
+
+/// `--mitsuba-variant`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum VariantArg {
+    /// RGB variants.
+    Rgb,
+    /// Spectral variants.
+    Spectral,
 }
 
 /// `--scale`.
@@ -96,6 +114,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         unit,
         exact_rd: exact_transport_rd(&result),
         spectral_albedo: spectral_albedo(&result),
+        mitsuba_variant: match args.mitsuba_variant {
+            VariantArg::Rgb => MitsubaVariant::Rgb,
+            VariantArg::Spectral => MitsubaVariant::Spectral,
+        },
     };
     let exported = match export_with(&result, format, &options) {
         Ok(e) => e,

@@ -29,7 +29,8 @@ delta light: the medium behind its dielectric boundary must render black, as the
 --extra includes a second exported fragment in the same scene and gives its materials to a second box
 beside the first, out of view (two materials' ids in one scene must not clash, and each shape must get
 its own material). --variant picks Mitsuba's variant (scalar_rgb by default; scalar_spectral uplifts
-the RGB coefficients to spectra); --spectral-medium uses the fragment's per-wavelength medium.
+the RGB coefficients to spectra; a fragment exported with `--mitsuba-variant spectral` has a medium
+per wavelength for them).
 
 Prints one JSON object: per channel (R, G, B) the mean over pixels and its standard error (pixel-to-pixel
 spread / sqrt(pixels)), the pixel count, spp, seconds, and the Mitsuba version.
@@ -56,16 +57,13 @@ def main():
     ap.add_argument("--light", choices=["constant", "directional"], default="constant")
     ap.add_argument("--extra", help="a second fragment, given to a box out of view")
     ap.add_argument("--variant", default="scalar_rgb")
-    ap.add_argument(
-        "--spectral-medium", action="store_true", help="use the fragment's <id>_medium_spectral"
-    )
     args = ap.parse_args()
 
     import mitsuba as mi
 
     mi.set_variant(args.variant)
 
-    suffix = "_medium_spectral" if args.spectral_medium else "_medium"
+    suffix = "_medium"
 
     def ids(path):
         root = ET.parse(path).getroot()

@@ -18,6 +18,24 @@ use super::{
 /// documentation recommends it for subsurface scattering). The usage comment names the `rr_depth` the
 /// integrator needs for this albedo ([`roulette_depth`]).
 pub fn mitsuba_fragment(params: &RendererParameters) -> String {
+    mitsuba_fragment_for(params, MitsubaVariant::Rgb)
+}
+
+/// Which of Mitsuba's variants a fragment is for: it decides the medium `<id>_medium` holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum MitsubaVariant {
+    /// RGB variants (`scalar_rgb`, `llvm_ad_rgb`, …): the channels' coefficients as RGB.
+    #[default]
+    Rgb,
+    /// Spectral variants (`scalar_spectral`, …): the medium per wavelength from the measured spectrum
+    /// ([`RendererParameters::spectral_medium`]); the RGB medium when the result has no spectrum.
+    Spectral,
+}
+
+/// [`mitsuba_fragment`] for `variant`'s kind of Mitsuba.
+pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant) -> String {
+    let spectral = variant == MitsubaVariant::Spectral && params.spectral_medium.is_some();
     let names = MaterialNames::new(&params.name);
     let id = &names.id;
     let u = params.unit.symbol();
@@ -80,14 +98,18 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20 a medium's reflectance is not linear in its coefficients, so a strongly coloured material\n\
          \x20 renders shifted in colour ({shift} per channel for the demo's materials, BENCHMARKS.md);\n\
          \x20 the RGB variants (scalar_rgb, llvm_rgb) render the channels exactly.{spectral_note}\n",
-        spectral_note = if params.spectral_medium.is_some() {
-            format!(
-                "\n\x20 In a spectral variant give the shape <ref name=\"interior\" id=\"{id}_medium_spectral\"/>\n\
-                 \x20 instead: the medium per wavelength, its albedo inverted from the MEASURED reflectance\n\
-                 \x20 spectrum with exact transport, sigma_t' interpolated between the channels."
-            )
+        spectral_note = if spectral {
+            "\n\x20 THIS FRAGMENT IS FOR SPECTRAL VARIANTS: its medium is given per wavelength, the albedo\n\
+             \x20 inverted from the MEASURED reflectance spectrum with exact transport (within 1 % of the\n\
+             \x20 measured colour for the demo's materials), sigma_t' interpolated between the channels.\n\
+             \x20 RGB variants render it wrong: export without the spectral variant option for them."
+        } else if params.spectral_medium.is_some() {
+            "\n\x20 This fragment is for RGB variants; for a spectral variant export it again with the\n\
+             \x20 option `mitsuba-variant spectral`: its medium is then given per wavelength from the\n\
+             \x20 measured reflectance spectrum and renders the measured colour."
         } else {
-            String::new()
+            "\n\x20 The result has no measured spectrum (rd_spectrum, written by `scatterfit measure`), so\n\
+             \x20 no per-wavelength medium can be written for spectral variants."
         },
         pct = format_percent(offset_fraction),
         verdict = if offset_fraction > 0.01 {
@@ -104,26 +126,31 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20       <float name=\"int_ior\" value=\"{eta}\"/>\n\
          \x20       <float name=\"ext_ior\" value=\"1\"/>\n\
          \x20   </bsdf>\n\
-         \x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
-         \x20       <rgb name=\"sigma_t\" value=\"{sigma_t_rgb}\"/>\n\
-         \x20       <float name=\"scale\" value=\"{scale}\"/>\n\
-         \x20       <rgb name=\"albedo\" value=\"{albedo_rgb}\"/>\n\
-         \x20       <boolean name=\"sample_emitters\" value=\"false\"/>\n\
-         \x20       <phase type=\"hg\">\n\
-         \x20           <float name=\"g\" value=\"0\"/>\n\
-         \x20       </phase>\n\
-         \x20   </medium>\n{spectral}\
+         {medium}\
          </scene>\n",
         eta = num(params.eta),
-        scale = num(scale),
-        spectral = spectral_medium(params, id),
+        medium = if spectral {
+            spectral_medium(params, id)
+        } else {
+            format!(
+                "\x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
+                 \x20       <rgb name=\"sigma_t\" value=\"{sigma_t_rgb}\"/>\n\
+                 \x20       <float name=\"scale\" value=\"{scale}\"/>\n\
+                 \x20       <rgb name=\"albedo\" value=\"{albedo_rgb}\"/>\n\
+                 \x20       <boolean name=\"sample_emitters\" value=\"false\"/>\n\
+                 \x20       <phase type=\"hg\">\n\
+                 \x20           <float name=\"g\" value=\"0\"/>\n\
+                 \x20       </phase>\n\
+                 \x20   </medium>\n",
+                scale = num(scale),
+            )
+        },
     ));
     s
 }
 
-/// The `<id>_medium_spectral` element for spectral variants, when the parameters have a spectral
-/// medium: σt and albedo as wavelength:value spectra (σt normalised like the RGB one, its magnitude in
-/// `scale`).
+/// The `<id>_medium` element for spectral variants, when the parameters have a spectral medium: σt
+/// and albedo as wavelength:value spectra (σt normalised like the RGB one, its magnitude in `scale`).
 fn spectral_medium(params: &RendererParameters, id: &str) -> String {
     let Some(m) = &params.spectral_medium else {
         return String::new();
@@ -138,7 +165,7 @@ fn spectral_medium(params: &RendererParameters, id: &str) -> String {
             .join(", ")
     };
     format!(
-        "\x20   <medium type=\"homogeneous\" id=\"{id}_medium_spectral\">\n\
+        "\x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
          \x20       <spectrum name=\"sigma_t\" value=\"{}\"/>\n\
          \x20       <float name=\"scale\" value=\"{}\"/>\n\
          \x20       <spectrum name=\"albedo\" value=\"{}\"/>\n\

@@ -72,7 +72,10 @@ mod pbrt;
 
 pub use blender::{BLENDER_MAX_ALBEDO, BlenderValues, blender_script};
 pub use json::{JSON_FORMAT_TAG, JSON_FORMAT_VERSION, json};
-pub use mitsuba::{RAY_EPSILON, mitsuba_fragment, ray_offset_fraction, roulette_depth};
+pub use mitsuba::{
+    MitsubaVariant, RAY_EPSILON, mitsuba_fragment, mitsuba_fragment_for, ray_offset_fraction,
+    roulette_depth,
+};
 pub use pbrt::{pbrt_material, pbrt_max_depth};
 pub use result_spectrum::extended_reflectance;
 
@@ -249,6 +252,8 @@ pub struct ExportOptions {
     /// caller): the spectral medium's albedo. `None` without a spectrum (or where the tables do not
     /// reach); then no spectral medium is written.
     pub spectral_albedo: Option<Vec<f64>>,
+    /// The kind of Mitsuba variant a Mitsuba fragment is for (RGB by default).
+    pub mitsuba_variant: MitsubaVariant,
 }
 
 impl ExportOptions {
@@ -258,6 +263,7 @@ impl ExportOptions {
             unit,
             exact_rd: None,
             spectral_albedo: None,
+            mitsuba_variant: MitsubaVariant::Rgb,
         }
     }
 }
@@ -706,7 +712,17 @@ pub fn export_with(
         Format::Pbrt => pbrt_material(&params),
         Format::Mitsuba => {
             warnings.extend(mitsuba::ray_offset_warning(&params));
-            mitsuba_fragment(&params)
+            if options.mitsuba_variant == MitsubaVariant::Spectral
+                && params.spectral_medium.is_none()
+            {
+                warnings.push(
+                    "the result has no measured reflectance spectrum (rd_spectrum, written by \
+                     `scatterfit measure`): the fragment's medium is the RGB one, which spectral \
+                     variants render shifted in colour"
+                        .into(),
+                );
+            }
+            mitsuba_fragment_for(&params, options.mitsuba_variant)
         }
         Format::Blender => {
             warnings.extend(blender::base_colour_warnings(&params));
@@ -1669,6 +1685,7 @@ mod tests {
             unit: SceneUnit::Millimetre,
             exact_rd: Some([0.8302 * 0.56, 0.7910, 0.7526 * 1.1]),
             spectral_albedo: None,
+            mitsuba_variant: MitsubaVariant::Rgb,
         };
         let e = export_with(&r, Format::Mitsuba, &options).unwrap();
         assert_eq!(e.warnings.len(), 1, "{:?}", e.warnings);
@@ -1725,6 +1742,7 @@ mod tests {
             unit: SceneUnit::Millimetre,
             exact_rd: None,
             spectral_albedo: Some(vec![0.99, 0.995, 0.999]),
+            mitsuba_variant: MitsubaVariant::Spectral,
         };
         let (p, _) = RendererParameters::from_result_with(&r, &options).unwrap();
         let m = p.spectral_medium.as_ref().unwrap();
@@ -1746,11 +1764,14 @@ mod tests {
         assert_eq!(spectral.2[1].1.len(), 10);
         let xml = export_with(&r, Format::Mitsuba, &options).unwrap().text;
         let doc = roxmltree::Document::parse(&xml).unwrap();
-        let id = format!("{}_medium_spectral", identifier("marble"));
-        let medium = doc
+        let id = format!("{}_medium", identifier("marble"));
+        let media: Vec<_> = doc
             .descendants()
-            .find(|n| n.attribute("id") == Some(id.as_str()))
-            .unwrap();
+            .filter(|n| n.has_tag_name("medium"))
+            .collect();
+        assert_eq!(media.len(), 1);
+        let medium = media[0];
+        assert_eq!(medium.attribute("id"), Some(id.as_str()));
         let albedo = medium
             .children()
             .find(|n| n.attribute("name") == Some("albedo"))
@@ -1760,6 +1781,24 @@ mod tests {
                 .attribute("value")
                 .unwrap()
                 .starts_with("360:0.99, 400:0.99")
+        );
+        // For RGB variants the same result gets the RGB medium, and the header points to the option.
+        let rgb = ExportOptions {
+            mitsuba_variant: MitsubaVariant::Rgb,
+            ..options.clone()
+        };
+        let xml = export_with(&r, Format::Mitsuba, &rgb).unwrap().text;
+        assert!(xml.contains("<rgb name=\"albedo\""));
+        assert!(xml.contains("mitsuba-variant spectral"));
+        // Asked for spectral without a spectrum: the RGB medium and a warning.
+        let mut no_spectrum = r.clone();
+        no_spectrum.rd_spectrum = None;
+        let e = export_with(&no_spectrum, Format::Mitsuba, &options).unwrap();
+        assert!(e.text.contains("<rgb name=\"albedo\""));
+        assert!(
+            e.warnings
+                .iter()
+                .any(|w| w.contains("no measured reflectance spectrum"))
         );
         // A wrong count of albedos is refused.
         let bad = ExportOptions {
