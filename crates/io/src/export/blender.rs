@@ -116,7 +116,7 @@ pub fn blender_script(params: &RendererParameters, v: &BlenderValues) -> String 
     }
     let model_notes: String = model_header(params, &[Renderer::Cycles])
         .iter()
-        .map(|l| python_docstring_text(l) + "\n")
+        .map(|l| super::wrap(&python_docstring_text(l), 100) + "\n")
         .collect();
     format!(
         r#""""scatterfit export for Blender (Cycles, Principled BSDF, Blender 4.0 or newer): {title}

@@ -3,7 +3,7 @@
 
 use super::{
     MaterialNames, Renderer, RendererParameters, channel_table_comment, joined, largest,
-    model_header, num, provenance_line, xml_comment,
+    model_header, num, provenance_line, wrap, xml_comment,
 };
 
 /// A Mitsuba 3 XML scene fragment: a `<scene>` holding a `dielectric` BSDF (`int_ior` = η, `ext_ior` = 1)
@@ -68,9 +68,9 @@ pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant
         header.push('\n');
     }
     header.push('\n');
-    s.push_str(&xml_comment(&header));
+    s.push_str(&xml_comment(&wrap(&header, 100)));
     s.push_str(&xml_comment(&channel_table_comment(params, "  ")));
-    s.push_str(&xml_comment(&format!(
+    s.push_str(&xml_comment(&wrap(&format!(
         "\n  HOW TO USE. Include this file in a scene (its ids are unique to this material's name, so\n\
          \x20 several materials' fragments can be included in one scene) and give a shape both refs:\n\
          \x20   <include filename=\"this-file.xml\"/>\n\
@@ -88,12 +88,12 @@ pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant
          \x20 lights, and no path through the smooth dielectric boundary can connect to them (the medium's\n\
          \x20 sample_emitters is off for the same reason). Light it with area emitters or an environment\n\
          \x20 (constant, envmap); Mitsuba 3 has no BSSRDF material to fall back on.\n\
-         \x20 SCENE UNIT AND RAY OFFSETS: Mitsuba offsets every ray leaving a surface by about\n\
-         \x20 1e-4 (1 + |p|) scene units (float32 `RayEpsilon`), which shifts the first scattering deeper\n\
-         \x20 and darkens the material. Here the shortest mean free path 1/sigma_t is {mfp} {u}; for an\n\
-         \x20 object about 1 scene unit from the origin the offset is {pct} of it{verdict}. In metre\n\
-         \x20 scenes a 0.2 mm mean free path rendered 17-23 % dark (BENCHMARKS.md): export\n\
-         \x20 in millimetres (the default scale) and build the scene in millimetres when you can.\n\
+         \x20 SCENE UNIT AND RAY OFFSETS: Mitsuba offsets every ray leaving a surface by about \
+         1e-4 (1 + |p|) scene units (float32 `RayEpsilon`), which shifts the first scattering deeper \
+         and darkens the material. Here the shortest mean free path 1/sigma_t is {mfp} {u}; for an \
+         object about 1 scene unit from the origin the offset is {pct} of it{verdict}. In metre \
+         scenes a 0.2 mm mean free path rendered 17-23 % dark (BENCHMARKS.md): export in \
+         millimetres (the default scale) and build the scene in millimetres when you can.\n\
          \x20 SPECTRAL VARIANTS (scalar_spectral, llvm_spectral, ...) turn each RGB into a smooth spectrum;\n\
          \x20 a medium's reflectance is not linear in its coefficients, so a strongly coloured material\n\
          \x20 renders shifted in colour ({shift} per channel for the demo's materials, BENCHMARKS.md);\n\
@@ -118,7 +118,7 @@ pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant
             " (negligible)"
         },
         shift = MITSUBA_SPECTRAL_SHIFT,
-    )));
+    ), 100)));
     s.push_str("-->\n");
     s.push_str(&format!(
         "<scene version=\"3.0.0\">\n\

@@ -1195,6 +1195,30 @@ pub fn one_line(text: &str) -> String {
         .collect()
 }
 
+/// `text` with every line longer than `width` characters broken at spaces, continuation lines
+/// indented like the line they continue (a word longer than the width stays whole).
+fn wrap(text: &str, width: usize) -> String {
+    let mut out = Vec::new();
+    for line in text.split('\n') {
+        let indent: String = line.chars().take_while(|c| *c == ' ').collect();
+        let mut current = String::new();
+        for word in line.trim_start_matches(' ').split(' ') {
+            let len = current.chars().count();
+            if len > indent.len() && len + 1 + word.chars().count() > width {
+                out.push(std::mem::take(&mut current));
+            }
+            if current.is_empty() {
+                current.push_str(&indent);
+            } else {
+                current.push(' ');
+            }
+            current.push_str(word);
+        }
+        out.push(current);
+    }
+    out.join("\n")
+}
+
 /// Text safe inside an XML comment (`<!-- … -->`): [`one_line`] line by line (our own newlines kept),
 /// no `--` (forbidden in comments) and no `-` at the end (it would make `--->`).
 pub fn xml_comment(text: &str) -> String {

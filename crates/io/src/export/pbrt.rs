@@ -4,7 +4,7 @@
 
 use super::{
     ChannelParameters, MaterialNames, Renderer, RendererParameters, SceneUnit,
-    channel_table_comment, joined, largest, model_header, num, one_line, provenance_line,
+    channel_table_comment, joined, largest, model_header, num, one_line, provenance_line, wrap,
 };
 
 /// The `maxdepth` pbrt's `volpath` integrator needs for the medium of `params`: the number of
@@ -60,14 +60,15 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
          Three routes, by light type:\n\
          1. NamedMaterial \"{id}\": pbrt's subsurface BSSRDF from the measured reflectance and mean free\n\
          \x20  path 1/sigma_t'; pbrt inverts its own diffusion model per wavelength for the albedo, so the\n\
-         \x20  rendered colour is the measured one (within pbrt's BSSRDF sampling, BENCHMARKS.md). Works\n\
+         \x20  rendered colour is the measured one within pbrt's BSSRDF sampling (-0.3 to -2.2 % at\n\
+         \x20  eta <= 1.3, down to -11 % at eta 2.4; BENCHMARKS.md), whatever model measured it. Works\n\
          \x20  with every light, point, spot and distant lights included: use it for delta lights.\n\
          2. NamedMaterial \"{id}-coefficients\": the same BSSRDF from sigma_a, sigma_s; its total\n\
          \x20  reflectance is pbrt's diffusion model's for this albedo, not the measured one.\n\
          3. Exact volumetric transport (slower): before WorldBegin write\n\
          \x20    Integrator \"volpath\" \"integer maxdepth\" [ {depth} ]\n\
          \x20  (pbrt's default maxdepth 5 stops a translucent medium's paths after 5 of the hundreds of\n\
-         \x20  scatterings it needs: 76 % too dark and grey. {depth} = 2 ceil(ln 1e-6 / ln albedo_max):\n\
+         \x20  scatterings it needs: ~80 % too dark and grey. {depth} = 2 ceil(ln 1e-6 / ln albedo_max):\n\
          \x20  absorption ends paths long before it; surface bounces count as depth too), then\n\
          \x20    AttributeBegin\n\
          \x20      MediumInterface \"{id}-medium\" \"\"\n\
@@ -127,8 +128,7 @@ pub fn pbrt_material(params: &RendererParameters) -> String {
                 SceneUnit::Millimetre => "10 for centimetres, 1000 for metres",
                 SceneUnit::Metre => "0.01 for centimetres, 0.001 for millimetres",
             }
-        )
-        .replace('\n', " "),
+        ),
     );
     s.push('\n');
     let main_is_reflectance = reflectance.is_some();
@@ -231,7 +231,7 @@ fn reflectance_parameter(params: &RendererParameters) -> Option<String> {
 /// Appends `text` as pbrt comment lines (`# …`), each line made safe by [`one_line`]: a comment ends
 /// at the line's end, so no character of free text may start a new line.
 fn push_comment(s: &mut String, text: &str) {
-    for line in text.split('\n') {
+    for line in wrap(text, 98).split('\n') {
         let line = one_line(line);
         if line.is_empty() {
             s.push_str("#\n");
