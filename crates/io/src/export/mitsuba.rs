@@ -78,6 +78,8 @@ pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant
          \x20       <ref id=\"{id}_boundary\"/>\n\
          \x20       <ref name=\"interior\" id=\"{id}_medium\"/>\n\
          \x20   </shape>\n\
+         \x20 Rendered so, with this fragment's variant kind, materials measured with the mc model showed \
+         their measured reflectance within 3 % (the demo's seven materials, BENCHMARKS.md).\n\
          \x20 Integrator: volpath with max_depth -1 and rr_depth {rr}:\n\
          \x20   <integrator type=\"volpath\"><integer name=\"max_depth\" value=\"-1\"/>\n\
          \x20       <integer name=\"rr_depth\" value=\"{rr}\"/></integrator>\n\
