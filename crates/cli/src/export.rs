@@ -171,13 +171,33 @@ fn exact_transport_rd(result: &MeasurementResult) -> Option<[f64; 3]> {
 
 /// The single-scattering albedo whose exact-transport total Rd is the measured Rd(λ), at each
 /// wavelength of the result's spectrum (the Monte Carlo tables' inversion): the spectral medium's
-/// albedo. `None` without a spectrum or where a wavelength's Rd cannot be inverted.
+/// albedo. Rd(λ) beyond what the tables reach at this η (a nearly black band, Rd below the lowest
+/// tabulated albedo's; or above the highest's) takes that end albedo: the light it misplaces is at
+/// most the lowest albedo's Rd (a few 10⁻³ at most). `None` without a spectrum or where the tables do
+/// not cover η (1.0–2.5).
 fn spectral_albedo(result: &MeasurementResult) -> Option<Vec<f64>> {
     let spec = result.rd_spectrum.as_ref()?;
     let mc = scatterfit_pipeline::fit::model_for(scatterfit_io::manifest::ModelName::Mc).ok()?;
+    let eta = result.eta;
+    let reach = |grid: &[f64]| {
+        grid.iter()
+            .copied()
+            .find(|&a| mc.rd_total(a, eta).is_finite())
+            .map(|a| (a, mc.rd_total(a, eta)))
+    };
+    let (a_lo, rd_lo) = reach(&[1e-3, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5])?;
+    let (a_hi, rd_hi) = reach(&[0.9999, 0.9995, 0.999, 0.995, 0.99])?;
     spec.rd
         .iter()
-        .map(|&rd| mc.albedo_from_rd(rd, result.eta).ok())
+        .map(|&rd| {
+            if rd <= rd_lo {
+                Some(a_lo)
+            } else if rd >= rd_hi {
+                Some(a_hi)
+            } else {
+                mc.albedo_from_rd(rd, eta).ok()
+            }
+        })
         .collect()
 }
 

@@ -715,12 +715,17 @@ pub fn export_with(
             if options.mitsuba_variant == MitsubaVariant::Spectral
                 && params.spectral_medium.is_none()
             {
-                warnings.push(
+                let why = if params.rd_spectrum.is_some() {
+                    "the result's measured spectrum could not be turned into albedos (η outside \
+                     the Monte Carlo tables' 1.0–2.5)"
+                } else {
                     "the result has no measured reflectance spectrum (rd_spectrum, written by \
-                     `scatterfit measure`): the fragment's medium is the RGB one, which spectral \
-                     variants render shifted in colour"
-                        .into(),
-                );
+                     `scatterfit measure`)"
+                };
+                warnings.push(format!(
+                    "{why}: the fragment's medium is the RGB one, which spectral variants render \
+                     shifted in colour"
+                ));
             }
             mitsuba_fragment_for(&params, options.mitsuba_variant)
         }
