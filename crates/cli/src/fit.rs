@@ -181,6 +181,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             ..Inputs::default()
         },
         version: env!("CARGO_PKG_VERSION").into(),
+        rd_spectrum: None,
     };
     if let Some(out) = &args.output {
         write_result_json(out, &result)?;

@@ -240,6 +240,21 @@ pub struct MeasurementResult {
     pub inputs: Inputs,
     /// The scatterfit version that wrote the file.
     pub version: String,
+    /// The spectrophotometer's diffuse reflectance spectrum (its SCE reading), which the channels'
+    /// `rd_total` were integrated from: what spectral renderers need to reproduce the colour
+    /// (`scatterfit export` writes it into pbrt's reflectance). Absent when the colour came from
+    /// L*a*b* or the result predates the field; never written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rd_spectrum: Option<RdSpectrum>,
+}
+
+/// A measured diffuse reflectance spectrum ([`MeasurementResult::rd_spectrum`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RdSpectrum {
+    /// Wavelengths [nm], increasing.
+    pub wavelength_nm: Vec<f64>,
+    /// The diffuse reflectance (SCE, fraction 0–1) at each wavelength.
+    pub rd: Vec<f64>,
 }
 
 impl MeasurementResult {
@@ -438,6 +453,7 @@ mod tests {
             ]),
             inputs: Inputs::default(),
             version: "0.1.0".into(),
+            rd_spectrum: None,
         }
     }
 
@@ -450,6 +466,20 @@ mod tests {
         let back = read_result_json(&path).unwrap();
         assert_eq!(back, r);
         assert_eq!(back.coefficients().unwrap()[1], (1.893, 0.0496));
+        // Without a spectrum the file has no `rd_spectrum` key (files stay as they were); with one
+        // it round-trips.
+        assert!(
+            !std::fs::read_to_string(&path)
+                .unwrap()
+                .contains("rd_spectrum")
+        );
+        let mut r = result();
+        r.rd_spectrum = Some(RdSpectrum {
+            wavelength_nm: vec![400.0, 410.0],
+            rd: vec![0.5, 0.25],
+        });
+        write_result_json(&path, &r).unwrap();
+        assert_eq!(read_result_json(&path).unwrap(), r);
     }
 
     /// The minimal hand-written file of ARCHITECTURE.md (only the stable names) is accepted.

@@ -396,8 +396,23 @@ impl Measurement {
                 }),
             },
             version: env!("CARGO_PKG_VERSION").into(),
+            rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()),
         }
     }
+}
+
+/// The SCE spectrum the channels' Rd came from (issue 18: spectral renderers need it), when the
+/// colour came from the spectrum rather than a measured L*a*b*.
+fn rd_spectrum(
+    analysis: Option<&scatterfit_optics::spectro::SpectroAnalysis>,
+) -> Option<scatterfit_io::result_json::RdSpectrum> {
+    let a = analysis?;
+    (a.colour_source == scatterfit_optics::spectro::ColourSource::SceSpectrum).then(|| {
+        scatterfit_io::result_json::RdSpectrum {
+            wavelength_nm: a.spectral.iter().map(|p| p.wavelength_nm).collect(),
+            rd: a.spectral.iter().map(|p| p.sce).collect(),
+        }
+    })
 }
 
 /// SHA-256 of a file's bytes, lower-case hex (`None` when it cannot be read: missing, not a
