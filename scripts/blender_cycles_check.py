@@ -1,8 +1,9 @@
 """How close Blender (Cycles) renders scatterfit's Blender export to the measured material.
 
-Not part of the test suite (Blender is not a CI dependency); BENCHMARKS.md ("exports") reports its
-output. Needs the `bpy` package (Blender as a Python module; `pip install bpy==4.2.*` under Python 3.11)
-for the render modes; `compare` needs only the standard library.
+Not part of the test suite (CI's Blender test is crates/cli/tests/blender.rs); BENCHMARKS.md
+("exports") reports its output. Needs the `bpy` package (Blender as a Python module; `pip install
+bpy==4.2.*` or `bpy==5.0.1` under Python 3.11) for the render modes; `compare` needs only the
+standard library.
 
     python blender_cycles_check.py uniform EXPORT.py SAMPLES OUT.json
     python blender_cycles_check.py edge    EXPORT.py SAMPLES OUT.json
@@ -46,7 +47,9 @@ def render(mode, export, samples, out):
     slab.data.materials.append(mat)
 
     scene.world = bpy.data.worlds.new("world")
-    scene.world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        # Deprecated in Blender 5.0 (removed in 6.0): worlds always use nodes there.
+        scene.world.use_nodes = True
     background = scene.world.node_tree.nodes["Background"]
     cam_data = bpy.data.cameras.new("camera")
     cam_data.type = "ORTHO"

@@ -11,8 +11,10 @@ use std::process::ExitCode;
 
 use crate::output::errln;
 use anyhow::{Context, bail};
-use scatterfit_io::export::{ExportError, Format, SceneUnit, export};
-use scatterfit_io::result_json::read_result_json;
+use scatterfit_io::export::{
+    ExportError, ExportOptions, Format, MitsubaVariant, SceneUnit, export_with,
+};
+use scatterfit_io::result_json::{MeasurementResult, read_result_json};
 
 /// Arguments of `scatterfit export`.
 #[derive(Debug, clap::Args)]
@@ -32,6 +34,13 @@ pub struct Args {
     /// instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Mitsuba only: the kind of Mitsuba variant the fragment is for. `rgb` (scalar_rgb, llvm_ad_rgb,
+    /// …) writes the channels' coefficients; `spectral` (scalar_spectral, …) a medium per wavelength
+    /// from the result's measured reflectance spectrum, which spectral variants render in the
+    /// measured colour (their uplift of RGB coefficients shifts strongly coloured materials by tens
+    /// of per cent).
+    #[arg(long, value_enum, default_value = "rgb", value_name = "KIND")]
+    pub mitsuba_variant: VariantArg,
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
@@ -64,6 +73,15 @@ impl From<FormatArg> for Format {
     }
 }
 
+/// `--mitsuba-variant`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum VariantArg {
+    /// RGB variants.
+    Rgb,
+    /// Spectral variants.
+    Spectral,
+}
+
 /// `--scale`.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub enum UnitArg {
@@ -92,7 +110,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     // The error's message already includes its cause; flatten it so `{:#}` does not repeat it.
     let result = read_result_json(&args.result).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let exported = match export(&result, format, unit) {
+    let options = ExportOptions {
+        unit,
+        exact_rd: exact_transport_rd(&result),
+        spectral_albedo: spectral_albedo(&result),
+        mitsuba_variant: match args.mitsuba_variant {
+            VariantArg::Rgb => MitsubaVariant::Rgb,
+            VariantArg::Spectral => MitsubaVariant::Spectral,
+        },
+    };
+    let exported = match export_with(&result, format, &options) {
         Ok(e) => e,
         Err(err @ ExportError::FailedChannel { .. }) => {
             return Err(crate::common::MeasurementFailed(format!(
@@ -101,7 +128,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             ))
             .into());
         }
-        Err(err) => return Err(err).context(format!("exporting {}", args.result.display())),
+        Err(err) => return Err(anyhow::anyhow!("{}: {err}", args.result.display())),
     };
     if !args.quiet {
         for w in &exported.warnings {
@@ -126,6 +153,54 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => crate::output::write_stdout_bytes(exported.text.as_bytes())?,
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Exact transport's total diffuse reflectance Rd_exact(α′, η) of each channel's exported medium (a
+/// half-space with the result's σ′s, σa, g = 0 and η), from the Monte Carlo tables shipped with
+/// scatterfit: what Mitsuba's and pbrt's volumetric path tracers render, which the export's header
+/// compares with the measured Rd. `None` when the tables do not cover the result (η outside 1.0–2.5)
+/// or a channel has no coefficients (the export then refuses it anyway).
+fn exact_transport_rd(result: &MeasurementResult) -> Option<[f64; 3]> {
+    let mc = scatterfit_mc::family(scatterfit_optics::ModelName::Mc).ok()?;
+    let [r, g, b] = result.coefficients().ok()?.map(|(sp, sa)| {
+        let rd = mc.rd_total(sp / (sp + sa), result.eta, 0.0).ok()?;
+        (rd.is_finite() && (0.0..=1.0).contains(&rd)).then_some(rd)
+    });
+    Some([r?, g?, b?])
+}
+
+/// The single-scattering albedo whose exact-transport total Rd is the measured Rd(λ), at each
+/// wavelength of the result's spectrum (the Monte Carlo tables' inversion): the spectral medium's
+/// albedo. Rd(λ) beyond what the tables reach at this η (a nearly black band, Rd below the lowest
+/// tabulated albedo's; or above the highest's) takes that end albedo: the light it misplaces is at
+/// most the lowest albedo's Rd (a few 10⁻³ at most). `None` without a spectrum or where the tables do
+/// not cover η (1.0–2.5).
+fn spectral_albedo(result: &MeasurementResult) -> Option<Vec<f64>> {
+    let spec = result.rd_spectrum.as_ref()?;
+    let mc = scatterfit_mc::family(scatterfit_optics::ModelName::Mc).ok()?;
+    let eta = result.eta;
+    let reach = |grid: &[f64]| {
+        grid.iter().copied().find_map(|a| {
+            mc.rd_total(a, eta, 0.0)
+                .ok()
+                .filter(|rd| rd.is_finite())
+                .map(|rd| (a, rd))
+        })
+    };
+    let (a_lo, rd_lo) = reach(&[1e-3, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5])?;
+    let (a_hi, rd_hi) = reach(&[0.9999, 0.9995, 0.999, 0.995, 0.99])?;
+    spec.rd
+        .iter()
+        .map(|&rd| {
+            if rd <= rd_lo {
+                Some(a_lo)
+            } else if rd >= rd_hi {
+                Some(a_hi)
+            } else {
+                mc.albedo_from_rd(rd, eta, 0.0).ok()
+            }
+        })
+        .collect()
 }
 
 /// Refuses an output whose extension does not match the format, an existing file without `--force`,

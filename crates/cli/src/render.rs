@@ -1035,7 +1035,7 @@ fn run_profile(
             })
     };
     let cols = [column("r")?, column("g")?, column("b")?];
-    let channels = result.channels.as_array();
+    let channels = result.channels.as_ref().into_array();
     let names = ["r", "g", "b"];
     let mut scales = [0.0; 3];
     for c in 0..3 {

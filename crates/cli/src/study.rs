@@ -333,7 +333,7 @@ fn study_sample(
         };
         let m = base.refit_values_only(settings)?;
         let result = m.to_result(None);
-        for (c, ch) in result.channels.as_array().iter().enumerate() {
+        for (c, ch) in result.channels.as_ref().into_array().iter().enumerate() {
             let t = &truth["channels"][c];
             let (sp, sa) = (
                 t["sigma_s_prime"].as_f64().unwrap_or(f64::NAN),

@@ -194,3 +194,75 @@ fn bad_input_exits_2() {
     let bad_format = run(dir.path(), &["export", "x.json", "--to", "povray"]);
     assert_eq!(bad_format.code, 2);
 }
+
+/// Issue 18: a number outside its documented range (here σ′s = 1e300, which is ∞ per metre and
+/// beyond float32 either way) is refused with exit 2 naming the field, and nothing is written.
+#[test]
+fn out_of_range_value_exits_2_naming_the_field() {
+    let dir = temp_dir();
+    let huge = r#"{ "status": "ok", "sigma_s_prime": 1e300, "sigma_s_prime_stderr": 0.01,
+        "sigma_a": 0.48, "sigma_a_stderr": 0.001, "albedo_prime": 1.0, "rd_total": 0.4, "mse": 1e-6 }"#;
+    write_result(&dir.path().join("result.json"), Some(huge));
+    for to in ["pbrt", "mitsuba", "blender", "json"] {
+        let out = run(
+            dir.path(),
+            &["export", "result.json", "--to", to, "--scale", "m"],
+        );
+        assert_eq!(out.code, 2, "{}", out.stderr);
+        assert!(
+            out.stderr.contains("channels.b.sigma_s_prime"),
+            "{}",
+            out.stderr
+        );
+        assert!(out.stdout.is_empty());
+    }
+}
+
+/// Issue 18: a dipole result exported for an exact renderer warns on stderr and in the header, with
+/// exact transport's Rd (from the Monte Carlo tables) beside the measured one; the same numbers
+/// labelled `mc` / `mc` do not warn.
+#[test]
+fn model_mismatch_warns_with_exact_transport_figures() {
+    let dir = temp_dir();
+    write_result(&dir.path().join("result.json"), None);
+    let out = run(dir.path(), &["export", "result.json", "--to", "mitsuba"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("its diffuse reflectance Rd will differ from the measured one by R "),
+        "{}",
+        out.stderr
+    );
+    assert!(out.stdout.contains("MODEL WARNING for Mitsuba"));
+    assert!(out.stdout.contains("Rd exact transport"));
+    // Relabelled as an exact-model measurement: no warning.
+    let text = std::fs::read_to_string(dir.path().join("result.json"))
+        .unwrap()
+        .replace("\"model\": \"dipole\"", "\"model\": \"mc\"")
+        .replace(
+            "\"albedo_model\": \"diffusion\"",
+            "\"albedo_model\": \"mc\"",
+        );
+    std::fs::write(dir.path().join("mc.json"), text).unwrap();
+    let mc = run(dir.path(), &["export", "mc.json", "--to", "mitsuba"]);
+    assert_eq!(mc.code, 0, "{}", mc.stderr);
+    assert!(mc.stderr.is_empty(), "{}", mc.stderr);
+    assert!(!mc.stdout.contains("MODEL WARNING"));
+}
+
+/// Issue 18: the pbrt export says where to include it and what integrator the medium needs.
+#[test]
+fn pbrt_header_gives_the_integrator_and_placement() {
+    let dir = temp_dir();
+    write_result(&dir.path().join("result.json"), None);
+    let out = run(dir.path(), &["export", "result.json", "--to", "pbrt"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let text = &out.stdout;
+    assert!(text.contains("after WorldBegin"), "{text}");
+    // skin1's largest albedo is R: 0.74/0.772 = 0.958549…; 2⌈ln 1e-6 / ln α⌉ = 2 · 327 = 654.
+    assert!(
+        text.contains("Integrator \"volpath\" \"integer maxdepth\" [ 654 ]"),
+        "{text}"
+    );
+    assert!(text.contains("BLACK under point, spot and distant lights"));
+}

@@ -26,7 +26,7 @@
 
 mod common;
 
-use common::{command, temp_dir, workspace_root};
+use common::{command, read_json, run_cached, synth_quick, temp_dir, workspace_root};
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -80,6 +80,11 @@ fn mitsuba_python(test: &str) -> Option<PathBuf> {
 
 /// A result file with per-channel (σ′s, σa, Rd) [mm⁻¹, mm⁻¹, 1].
 fn write_result(path: &Path, eta: f64, channels: [(f64, f64, Option<f64>); 3]) {
+    write_named_result(path, "mitsuba test slab", eta, channels);
+}
+
+/// [`write_result`] with the material's name.
+fn write_named_result(path: &Path, name: &str, eta: f64, channels: [(f64, f64, Option<f64>); 3]) {
     let ch = |(sp, sa, rd): (f64, f64, Option<f64>)| {
         serde_json::json!({
             "status": "ok", "sigma_s_prime": sp, "sigma_s_prime_stderr": null, "sigma_a": sa,
@@ -87,7 +92,7 @@ fn write_result(path: &Path, eta: f64, channels: [(f64, f64, Option<f64>); 3]) {
         })
     };
     let result = serde_json::json!({
-        "name": "mitsuba test slab", "eta": eta, "eta_source": "given", "method": "proposed",
+        "name": name, "eta": eta, "eta_source": "given", "method": "proposed",
         "model": "mc", "albedo_model": "mc",
         "channels": { "r": ch(channels[0]), "g": ch(channels[1]), "b": ch(channels[2]) },
         "version": "0.1.0"
@@ -97,23 +102,20 @@ fn write_result(path: &Path, eta: f64, channels: [(f64, f64, Option<f64>); 3]) {
 
 /// `scatterfit export RESULT --to mitsuba --scale UNIT -o OUT` (the real binary).
 fn export(dir: &Path, unit: &str) -> PathBuf {
-    let out = dir.join(format!("material-{unit}.xml"));
+    export_file(dir, "result.json", unit, &format!("material-{unit}.xml")).0
+}
+
+/// `scatterfit export RESULT --to mitsuba --scale UNIT -o OUT`: the fragment and the command's stderr.
+fn export_file(dir: &Path, result: &str, unit: &str, out: &str) -> (PathBuf, String) {
+    let out = dir.join(out);
     let o = command()
-        .args([
-            "export",
-            "result.json",
-            "--to",
-            "mitsuba",
-            "--scale",
-            unit,
-            "-o",
-        ])
+        .args(["export", result, "--to", "mitsuba", "--scale", unit, "-o"])
         .arg(&out)
         .current_dir(dir)
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    out
+    (out, String::from_utf8_lossy(&o.stderr).into_owned())
 }
 
 /// What `mitsuba_slab.py` prints.
@@ -125,6 +127,18 @@ struct Render {
     pixels: u32,
     seconds: f64,
     mitsuba: String,
+    /// The brightest pixel per channel.
+    max: [f64; 3],
+}
+
+/// Scene options of `mitsuba_slab.py` beyond the slab's size.
+#[derive(Default)]
+struct Scene<'a> {
+    backing: bool,
+    directional: bool,
+    extra: Option<&'a Path>,
+    /// Mitsuba's variant (`scalar_rgb` when `None`).
+    variant: Option<&'a str>,
 }
 
 fn render(
@@ -133,6 +147,27 @@ fn render(
     width: f64,
     thickness: f64,
     backing: bool,
+    spp: u32,
+) -> Render {
+    render_scene(
+        python,
+        fragment,
+        width,
+        thickness,
+        &Scene {
+            backing,
+            ..Scene::default()
+        },
+        spp,
+    )
+}
+
+fn render_scene(
+    python: &Path,
+    fragment: &Path,
+    width: f64,
+    thickness: f64,
+    scene: &Scene,
     spp: u32,
 ) -> Render {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/mitsuba_slab.py");
@@ -145,8 +180,17 @@ fn render(
         .args(["--width", &width.to_string()])
         .args(["--thickness", &thickness.to_string()])
         .args(["--spp", &spp.to_string(), "--res", "16", "--seed", "7"]);
-    if backing {
+    if scene.backing {
         cmd.arg("--backing");
+    }
+    if scene.directional {
+        cmd.args(["--light", "directional"]);
+    }
+    if let Some(extra) = scene.extra {
+        cmd.arg("--extra").arg(extra);
+    }
+    if let Some(variant) = scene.variant {
+        cmd.args(["--variant", variant]);
     }
     let o = cmd.output().unwrap();
     assert!(
@@ -231,6 +275,224 @@ fn thin_slab_in_metres_matches_adding_doubling() {
         r.mean[1],
         r.stderr[1],
         THIN_UR1,
+    );
+}
+
+/// Issue 18: a material whose mean free path is sub-millimetre (σ′t = 5 mm⁻¹, 0.2 mm), in a metre
+/// scene. Mitsuba offsets rays leaving a surface by ≈ 9·10⁻⁵ (1 + |p|) scene units — 0.09 mm at the
+/// origin in metres, 0.45 mean free paths — which moves the first scattering deeper and darkens the
+/// render. The export must say so (stderr and header), the metre render must show the documented
+/// darkening (measured 17–23 %; the test asks for more than 8 % in every channel), and the same
+/// material exported in millimetres (the default) must render right.
+#[test]
+fn metre_scene_with_submillimetre_mean_free_path_is_flagged() {
+    let Some(python) = mitsuba_python("metre_scene_with_submillimetre_mean_free_path_is_flagged")
+    else {
+        return;
+    };
+    let dir = temp_dir();
+    let k = 5.0;
+    write_result(
+        &dir.path().join("result.json"),
+        THICK_ETA,
+        THICK_CASES.map(|(a, rd)| (a * k, (1.0 - a) * k, Some(rd))),
+    );
+    let (metre, stderr) = export_file(dir.path(), "result.json", "m", "metre.xml");
+    assert!(stderr.contains("will render dark"), "{stderr}");
+    let header = std::fs::read_to_string(&metre).unwrap();
+    assert!(header.contains("ABOVE 1 %"), "{header}");
+    let (mm, stderr) = export_file(dir.path(), "result.json", "mm", "mm.xml");
+    assert!(!stderr.contains("render dark"), "{stderr}");
+    // Half-spaces: 400 mean free paths deep, 800 wide, in each unit.
+    let in_m = render(&python, &metre, 0.16, 0.08, false, 256);
+    let in_mm = render(&python, &mm, 160.0, 80.0, false, 256);
+    for (c, (albedo, rd)) in THICK_CASES.iter().enumerate() {
+        let want = rd + r0(THICK_ETA);
+        check(
+            &format!("σ′t = 5 mm⁻¹, α′ = {albedo}, millimetres"),
+            in_mm.mean[c],
+            in_mm.stderr[c],
+            want,
+        );
+        let dark = 1.0 - in_m.mean[c] / want;
+        eprintln!(
+            "σ′t = 5 mm⁻¹, α′ = {albedo}, metres: Mitsuba {:.5} ± {:.5}, {:.1} % dark",
+            in_m.mean[c],
+            in_m.stderr[c],
+            100.0 * dark
+        );
+        assert!(
+            dark > 0.08,
+            "the metre render is only {:.1} % dark: update the export's header and BENCHMARKS.md",
+            100.0 * dark
+        );
+    }
+}
+
+/// Two materials' fragments in one scene — "pink plastic" and "pink-plastic", whose ids collided
+/// before issue 18 — load together, and each shape gets its own medium: each render, with the other
+/// material present beside it, shows its own Rd (α′ = 0.8 and 0.9, η = 1.4).
+#[test]
+fn two_fragments_in_one_scene() {
+    let Some(python) = mitsuba_python("two_fragments_in_one_scene") else {
+        return;
+    };
+    let dir = temp_dir();
+    let cases = [
+        ("pink plastic", THICK_CASES[0]),
+        ("pink-plastic", THICK_CASES[1]),
+    ];
+    let mut fragments = Vec::new();
+    for (k, (name, (a, rd))) in cases.iter().enumerate() {
+        let result = format!("result-{k}.json");
+        write_named_result(
+            &dir.path().join(&result),
+            name,
+            THICK_ETA,
+            [(*a, 1.0 - a, Some(*rd)); 3],
+        );
+        fragments.push(export_file(dir.path(), &result, "mm", &format!("m{k}.xml")).0);
+    }
+    for (k, (name, (a, rd))) in cases.iter().enumerate() {
+        let other = &fragments[1 - k];
+        let r = render_scene(
+            &python,
+            &fragments[k],
+            400.0,
+            200.0,
+            &Scene {
+                extra: Some(other),
+                ..Scene::default()
+            },
+            128,
+        );
+        check(
+            &format!("\"{name}\" (α′ = {a}) beside the other"),
+            r.mean[1],
+            r.stderr[1],
+            rd + r0(THICK_ETA),
+        );
+    }
+}
+
+/// The documented behaviour under a delta light: a `directional` emitter along the normal lights
+/// nothing behind the smooth dielectric (no path can connect to a delta light through it), so every
+/// pixel is exactly black, as the fragment's header says.
+#[test]
+fn directional_light_renders_the_medium_black() {
+    let Some(python) = mitsuba_python("directional_light_renders_the_medium_black") else {
+        return;
+    };
+    let dir = temp_dir();
+    write_result(
+        &dir.path().join("result.json"),
+        THICK_ETA,
+        THICK_CASES.map(|(a, rd)| (a, 1.0 - a, Some(rd))),
+    );
+    let fragment = export(dir.path(), "mm");
+    let header = std::fs::read_to_string(&fragment).unwrap();
+    assert!(header.contains("renders BLACK under point, spot and directional"));
+    let r = render_scene(
+        &python,
+        &fragment,
+        400.0,
+        200.0,
+        &Scene {
+            directional: true,
+            ..Scene::default()
+        },
+        16,
+    );
+    assert_eq!(r.max, [0.0; 3], "{r:?}");
+}
+
+/// Issue 18: a spectral variant (`scalar_spectral`) uplifts RGB coefficients to smooth spectra, and a
+/// strongly coloured medium renders shifted (red aluminium's red: −42 %, BENCHMARKS.md). A rig-twin
+/// red aluminium measured with the exact model keeps its spectrophotometer spectrum in the result,
+/// and `--mitsuba-variant spectral` writes a medium per wavelength from it: rendered in
+/// `scalar_spectral` it must show the measured R0 + Rd in every channel. Tolerance: 4 s.e. + 0.002
+/// as elsewhere, plus 1.5 % for the two colour conversions (ours: ASTM E308 10-nm D65 weights; Mitsuba's
+/// CIE 1931 fits and D65 spectrum). The RGB fragment in the same variant must stay > 20 % dark in R
+/// (measured −42 %), which is why the option exists.
+#[test]
+fn spectral_variant_renders_the_measured_colour() {
+    let Some(python) = mitsuba_python("spectral_variant_renders_the_measured_colour") else {
+        return;
+    };
+    let dir = temp_dir();
+    synth_quick(dir.path(), "red-aluminum", "ra");
+    let measured = run_cached(
+        dir.path(),
+        &[
+            "measure",
+            "ra",
+            "--model",
+            "mc",
+            "--albedo-model",
+            "mc",
+            "--quiet",
+        ],
+    );
+    assert_eq!(measured.code, 0, "{}", measured.stderr);
+    let result = read_json(&dir.path().join("ra/result.json"));
+    assert!(
+        result["rd_spectrum"]["rd"]
+            .as_array()
+            .is_some_and(|a| a.len() > 2)
+    );
+    let eta = result["eta"].as_f64().unwrap();
+    let want =
+        ["r", "g", "b"].map(|c| result["channels"][c]["rd_total"].as_f64().unwrap() + r0(eta));
+    let export = |variant: &str, out: &str| -> PathBuf {
+        let path = dir.path().join(out);
+        let o = command()
+            .args([
+                "export",
+                "ra/result.json",
+                "--to",
+                "mitsuba",
+                "--mitsuba-variant",
+                variant,
+                "-o",
+            ])
+            .arg(&path)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        path
+    };
+    let spectral = export("spectral", "spectral.xml");
+    let rgb = export("rgb", "rgb.xml");
+    let scene = Scene {
+        variant: Some("scalar_spectral"),
+        ..Scene::default()
+    };
+    let r = render_scene(&python, &spectral, 400.0, 200.0, &scene, 128);
+    for (c, label) in ["R", "G", "B"].iter().enumerate() {
+        let tol = 4.0 * r.stderr[c] + 0.002 + 0.015 * want[c];
+        eprintln!(
+            "red aluminium {label}, scalar_spectral, spectral medium: Mitsuba {:.5} ± {:.5}, measured \
+             {:.5} (tolerance {tol:.5})",
+            r.mean[c], r.stderr[c], want[c]
+        );
+        assert!(
+            (r.mean[c] - want[c]).abs() <= tol,
+            "{label}: {:.5} ± {:.5} against the measured {:.5}",
+            r.mean[c],
+            r.stderr[c],
+            want[c]
+        );
+    }
+    let shifted = render_scene(&python, &rgb, 400.0, 200.0, &scene, 128);
+    let dark = 1.0 - shifted.mean[0] / want[0];
+    eprintln!(
+        "red aluminium R, scalar_spectral, RGB medium: {:.1} % dark",
+        100.0 * dark
+    );
+    assert!(
+        dark > 0.2,
+        "the RGB medium's shift in a spectral variant changed: {dark}"
     );
 }
 

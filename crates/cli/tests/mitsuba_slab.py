@@ -4,6 +4,7 @@ Used by crates/cli/tests/mitsuba.rs (and its ignored high-quality benchmark); ru
 environment that .ci/run makes (`pip install mitsuba`). Standard library + mitsuba only.
 
     python mitsuba_slab.py FRAGMENT.xml --width W --thickness T [--backing] [--spp N] [--res R] [--seed S]
+        [--light constant|directional] [--extra FRAGMENT2.xml] [--variant scalar_rgb|scalar_spectral]
 
 The scene: FRAGMENT.xml (what `scatterfit export --to mitsuba` writes) is <include>d; a box W wide and
 T thick, its top face at z = 0, gets the fragment's dielectric BSDF as its boundary and its medium as its
@@ -22,6 +23,14 @@ reciprocity is the reflectance of the slab for light arriving along the camera d
 normal: the specular Fresnel reflectance R0 = ((eta - 1)/(eta + 1))^2 plus the diffuse reflectance Rd
 for collimated normal incidence (MCML's Rd), plus, without --backing, the transmittance of light from
 below (zero for a thick slab).
+
+--light directional replaces the environment by a `directional` emitter shining straight down (a
+delta light: the medium behind its dielectric boundary must render black, as the export's header says).
+--extra includes a second exported fragment in the same scene and gives its materials to a second box
+beside the first, out of view (two materials' ids in one scene must not clash, and each shape must get
+its own material). --variant picks Mitsuba's variant (scalar_rgb by default; scalar_spectral uplifts
+the RGB coefficients to spectra; a fragment exported with `--mitsuba-variant spectral` has a medium
+per wavelength for them).
 
 Prints one JSON object: per channel (R, G, B) the mean over pixels and its standard error (pixel-to-pixel
 spread / sqrt(pixels)), the pixel count, spp, seconds, and the Mitsuba version.
@@ -45,21 +54,32 @@ def main():
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--res", type=int, default=16)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--light", choices=["constant", "directional"], default="constant")
+    ap.add_argument("--extra", help="a second fragment, given to a box out of view")
+    ap.add_argument("--variant", default="scalar_rgb")
     args = ap.parse_args()
 
     import mitsuba as mi
 
-    mi.set_variant("scalar_rgb")
+    mi.set_variant(args.variant)
+
+    suffix = "_medium"
+
+    def ids(path):
+        root = ET.parse(path).getroot()
+        bsdf = [e for e in root if e.tag == "bsdf"]
+        medium = [e for e in root if e.tag == "medium" and e.get("id", "").endswith(suffix)]
+        if len(bsdf) != 1 or len(medium) != 1:
+            sys.exit(f"{path}: expected one <bsdf> and one <medium> with an id ending {suffix}")
+        return bsdf[0].get("id"), medium[0].get("id"), medium[0]
 
     fragment = os.path.abspath(args.fragment)
-    root = ET.parse(fragment).getroot()
-    bsdf = [e for e in root if e.tag == "bsdf"]
-    medium = [e for e in root if e.tag == "medium"]
-    if len(bsdf) != 1 or len(medium) != 1:
-        sys.exit(f"{fragment}: expected one <bsdf> and one <medium> at the top level")
-    bsdf_id, medium_id = bsdf[0].get("id"), medium[0].get("id")
-    albedo = [e for e in medium[0] if e.tag == "rgb" and e.get("name") == "albedo"]
-    alpha = max(float(x) for x in albedo[0].get("value").split(",")) if albedo else 0.99
+    bsdf_id, medium_id, medium = ids(fragment)
+    albedo = [e for e in medium if e.tag in ("rgb", "spectrum") and e.get("name") == "albedo"]
+    # "a, b, c" (rgb) or "λ:a, λ:b, …" (spectrum): the largest value.
+    alpha = (
+        max(float(x.split(":")[-1]) for x in albedo[0].get("value").split(",")) if albedo else 0.99
+    )
     # Russian roulette only once every channel's throughput is below 1e-3: Mitsuba's volpath
     # survives a roulette with q = min(max throughput, 0.95), so at albedos above 0.95 early
     # roulette leaves the long paths that carry much of Rd (α' = 0.999: hundreds of scatterings)
@@ -67,6 +87,31 @@ def main():
     rr_depth = max(5, math.ceil(math.log(1e-3) / math.log(alpha))) if alpha < 1 else 100000
 
     w, t = args.width, args.thickness
+    extra = ""
+    if args.extra:
+        extra_path = os.path.abspath(args.extra)
+        if os.path.dirname(extra_path) != os.path.dirname(fragment):
+            sys.exit("--extra must be in the same folder as the fragment")
+        extra_bsdf, extra_medium, _ = ids(extra_path)
+        extra = f"""
+    <include filename="{os.path.basename(extra_path)}"/>
+    <shape type="cube">
+        <transform name="to_world">
+            <scale x="{w / 2}" y="{w / 2}" z="{t / 2}"/>
+            <translate x="{2 * w}" z="{-t / 2}"/>
+        </transform>
+        <ref id="{extra_bsdf}"/>
+        <ref name="interior" id="{extra_medium}"/>
+    </shape>"""
+    if args.light == "constant":
+        light = """<emitter type="constant">
+        <rgb name="radiance" value="1, 1, 1"/>
+    </emitter>"""
+    else:
+        light = """<emitter type="directional">
+        <vector name="direction" x="0" y="0" z="-1"/>
+        <rgb name="irradiance" value="1, 1, 1"/>
+    </emitter>"""
     backing = ""
     if args.backing:
         backing = f"""
@@ -97,9 +142,7 @@ def main():
             <integer name="sample_count" value="{args.spp}"/>
         </sampler>
     </sensor>
-    <emitter type="constant">
-        <rgb name="radiance" value="1, 1, 1"/>
-    </emitter>
+    {light}
     <shape type="cube">
         <transform name="to_world">
             <scale x="{w / 2}" y="{w / 2}" z="{t / 2}"/>
@@ -107,7 +150,7 @@ def main():
         </transform>
         <ref id="{bsdf_id}"/>
         <ref name="interior" id="{medium_id}"/>
-    </shape>{backing}
+    </shape>{backing}{extra}
 </scene>
 """
     scene_path = os.path.join(os.path.dirname(fragment), "mitsuba_slab_scene.xml")
@@ -137,6 +180,8 @@ def main():
                 "spp": args.spp,
                 "seconds": seconds,
                 "rr_depth": rr_depth,
+                "max": [max(values[c::3]) for c in range(3)],
+                "variant": args.variant,
                 "mitsuba": mi.__version__,
             }
         )

@@ -467,6 +467,10 @@ pub struct RunOptions {
     /// How α′ came from the spectrophotometer's Rd.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub albedo_model: Option<AlbedoModel>,
+    /// What the HDR and profile stages found and corrected of a real camera (black level,
+    /// exposure times, flat frame, background), as they serialise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera: Option<serde_json::Value>,
     /// The bracket's detection limit per channel (R, G, B) [relative radiance]; `null` where
     /// unknown.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -535,6 +539,21 @@ pub struct MeasurementResult {
     pub inputs: Inputs,
     /// The scatterfit version that wrote the file.
     pub version: String,
+    /// The spectrophotometer's diffuse reflectance spectrum (its SCE reading), which the channels'
+    /// `rd_total` were integrated from: what spectral renderers need to reproduce the colour
+    /// (`scatterfit export` writes it into pbrt's reflectance). Absent when the colour came from
+    /// L*a*b* or the result predates the field; never written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rd_spectrum: Option<RdSpectrum>,
+}
+
+/// A measured diffuse reflectance spectrum ([`MeasurementResult::rd_spectrum`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RdSpectrum {
+    /// Wavelengths [nm], increasing.
+    pub wavelength_nm: Vec<f64>,
+    /// The diffuse reflectance (SCE, fraction 0–1) at each wavelength.
+    pub rd: Vec<f64>,
 }
 
 impl MeasurementResult {
@@ -789,6 +808,7 @@ mod tests {
             ]),
             inputs: Inputs::default(),
             version: "0.1.0".into(),
+            rd_spectrum: None,
         }
     }
 
@@ -801,6 +821,20 @@ mod tests {
         let back = read_result_json(&path).unwrap();
         assert_eq!(back, r);
         assert_eq!(back.coefficients().unwrap().g, (1.893, 0.0496));
+        // Without a spectrum the file has no `rd_spectrum` key (files stay as they were); with one
+        // it round-trips.
+        assert!(
+            !std::fs::read_to_string(&path)
+                .unwrap()
+                .contains("rd_spectrum")
+        );
+        let mut r = result();
+        r.rd_spectrum = Some(RdSpectrum {
+            wavelength_nm: vec![400.0, 410.0],
+            rd: vec![0.5, 0.25],
+        });
+        write_result_json(&path, &r).unwrap();
+        assert_eq!(read_result_json(&path).unwrap(), r);
     }
 
     /// The meanings are enums in code and today's strings in the file: every name, in every
@@ -817,6 +851,7 @@ mod tests {
             method: Some(Method::Existing),
             model: Some(ModelName::BetterDipole),
             albedo_model: Some(AlbedoModel::Mc),
+            camera: Some(serde_json::json!({"background": "none"})),
             normalise_with_spectro: Some(false),
             r_min_mm: Some(1.0),
             r_max_px: Some(300.0),
@@ -832,7 +867,7 @@ mod tests {
         let options = serde_json::to_string(&r.inputs.options).unwrap();
         assert_eq!(
             options,
-            r#"{"albedo_model":"mc","detection_limit":[0.25,null,1.0],"method":"existing","model":"better-dipole","normalise_with_spectro":false,"r_max_px":300.0,"r_min_mm":1.0,"response":"recovered","spot_radius_mm":0.5}"#
+            r#"{"albedo_model":"mc","camera":{"background":"none"},"detection_limit":[0.25,null,1.0],"method":"existing","model":"better-dipole","normalise_with_spectro":false,"r_max_px":300.0,"r_min_mm":1.0,"response":"recovered","spot_radius_mm":0.5}"#
         );
         let back = parse_result_json(&v.to_string(), Path::new("r.json")).unwrap();
         assert_eq!(back, r);
@@ -873,8 +908,13 @@ mod tests {
             Err(ResultJsonError::UnknownModel { found, .. }) => assert_eq!(found, "Photon-Tracer"),
             other => panic!("{other:?}"),
         }
-        let err = parse_result_json(&text, Path::new("r.json")).unwrap_err().to_string();
-        assert!(err.contains("Photon-Tracer") && err.contains("better-dipole"), "{err}");
+        let err = parse_result_json(&text, Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("Photon-Tracer") && err.contains("better-dipole"),
+            "{err}"
+        );
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("result.json");
         std::fs::write(&path, &text).unwrap();
@@ -892,7 +932,10 @@ mod tests {
         v["eta_source"] = serde_json::json!("");
         v.as_object_mut().unwrap().remove("albedo_model");
         let r = parse_result_json(&v.to_string(), Path::new("r.json")).unwrap();
-        assert_eq!((r.model, r.method), (ModelName::BetterDipole, Method::Existing));
+        assert_eq!(
+            (r.model, r.method),
+            (ModelName::BetterDipole, Method::Existing)
+        );
         assert_eq!((r.eta_source, r.albedo_model), (None, None));
         v["method"] = serde_json::json!("guessed");
         let err = parse_result_json(&v.to_string(), Path::new("r.json"))
@@ -907,7 +950,10 @@ mod tests {
         let mut c = channel(2.0, 0.01);
         c.sigma_s_prime_stderr_spectro = Some(0.03);
         let e = c.sigma_s_prime_estimate().unwrap();
-        assert_eq!((e.value, e.fit, e.spectro, e.g), (2.0, Some(0.01), Some(0.03), None));
+        assert_eq!(
+            (e.value, e.fit, e.spectro, e.g),
+            (2.0, Some(0.01), Some(0.03), None)
+        );
         let e = c.sigma_a_estimate().unwrap();
         assert_eq!((e.fit, e.spectro), (Some(0.001), None));
         c.sigma_a = None;

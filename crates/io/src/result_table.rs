@@ -197,17 +197,15 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
     let notes: Vec<String> = results
         .iter()
         .flat_map(|r| {
-            r.channels
-                .iter_channels()
-                .filter_map(move |(n, c)| {
-                    c.problem.as_ref().map(|p| {
-                        format!(
-                            "- {} {n}: {}",
-                            crate::escape::markdown_cell(&r.name),
-                            crate::escape::markdown_cell(p)
-                        )
-                    })
+            r.channels.iter_channels().filter_map(move |(n, c)| {
+                c.problem.as_ref().map(|p| {
+                    format!(
+                        "- {} {n}: {}",
+                        crate::escape::markdown_cell(&r.name),
+                        crate::escape::markdown_cell(p)
+                    )
                 })
+            })
         })
         .collect();
     let errors = errors_note(results);

@@ -185,27 +185,23 @@ impl<'a> SampleFiles<'a> {
     }
 
     /// Refuses settings the folder cannot be written with, before any file is written.
-    fn check(&self) -> Result<(), SampleFolderError> {
+    fn check(&self, frames: usize) -> Result<(), SampleFolderError> {
         let invalid = |field, detail: String| SampleFolderError::Invalid {
             name: crate::escape::token(self.name),
             field,
             detail,
         };
-        if self.frames.len() < 2 {
+        if frames < 2 {
             return Err(invalid(
                 "bracket",
-                format!(
-                    "{} frame(s): a bracket needs at least two exposures",
-                    self.frames.len()
-                ),
+                format!("{frames} frame(s): a bracket needs at least two exposures"),
             ));
         }
-        if self.frames.len() != self.times_s.len() {
+        if frames != self.times_s.len() {
             return Err(invalid(
                 "bracket",
                 format!(
-                    "{} frames but {} shutter times: give one time per frame",
-                    self.frames.len(),
+                    "{frames} frames but {} shutter times: give one time per frame",
                     self.times_s.len()
                 ),
             ));
@@ -253,6 +249,30 @@ pub fn file_names(frames: usize, truth: bool) -> Vec<String> {
     v
 }
 
+/// What a real camera adds to a sample folder (issue 16): linear frames instead of the 8-bit ones, a
+/// flat frame, a spot image, and the `[camera]` keys that name them. Default: nothing.
+#[derive(Debug, Clone, Default)]
+pub struct CameraFiles {
+    /// Linear 16-bit frames (written instead of [`SampleFiles::frames`] when not empty), shortest
+    /// first, at [`SampleFiles::times_s`].
+    pub frames_u16: Vec<ImageBuf<u16>>,
+    /// Write `frames_u16` as DNG files (with these black and white levels and each frame's
+    /// exposure time in the metadata) instead of 16-bit PNG.
+    pub dng_levels: Option<([u16; 3], u16)>,
+    /// A flat frame (`flat.png`, `camera.flat`).
+    pub flat: Option<CameraFrame>,
+    /// The spot on a thin opaque white target (`spot.png`, `camera.spot_image`).
+    pub spot_image: Option<CameraFrame>,
+    /// `camera.spot_profile` (e.g. "gaussian").
+    pub spot_profile: Option<crate::manifest::SpotProfileName>,
+}
+
+/// The frame files of a bracket of `frames` frames: `frame_NN.png`, or `.dng`.
+fn frame_names(frames: usize, dng: bool) -> Vec<String> {
+    let ext = if dng { "dng" } else { "png" };
+    (0..frames).map(|j| format!("frame_{j:02}.{ext}")).collect()
+}
+
 /// Writes the folder (created if missing). Every file is written atomically; the manifest last, so
 /// a folder with a `sample.toml` is complete.
 ///
@@ -263,7 +283,24 @@ pub fn write_sample_folder(
     dir: &Path,
     s: &SampleFiles<'_>,
 ) -> Result<Vec<PathBuf>, SampleFolderError> {
-    s.check()?;
+    write_sample_folder_with(dir, s, &CameraFiles::default())
+}
+
+/// [`write_sample_folder`] with a real camera's files ([`CameraFiles`]).
+///
+/// # Errors
+/// As [`write_sample_folder`].
+pub fn write_sample_folder_with(
+    dir: &Path,
+    s: &SampleFiles<'_>,
+    extra: &CameraFiles,
+) -> Result<Vec<PathBuf>, SampleFolderError> {
+    let frame_count = if extra.frames_u16.is_empty() {
+        s.frames.len()
+    } else {
+        extra.frames_u16.len()
+    };
+    s.check(frame_count)?;
     std::fs::create_dir_all(dir).map_err(|source| SampleFolderError::CreateDir {
         path: dir.to_path_buf(),
         source,
@@ -272,13 +309,44 @@ pub fn write_sample_folder(
     let spectro = dir.join("spectro.csv");
     crate::spectro::write_spectro_csv(&spectro, s.reading, s.provenance)?;
     written.push(spectro);
-    let names: Vec<String> = (0..s.frames.len())
-        .map(|j| format!("frame_{j:02}.png"))
-        .collect();
-    s.frames.par_iter().zip(&names).try_for_each(|(f, name)| {
-        crate::image_files::write_camera_frame(&dir.join(name), &CameraFrame::U8(f.clone()))
-    })?;
+    let names: Vec<String> = if extra.frames_u16.is_empty() {
+        let names = frame_names(s.frames.len(), false);
+        s.frames.par_iter().zip(&names).try_for_each(|(f, name)| {
+            crate::image_files::write_camera_frame(&dir.join(name), &CameraFrame::U8(f.clone()))
+        })?;
+        names
+    } else {
+        let names = frame_names(extra.frames_u16.len(), extra.dng_levels.is_some());
+        extra
+            .frames_u16
+            .par_iter()
+            .zip(&names)
+            .zip(s.times_s)
+            .try_for_each(|((f, name), &t)| match extra.dng_levels {
+                Some((black, white)) => crate::raw::write_dng(
+                    &dir.join(name),
+                    f,
+                    &crate::raw::DngInfo {
+                        black_level: black,
+                        white_level: white,
+                        exposure_time_s: t,
+                    },
+                ),
+                None => crate::image_files::write_camera_frame(
+                    &dir.join(name),
+                    &CameraFrame::U16(f.clone()),
+                ),
+            })?;
+        names
+    };
     written.extend(names.iter().map(|n| dir.join(n)));
+    for (name, frame) in [("flat.png", &extra.flat), ("spot.png", &extra.spot_image)] {
+        if let Some(f) = frame {
+            let path = dir.join(name);
+            crate::image_files::write_camera_frame(&path, f)?;
+            written.push(path);
+        }
+    }
     let exposures = dir.join("exposures.csv");
     let entries: Vec<(String, f64)> = names
         .iter()
@@ -312,6 +380,9 @@ pub fn write_sample_folder(
             exposures: Some("exposures.csv".into()),
             mm_per_pixel: Some(s.mm_per_pixel),
             spot_diameter_mm: Some(s.spot_diameter_mm),
+            flat: extra.flat.as_ref().map(|_| "flat.png".into()),
+            spot_image: extra.spot_image.as_ref().map(|_| "spot.png".into()),
+            spot_profile: extra.spot_profile,
             ..Default::default()
         },
         fit: s.fit.clone(),
@@ -371,8 +442,7 @@ mod tests {
         assert_eq!(m.camera.mm_per_pixel, Some(0.25));
         assert_eq!(m.camera.spot_diameter_mm, Some(0.8));
         assert_eq!(m.fit.model, fit.model);
-        let listed =
-            crate::bracket::read_exposures_csv(&dir.path().join("exposures.csv")).unwrap();
+        let listed = crate::bracket::read_exposures_csv(&dir.path().join("exposures.csv")).unwrap();
         let listed_times: Vec<f64> = listed.iter().map(|e| e.time_s).collect();
         assert_eq!(listed_times, times);
     }
@@ -392,15 +462,29 @@ mod tests {
         let base = SampleFiles::new("s", &reading).bracket(&frames, &[0.1, 1.0]);
         assert_eq!(field(base.clone().write(&target)), "mm_per_pixel");
         assert_eq!(
-            field(base.clone().mm_per_pixel(0.1).spot_diameter_mm(0.0).write(&target)),
+            field(
+                base.clone()
+                    .mm_per_pixel(0.1)
+                    .spot_diameter_mm(0.0)
+                    .write(&target)
+            ),
             "spot_diameter_mm"
         );
         assert_eq!(
-            field(base.clone().bracket(&frames, &[0.1]).mm_per_pixel(0.1).write(&target)),
+            field(
+                base.clone()
+                    .bracket(&frames, &[0.1])
+                    .mm_per_pixel(0.1)
+                    .write(&target)
+            ),
             "bracket"
         );
         assert_eq!(
-            field(SampleFiles::new("s", &reading).mm_per_pixel(0.1).write(&target)),
+            field(
+                SampleFiles::new("s", &reading)
+                    .mm_per_pixel(0.1)
+                    .write(&target)
+            ),
             "bracket"
         );
         let err = base.write(&target).unwrap_err().to_string();

@@ -102,7 +102,10 @@ mod tests {
             g: Some(12.0),
         };
         assert_eq!(e.total(), Some(13.0));
-        assert_eq!(Estimate::new(7.0).with_fit(3.0).with_spectro(4.0).total(), Some(5.0));
+        assert_eq!(
+            Estimate::new(7.0).with_fit(3.0).with_spectro(4.0).total(),
+            Some(5.0)
+        );
         assert_eq!(Estimate::new(7.0).with_spectro(0.5).total(), Some(0.5));
         assert_eq!(Estimate::new(7.0).with_fit(0.0).total(), Some(0.0));
         assert_eq!(Estimate::new(7.0).total(), None);

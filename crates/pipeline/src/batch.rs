@@ -129,11 +129,7 @@ impl BatchRequest {
         let mut sizes: Vec<u64> = self
             .samples
             .iter()
-            .map(|s| {
-                s.inputs
-                    .as_ref()
-                    .map_or(0, SampleInputs::peak_memory_bytes)
-            })
+            .map(|s| s.inputs.as_ref().map_or(0, SampleInputs::peak_memory_bytes))
             .collect();
         sizes.sort_unstable_by(|a, b| b.cmp(a));
         let mut jobs = requested;
@@ -280,7 +276,8 @@ mod tests {
     #[test]
     fn jobs_fit_the_memory_budget() {
         let dir = tempfile::tempdir().unwrap();
-        let missing = |k: usize| BatchSample::new(dir.path().join(format!("none{k}")), Overrides::default());
+        let missing =
+            |k: usize| BatchSample::new(dir.path().join(format!("none{k}")), Overrides::default());
         let request = BatchRequest::from_samples((0..3).map(missing).collect()).jobs(8);
         let plan = request.plan();
         assert_eq!((plan.requested, plan.jobs, plan.memory_needed), (3, 3, 0));
@@ -296,11 +293,17 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let dirs: Vec<PathBuf> = (0..4).map(|k| dir.path().join(format!("s{k}"))).collect();
         let seen = std::sync::Mutex::new(Vec::new());
-        let outcome = measure_batch(BatchRequest::new(dirs.clone(), Overrides::default()).jobs(2), &|e| {
-            if let BatchEvent::Finished { finished, total, .. } = e {
-                seen.lock().unwrap().push((finished, total));
-            }
-        })
+        let outcome = measure_batch(
+            BatchRequest::new(dirs.clone(), Overrides::default()).jobs(2),
+            &|e| {
+                if let BatchEvent::Finished {
+                    finished, total, ..
+                } = e
+                {
+                    seen.lock().unwrap().push((finished, total));
+                }
+            },
+        )
         .unwrap();
         let got: Vec<&PathBuf> = outcome.samples.iter().map(|s| &s.dir).collect();
         assert_eq!(got, dirs.iter().collect::<Vec<_>>());

@@ -51,7 +51,11 @@ pub fn compare_measurement(proposed: Measurement, exact: bool) -> Result<Compare
 ///
 /// # Errors
 /// As [`crate::measure_inputs`] and [`compare_measurement`].
-pub fn compare_sample(inputs: &SampleInputs, overrides: &Overrides, exact: bool) -> Result<Compared> {
+pub fn compare_sample(
+    inputs: &SampleInputs,
+    overrides: &Overrides,
+    exact: bool,
+) -> Result<Compared> {
     let overrides = overrides.method(Method::Proposed);
     compare_measurement(measure_inputs(inputs, &overrides, &|_| {})?, exact)
 }

@@ -37,6 +37,7 @@
 #![forbid(unsafe_code)]
 
 pub mod batch;
+pub mod camera;
 pub mod compare;
 mod error;
 pub mod fit;
@@ -58,12 +59,12 @@ pub use measure::{
     Measurement, Overrides, Stage, Timings, fit_settings, measure_inputs, measure_sample,
 };
 pub use samples::{SampleDirs, SampleInputs, misspelt_manifest, sample_dirs, sample_inputs};
-/// The one name → forward model factory (the Monte Carlo tables live in `scatterfit_mc`).
-pub use scatterfit_mc::{albedo_family, family};
 /// What a result file holds, and where its named values come from.
 pub use scatterfit_io::result_json::{
     AlbedoSource, ChannelResult, ChannelStatus, EtaSource, MeasurementResult, ResponseKind,
 };
+/// The one name → forward model factory (the Monte Carlo tables live in `scatterfit_mc`).
+pub use scatterfit_mc::{albedo_family, family};
 /// The vocabulary a program using the pipeline needs: what to fit with, per-channel values, and
 /// a value with its uncertainty terms.
 pub use scatterfit_optics::{AlbedoModel, Channel, Estimate, Method, ModelFamily, ModelName, Rgb};

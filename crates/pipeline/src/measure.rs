@@ -4,19 +4,20 @@
 use std::path::Path;
 use std::time::Instant;
 
-use scatterfit_io::manifest::SampleManifest;
-use scatterfit_io::result_json::{
-    AlbedoSource, FileRef, Inputs, MeasurementResult, RunOptions,
-};
+use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest};
+use scatterfit_io::result_json::{AlbedoSource, FileRef, Inputs, MeasurementResult, RunOptions};
 use scatterfit_mc::{albedo_family, family};
 use scatterfit_optics::{AlbedoModel, Estimate, Method, ModelName, Rgb};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
-use crate::fit::{ChannelOutcome, FitSettings, channel_result, fit_and_propagate, fit_stage};
+use crate::fit::{
+    ChannelOutcome, FitSettings, SpotShape, channel_result, fit_and_propagate, fit_stage,
+};
+use crate::hdr::BlackLevel;
 use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
-use crate::profile::{ProfileSettings, ProfileStage, profile_stage};
+use crate::profile::{ProfileSettings, ProfileStage, profile_stage_with};
 use crate::samples::{SampleInputs, sample_inputs};
 use crate::spectro::{SpectroStage, spectro_stage};
 
@@ -179,11 +180,23 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
             "normalising with the spectrophotometer applies to the proposed method only".into(),
         ));
     }
+    // The spot: a disk (the paper's), or a Gaussian of that 1/e² diameter (issue 16); a spot
+    // image replaces this once the bracket is merged (measure_sample).
+    let diameter = manifest.camera.spot_diameter_mm.unwrap_or(1.0);
+    let (spot, spot_radius_mm) = match manifest.camera.spot_profile {
+        Some(scatterfit_io::manifest::SpotProfileName::Gaussian) => {
+            let s = scatterfit_fit::RadialSpot::gaussian(0.5 * diameter)
+                .map_err(|e| PipelineError::Input(format!("camera.spot_profile: {e}")))?;
+            (SpotShape::Radial(s), s.radius_enclosing(0.99))
+        }
+        _ => (SpotShape::Disk, 0.5 * diameter),
+    };
     Ok(FitSettings {
         method,
         model,
         albedo_model,
-        spot_radius_mm: 0.5 * manifest.camera.spot_diameter_mm.unwrap_or(1.0),
+        spot,
+        spot_radius_mm,
         r_min_mm: manifest.fit.r_min_mm,
         normalise_with_spectro: normalise,
     })
@@ -255,6 +268,15 @@ fn measure_from(
                 .as_ref()
                 .map(|p| manifest.resolve(p));
             inputs.dark = manifest.camera.dark.as_ref().map(|p| manifest.resolve(p));
+            // A real camera (issue 16): black level, shutter times, flat frame.
+            inputs.flat = manifest.camera.flat.as_ref().map(|p| manifest.resolve(p));
+            inputs.exposure_correction = manifest.camera.exposure_correction.unwrap_or_default();
+            inputs.black_level = match manifest.camera.black_level {
+                None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
+                Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
+                Some(BlackLevelSetting::One(v)) => BlackLevel::Given(vec![v]),
+                Some(BlackLevelSetting::PerChannel(v)) => BlackLevel::Given(v.to_vec()),
+            };
             // Pixels dark in every frame are evidence of radiance below the first code: keep them
             // as 0 so far rings are not averaged over their brighter pixels only; pixels saturated
             // everywhere are masked out by the profile stage.
@@ -266,7 +288,7 @@ fn measure_from(
     };
     let t_profile = Instant::now();
     progress(Stage::Profile);
-    let profile = profile_stage(
+    let profile = profile_stage_with(
         &hdr.hdr.radiance,
         Some(&hdr.hdr.clipped),
         &hdr.detection_limit,
@@ -276,7 +298,18 @@ fn measure_from(
             ring_width_px: 1.0,
             center_px: manifest.camera.center_px,
         },
+        manifest.camera.background.unwrap_or_default(),
     )?;
+    let mut settings = settings;
+    if let Some(p) = &manifest.camera.spot_image {
+        let s = crate::hdr::spot_kernel_from_image(
+            &manifest.resolve(p),
+            &hdr,
+            manifest.camera.mm_per_pixel.unwrap_or(f64::NAN),
+        )?;
+        settings.spot = SpotShape::Radial(s);
+        settings.spot_radius_mm = s.radius_enclosing(0.99);
+    }
     let profile_s = t_profile.elapsed().as_secs_f64();
     let data = profile.rgb_data()?;
     progress(Stage::Fit);
@@ -440,11 +473,30 @@ impl Measurement {
                             .map(|v| v.is_finite().then_some(*v))
                             .collect(),
                     ),
+                    camera: Some(serde_json::json!({
+                        "corrections": self.hdr.corrections,
+                        "background": self.profile.background,
+                    })),
                 },
             },
             version: env!("CARGO_PKG_VERSION").into(),
+            rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()),
         }
     }
+}
+
+/// The SCE spectrum the channels' Rd came from (issue 18: spectral renderers need it), when the
+/// colour came from the spectrum rather than a measured L*a*b*.
+fn rd_spectrum(
+    analysis: Option<&scatterfit_optics::spectro::SpectroAnalysis>,
+) -> Option<scatterfit_io::result_json::RdSpectrum> {
+    let a = analysis?;
+    (a.colour_source == scatterfit_optics::spectro::ColourSource::SceSpectrum).then(|| {
+        scatterfit_io::result_json::RdSpectrum {
+            wavelength_nm: a.spectral.iter().map(|p| p.wavelength_nm).collect(),
+            rd: a.spectral.iter().map(|p| p.sce).collect(),
+        }
+    })
 }
 
 /// SHA-256 of a file's bytes, lower-case hex (`None` when it cannot be read: missing, not a
@@ -456,4 +508,3 @@ pub fn hash_file(path: &Path) -> Option<String> {
     let digest = Sha256::digest(&bytes);
     Some(digest.iter().map(|b| format!("{b:02x}")).collect())
 }
-

@@ -70,6 +70,7 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
         model: request.model,
         albedo_model: AlbedoModel::Diffusion,
         spot_radius_mm: 0.5 * request.spot_diameter_mm,
+        spot: crate::fit::SpotShape::Disk,
         r_min_mm: request.r_min_mm,
         normalise_with_spectro: request.normalise_with_spectro,
     };
@@ -117,6 +118,7 @@ impl ProfileFit {
                 ..Inputs::default()
             },
             version: env!("CARGO_PKG_VERSION").into(),
+            rd_spectrum: None,
         }
     }
 }

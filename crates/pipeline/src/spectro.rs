@@ -289,11 +289,7 @@ fn from_rd(reading: Reading, albedo: &dyn ModelFamily) -> SpectroStage {
     let problems = inverted.map(std::result::Result::err);
     let rd_pm = rd.map(|r| [r * (1.0 - repeatability), r * (1.0 + repeatability)]);
     let albedo_pm = rd_pm.map(|rd_pm| {
-        std::array::from_fn(|k| {
-            albedo
-                .albedo_from_rd(rd_pm[k], eta_pm[k], ISOTROPIC)
-                .ok()
-        })
+        std::array::from_fn(|k| albedo.albedo_from_rd(rd_pm[k], eta_pm[k], ISOTROPIC).ok())
     });
     let albedo_prime_stderr = albedo_pm.map(|pm| match pm {
         [Some(a0), Some(a1)] => Some(0.5 * (a1 - a0).abs()),

@@ -3,7 +3,8 @@
 //! approximate.
 
 use super::{
-    CHANNEL_LABELS, CHANNEL_NAMES, RendererParameters, joined, largest, num, provenance_line,
+    CHANNEL_LABELS, CHANNEL_NAMES, MaterialNames, Renderer, RendererParameters, joined, largest,
+    model_header, num, provenance_line, python_docstring_text, python_literal,
 };
 
 /// Largest reduced albedo used for the Blender radius: σa = 0 would make the diffusion length
@@ -24,13 +25,15 @@ pub const BLENDER_MAX_ALBEDO: f64 = 0.999_999;
 ///   1/(4π) ("to look like the older Cubic/Gaussian/Burley models"), i.e. 1/σ′t = radius/(4π).
 ///
 /// We use the Skin mode, whose radius is a physical quantity the measurement gives:
-/// - **Subsurface Radius · Subsurface Scale = ℓ = 1/σtr = 1/√(3σaσ′t)** per channel (α′ capped at
-///   [`BLENDER_MAX_ALBEDO`] for σa = 0). The radius is written normalised to a largest component of 1
-///   and its magnitude, in scene units, is the Subsurface Scale — Blender's own split (a colour-like
-///   radius and a distance). Cycles then recovers our 1/σ′t exactly when Base Color is the dipole's
-///   Rd(α′) — results measured with `albedo_model = diffusion` — and within the dipole's albedo bias
-///   otherwise. 1/σ′t itself would be the wrong length here: Cycles would read it as a diffusion length
-///   √(3(1 − α′)) times too short (18× at α′ = 0.999).
+/// - **Subsurface Radius · Subsurface Scale = ℓ = (1/σ′t)/√(3(1 − α′d))** per channel, where α′d is
+///   the classical dipole's albedo of Base Color at η (`scatterfit_optics::dipole::albedo_from_rd`,
+///   the inversion Cycles itself makes): Cycles then recovers exactly our mean free path 1/σ′t,
+///   whatever the result's albedo model. For a result whose α′ came from the dipole (α′d = α′) this is
+///   the diffusion length 1/σtr = 1/√(3σaσ′t). (α′d is capped at [`BLENDER_MAX_ALBEDO`].) The radius is
+///   written normalised to a largest component of 1 and its magnitude, in scene units, is the
+///   Subsurface Scale — Blender's own split (a colour-like radius and a distance). 1/σ′t itself would
+///   be the wrong length here: Cycles would read it as a diffusion length √(3(1 − α′)) times too short
+///   (18× at α′ = 0.999).
 /// - **Base Color = Rd** per channel, the measured total diffuse reflectance in linear sRGB (Blender's
 ///   default scene-linear space has the sRGB primaries).
 /// - Subsurface IOR = IOR = η; Subsurface Anisotropy = 0; Subsurface Weight = 1; Roughness = 0 (a
@@ -52,7 +55,8 @@ pub struct BlenderValues {
     pub subsurface_radius: [f64; 3],
     /// Subsurface Scale [scene units]: the largest diffusion length.
     pub subsurface_scale: f64,
-    /// Diffusion length ℓ = 1/σtr per channel [scene units] (= radius · scale).
+    /// The length Cycles reads as the diffusion length, ℓ = (1/σ′t)/√(3(1 − α′d)) per channel [scene
+    /// units] (= radius · scale; 1/σtr for a dipole-albedo result).
     pub diffusion_length: [f64; 3],
     /// Transport mean free path 1/σ′t per channel [scene units], for reference.
     pub mfp: [f64; 3],
@@ -65,15 +69,22 @@ impl BlenderValues {
     pub fn new(params: &RendererParameters) -> Self {
         let chans = params.channels.as_array();
         let mfp = chans.map(|c| c.mfp);
-        // ℓ = 1/σtr = (1/σ′t)/√(3(1 − α′)) (Jensen et al. 2001, §2.4), α′ capped.
-        let diffusion_length =
-            chans.map(|c| c.mfp / (3.0 * (1.0 - c.albedo.min(BLENDER_MAX_ALBEDO))).sqrt());
+        let base_color = chans.map(|c| {
+            c.rd_total
+                .unwrap_or_else(|| scatterfit_optics::dipole::rd_total(c.albedo, params.eta))
+        });
+        // α′d: the classical dipole's albedo of Base Color, as Cycles inverts it (Jensen et al. 2001,
+        // eq. 5 with the Fdr polynomial); the channel's α′ where Rd cannot be inverted (Rd = 0).
+        let alpha_d = [0, 1, 2].map(|k| {
+            scatterfit_optics::dipole::albedo_from_rd(base_color[k], params.eta)
+                .unwrap_or(chans[k].albedo)
+                .min(BLENDER_MAX_ALBEDO)
+        });
+        // ℓ = (1/σ′t)/√(3(1 − α′d)): Cycles' 1/σ′t = ℓ √(3(1 − α′d)) is then ours.
+        let diffusion_length = [0, 1, 2].map(|k| mfp[k] / (3.0 * (1.0 - alpha_d[k])).sqrt());
         let scale = largest(diffusion_length);
         Self {
-            base_color: chans.map(|c| {
-                c.rd_total
-                    .unwrap_or_else(|| scatterfit_optics::dipole::rd_total(c.albedo, params.eta))
-            }),
+            base_color,
             subsurface_radius: diffusion_length.map(|l| l / scale),
             subsurface_scale: scale,
             diffusion_length,
@@ -89,7 +100,7 @@ impl BlenderValues {
 pub fn blender_script(params: &RendererParameters, v: &BlenderValues) -> String {
     let u = params.unit.symbol();
     let chans = params.channels.as_array();
-    let name_literal = python_string(&params.name);
+    let names = MaterialNames::new(&params.name);
     let triple = |x: [f64; 3]| format!("({})", joined(x, py_num, ", "));
     let mut rows = String::new();
     for (k, label) in CHANNEL_LABELS.iter().enumerate() {
@@ -103,35 +114,42 @@ pub fn blender_script(params: &RendererParameters, v: &BlenderValues) -> String 
             num(chans[k].sigma_s),
         ));
     }
+    let model_notes: String = model_header(params, &[Renderer::Cycles])
+        .iter()
+        .map(|l| super::wrap(&python_docstring_text(l), 100) + "\n")
+        .collect();
     format!(
         r#""""scatterfit export for Blender (Cycles, Principled BSDF, Blender 4.0 or newer): {title}
 
 {provenance}
 Scene unit: 1 Blender unit = 1 {u}. Run with `blender --python THIS.py` or from the Text Editor;
-it creates (or updates) the material and leaves assigning it to objects to you.
+it creates (or updates) the material {blender_name} and leaves assigning it to objects to you.
 
-| channel | Base Color = Rd (linear sRGB) | 1/sigma_tr [{u}] | Subsurface Radius | 1/sigma_t' [{u}] | sigma_a [1/{u}] | sigma_s' [1/{u}] |
+| channel | Base Color = Rd (linear sRGB) | radius * scale [{u}] | Subsurface Radius | 1/sigma_t' [{u}] | sigma_a [1/{u}] | sigma_s' [1/{u}] |
 |---|---|---|---|---|---|---|
 {rows}
-Subsurface Scale = {scale} {u} (the largest diffusion length 1/sigma_tr); IOR = Subsurface IOR = eta =
-{ior} (relative to air). Subsurface Weight = 1, Subsurface Anisotropy = 0, Roughness = 0 (smooth),
-method Random Walk (Skin).
+Subsurface Scale = {scale} {u}; IOR = Subsurface IOR = eta = {ior} (relative to air).
+Subsurface Weight = 1, Subsurface Anisotropy = 0, Roughness = 0 (smooth), method Random Walk (Skin).
 
-Mapping: in Random Walk (Skin) mode Cycles reads Subsurface Radius * Scale as the diffusion length
-1/sigma_tr and recovers the mean free path 1/sigma_t' from it with the classical dipole's albedo of
-Base Color and Subsurface IOR (Jensen et al. 2001) - exactly scatterfit's sigma_t' when the result's
-albedo model is the dipole. Base Color is the measured diffuse reflectance Rd.
+Mapping: in Random Walk (Skin) mode Cycles reads Subsurface Radius * Scale as a diffusion length and
+recovers the mean free path 1/sigma_t' from it with the classical dipole's albedo of Base Color and
+Subsurface IOR (Jensen et al. 2001); the radius is chosen so that this gives scatterfit's 1/sigma_t'
+(for a result whose albedo came from the dipole it is the diffusion length 1/sigma_tr). Base Color
+is the measured diffuse reflectance Rd.
 Approximate: Cycles derives the walk's single-scattering albedo from Base Color with its own fit
 (Chiang, Kutz & Burley 2016), lower than exact transport behind a Fresnel boundary needs; measured with
-Blender 4.2, renders come out 6-9 % darker in total reflectance and less translucent (the glow beyond
-a shadow edge decays 1.25-1.7x faster) than the measured material. For exact transport use the Mitsuba
-or pbrt volumetric export.
-"""
+Blender 4.2 and 5.0, renders come out 6-9 % darker in total reflectance at eta 1.4 (albedos 0.8-0.95),
+1-13 % darker for the demo's seven materials (11-13 % at eta 1.9-2.4), and less translucent (the glow
+beyond a shadow edge decays 1.25-1.7x faster) than the measured material. Base Color carries the
+colour, so this holds whatever model the result was measured with. For exact transport use the
+Mitsuba or pbrt volumetric export.
+{model_notes}"""
 
 import bpy
 
 VALUES = {{
-    "material": {name_literal},
+    "material": {material},
+    "name": {full_name},
     "base_color": {base},
     "subsurface_radius": {radius},
     "subsurface_scale": {scale},
@@ -142,7 +160,9 @@ VALUES = {{
 def apply(values=VALUES):
     """Creates or updates the material `values["material"]` and returns it."""
     mat = bpy.data.materials.get(values["material"]) or bpy.data.materials.new(values["material"])
-    mat.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        # Blender 5.0 deprecates Material.use_nodes (removed in 6.0): materials always use nodes.
+        mat.use_nodes = True
     nodes = mat.node_tree.nodes
     bsdf = next((n for n in nodes if n.type == "BSDF_PRINCIPLED"), None)
     if bsdf is None:
@@ -175,8 +195,11 @@ def apply(values=VALUES):
 if __name__ == "__main__":
     print("scatterfit: material", repr(apply().name), "set")
 "#,
-        title = python_docstring_text(&format!("\"{}\"", params.name)),
+        title = python_docstring_text(&format!("\"{}\"", names.display)),
         provenance = python_docstring_text(&provenance_line(params)),
+        blender_name = python_docstring_text(&format!("\"{}\"", names.blender)),
+        material = python_literal(&names.blender),
+        full_name = python_literal(&params.name),
         base = triple(v.base_color),
         radius = triple(v.subsurface_radius),
         scale = py_num(v.subsurface_scale),
@@ -210,61 +233,107 @@ fn py_num(x: f64) -> String {
     }
 }
 
-/// A Python string literal for `text` (JSON string syntax is valid Python for these characters).
-fn python_string(text: &str) -> String {
-    serde_json::to_string(text).unwrap_or_else(|_| "\"material\"".into())
-}
-
-/// Text safe inside a Python triple-quoted docstring: no `"""`, no backslashes, no control characters.
-fn python_docstring_text(text: &str) -> String {
-    let s: String = text
-        .chars()
-        .map(|c| match c {
-            '\\' => '/',
-            c if c.is_control() => ' ',
-            c => c,
-        })
-        .collect();
-    s.replace("\"\"\"", "'''")
-}
-
 #[cfg(test)]
 mod tests {
-    use super::super::fixtures::{close, marble};
+    use super::super::fixtures::{SA, SP, close, marble};
     use super::super::{Format, SceneUnit, export};
     use super::*;
 
-    /// Blender: radius · scale = 1/σtr in scene units (docs/physics.md §1.5: the marble's 1/σtr is
-    /// 8.509, 5.566, 3.951 mm), base colour = the measured Rd.
+    /// Blender: radius · scale = 1/σtr in scene units for a result whose Rd is the dipole's
+    /// (docs/physics.md §1.5: the marble's 1/σtr is 8.509, 5.566, 3.951 mm; its Rd is the dipole's
+    /// at η = 1.5 to 4 digits), base colour = the measured Rd.
     #[test]
     fn blender_values_and_script() {
-        let r = marble();
+        let mut r = marble();
+        for (k, c) in [&mut r.channels.r, &mut r.channels.g, &mut r.channels.b]
+            .into_iter()
+            .enumerate()
+        {
+            c.rd_total = Some(scatterfit_optics::dipole::rd_total(
+                SP[k] / (SP[k] + SA[k]),
+                1.5,
+            ));
+        }
         for (unit, k) in [(SceneUnit::Millimetre, 1.0), (SceneUnit::Metre, 1000.0)] {
             let (p, _) = RendererParameters::from_result(&r, unit).unwrap();
             let v = BlenderValues::new(&p);
             for (c, want_mm) in [8.509, 5.566, 3.951].into_iter().enumerate() {
                 let got_mm = v.subsurface_radius[c] * v.subsurface_scale * k;
                 assert!((got_mm - want_mm).abs() < 5e-4, "{got_mm}");
+                let sigma_tr = (3.0 * SA[c] * (SA[c] + SP[c])).sqrt();
+                assert!(close(got_mm, 1.0 / sigma_tr, 1e-9), "{got_mm}");
                 assert!(v.subsurface_radius[c] <= 1.0);
             }
-            assert_eq!(v.base_color, [0.8302, 0.7910, 0.7526]);
+            assert_eq!(v.base_color, p.per_channel(|c| c.rd_total.unwrap()));
             let text = export(&r, Format::Blender, unit).unwrap().text;
             assert!(text.contains("\"subsurface_scale\": "));
             assert!(text.contains("bsdf.subsurface_method = \"RANDOM_WALK_SKIN\""));
             assert!(text.contains("\"material\": \"marble\""));
+            assert!(text.contains("if bpy.app.version < (5, 0, 0):"), "{text}");
             assert!(text.contains(&format!("1 Blender unit = 1 {}", unit.symbol())));
         }
-        // σa = 0: the diffusion length is capped, not infinite.
+        // σa = 0: the length comes from Base Color's dipole albedo, finite.
         let mut r = marble();
         r.channels.g.sigma_a = Some(0.0);
         let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
         let v = BlenderValues::new(&p);
         assert!(v.subsurface_scale.is_finite());
+        let alpha_d = scatterfit_optics::dipole::albedo_from_rd(0.7910, 1.5).unwrap();
         assert!(close(
             v.diffusion_length[1],
-            1.0 / 2.62 / (3e-6_f64).sqrt(),
-            1e-6
+            1.0 / 2.62 / (3.0 * (1.0 - alpha_d)).sqrt(),
+            1e-9
         ));
+        // A black channel (Rd = 0) and σa = 0 with Rd = 1: still finite.
+        r.channels.g.rd_total = Some(1.0);
+        r.channels.b.rd_total = Some(0.0);
+        let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
+        let v = BlenderValues::new(&p);
+        assert!(v.diffusion_length.iter().all(|l| l.is_finite() && *l > 0.0));
+    }
+
+    /// Cycles' own inversion: with Base Color = Rd and radius · scale = ℓ, Cycles sets 1/σ′t =
+    /// ℓ √(3(1 − α′d(Rd))); that must be the result's 1/σ′t for any albedo model (here an α′ whose Rd
+    /// is not the dipole's, as `albedo_model = mc` gives).
+    #[test]
+    fn cycles_recovers_our_mean_free_path() {
+        let mut r = marble();
+        r.channels.r.rd_total = Some(0.6);
+        let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
+        let v = BlenderValues::new(&p);
+        for k in 0..3 {
+            let a = scatterfit_optics::dipole::albedo_from_rd(v.base_color[k], 1.5).unwrap();
+            let mfp = v.diffusion_length[k] * (3.0 * (1.0 - a)).sqrt();
+            assert!(close(mfp, 1.0 / (SA[k] + SP[k]), 1e-12), "{k}");
+        }
+    }
+
+    /// Blender names: the name itself when clean, a hashed one within 63 bytes otherwise, written as
+    /// an ASCII Python literal.
+    #[test]
+    fn blender_names_fit_and_stay_apart() {
+        let long = "é".repeat(40);
+        let mut r = marble();
+        r.name = long.clone();
+        let text = export(&r, Format::Blender, SceneUnit::Millimetre)
+            .unwrap()
+            .text;
+        let names = MaterialNames::new(&long);
+        assert!(names.blender.len() <= 63, "{}", names.blender);
+        assert!(
+            names
+                .blender
+                .ends_with(&format!(" #{}", super::super::name_hash(&long)))
+        );
+        assert!(text.contains(&format!("\"material\": {}", python_literal(&names.blender))));
+        assert!(text.is_ascii() || !text.contains("\"material\": \"é"));
+        assert_eq!(MaterialNames::new("marble").blender, "marble");
+        // A clean name that looks hashed gets its own hash: it cannot take another's material.
+        let tricky = format!("x #{}", super::super::name_hash("x\n"));
+        assert_ne!(
+            MaterialNames::new(&tricky).blender,
+            MaterialNames::new("x\n").blender
+        );
     }
 
     /// Without rd_total the base colour falls back to the dipole's Rd, with a warning: at the marble's
@@ -274,8 +343,13 @@ mod tests {
         let mut r = marble();
         r.channels.r.rd_total = None;
         let e = export(&r, Format::Blender, SceneUnit::Millimetre).unwrap();
-        assert_eq!(e.warnings.len(), 1, "{:?}", e.warnings);
-        assert!(e.warnings[0].contains("channel r"));
+        let w: Vec<&String> = e
+            .warnings
+            .iter()
+            .filter(|w| w.contains("rd_total"))
+            .collect();
+        assert_eq!(w.len(), 1, "{:?}", e.warnings);
+        assert!(w[0].contains("channel r"));
         let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
         assert!((BlenderValues::new(&p).base_color[0] - 0.83019146).abs() < 1e-7);
     }

@@ -2,7 +2,8 @@
 //! `dielectric` boundary and a `homogeneous` medium.
 
 use super::{
-    RendererParameters, channel_table_comment, identifier, joined, largest, num, provenance_line,
+    MaterialNames, Renderer, RendererParameters, channel_table_comment, joined, largest,
+    model_header, num, provenance_line, wrap, xml_comment,
 };
 
 /// A Mitsuba 3 XML scene fragment: a `<scene>` holding a `dielectric` BSDF (`int_ior` = η, `ext_ior` = 1)
@@ -17,7 +18,26 @@ use super::{
 /// documentation recommends it for subsurface scattering). The usage comment names the `rr_depth` the
 /// integrator needs for this albedo ([`roulette_depth`]).
 pub fn mitsuba_fragment(params: &RendererParameters) -> String {
-    let id = identifier(&params.name);
+    mitsuba_fragment_for(params, MitsubaVariant::Rgb)
+}
+
+/// Which of Mitsuba's variants a fragment is for: it decides the medium `<id>_medium` holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum MitsubaVariant {
+    /// RGB variants (`scalar_rgb`, `llvm_ad_rgb`, …): the channels' coefficients as RGB.
+    #[default]
+    Rgb,
+    /// Spectral variants (`scalar_spectral`, …): the medium per wavelength from the measured spectrum
+    /// ([`RendererParameters::spectral_medium`]); the RGB medium when the result has no spectrum.
+    Spectral,
+}
+
+/// [`mitsuba_fragment`] for `variant`'s kind of Mitsuba.
+pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant) -> String {
+    let spectral = variant == MitsubaVariant::Spectral && params.spectral_medium.is_some();
+    let names = MaterialNames::new(&params.name);
+    let id = &names.id;
     let u = params.unit.symbol();
     let chans = params.channels.as_array();
     let scale = largest(chans.map(|c| c.sigma_t));
@@ -25,11 +45,12 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     let sigma_t_rgb = rgb(chans.map(|c| c.sigma_t / scale));
     let albedo_rgb = rgb(chans.map(|c| c.albedo));
     let rr = roulette_depth(largest(chans.map(|c| c.albedo)));
-    let mfp = num(chans.iter().map(|c| c.mfp).fold(f64::INFINITY, f64::min));
+    let mfp = num(shortest_mfp(params));
+    let offset_fraction = ray_offset_fraction(params);
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
-    s.push_str(&xml_comment(&format!(
-        "  scatterfit export for Mitsuba 3: \"{}\"\n\
-         \x20 {}\n\
+    let mut header = format!(
+        "  scatterfit export for Mitsuba 3: \"{display}\"\n\
+         \x20 {provenance}\n\
          \x20 Scene unit: 1 scene unit = 1 {u}. The medium's extinction is sigma_t = scale * rgb(sigma_t) per\n\
          \x20 {u}: the colour is normalised to a largest component of 1 (RGB values must lie in [0, 1] in\n\
          \x20 spectral variants) and its magnitude is `scale`. For a scene in another unit multiply `scale` by\n\
@@ -38,23 +59,68 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20 and an isotropic phase function (g = 0): the measurement gives sigma_s' = sigma_s (1 - g) only,\n\
          \x20 and a diffusive material looks the same for every (sigma_s, g) with that sigma_s'.\n\
          \x20 Channels are linear sRGB. eta is relative to air; the boundary is smooth.\n\n",
-        params.name,
-        provenance_line(params),
-    )));
+        display = names.display,
+        provenance = provenance_line(params),
+    );
+    for line in model_header(params, &[Renderer::MitsubaVolpath]) {
+        header.push_str("  ");
+        header.push_str(&line);
+        header.push('\n');
+    }
+    header.push('\n');
+    s.push_str(&xml_comment(&wrap(&header, 100)));
     s.push_str(&xml_comment(&channel_table_comment(params, "  ")));
-    s.push_str(&xml_comment(&format!(
-        "\n  Use with the volpath integrator, max_depth -1 and rr_depth {rr} (Russian roulette only once\n\
-         \x20 the albedo has taken the throughput below 1e-3: Mitsuba's roulette survival is capped at\n\
-         \x20 0.95 per scattering, which at albedos near 1 leaves the long paths carrying much of the\n\
-         \x20 diffuse reflectance to rare, heavy samples and makes short renders too dark). Mitsuba\n\
-         \x20 offsets rays leaving a surface by about 1e-4 (1 + |p|) scene units: keep that well below\n\
-         \x20 the mean free path 1/sigma_t ({mfp} {u} here) or low-albedo renders come out dark.\n\
+    s.push_str(&xml_comment(&wrap(&format!(
+        "\n  HOW TO USE. Include this file in a scene (its ids are unique to this material's name, so\n\
+         \x20 several materials' fragments can be included in one scene) and give a shape both refs:\n\
          \x20   <include filename=\"this-file.xml\"/>\n\
          \x20   <shape type=\"...\">\n\
          \x20       <ref id=\"{id}_boundary\"/>\n\
          \x20       <ref name=\"interior\" id=\"{id}_medium\"/>\n\
-         \x20   </shape>\n"
-    )));
+         \x20   </shape>\n\
+         \x20 Rendered so, with this fragment's variant kind, materials measured with the mc model showed \
+         their measured reflectance within 3 % (the demo's seven materials, BENCHMARKS.md).\n\
+         \x20 Integrator: volpath with max_depth -1 and rr_depth {rr}:\n\
+         \x20   <integrator type=\"volpath\"><integer name=\"max_depth\" value=\"-1\"/>\n\
+         \x20       <integer name=\"rr_depth\" value=\"{rr}\"/></integrator>\n\
+         \x20 (Russian roulette only once the albedo has taken the throughput below 1e-3: Mitsuba's\n\
+         \x20 roulette survival is capped at 0.95 per scattering, which at albedos near 1 leaves the long\n\
+         \x20 paths carrying much of the diffuse reflectance to rare, heavy samples: short renders too dark.)\n\
+         \x20 LIGHTS: the medium renders BLACK under point, spot and directional emitters: they are delta\n\
+         \x20 lights, and no path through the smooth dielectric boundary can connect to them (the medium's\n\
+         \x20 sample_emitters is off for the same reason). Light it with area emitters or an environment\n\
+         \x20 (constant, envmap); Mitsuba 3 has no BSSRDF material to fall back on.\n\
+         \x20 SCENE UNIT AND RAY OFFSETS: Mitsuba offsets every ray leaving a surface by about \
+         1e-4 (1 + |p|) scene units (float32 `RayEpsilon`), which shifts the first scattering deeper \
+         and darkens the material. Here the shortest mean free path 1/sigma_t is {mfp} {u}; for an \
+         object about 1 scene unit from the origin the offset is {pct} of it{verdict}. In metre \
+         scenes a 0.2 mm mean free path rendered 17-23 % dark (BENCHMARKS.md): export in \
+         millimetres (the default scale) and build the scene in millimetres when you can.\n\
+         \x20 SPECTRAL VARIANTS (scalar_spectral, llvm_spectral, ...) turn each RGB into a smooth spectrum;\n\
+         \x20 a medium's reflectance is not linear in its coefficients, so a strongly coloured material\n\
+         \x20 renders shifted in colour ({shift} per channel for the demo's materials, BENCHMARKS.md);\n\
+         \x20 the RGB variants (scalar_rgb, llvm_rgb) render the channels exactly.{spectral_note}\n",
+        spectral_note = if spectral {
+            "\n\x20 THIS FRAGMENT IS FOR SPECTRAL VARIANTS: its medium is given per wavelength, the albedo\n\
+             \x20 inverted from the MEASURED reflectance spectrum with exact transport (within 1 % of the\n\
+             \x20 measured colour for the demo's materials), sigma_t' interpolated between the channels.\n\
+             \x20 RGB variants render it wrong: export without the spectral variant option for them."
+        } else if params.spectral_medium.is_some() {
+            "\n\x20 This fragment is for RGB variants; for a spectral variant export it again with the\n\
+             \x20 option `mitsuba-variant spectral`: its medium is then given per wavelength from the\n\
+             \x20 measured reflectance spectrum and renders the measured colour."
+        } else {
+            "\n\x20 The result has no measured spectrum (rd_spectrum, written by `scatterfit measure`), so\n\
+             \x20 no per-wavelength medium can be written for spectral variants."
+        },
+        pct = format_percent(offset_fraction),
+        verdict = if offset_fraction > 0.01 {
+            ": ABOVE 1 %, expect a visibly dark render; use a millimetre scene"
+        } else {
+            " (negligible)"
+        },
+        shift = MITSUBA_SPECTRAL_SHIFT,
+    ), 100)));
     s.push_str("-->\n");
     s.push_str(&format!(
         "<scene version=\"3.0.0\">\n\
@@ -62,20 +128,113 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
          \x20       <float name=\"int_ior\" value=\"{eta}\"/>\n\
          \x20       <float name=\"ext_ior\" value=\"1\"/>\n\
          \x20   </bsdf>\n\
-         \x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
-         \x20       <rgb name=\"sigma_t\" value=\"{sigma_t_rgb}\"/>\n\
-         \x20       <float name=\"scale\" value=\"{scale}\"/>\n\
-         \x20       <rgb name=\"albedo\" value=\"{albedo_rgb}\"/>\n\
+         {medium}\
+         </scene>\n",
+        eta = num(params.eta),
+        medium = if spectral {
+            spectral_medium(params, id)
+        } else {
+            format!(
+                "\x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
+                 \x20       <rgb name=\"sigma_t\" value=\"{sigma_t_rgb}\"/>\n\
+                 \x20       <float name=\"scale\" value=\"{scale}\"/>\n\
+                 \x20       <rgb name=\"albedo\" value=\"{albedo_rgb}\"/>\n\
+                 \x20       <boolean name=\"sample_emitters\" value=\"false\"/>\n\
+                 \x20       <phase type=\"hg\">\n\
+                 \x20           <float name=\"g\" value=\"0\"/>\n\
+                 \x20       </phase>\n\
+                 \x20   </medium>\n",
+                scale = num(scale),
+            )
+        },
+    ));
+    s
+}
+
+/// The `<id>_medium` element for spectral variants, when the parameters have a spectral medium: σt
+/// and albedo as wavelength:value spectra (σt normalised like the RGB one, its magnitude in `scale`).
+fn spectral_medium(params: &RendererParameters, id: &str) -> String {
+    let Some(m) = &params.spectral_medium else {
+        return String::new();
+    };
+    let scale = m.sigma_t.iter().copied().fold(0.0_f64, f64::max);
+    let pairs = |v: &[f64], k: f64| -> String {
+        m.wavelength_nm
+            .iter()
+            .zip(v)
+            .map(|(l, x)| format!("{}:{}", num(*l), num(x / k)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    format!(
+        "\x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
+         \x20       <spectrum name=\"sigma_t\" value=\"{}\"/>\n\
+         \x20       <float name=\"scale\" value=\"{}\"/>\n\
+         \x20       <spectrum name=\"albedo\" value=\"{}\"/>\n\
          \x20       <boolean name=\"sample_emitters\" value=\"false\"/>\n\
          \x20       <phase type=\"hg\">\n\
          \x20           <float name=\"g\" value=\"0\"/>\n\
          \x20       </phase>\n\
-         \x20   </medium>\n\
-         </scene>\n",
-        eta = num(params.eta),
-        scale = num(scale),
-    ));
-    s
+         \x20   </medium>\n",
+        pairs(&m.sigma_t, scale),
+        num(scale),
+        pairs(&m.albedo, 1.0),
+    )
+}
+
+/// The shortest mean free path 1/σt of the channels [scene units].
+fn shortest_mfp(params: &RendererParameters) -> f64 {
+    params
+        .per_channel(|c| c.mfp)
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Mitsuba's ray-spawn offset for an object about 1 scene unit from the origin, (1 + 1) ·
+/// [`RAY_EPSILON`] scene units, as a fraction of the shortest mean free path. Measured (BENCHMARKS.md):
+/// a half-space of mean free path 0.2 mm rendered 17–23 % dark in a metre scene (offset 0.45 mean
+/// free paths at the origin) and right in a millimetre one.
+pub fn ray_offset_fraction(params: &RendererParameters) -> f64 {
+    2.0 * RAY_EPSILON / shortest_mfp(params)
+}
+
+/// A warning when Mitsuba's ray offset is above 1 % of the shortest mean free path (metre scenes of
+/// materials with sub-millimetre mean free paths).
+pub(super) fn ray_offset_warning(params: &RendererParameters) -> Option<String> {
+    let f = ray_offset_fraction(params);
+    (f > 0.01).then(|| {
+        format!(
+            "in a {} scene Mitsuba offsets rays leaving a surface by about {} {u} (an object 1 {u} \
+             from the origin), {} of this material's shortest mean free path ({} {u}): it will render \
+             dark (a 0.2 mm mean free path rendered 17-23 % dark in metres); export with --scale mm \
+             and build the scene in millimetres",
+            params.unit.word(),
+            num(2.0 * RAY_EPSILON),
+            format_percent(f),
+            num(shortest_mfp(params)),
+            u = params.unit.symbol(),
+        )
+    })
+}
+
+/// Mitsuba 3's ray-spawn epsilon for float32 variants, `math::RayEpsilon` = 1500 · 2⁻²⁴ (drjit
+/// `Epsilon` for float is 2⁻²⁴): rays leaving a surface at p start (1 + max |p_i|) · this further.
+pub const RAY_EPSILON: f64 = 1500.0 / 16_777_216.0;
+
+/// What the header says of Mitsuba's spectral shift (measured on the demo's materials,
+/// BENCHMARKS.md "exports").
+const MITSUBA_SPECTRAL_SHIFT: &str = "+13 % to -42 %";
+
+/// A fraction as a short percentage (`0.03 %`, `12 %`).
+fn format_percent(x: f64) -> String {
+    let p = 100.0 * x;
+    if p >= 10.0 {
+        format!("{p:.0} %")
+    } else {
+        // Two significant digits.
+        let digits = (1 - p.log10().floor() as i32).max(0) as usize;
+        format!("{p:.digits$} %")
+    }
 }
 
 /// The number of scatterings after which the throughput of a path in a medium of single-scattering
@@ -89,18 +248,6 @@ pub fn roulette_depth(albedo: f64) -> u64 {
     ((1e-3_f64.ln() / albedo.ln()).ceil()).clamp(5.0, 100_000.0) as u64
 }
 
-/// Text safe inside an XML comment: no `--` (forbidden there) and no control characters but newlines.
-fn xml_comment(text: &str) -> String {
-    let mut s: String = text
-        .chars()
-        .map(|c| if c.is_control() && c != '\n' { ' ' } else { c })
-        .collect();
-    while s.contains("--") {
-        s = s.replace("--", "- -");
-    }
-    s
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::fixtures::{SA, SP, close, marble};
@@ -111,6 +258,7 @@ mod tests {
     #[test]
     fn mitsuba_medium_reproduces_the_coefficients() {
         let r = marble();
+        let id = super::super::identifier("marble");
         for (unit, k) in [(SceneUnit::Millimetre, 1.0), (SceneUnit::Metre, 1000.0)] {
             let text = export(&r, Format::Mitsuba, unit).unwrap().text;
             let doc = roxmltree::Document::parse(&text).expect("well-formed XML");
@@ -119,7 +267,10 @@ mod tests {
                 .find(|n| n.has_tag_name("medium"))
                 .unwrap();
             assert_eq!(medium.attribute("type"), Some("homogeneous"));
-            assert_eq!(medium.attribute("id"), Some("marble_medium"));
+            assert_eq!(
+                medium.attribute("id"),
+                Some(format!("{id}_medium").as_str())
+            );
             let value = |tag: &str, name: &str| -> Vec<f64> {
                 medium
                     .descendants()
@@ -142,7 +293,10 @@ mod tests {
             assert_eq!(value("float", "g"), vec![0.0]);
             let bsdf = doc.descendants().find(|n| n.has_tag_name("bsdf")).unwrap();
             assert_eq!(bsdf.attribute("type"), Some("dielectric"));
-            assert_eq!(bsdf.attribute("id"), Some("marble_boundary"));
+            assert_eq!(
+                bsdf.attribute("id"),
+                Some(format!("{id}_boundary").as_str())
+            );
             let ior = |name: &str| {
                 bsdf.children()
                     .find(|n| n.attribute("name") == Some(name))
