@@ -182,6 +182,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         },
         version: env!("CARGO_PKG_VERSION").into(),
         rd_spectrum: None,
+        spectro_port: None,
     };
     if let Some(out) = &args.output {
         write_result_json(out, &result)?;

@@ -246,6 +246,28 @@ pub struct MeasurementResult {
     /// L*a*b* or the result predates the field; never written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rd_spectrum: Option<RdSpectrum>,
+    /// The spectrophotometer port's edge-loss correction (issue 15; `spectro.aperture_mm` in the
+    /// manifest): the channels' `rd_total` and `albedo_prime` are then the corrected values. Absent:
+    /// the reading was taken as loss-free (no port given). Never written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectro_port: Option<PortResult>,
+}
+
+/// What the port correction did ([`MeasurementResult::spectro_port`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PortResult {
+    /// Diameter of the measured aperture [mm].
+    pub aperture_mm: f64,
+    /// Diameter of the lit disc [mm].
+    pub illuminated_mm: f64,
+    /// Rd per channel as the instrument read it.
+    pub rd_read: scatterfit_optics::Rgb<f64>,
+    /// The fraction of the true Rd the instrument read, per channel (`None`: the channel was left
+    /// uncorrected, see `problems`).
+    pub reading_fraction: scatterfit_optics::Rgb<Option<f64>>,
+    /// Why a channel was left uncorrected.
+    #[serde(default)]
+    pub problems: scatterfit_optics::Rgb<Option<String>>,
 }
 
 /// A measured diffuse reflectance spectrum ([`MeasurementResult::rd_spectrum`]).
@@ -454,6 +476,7 @@ mod tests {
             inputs: Inputs::default(),
             version: "0.1.0".into(),
             rd_spectrum: None,
+            spectro_port: None,
         }
     }
 

@@ -5,7 +5,9 @@
 //!    (in two halves, [`hdr::read_frames`] and [`hdr::merge_frames`], for a caller that reports
 //!    between them);
 //! 3. [`profile::profile_stage`] — spot centre and radial profile Rd(r);
-//! 4. [`fit::fit_stage`] — σ′s and σa per channel.
+//! 4. [`port::correct_port`] — the spectrophotometer port's edge loss, when the manifest gives the
+//!    port (`spectro.aperture_mm`): Rd and α′ corrected from the fitted profile;
+//! 5. [`fit::fit_stage`] — σ′s and σa per channel.
 //!
 //! [`measure_sample`] runs them on a sample folder (its `sample.toml`). The command-line tool's
 //! commands parse their arguments, call these functions and print; no command calls another's file.
@@ -18,6 +20,7 @@ mod error;
 pub mod fit;
 pub mod hdr;
 pub mod measure;
+pub mod port;
 pub mod profile;
 pub mod spectro;
 

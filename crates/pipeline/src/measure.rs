@@ -8,7 +8,7 @@ use scatterfit_fit::ProfileData;
 use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest, read_manifest};
 use scatterfit_io::result_json::{Channels, FileRef, Inputs, MeasurementResult};
 use scatterfit_mc::{albedo_family, family};
-use scatterfit_optics::{AlbedoModel, Method, ModelName};
+use scatterfit_optics::{AlbedoModel, Method, ModelName, Rgb};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
@@ -73,6 +73,10 @@ pub struct Measurement {
     pub fits: Vec<ChannelOutcome>,
     /// Per channel, the spectrophotometer's part of the uncertainty ([`propagate_spectro`]).
     pub spectro_errors: Vec<Option<SpectroErrors>>,
+    /// The port's edge-loss correction (`spectro.aperture_mm` given; `spectro` is then the
+    /// corrected stage and the correction keeps the reading), or `None`: the reading was taken as
+    /// loss-free.
+    pub port: Option<crate::port::PortCorrection>,
     /// Wall times per stage [s].
     pub timings: Timings,
 }
@@ -234,6 +238,17 @@ pub fn measure_sample(
     let data: Vec<ProfileData> = (0..3)
         .map(|c| profile.channel_data(c))
         .collect::<Result<_>>()?;
+    let port = crate::port::port_of(
+        manifest.spectro.aperture_mm,
+        manifest.spectro.illuminated_mm,
+    )?;
+    let (spectro, port) = match port {
+        Some(p) => {
+            let (s, c) = crate::port::correct_port(&data, &spectro, &settings, model, albedo, p);
+            (s, Some(c))
+        }
+        None => (spectro, None),
+    };
     let fits = fit_stage(&data, &spectro, &settings, model);
     let spectro_errors = propagate_spectro(&data, &spectro, &settings, model, &fits);
     let fit_s = t_fit.elapsed().as_secs_f64();
@@ -253,6 +268,7 @@ pub fn measure_sample(
         profile,
         fits,
         spectro_errors,
+        port,
         timings,
     })
 }
@@ -295,11 +311,24 @@ impl Measurement {
     fn refit_inner(&self, settings: FitSettings, propagate: bool) -> Result<Measurement> {
         let model = family(settings.model)?;
         let albedo = albedo_family(settings.albedo_model, settings.model)?;
-        let spectro = self.spectro.with_albedo_model(albedo);
         let t = Instant::now();
         let data: Vec<ProfileData> = (0..3)
             .map(|c| self.profile.channel_data(c))
             .collect::<Result<_>>()?;
+        // The port correction depends on the model: start again from the reading.
+        let (spectro, port) = match &self.port {
+            Some(p) => {
+                let port = scatterfit_optics::port::Port::new(p.illuminated_mm, p.aperture_mm)
+                    .map_err(|e| {
+                        PipelineError::Input(format!("the spectrophotometer port: {e}"))
+                    })?;
+                let read = p.read.with_albedo_model(albedo);
+                let (s, c) =
+                    crate::port::correct_port(&data, &read, &settings, model, albedo, port);
+                (s, Some(c))
+            }
+            None => (self.spectro.with_albedo_model(albedo), None),
+        };
         let fits = fit_stage(&data, &spectro, &settings, model);
         let spectro_errors = if propagate {
             propagate_spectro(&data, &spectro, &settings, model, &fits)
@@ -316,6 +345,7 @@ impl Measurement {
             profile: self.profile.clone(),
             fits,
             spectro_errors,
+            port,
             timings,
         })
     }
@@ -397,6 +427,16 @@ impl Measurement {
             },
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()),
+            spectro_port: self
+                .port
+                .as_ref()
+                .map(|p| scatterfit_io::result_json::PortResult {
+                    aperture_mm: p.aperture_mm,
+                    illuminated_mm: p.illuminated_mm,
+                    rd_read: Rgb::from_array(p.read.rd),
+                    reading_fraction: p.reading_fraction,
+                    problems: p.problems.clone(),
+                }),
         }
     }
 }

@@ -6,7 +6,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use scatterfit_io::result_json::{MeasurementResult, write_result_json};
-use scatterfit_io::result_table::{errors_note, sig4, sigma_cells, table1_csv, table1_markdown};
+use scatterfit_io::result_table::{
+    errors_note, port_note, sig4, sigma_cells, table1_csv, table1_markdown,
+};
 use scatterfit_pipeline::Measurement;
 
 use crate::error::{ReportError, Result};
@@ -117,6 +119,9 @@ pub fn summary_text(r: &MeasurementResult) -> String {
     let errors = errors_note(std::slice::from_ref(r));
     if !errors.is_empty() {
         let _ = write!(t, "  {errors}");
+    }
+    if r.spectro_port.is_some() {
+        let _ = write!(t, "  {}", port_note(std::slice::from_ref(r)));
     }
     t
 }

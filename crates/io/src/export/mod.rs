@@ -1331,6 +1331,7 @@ mod fixtures {
             inputs: Inputs::default(),
             version: "0.1.0".into(),
             rd_spectrum: None,
+            spectro_port: None,
         }
     }
 
