@@ -79,6 +79,9 @@ pub struct Corrections {
     pub exposure_applied: bool,
     /// The flat frame divided out, with its smoothed fall-off (min and max of the divisor).
     pub flat: Option<(PathBuf, f64, f64)>,
+    /// The codes 16-bit frames use and the saturation found ([`crate::checks::code_range`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub codes: Option<crate::checks::CodeRange>,
 }
 
 /// The 8-bit code at which a pixel counts as detected in the longest exposure. Below it the tone
@@ -527,6 +530,12 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             Some(r) => (r.levels.white.min(f64::from(u16::MAX)) as u16).max(2),
             None => inputs.saturation,
         };
+        // The codes the frames use (8- or 12-bit data in 16-bit files; crate::checks).
+        let code_range = raw
+            .is_none()
+            .then(|| crate::checks::code_range(&bufs, saturation))
+            .transpose()?;
+        let saturation = code_range.as_ref().map_or(saturation, |c| c.saturation);
         scatterfit_imaging::check_bracket_order(&bufs, &times, saturation)
             .map_err(imaging(&order_context()))?;
         let dark = dark.and_then(|d| match d {
@@ -619,6 +628,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             corrections.flat = Some(divide_flat(&mut hdr, path, f.width(), f.height(), ch, lin)?);
         }
         corrections.black_level = black;
+        corrections.codes = code_range;
         let t_max = times_used.iter().copied().fold(0.0f64, f64::max);
         let detection_limit = vec![DETECTION_DN_16BIT / t_max; hdr.radiance.channels()];
         HdrStage {

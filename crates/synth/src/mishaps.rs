@@ -18,7 +18,13 @@ use crate::rig::CameraModel;
 ///
 /// # Panics
 /// If the window does not lie inside the frames (a test's mistake, not user input).
-pub fn crop(frames: &[ImageBuf<u8>], x0: usize, y0: usize, w: usize, h: usize) -> Vec<ImageBuf<u8>> {
+pub fn crop(
+    frames: &[ImageBuf<u8>],
+    x0: usize,
+    y0: usize,
+    w: usize,
+    h: usize,
+) -> Vec<ImageBuf<u8>> {
     frames.iter().map(|f| crop_one(f, x0, y0, w, h)).collect()
 }
 
@@ -191,7 +197,10 @@ mod tests {
         }
         // No second spot of zero strength changes nothing.
         let f = ramp(6, 5);
-        assert_eq!(second_spot(std::slice::from_ref(&f), &cam, 2, -1, 0.0)[0], f);
+        assert_eq!(
+            second_spot(std::slice::from_ref(&f), &cam, 2, -1, 0.0)[0],
+            f
+        );
     }
 
     #[test]
