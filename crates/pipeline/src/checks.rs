@@ -102,8 +102,9 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
             ));
         }
     }
-    // (e) The codes the frames use.
+    // (e) The codes the frames use; (f) the frames registered.
     reasons.extend(code_reasons(m));
+    reasons.extend(registration_reasons(m));
     // (d) Exactly one spot.
     if let Some(msg) = second_spot(m, a_px) {
         reasons.push(suspect(ReasonKind::SecondSpot, msg));
@@ -466,6 +467,92 @@ pub fn code_reasons(m: &Measurement) -> Vec<Reason> {
         )];
     }
     Vec::new()
+}
+
+/// Where the spot is in each frame of a bracket, to see whether the camera moved.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Registration {
+    /// Per frame (shortest first), the centroid [x, y] px of the pixels at least half the
+    /// saturation (a radially symmetric spot's half-saturated disk is centred on the spot in every
+    /// frame); `None` where fewer than [`REGISTRATION_MIN_PIXELS`] pixels are, or the disk touches
+    /// the frame's edge.
+    pub centroids: Vec<Option<[f64; 2]>>,
+    /// The largest shift between two frames' centroids [px].
+    pub max_shift_px: f64,
+}
+
+/// Pixels a frame's half-saturated disk needs for its centroid to count.
+pub const REGISTRATION_MIN_PIXELS: usize = 12;
+
+/// A shift between frames beyond this [px] makes every channel suspect: the rings of the merged
+/// map then average light from two positions. The good twins' centroids agree to 0.5 px.
+pub const MAX_FRAME_SHIFT_PX: f64 = 1.5;
+
+/// The spot's centroid in each frame ([`Registration`]); `level(j, i)` is sample `i` of frame `j`
+/// as a fraction of its saturation, `w × h` pixels of `ch` channels.
+pub fn registration(
+    frames: usize,
+    w: usize,
+    h: usize,
+    ch: usize,
+    level: &dyn Fn(usize, usize) -> f64,
+) -> Registration {
+    let centroids: Vec<Option<[f64; 2]>> = (0..frames)
+        .map(|j| {
+            let (mut n, mut sx, mut sy) = (0usize, 0.0, 0.0);
+            let mut edge = false;
+            for y in 0..h {
+                for x in 0..w {
+                    let i = (y * w + x) * ch;
+                    let v = (0..ch).map(|c| level(j, i + c)).sum::<f64>() / ch as f64;
+                    if v >= 0.5 {
+                        n += 1;
+                        sx += x as f64;
+                        sy += y as f64;
+                        edge |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+                    }
+                }
+            }
+            (n >= REGISTRATION_MIN_PIXELS && !edge).then(|| [sx / n as f64, sy / n as f64])
+        })
+        .collect();
+    let found: Vec<[f64; 2]> = centroids.iter().flatten().copied().collect();
+    let mut max_shift_px = 0.0f64;
+    for a in &found {
+        for b in &found {
+            max_shift_px = max_shift_px.max((a[0] - b[0]).hypot(a[1] - b[1]));
+        }
+    }
+    Registration {
+        centroids,
+        max_shift_px,
+    }
+}
+
+/// The frames' registration as a finding: suspect beyond [`MAX_FRAME_SHIFT_PX`].
+pub fn registration_reasons(m: &Measurement) -> Vec<Reason> {
+    let Some(r) = &m.hdr.corrections.registration else {
+        return Vec::new();
+    };
+    if r.max_shift_px <= MAX_FRAME_SHIFT_PX {
+        return Vec::new();
+    }
+    let list: Vec<String> = r
+        .centroids
+        .iter()
+        .enumerate()
+        .filter_map(|(j, c)| c.map(|[x, y]| format!("{j}: ({x:.1}, {y:.1})")))
+        .collect();
+    vec![suspect(
+        ReasonKind::Misregistered,
+        format!(
+            "the spot moves by up to {:.1} px between the frames (its centre per frame, shortest \
+             first: {}): the camera or the sample moved during the bracket — fix the rig and take \
+             the bracket again",
+            r.max_shift_px,
+            list.join(", ")
+        ),
+    )]
 }
 
 #[cfg(test)]

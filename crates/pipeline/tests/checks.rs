@@ -78,7 +78,7 @@ fn has(q: &[Quality; 3], kind: ReasonKind) -> bool {
 }
 
 #[test]
-fn the_good_twin_is_ok_and_its_bad_cases_are_suspect() {
+fn the_good_twin_is_ok_and_a_spot_off_centre_or_doubled_is_suspect() {
     let root = tempfile::tempdir().unwrap();
     let s = twin();
     let (f, t) = (&s.bracket.frames, &s.bracket.times_s);
@@ -122,6 +122,15 @@ fn the_good_twin_is_ok_and_its_bad_cases_are_suspect() {
         let (_, q) = measure(label, &d);
         assert!(has(&q, ReasonKind::SecondSpot), "{label}: {q:?}");
     }
+}
+
+#[test]
+fn a_wrong_scale_a_bumped_camera_and_a_centre_off_the_spot_are_suspect() {
+    let root = tempfile::tempdir().unwrap();
+    let s = twin();
+    let (f, t) = (&s.bracket.frames, &s.bracket.times_s);
+    let mmpp = RigSpec::quick().mm_per_pixel;
+    let [cx, cy] = s.bracket.center_px;
     // (c) mm_per_pixel 10× too large and 10× too small: the spot's size in the image disagrees.
     for (label, scale) in [("mm_per_pixel ×10", 10.0), ("mm_per_pixel ×0.1", 0.1)] {
         let d = root.path().join(label.replace([' ', '×'], "_"));
@@ -136,6 +145,13 @@ fn the_good_twin_is_ok_and_its_bad_cases_are_suspect() {
             q.iter().all(|q| q.verdict >= Verdict::Suspect) && suspect >= 1,
             "{label}: {q:?}"
         );
+    }
+    // (f) The camera bumped by 8 px (and by 3 px) before the 7th frame.
+    for (label, dx) in [("bumped 8 px", 8), ("bumped 3 px", 3)] {
+        let d = root.path().join(label.replace(' ', "_"));
+        write(&d, &mishaps::bump(f, 6, dx, 0), t, mmpp);
+        let (_, q) = measure(label, &d);
+        assert!(has(&q, ReasonKind::Misregistered), "{label}: {q:?}");
     }
     // A given centre 100 px off the spot.
     let d = root.path().join("centre-off");
