@@ -9,8 +9,9 @@
 //! fit give parameters); `quality` says whether they can be trusted.
 //!
 //! The thresholds are set against the demo (the paper rig's twins of the seven materials, dipole
-//! fits: rms log residual ≤ 0.24, spot-size ratio 1.0–1.6) and the quick twins the tests use, with
-//! the bad cases of `scatterfit_synth::mishaps` on the other side (`tests/checks.rs`).
+//! fits: rms log residual ≤ 0.24, spot-size ratio 1.02–1.04, frame shifts ≤ 0.18 px; every channel
+//! `ok`) and the quick twins the tests use, with the bad cases of `scatterfit_synth::mishaps` on the
+//! other side (`tests/checks.rs`).
 
 use scatterfit_fit::FitReport;
 use scatterfit_imaging::{CenterOptions, find_spot_center};
@@ -28,8 +29,8 @@ pub const MAX_RMS_LOG_RESIDUAL: f64 = 0.4;
 
 /// The spot's half width at half maximum in the image, over the light spot's radius
 /// (`spot_diameter_mm / 2 / mm_per_pixel`), outside this range makes every channel suspect: the
-/// scale or the spot's diameter is wrong (a 10× typo gives 0.1 or 10). Good samples give 0.95–1.7
-/// (the blur of subsurface scattering widens the spot, never shrinks it much).
+/// scale or the spot's diameter is wrong (a 10× typo gives 0.1 or 10). Good samples give 1.02–1.04
+/// (demo) and 1.02–1.19 (quick twins; the blur of subsurface scattering widens the spot, never shrinks it much).
 pub const SPOT_SIZE_RATIO: (f64, f64) = (0.6, 2.5);
 
 /// A pixel at least this many times its ring's median and [`SECOND_SPOT_Z`] robust standard
@@ -169,7 +170,7 @@ pub fn spot_hwhm_px(m: &Measurement) -> Option<f64> {
         .map(sum)
         .filter(|v| v.is_finite())
         .fold(f64::NAN, f64::max);
-    if !(peak > 0.0) {
+    if peak.is_nan() || peak <= 0.0 {
         return None;
     }
     for k in 1..rings.len() {
@@ -485,7 +486,7 @@ pub struct Registration {
 pub const REGISTRATION_MIN_PIXELS: usize = 12;
 
 /// A shift between frames beyond this [px] makes every channel suspect: the rings of the merged
-/// map then average light from two positions. The good twins' centroids agree to 0.5 px.
+/// map then average light from two positions. The demo's frames agree to 0.18 px.
 pub const MAX_FRAME_SHIFT_PX: f64 = 1.5;
 
 /// The spot's centroid in each frame ([`Registration`]); `level(j, i)` is sample `i` of frame `j`

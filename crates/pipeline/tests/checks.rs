@@ -218,8 +218,6 @@ fn frames_that_do_not_use_their_bit_depth_are_found() {
     assert!(has(&q, ReasonKind::BitDepth), "{q:?}");
     // 8-bit frames scaled by 257: refused with the reason.
     let d = with_frames("8-in-16 x257", scaled_to_u16(f));
-    let e = measure_sample(&d, &Overrides::default(), &|_| {})
-        .err()
-        .expect("refused");
+    let e = measure_sample(&d, &Overrides::default(), &|_| {}).expect_err("refused");
     assert!(e.to_string().contains("multiple of 257"), "{e}");
 }
