@@ -88,6 +88,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                         .filter_map(|c| c.problem.clone())
                         .collect();
                     failed.push((o.dir.clone(), why.join("; ")));
+                } else if !crate::common::trusted(&r) {
+                    failed.push((o.dir.clone(), crate::common::suspect_text(&r)));
                 }
                 results.push(r);
             }
@@ -110,7 +112,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             out!("{}", scatterfit_report::summary_text(r))?;
         }
         outln!(
-            "\n{} of {} samples measured completely; summary: {} and {}",
+            "\n{} of {} samples measured completely with every check ok; summary: {} and {}",
             samples - failed.len(),
             samples,
             args.output_dir.join("summary.csv").display(),
@@ -118,7 +120,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
     }
     if !failed.is_empty() {
-        errln!("\n{} sample(s) failed or are incomplete:", failed.len());
+        errln!(
+            "\n{} sample(s) failed, are incomplete or suspect:",
+            failed.len()
+        );
         for (dir, why) in &failed {
             errln!("  {}: {why}", dir.display());
         }

@@ -206,6 +206,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
              compare.md (Table 2), accuracy.md",
             out.display()
         )?;
+        // The data checks' verdict on the proposed method's channels (RELIABILITY.md).
+        let suspect: Vec<String> = proposed
+            .iter()
+            .filter(|r| !crate::common::trusted(r))
+            .map(|r| {
+                format!(
+                    "{}: {}",
+                    scatterfit_io::escape::one_line(&r.name),
+                    crate::common::suspect_text(r)
+                )
+            })
+            .collect();
+        if suspect.is_empty() {
+            outln!("quality: every channel of the proposed method passes the data checks (ok)")?;
+        } else {
+            outln!("quality: {}", suspect.join("; "))?;
+        }
     }
     if !failed.is_empty() {
         errln!("\n{} sample(s) failed:", failed.len());

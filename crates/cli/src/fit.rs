@@ -167,7 +167,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         model: model_name.name().into(),
         albedo_model: "given".into(),
         channels: Channels::from_array(std::array::from_fn(|c| {
-            channel_result(&fits[c], &spectro, c, None)
+            // The fit's own checks (no image here: the residuals and the ranges).
+            let mut r = channel_result(&fits[c], &spectro, c, None);
+            r.quality = Some(scatterfit_pipeline::checks::Quality::from_reasons(
+                scatterfit_pipeline::checks::fit_reasons(&fits[c], args.eta),
+            ));
+            r
         })),
         inputs: Inputs {
             profile: Some(args.profile.to_string_lossy().into_owned()),

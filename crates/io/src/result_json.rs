@@ -150,6 +150,10 @@ pub struct ChannelResult {
     /// Why the channel failed or what to watch out for.
     #[serde(default)]
     pub problem: Option<String>,
+    /// The data checks' verdict on the channel (`crate::quality`); `None` in files written before
+    /// the checks, or where no check ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quality: Option<crate::quality::Quality>,
 }
 
 /// The three channels.
@@ -455,6 +459,7 @@ mod tests {
             rings_below_detection: 40,
             rings_invalid: 0,
             problem: None,
+            quality: None,
         }
     }
 

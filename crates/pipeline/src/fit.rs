@@ -269,6 +269,7 @@ pub fn channel_result(
             rings_below_detection: 0,
             rings_invalid: 0,
             problem: Some(problem.clone()),
+            quality: None,
         },
         ChannelOutcome::Fitted(r) => {
             let status = if !r.converged {
@@ -328,6 +329,7 @@ pub fn channel_result(
                 rings_below_detection: r.rings_below_detection,
                 rings_invalid: r.rings_invalid,
                 problem,
+                quality: None,
             }
         }
     }

@@ -16,6 +16,7 @@
 #![forbid(unsafe_code)]
 
 pub mod camera;
+pub mod checks;
 mod error;
 pub mod fit;
 pub mod hdr;

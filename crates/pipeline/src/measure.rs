@@ -355,6 +355,11 @@ impl Measurement {
         self.fits.iter().all(ChannelOutcome::is_measurement)
     }
 
+    /// The data checks' verdict per channel (R, G, B; [`crate::checks`]).
+    pub fn quality(&self) -> [crate::checks::Quality; 3] {
+        crate::checks::quality(self)
+    }
+
     /// The result file's content. `profile_file` is the profile CSV's name as written beside the
     /// result (recorded in `inputs.profile`).
     pub fn to_result(&self, profile_file: Option<&str>) -> MeasurementResult {
@@ -381,13 +386,16 @@ impl Measurement {
                 file_ref(&rel)
             })
             .collect();
+        let mut quality = crate::checks::quality(self).map(Some);
         let channels = Channels::from_array(std::array::from_fn(|c| {
-            channel_result(
+            let mut r = channel_result(
                 &self.fits[c],
                 &self.spectro,
                 c,
                 self.spectro_errors.get(c).and_then(Option::as_ref),
-            )
+            );
+            r.quality = quality[c].take();
+            r
         }));
         MeasurementResult {
             name: m.display_name(),

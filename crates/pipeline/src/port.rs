@@ -20,8 +20,8 @@ use serde::Serialize;
 use crate::fit::FitSettings;
 use crate::spectro::SpectroStage;
 
-/// Rounds before giving up on a channel (it converges in 3–6 on the rig twin).
-const MAX_ROUNDS: usize = 30;
+/// Rounds before giving up on a channel (it converges in 3–10 on the rig twin).
+const MAX_ROUNDS: usize = 60;
 
 /// Relative change of Rd between rounds that ends the iteration.
 const TOLERANCE: f64 = 1e-6;
@@ -86,15 +86,15 @@ pub fn correct_port(
         };
         let rd_read = read.rd[c];
         let mut rd_c = rd_read;
+        let mut albedo_prime = match albedo.albedo_from_rd(rd_c, read.eta, 0.0) {
+            Ok(a) => a,
+            Err(e) => {
+                problems[ch] = Some(format!("α′ from Rd = {rd_c:.4}: {e}"));
+                continue;
+            }
+        };
         for round in 1..=MAX_ROUNDS {
             rounds[ch] = round;
-            let albedo_prime = match albedo.albedo_from_rd(rd_c, read.eta, 0.0) {
-                Ok(a) => a,
-                Err(e) => {
-                    problems[ch] = Some(format!("α′ from Rd = {rd_c:.4}: {e}"));
-                    break;
-                }
-            };
             let input = ChannelInput {
                 eta: read.eta,
                 albedo_prime: Some(albedo_prime),
@@ -127,15 +127,39 @@ pub fn correct_port(
                     break;
                 }
             };
-            let next = rd_read / f;
-            let done = ((next - rd_c) / rd_c).abs() < TOLERANCE;
-            rd_c = next;
+            let target = rd_read / f;
             fraction[ch] = Some(f);
-            if done {
+            if ((target - rd_c) / rd_c).abs() < TOLERANCE {
                 break;
             }
+            // Step towards the target, halving the step while its Rd lies beyond what the albedo
+            // model can invert (an early round's F, from a fit at a too-low α′, can overshoot;
+            // damped, the next rounds approach the fixed point from inside the model's range).
+            let mut step = target - rd_c;
+            let mut next = None;
+            for _ in 0..40 {
+                if let Ok(a) = albedo.albedo_from_rd(rd_c + step, read.eta, 0.0) {
+                    next = Some((rd_c + step, a));
+                    break;
+                }
+                step *= 0.5;
+            }
+            let Some((rd_next, a_next)) = next else {
+                problems[ch] = Some(format!(
+                    "the corrected Rd ({target:.4}) lies beyond what the {} albedo model can \
+                     invert at η = {:.4}",
+                    albedo.name(),
+                    read.eta
+                ));
+                break;
+            };
+            rd_c = rd_next;
+            albedo_prime = a_next;
             if round == MAX_ROUNDS {
-                problems[ch] = Some(format!("not converged in {MAX_ROUNDS} rounds"));
+                problems[ch] = Some(format!(
+                    "not converged in {MAX_ROUNDS} rounds (Rd {rd_c:.4}, the port's F asks for \
+                     {target:.4}: beyond the albedo model's range?)"
+                ));
             }
         }
         if problems[ch].is_none() {

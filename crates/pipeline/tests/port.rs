@@ -20,6 +20,16 @@ use scatterfit_synth::{RigSpec, synthesize};
 /// σa's relative error per channel of `name`: the port's reading taken as loss-free, the port's
 /// reading corrected (the manifest names the port), and the loss-free reading (the twin's baseline).
 fn errors(name: &str, illuminated_mm: f64, aperture_mm: f64, seed: u64) -> [[f64; 3]; 3] {
+    errors_both(name, illuminated_mm, aperture_mm, seed).map(|run| run.map(|(_, sa)| sa))
+}
+
+/// σ′s's and σa's relative errors per channel, as [`errors`].
+fn errors_both(
+    name: &str,
+    illuminated_mm: f64,
+    aperture_mm: f64,
+    seed: u64,
+) -> [[(f64, f64); 3]; 3] {
     let m = by_name(name).unwrap();
     let rig = RigSpec::quick();
     let s = synthesize(
@@ -50,7 +60,7 @@ fn errors(name: &str, illuminated_mm: f64, aperture_mm: f64, seed: u64) -> [[f64
     });
     let reading = reading_for(read, m.eta).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let mut out = [[0.0; 3]; 3];
+    let mut out = [[(0.0, 0.0); 3]; 3];
     for (k, with_port) in [false, true, false].into_iter().enumerate() {
         let folder = dir.path().join(format!("{name}-{k}"));
         write_sample_folder(
@@ -88,7 +98,12 @@ fn errors(name: &str, illuminated_mm: f64, aperture_mm: f64, seed: u64) -> [[f64
         assert_eq!(meas.port.is_some(), with_port);
         let result = meas.to_result(None);
         out[k] = std::array::from_fn(|c| {
-            result.channels.as_array()[c].sigma_a.unwrap() / m.sigma_a[c] - 1.0
+            let ch = result.channels.as_array()[c];
+            (
+                ch.sigma_s_prime
+                    .map_or(f64::NAN, |v| v / m.sigma_s_prime[c] - 1.0),
+                ch.sigma_a.map_or(f64::NAN, |v| v / m.sigma_a[c] - 1.0),
+            )
         });
         if let Some(p) = &meas.port {
             eprintln!(
@@ -130,6 +145,65 @@ fn an_8_mm_port_lit_over_14_mm_is_corrected() {
         assert!(
             left < 0.3 * raw_bias,
             "{name}: {raw:?} → {corrected:?} (baseline {base:?})"
+        );
+    }
+}
+
+/// The port study behind BENCHMARKS.md "The spectrophotometer port: the correction on the twin":
+/// materials from α′ 0.35 to 0.9995, an 8 mm aperture lit over 14 mm and over 8 mm; per channel
+/// σ′s and σa as read (loss-free), corrected, and the twin's baseline (the loss-free reading).
+/// Prints a Markdown table; about 3 min on 2 cores.
+#[test]
+#[ignore = "study: prints BENCHMARKS.md's table (cargo test -p scatterfit-pipeline --test port -- --ignored --nocapture)"]
+fn port_study() {
+    let materials = [
+        "ketchup",
+        "skin1",
+        "brown-leather",
+        "skin2",
+        "potato",
+        "wood-tile",
+        "apple",
+        "sulfur",
+        "pink-plastic",
+        "marble",
+    ];
+    println!(
+        "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let pct = |x: f64| format!("{:+.1} %", 100.0 * x);
+    for (ill, ap) in [(14.0, 8.0), (8.0, 8.0)] {
+        let mut left = Vec::new();
+        for (k, name) in materials.iter().enumerate() {
+            let m = by_name(name).unwrap();
+            let [raw, cor, base] = errors_both(name, ill, ap, 20 + k as u64);
+            for c in 0..3 {
+                println!(
+                    "| {ill} / {ap} mm | {name} | {} | {:.4} | {} / {} / {} | {} / {} / {} |",
+                    ["R", "G", "B"][c],
+                    m.albedo_prime()[c],
+                    pct(raw[c].0),
+                    pct(cor[c].0),
+                    pct(base[c].0),
+                    pct(raw[c].1),
+                    pct(cor[c].1),
+                    pct(base[c].1)
+                );
+                left.push(((cor[c].0 - base[c].0).abs(), (cor[c].1 - base[c].1).abs()));
+            }
+        }
+        let mut sp: Vec<f64> = left.iter().map(|l| l.0).filter(|v| v.is_finite()).collect();
+        let mut sa: Vec<f64> = left.iter().map(|l| l.1).filter(|v| v.is_finite()).collect();
+        sp.sort_by(f64::total_cmp);
+        sa.sort_by(f64::total_cmp);
+        println!(
+            "port {ill}/{ap} mm: corrected − baseline, median / worst: σ′s {:.2} % / {:.2} %, σa {:.2} % / {:.2} % ({} channels)",
+            100.0 * sp[sp.len() / 2],
+            100.0 * sp[sp.len() - 1],
+            100.0 * sa[sa.len() / 2],
+            100.0 * sa[sa.len() - 1],
+            sa.len()
         );
     }
 }

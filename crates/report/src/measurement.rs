@@ -81,8 +81,20 @@ pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
     })
 }
 
+/// `quality: R ok · G suspect · B ok` (the data checks' verdict per channel), `None` for a result
+/// without verdicts (written before the checks, or by a command that makes none).
+pub fn quality_line(r: &MeasurementResult) -> Option<String> {
+    let cells: Vec<String> = ["R", "G", "B"]
+        .iter()
+        .zip(r.channels.as_array())
+        .filter_map(|(name, c)| c.quality.as_ref().map(|q| format!("{name} {}", q.verdict)))
+        .collect();
+    (!cells.is_empty()).then(|| format!("quality: {}", cells.join(" · ")))
+}
+
 /// A human summary of one result, as `scatterfit measure` prints it: η and, per channel,
-/// σ′s ± error, σa ± error, α′, MSE, fit time and rings used.
+/// σ′s ± error, σa ± error, α′, MSE, fit time and rings used, the data checks' findings and
+/// their verdict per channel ([`quality_line`]).
 pub fn summary_text(r: &MeasurementResult) -> String {
     let mut t = String::new();
     let eta = match r.eta_stderr {
@@ -115,6 +127,17 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         if let Some(p) = &c.problem {
             let _ = writeln!(t, "      note: {}", scatterfit_io::escape::one_line(p));
         }
+        for reason in c.quality.iter().flat_map(|q| &q.reasons) {
+            let _ = writeln!(
+                t,
+                "      {}: {}",
+                reason.severity,
+                scatterfit_io::escape::one_line(&reason.message)
+            );
+        }
+    }
+    if let Some(line) = quality_line(r) {
+        let _ = writeln!(t, "  {line}");
     }
     let errors = errors_note(std::slice::from_ref(r));
     if !errors.is_empty() {

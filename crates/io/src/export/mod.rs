@@ -1308,6 +1308,7 @@ mod fixtures {
             rings_below_detection: 40,
             rings_invalid: 0,
             problem: None,
+            quality: None,
         }
     }
 
