@@ -279,22 +279,6 @@ fn parse_size(text: &str) -> Result<(usize, usize), String> {
     Ok((w, h))
 }
 
-/// The existing method's parameters quoted with Figure 5 (σ′s, σa per R, G, B) [mm⁻¹].
-const EXISTING_2014: [(&str, [(f64, f64); 3]); 3] = [
-    (
-        "pink-plastic",
-        [(2.152, 1.152e-10), (1.522, 0.4515), (1.864, 0.007945)],
-    ),
-    (
-        "blue-coating",
-        [(1.128, 2.118), (1.484, 1.857), (1.923, 0.2809)],
-    ),
-    (
-        "brown-leather",
-        [(1.624, 1.841), (1.222, 2.529), (0.9038, 2.754)],
-    ),
-];
-
 /// One parameter set, wherever it came from.
 struct Params {
     /// Display name.
@@ -323,52 +307,30 @@ fn material_for(p: &Params, model: Option<ModelName>) -> anyhow::Result<Material
 fn load_params(spec: &str, model: Option<ModelName>) -> anyhow::Result<Params> {
     let path = Path::new(spec);
     if !path.exists() {
-        let key = spec.trim().to_ascii_lowercase().replace([' ', '_'], "-");
-        if let Some(base) = key.strip_suffix("-existing") {
-            if let (Some(m), Some((_, c))) = (
-                scatterfit_synth::materials::CHOI_2014
-                    .iter()
-                    .find(|m| m.name == base),
-                EXISTING_2014.iter().find(|(n, _)| *n == base),
-            ) {
-                return Ok(Params {
-                    model: ModelName::Dipole,
-                    name: base.replace('-', " "),
-                    method: "existing".into(),
-                    source: "published: Choi et al. 2014, Figure 5 (existing method; η of Table 1)"
-                        .into(),
-                    eta: m.eta,
-                    coefficients: *c,
-                    result: None,
-                });
-            }
-        } else if let Some(m) = scatterfit_synth::materials::CHOI_2014
-            .iter()
-            .find(|m| m.name == key)
-        {
+        // Choi et al.'s published sets (scatterfit_synth::materials: Table 1, and the existing
+        // method's quoted with Figure 5).
+        if let Some(set) = scatterfit_synth::materials::choi_2014_set(spec) {
+            let m = set.material;
             return Ok(Params {
                 model: ModelName::Dipole,
                 name: m.name.replace('-', " "),
-                method: "proposed".into(),
-                source: "published: Choi et al. 2014, Table 1".into(),
+                method: set.method.name().into(),
+                source: format!("published: {}", set.citation()),
                 eta: m.eta,
                 coefficients: std::array::from_fn(|c| (m.sigma_s_prime[c], m.sigma_a[c])),
                 result: None,
             });
         }
+        let (proposed, existing): (Vec<_>, Vec<_>) = scatterfit_synth::materials::choi_2014_sets()
+            .partition(|s| s.method == scatterfit_optics::Method::Proposed);
+        let names = |v: Vec<scatterfit_synth::materials::PublishedSet>| {
+            v.iter().map(|s| s.key()).collect::<Vec<_>>().join(", ")
+        };
         bail!(
             "{spec}: no such file, and not a published material; give a result.json of \
              `scatterfit measure` or one of: {}, and {}",
-            scatterfit_synth::materials::CHOI_2014
-                .iter()
-                .map(|m| m.name)
-                .collect::<Vec<_>>()
-                .join(", "),
-            EXISTING_2014
-                .iter()
-                .map(|(n, _)| format!("{n}-existing"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            names(proposed),
+            names(existing)
         );
     }
     let result = read_result_json(path)?;
