@@ -221,11 +221,22 @@ mod tests {
         let p = choi_2014_set(" Pink_Plastic ").unwrap();
         assert_eq!((p.material, p.method), (&CHOI_2014[0], Method::Proposed));
         let e = choi_2014_set("brown-leather-existing").unwrap();
-        assert_eq!((e.material, e.method), (&CHOI_2014_EXISTING[2], Method::Existing));
+        assert_eq!(
+            (e.material, e.method),
+            (&CHOI_2014_EXISTING[2], Method::Existing)
+        );
         assert_eq!(e.key(), "brown-leather-existing");
         assert!(e.citation().contains("Figure 5") && p.citation().contains("Table 1"));
-        assert_eq!(choi_2014_set("nephrite-existing"), None, "not quoted in the paper");
-        assert_eq!(choi_2014_set("apple"), None, "Jensen et al.'s, not Choi et al.'s");
+        assert_eq!(
+            choi_2014_set("nephrite-existing"),
+            None,
+            "not quoted in the paper"
+        );
+        assert_eq!(
+            choi_2014_set("apple"),
+            None,
+            "Jensen et al.'s, not Choi et al.'s"
+        );
         assert_eq!(choi_2014_sets().count(), 10);
         // Not rig-twin materials: `synth --material` takes Table 1's and Jensen et al.'s only.
         assert!(all().all(|m| m.source != "choi2014-existing"));
