@@ -149,6 +149,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         model: model_name,
         albedo_model: AlbedoModel::Diffusion,
         spot_radius_mm: 0.5 * args.spot_diameter_mm,
+        spot: scatterfit_pipeline::fit::SpotShape::Disk,
         r_min_mm: args.r_min_mm,
         normalise_with_spectro: args.normalise_with_spectro,
     };

@@ -50,6 +50,15 @@ enum Command {
     /// Run the pipeline on built-in example measurements.
     Demo(demo::Args),
     /// Measure a sample folder: σ′s, σa and η per RGB channel (spectro → HDR → profile → fit).
+    ///
+    /// Real cameras: frames whose times are out of order, or a frame far off its time, are refused
+    /// (exit 1, naming the frames); the camera response is recovered monotone (a good bracket is
+    /// never refused for a dip at low codes); shutter times are estimated from the frames and used
+    /// when off by more than 1 %; linear 16-bit and RAW frames (DNG, CR2, CR3, NEF, ARW, RAF, …) lose
+    /// their black level (camera.black_level, else the RAW metadata, else the frame's far corners);
+    /// veiling glare is fitted beyond the profile and subtracted (camera.background); camera.flat
+    /// divides out vignetting; camera.spot_profile = "gaussian" or camera.spot_image sets the spot's
+    /// shape for the fit. result.json's inputs.options.camera says what was found and corrected.
     Measure(measure::Args),
     /// Fit a radial profile you already have (a profile CSV), given η and α′.
     Fit(fit::Args),
@@ -64,10 +73,20 @@ enum Command {
     /// Build (or show) a cached Monte Carlo profile table Rd(α′, r) for one η and g.
     Table(table::Args),
     /// Merge an exposure bracket into an HDR radiance map (Debevec & Malik 1997).
+    ///
+    /// The frames' order is checked first (a longer exposure that is darker than its neighbour is
+    /// refused, naming both files); the recovered response is monotone by construction; shutter
+    /// times are estimated from the frames and used when off by more than 1 %; RAW frames (DNG and
+    /// the vendors' formats) are merged as linear data less the black level in their metadata;
+    /// linear 16-bit frames with a pedestal lose the black level found in the far corners.
     Merge(merge::Args),
     /// Radial profile Rd(r) around the light spot of a radiance map.
     Profile(profile::Args),
     /// The rig twin: write a synthetic sample folder (Monte Carlo spectro reading and bracket).
+    ///
+    /// Besides the paper's rig, the twin has other cameras (--camera: 8-bit tone curves, linear
+    /// 16-bit, DNG raw) and a real rig's effects (--glare, --vignetting with a flat frame,
+    /// --exposure-error, --gaussian-spot, --spot-image), each off by default.
     Synth(synth::Args),
     /// The bias study: rig-twin samples over α′ and η fitted with every model and method.
     Study(study::Args),

@@ -39,8 +39,9 @@ pub enum WeightingArg {
 /// Arguments of `scatterfit merge`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The frames of the bracket (PNG, TIFF or JPEG; 8- or 16-bit; grey or RGB). May be omitted when
-    /// --exposures lists them.
+    /// The frames of the bracket (PNG, TIFF or JPEG; 8- or 16-bit; grey or RGB; or camera RAW: DNG,
+    /// CR2, CR3, NEF, ARW, RAF, ORF, RW2, PEF, …, whose times come from their metadata). May be
+    /// omitted when --exposures lists them.
     pub images: Vec<PathBuf>,
     /// Exposure times: a CSV with header `file,time_s` (paths relative to the CSV's folder; times in
     /// seconds, `0.01` or `1/100`). Without it, times come from each file's EXIF ExposureTime.

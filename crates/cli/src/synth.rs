@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use crate::common::{cache_dir, check_output_files, parse_rgb, shutter};
 use crate::output::outln;
-use crate::twin::{Material, synthesize, write_sample_with};
+use crate::twin::{Material, synthesize_on, write_sample_with};
 
 /// Arguments of `scatterfit synth`.
 #[derive(Debug, clap::Args)]
@@ -53,6 +53,35 @@ pub struct Args {
     /// and for tests; not for accuracy studies.
     #[arg(long)]
     pub quick: bool,
+    /// The twin's camera: naka-rushton (the default, 8-bit), linear, gamma22, srgb, log, s-curve
+    /// (8-bit tone curves), linear16 (linear 16-bit PNG, black level 1024 DN) or dng (14-bit raw
+    /// DNG files, black level 512, white 16383, exposure times in their metadata).
+    #[arg(long, value_name = "NAME", value_parser = parse_camera, default_value = "naka-rushton")]
+    pub camera: String,
+    /// Camera read noise [electrons, 0 to 1000] (default 3).
+    #[arg(long, value_name = "E", value_parser = crate::numeric::parse_finite)]
+    pub read_noise: Option<f64>,
+    /// Veiling glare: stray light spread over the frame, as a fraction of the spot's central
+    /// radiance, in [0, 0.1] (a lens: 1e-4 to 1e-3; the profile's far tail is 1e-5).
+    #[arg(long, value_name = "F", default_value_t = 0.0, value_parser = crate::numeric::parse_finite)]
+    pub glare: f64,
+    /// Vignetting: the frame's corner receives this fraction less light, in [0, 0.9]; a flat frame
+    /// (flat.png, camera.flat) is written with it.
+    #[arg(long, value_name = "V", default_value_t = 0.0, value_parser = crate::numeric::parse_finite)]
+    pub vignetting: f64,
+    /// Shutter error: each frame's true exposure differs from its nominal time by a random factor
+    /// exp(ε), ε with this standard deviation, in [0, 0.3] (0.03 = 3 %); the files keep the nominal
+    /// times.
+    #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = crate::numeric::parse_finite)]
+    pub exposure_error: f64,
+    /// A Gaussian beam (the spot's 1/e² diameter is the rig's 1 mm) instead of a uniform disk;
+    /// the manifest says `spot_profile = "gaussian"`.
+    #[arg(long)]
+    pub gaussian_spot: bool,
+    /// Also write spot.png, the spot on a thin opaque white target, and name it as
+    /// `camera.spot_image` (the fit's kernel is then measured, not assumed).
+    #[arg(long)]
+    pub spot_image: bool,
     /// Overwrite existing files in the folder.
     #[arg(long)]
     pub force: bool,
@@ -114,6 +143,48 @@ fn material_from(args: &Args) -> anyhow::Result<Material> {
     })
 }
 
+/// The camera names `--camera` takes.
+fn parse_camera(s: &str) -> Result<String, String> {
+    if scatterfit_synth::CameraModel::named(s).is_some() {
+        Ok(s.to_string())
+    } else {
+        Err(format!(
+            "unknown camera `{s}`; the twin has: {}",
+            scatterfit_synth::CameraModel::NAMES.join(", ")
+        ))
+    }
+}
+
+/// The rig the flags describe.
+fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
+    let mut rig = if args.quick {
+        RigSpec::quick()
+    } else {
+        RigSpec::paper()
+    };
+    rig.camera = scatterfit_synth::CameraModel::named(&args.camera)
+        .with_context(|| format!("--camera {}: unknown", args.camera))?;
+    if let Some(e) = args.read_noise {
+        crate::numeric::ensure(
+            (0.0..=1000.0).contains(&e),
+            "--read-noise",
+            e,
+            "0 to 1000 electrons",
+        )?;
+        rig.camera.read_noise_e = e;
+    }
+    rig.effects = scatterfit_synth::rig::RigEffects {
+        glare: args.glare,
+        vignetting: args.vignetting,
+        exposure_error: args.exposure_error,
+        gaussian_spot: args.gaussian_spot,
+        spot_image: args.spot_image,
+    };
+    rig.validate()
+        .map_err(|e| anyhow::anyhow!("{e} (check --glare, --vignetting, --exposure-error)"))?;
+    Ok(rig)
+}
+
 #[derive(Serialize)]
 struct Summary<'a> {
     output_dir: &'a std::path::Path,
@@ -124,23 +195,29 @@ struct Summary<'a> {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let m = material_from(&args)?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let rig = if args.quick {
-        RigSpec::quick()
-    } else {
-        RigSpec::paper()
-    };
-    check_output_files(
-        &args.output_dir,
-        &file_names(rig.times_s.len(), true),
-        args.force,
-    )?;
+    let rig = rig_from(&args)?;
+    let mut names = file_names(rig.times_s.len(), true);
+    if args.camera == "dng" {
+        for n in &mut names {
+            if n.starts_with("frame_") {
+                *n = n.replace(".png", ".dng");
+            }
+        }
+    }
+    if args.vignetting > 0.0 {
+        names.push("flat.png".into());
+    }
+    if args.spot_image {
+        names.push("spot.png".into());
+    }
+    check_output_files(&args.output_dir, &names, args.force)?;
     let cache = cache_dir(args.cache_dir.as_deref());
-    let sample = synthesize(
+    let sample = synthesize_on(
         &m,
+        &rig,
         args.seed,
         cache.as_deref(),
         args.quiet || args.json,
-        args.quick,
     )?;
     write_sample_with(
         &args.output_dir,

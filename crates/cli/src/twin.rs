@@ -5,7 +5,8 @@ use std::path::Path;
 use std::sync::Mutex;
 
 use anyhow::Context;
-use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
+use scatterfit_io::image_files::CameraFrame;
+use scatterfit_io::sample_folder::{CameraFiles, SampleFiles, write_sample_folder_with};
 use scatterfit_synth::{RigSpec, SyntheticSample};
 
 use crate::common::bar;
@@ -36,6 +37,17 @@ pub fn synthesize(
     } else {
         RigSpec::paper()
     };
+    synthesize_on(m, &rig, seed, cache, quiet)
+}
+
+/// Synthesises `m` on `rig` (a camera or effects of issue 16), with a progress bar.
+pub fn synthesize_on(
+    m: &Material,
+    rig: &RigSpec,
+    seed: u64,
+    cache: Option<&Path>,
+    quiet: bool,
+) -> anyhow::Result<SyntheticSample> {
     let bar = bar(
         3,
         &format!("{} {{msg}} {{bar:30}} {{percent}}% {{elapsed}}", m.name),
@@ -47,7 +59,7 @@ pub fn synthesize(
         m.sigma_s_prime,
         m.sigma_a,
         m.eta,
-        &rig,
+        rig,
         seed,
         cache,
         &|c, d, t| {
@@ -76,7 +88,29 @@ pub fn write_sample_with(
     fit: scatterfit_io::manifest::FitSection,
 ) -> anyhow::Result<()> {
     let truth = serde_json::to_string_pretty(&s.truth).context("serialising the truth")?;
-    write_sample_folder(
+    let frame = |f: &scatterfit_synth::rig::Frame| match f {
+        scatterfit_synth::rig::Frame::U8(b) => CameraFrame::U8(b.clone()),
+        scatterfit_synth::rig::Frame::U16(b) => CameraFrame::U16(b.clone()),
+    };
+    let rig = &s.truth.rig;
+    let extra = CameraFiles {
+        frames_u16: s.bracket.frames_u16.clone(),
+        dng_levels: match rig.camera.output {
+            scatterfit_synth::rig::SensorOutput::Linear {
+                black_level,
+                white_level,
+            } if white_level < 65535.0 => Some((
+                black_level.map(|b| b.round() as u16),
+                white_level.round() as u16,
+            )),
+            _ => None,
+        },
+        flat: s.bracket.flat.as_ref().map(frame),
+        spot_image: s.bracket.spot_image.as_ref().map(frame),
+        spot_profile: (rig.effects.gaussian_spot && s.bracket.spot_image.is_none())
+            .then_some(scatterfit_io::manifest::SpotProfileName::Gaussian),
+    };
+    write_sample_folder_with(
         dir,
         &SampleFiles {
             name: &s.truth.name,
@@ -94,6 +128,7 @@ pub fn write_sample_with(
             ),
             fit,
         },
+        &extra,
     )
     .map_err(anyhow::Error::msg)?;
     Ok(())

@@ -44,6 +44,7 @@ mod error;
 pub mod model;
 mod problem;
 pub mod profile;
+pub mod radial_spot;
 pub mod spot;
 
 use std::time::Instant;
@@ -55,6 +56,7 @@ use serde::{Deserialize, Serialize};
 pub use error::{FitError, Result};
 pub use model::{Spot, model_profile, node_spacing};
 pub use profile::{ProfileData, Ring, RingSelection, Selected, select_rings};
+pub use radial_spot::RadialSpot;
 pub use spot::SpotKernel;
 
 use error::check;
@@ -267,14 +269,7 @@ impl<'a> PreparedFit<'a> {
             },
             u => u,
         };
-        let kernel = match opts.spot {
-            Spot::Point => None,
-            Spot::Disk { radius_mm } => Some(SpotKernel::new(
-                radius_mm,
-                &selected.r_mm,
-                node_spacing(radius_mm, &selected.r_mm),
-            )?),
-        };
+        let kernel = model::spot_kernel(opts.spot, &selected.r_mm)?;
         Ok(Self {
             model,
             input: *input,

@@ -16,6 +16,9 @@ use scatterfit_optics::{ModelFamily, OpticalProperties, ProfileSample};
 use crate::spot::SpotKernel;
 
 /// How the light spot enters the model.
+// `Radial` holds its disks inline (≈ 0.5 KB) so that the fit's options stay `Copy`; they are copied
+// once per fit, not per iteration.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Spot {
     /// A point of incidence: the model as it stands (the paper's treatment).
@@ -25,6 +28,9 @@ pub enum Spot {
         /// Radius [mm].
         radius_mm: f64,
     },
+    /// A radial spot of any shape (Gaussian, measured) as a mixture of disks
+    /// ([`crate::radial_spot`]).
+    Radial(crate::radial_spot::RadialSpot),
 }
 
 /// The model's profile at `radii_mm` for `props`, convolved with the spot when it is a disk: the
@@ -45,9 +51,8 @@ pub fn model_profile(
             model.eval(props, radii_mm, &mut out);
             Ok(out.iter().map(|s| s.rd).collect())
         }
-        Spot::Disk { radius_mm } => {
-            let h = node_spacing(radius_mm, radii_mm);
-            let kernel = SpotKernel::new(radius_mm, radii_mm, h)?;
+        Spot::Disk { .. } | Spot::Radial(_) => {
+            let kernel = spot_kernel(spot, radii_mm)?.expect("not a point");
             let mut nodes = vec![zero; kernel.nodes().len()];
             model.eval(props, kernel.nodes(), &mut nodes);
             let values: Vec<f64> = nodes.iter().map(|s| s.rd).collect();
@@ -56,6 +61,28 @@ pub fn model_profile(
             Ok(out)
         }
     }
+}
+
+/// The spot's convolution map for rings at `radii_mm` (`None` for a point of incidence): a disk's
+/// with node spacing [`node_spacing`], a radial spot's as its mixture of disks with the spacing of
+/// its equivalent disk.
+///
+/// # Errors
+/// As [`SpotKernel::new`].
+pub fn spot_kernel(spot: Spot, radii_mm: &[f64]) -> crate::Result<Option<SpotKernel>> {
+    Ok(match spot {
+        Spot::Point => None,
+        Spot::Disk { radius_mm } => Some(SpotKernel::new(
+            radius_mm,
+            radii_mm,
+            node_spacing(radius_mm, radii_mm),
+        )?),
+        Spot::Radial(s) => Some(SpotKernel::from_disks(
+            &s,
+            radii_mm,
+            node_spacing(s.equivalent_radius_mm(), radii_mm),
+        )?),
+    })
 }
 
 /// The node spacing used for a disk of radius a and these rings: a/8, or the median ring spacing

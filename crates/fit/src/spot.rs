@@ -158,6 +158,50 @@ impl SpotKernel {
         })
     }
 
+    /// The map for a spot of any radial shape given as a mixture of uniform disks
+    /// ([`crate::radial_spot::RadialSpot`]): Σ_k w_k × (the disk map of radius a_k), on one node
+    /// grid reaching the outer disk. [`SpotKernel::radius_mm`] is then the radius of the disk with
+    /// the spot's second moment (for the start search's coarse kernel).
+    ///
+    /// # Errors
+    /// As [`SpotKernel::new`].
+    pub fn from_disks(
+        spot: &crate::radial_spot::RadialSpot,
+        r_mm: &[f64],
+        h_mm: f64,
+    ) -> Result<Self> {
+        let outer = spot.outer_radius_mm();
+        let mut k = Self::new(outer, r_mm, h_mm)?;
+        for (i, &r) in r_mm.iter().enumerate() {
+            let mut w = vec![0.0f64; k.nodes.len()];
+            let (mut lo, mut hi) = (usize::MAX, 0usize);
+            for (a, weight) in spot.disks() {
+                if weight == 0.0 {
+                    continue;
+                }
+                let part = row(r, a, &k.nodes);
+                for (j, v) in part.weights.iter().enumerate() {
+                    w[part.first + j] += weight * v;
+                }
+                lo = lo.min(part.first);
+                hi = hi.max(part.first + part.weights.len());
+            }
+            k.rows[i] = if lo < hi {
+                Row {
+                    first: lo,
+                    weights: w[lo..hi].to_vec(),
+                }
+            } else {
+                Row {
+                    first: 0,
+                    weights: Vec::new(),
+                }
+            };
+        }
+        k.radius_mm = spot.equivalent_radius_mm();
+        Ok(k)
+    }
+
     /// Spot radius [mm].
     pub fn radius_mm(&self) -> f64 {
         self.radius_mm

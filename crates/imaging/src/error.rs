@@ -149,6 +149,53 @@ pub enum ImagingError {
         /// downward).
         span: f64,
     },
+    /// The frames do not brighten with their exposure times: a frame with a longer time is darker
+    /// than (or the same as) one with a shorter time — times reversed or shuffled, or one frame
+    /// listed twice. Seen directly in the frames, before any response is recovered
+    /// ([`crate::check_bracket_order`]).
+    #[error(
+        "the frames do not brighten with their exposure times: {what} (frame {longer} at {t_longer} s \
+         against frame {shorter} at {t_shorter} s, counting frames in the order given from 0; of the \
+         {compared} pixel values that are unclipped in either and differ, {darker} got darker and \
+         {brighter} brighter with the longer time) — are the exposure times in the right order, each \
+         with its own frame? (check the exposures CSV or the files' EXIF times)"
+    )]
+    BracketOutOfOrder {
+        /// What was seen: "the longer exposure is darker", "the two frames are identical", …
+        what: &'static str,
+        /// Index (as given) of the frame with the shorter time.
+        shorter: usize,
+        /// Index (as given) of the frame with the longer time.
+        longer: usize,
+        /// Its time [s].
+        t_shorter: f64,
+        /// Its time [s].
+        t_longer: f64,
+        /// Pixel values compared (not clipped at the same end in both frames).
+        compared: usize,
+        /// Of those, how many are lower in the longer exposure.
+        darker: usize,
+        /// And how many higher.
+        brighter: usize,
+    },
+    /// A frame holds far more or less light than its exposure time says, measured against its
+    /// neighbours on the pixels well exposed in both: more than a shutter's error.
+    #[error(
+        "frame {frame} (at {time_s} s, counting frames by time from 0) holds {factor:.3} × the \
+         light its exposure time says, measured against its neighbours on the pixels well exposed \
+         in both — more than a shutter's error ({limit:.0} %): is it the right file for that time \
+         (one frame listed twice, a frame of another bracket, the light changed)?"
+    )]
+    ExposureMismatch {
+        /// Index of the frame, by time.
+        frame: usize,
+        /// Its nominal time [s].
+        time_s: f64,
+        /// Its estimated exposure over the nominal one.
+        factor: f64,
+        /// The largest deviation taken for a shutter's [%].
+        limit: f64,
+    },
     /// The dark frame is at or above the signal: fewer than [`crate::MIN_VALID_FRACTION`] of a
     /// channel's pixels rise above it even in the longest exposure.
     #[error(
@@ -228,6 +275,8 @@ impl ImagingError {
             Self::NotEnoughSamples { .. }
                 | Self::SolveFailed { .. }
                 | Self::ResponseNotIncreasing { .. }
+                | Self::BracketOutOfOrder { .. }
+                | Self::ExposureMismatch { .. }
                 | Self::NoValidRadiance { .. }
                 | Self::NoSpot { .. }
         )

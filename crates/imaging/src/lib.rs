@@ -20,6 +20,7 @@ pub mod buffer;
 pub mod center;
 pub mod error;
 pub mod merge;
+pub mod order;
 pub mod profile;
 pub mod response;
 pub mod text;
@@ -29,8 +30,9 @@ pub use center::{CenterOptions, SpotCenter, find_spot_center};
 pub use error::{ImagingError, Result};
 pub use merge::{
     CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MIN_VALID_FRACTION,
-    MergeOptions, Weighting, merge, merge_linear_u16,
+    MergeOptions, Weighting, merge, merge_linear_black, merge_linear_u16,
 };
+pub use order::check_bracket_order;
 pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{
     CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,

@@ -317,7 +317,7 @@ pub fn gsolve(z: &[u8], ln_dt: &[f64], lambda: f64, channel: usize) -> Result<Ch
         k += 1;
     }
     debug_assert_eq!(k, rows);
-    let g_vec = solve_least_squares(a, b).ok_or(ImagingError::SolveFailed {
+    let g_vec = solve_monotone(a, b).ok_or(ImagingError::SolveFailed {
         channel,
         reason: "the system is rank deficient (too few distinct code values among the samples?)",
     })?;
@@ -370,6 +370,137 @@ pub fn gsolve(z: &[u8], ln_dt: &[f64], lambda: f64, channel: usize) -> Result<Ch
     })
 }
 
+/// The least-squares g that never decreases: min |A g − b| subject to g(z) ≥ g(z − 1).
+///
+/// The unconstrained minimiser is found first (Householder QR); when it already rises everywhere it
+/// is the answer (the constraint is inactive, so nothing changes for a good bracket). Otherwise g
+/// is written as cumulative sums of its increments, g = T d with d(z) = g(z) − g(z − 1) ≥ 0 and
+/// the gauge g(128) = 0 built in, and the non-negative least-squares problem min |A T d − b|,
+/// d ≥ 0, is solved exactly by Lawson & Hanson's active-set algorithm (Solving Least Squares
+/// Problems, 1974, ch. 23) on the triangular factor of A T (255 unknowns), warm-started from the
+/// unconstrained increments. Monotone by construction: a dip that noise at low codes would make
+/// becomes a flat stretch, and a bracket in the wrong order is found by
+/// [`crate::check_bracket_order`], not by the shape of g.
+fn solve_monotone(a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>> {
+    let g = solve_least_squares(a.clone(), b.clone())?;
+    if g.as_slice().windows(2).all(|w| w[1] >= w[0]) {
+        return Some(g);
+    }
+    // g = T d: g(z) = Σ_{k=129..=z} d_k above the gauge, −Σ_{k=z+1..=128} d_k below; d_k is
+    // column k − 1 (k = 1..=255).
+    let n = LEVELS - 1;
+    let mut at = DMatrix::<f64>::zeros(a.nrows(), n);
+    for r in 0..a.nrows() {
+        // (A T)[r, k−1] = Σ_{z ≥ k} A[r, z] for k > 128, −Σ_{z < k} A[r, z] for k ≤ 128.
+        let mut acc = 0.0;
+        for z in (129..LEVELS).rev() {
+            acc += a[(r, z)];
+            at[(r, z - 1)] = acc;
+        }
+        let mut acc = 0.0;
+        for k in 1..=128 {
+            acc += a[(r, k - 1)];
+            at[(r, k - 1)] = -acc;
+        }
+    }
+    let qr = at.qr();
+    let mut qtb = b;
+    qr.q_tr_mul(&mut qtb);
+    let r = qr.r();
+    let c = qtb.rows(0, n).into_owned();
+    let start: Vec<bool> = (1..LEVELS).map(|k| g[k] - g[k - 1] > 0.0).collect();
+    let d = nnls(&r, &c, &start)?;
+    let mut out = DVector::<f64>::zeros(LEVELS);
+    for z in 129..LEVELS {
+        out[z] = out[z - 1] + d[z - 1];
+    }
+    for z in (0..128).rev() {
+        out[z] = out[z + 1] - d[z];
+    }
+    Some(out)
+}
+
+/// Lawson & Hanson's NNLS, min |R x − c| subject to x ≥ 0, for a square R, starting with the
+/// columns flagged in `passive` free (a warm start; the algorithm makes it feasible first).
+fn nnls(r: &DMatrix<f64>, c: &DVector<f64>, passive: &[bool]) -> Option<DVector<f64>> {
+    let n = r.ncols();
+    let mut p: Vec<bool> = passive.to_vec();
+    let mut x = DVector::<f64>::zeros(n);
+    let tol = 1e-12 * r.amax().max(1.0) * c.amax().max(1.0) * n as f64;
+    // Least squares on the passive columns; zeros elsewhere.
+    let solve_p = |p: &[bool]| -> Option<DVector<f64>> {
+        let cols: Vec<usize> = (0..n).filter(|&j| p[j]).collect();
+        let mut s = DVector::<f64>::zeros(n);
+        if cols.is_empty() {
+            return Some(s);
+        }
+        let sub = r.select_columns(&cols);
+        let sol = solve_least_squares(sub, c.clone())?;
+        for (i, &j) in cols.iter().enumerate() {
+            s[j] = sol[i];
+        }
+        Some(s)
+    };
+    // Make the warm start feasible: drop the columns whose solution is not positive until none is.
+    for _ in 0..n {
+        let s = solve_p(&p)?;
+        let bad: Vec<usize> = (0..n).filter(|&j| p[j] && s[j] <= 0.0).collect();
+        if bad.is_empty() {
+            x = s;
+            break;
+        }
+        for j in bad {
+            p[j] = false;
+        }
+    }
+    // Lawson & Hanson's inner loop: from a feasible x (positive on the passive set but for a
+    // column just freed), step toward the passive solution s until it is feasible.
+    let inner = |p: &mut Vec<bool>, x: &mut DVector<f64>| -> Option<()> {
+        for _ in 0..3 * n {
+            let s = solve_p(p)?;
+            if (0..n).all(|j| !p[j] || s[j] > 0.0) {
+                *x = s;
+                return Some(());
+            }
+            let mut alpha = 1.0f64;
+            for j in 0..n {
+                if p[j] && s[j] <= 0.0 {
+                    alpha = alpha.min(x[j] / (x[j] - s[j]));
+                }
+            }
+            for j in 0..n {
+                x[j] += alpha * (s[j] - x[j]);
+                if p[j] && x[j] <= tol.min(1e-15) {
+                    p[j] = false;
+                    x[j] = 0.0;
+                }
+            }
+            // Columns with a non-positive solution that α did not zero (α = 0 when x_j = 0).
+            for j in 0..n {
+                if p[j] && s[j] <= 0.0 && x[j] <= 0.0 {
+                    p[j] = false;
+                }
+            }
+        }
+        None
+    };
+    for _ in 0..3 * n {
+        let resid = c - r * &x;
+        let w = r.tr_mul(&resid);
+        let best = (0..n)
+            .filter(|&j| !p[j])
+            .max_by(|&i, &j| w[i].total_cmp(&w[j]));
+        match best {
+            Some(t) if w[t] > tol => {
+                p[t] = true;
+                inner(&mut p, &mut x)?;
+            }
+            _ => return Some(x),
+        }
+    }
+    Some(x)
+}
+
 /// Least squares min |A x − b| by Householder QR (A has full column rank or `None`).
 fn solve_least_squares(a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>> {
     let ncols = a.ncols();
@@ -406,6 +537,7 @@ pub fn recover_response(
     opts: &CalibrateOptions,
 ) -> Result<Calibration> {
     check_bracket(frames, times_s)?;
+    crate::order::check_bracket_order(frames, times_s, u8::MAX)?;
     let p = frames.len();
     let min = min_response_samples(p);
     if !(min..=MAX_RESPONSE_SAMPLES).contains(&opts.samples) {

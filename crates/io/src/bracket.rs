@@ -351,6 +351,8 @@ pub struct BracketFrame {
     pub frame: CameraFrame,
     /// True if the file's alpha channel was dropped.
     pub dropped_alpha: bool,
+    /// A camera RAW file's metadata (levels, exposure time); `None` for other files.
+    pub raw: Option<crate::image_files::RawInfo>,
 }
 
 /// A validated exposure bracket: at least two frames of one shape and bit depth, with distinct
@@ -570,11 +572,12 @@ pub fn read_bracket_within(
         .par_iter()
         .map(|(path, time)| {
             let bytes = crate::image_files::read_image_bytes(path, budget)?;
-            let time_s = match time {
-                TimeOf::Known { time_s, .. } => *time_s,
-                TimeOf::Exif => exif_exposure_time(&bytes, path)?,
-            };
             let decoded = decode_camera_frame(&bytes, path)?;
+            let time_s = match (time, decoded.raw.and_then(|r| r.exposure_time_s)) {
+                (TimeOf::Known { time_s, .. }, _) => *time_s,
+                (TimeOf::Exif, Some(t)) if t.is_finite() && t > 0.0 => t,
+                (TimeOf::Exif, _) => exif_exposure_time(&bytes, path)?,
+            };
             drop(bytes);
             on_frame_read(path);
             Ok(BracketFrame {
@@ -582,6 +585,7 @@ pub fn read_bracket_within(
                 time_s,
                 frame: decoded.frame,
                 dropped_alpha: decoded.dropped_alpha,
+                raw: decoded.raw,
             })
         })
         .collect();

@@ -150,6 +150,17 @@ pub struct DecodedFrame {
     pub frame: CameraFrame,
     /// True if the file had an alpha channel, which was dropped.
     pub dropped_alpha: bool,
+    /// A camera RAW file's levels and exposure time from its metadata (`None` for other files).
+    pub raw: Option<RawInfo>,
+}
+
+/// What a camera RAW file's metadata say ([`crate::raw`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RawInfo {
+    /// Black and white levels [DN].
+    pub levels: crate::raw::RawLevels,
+    /// The exposure time [s], if the file records one.
+    pub exposure_time_s: Option<f64>,
 }
 
 /// Reads a camera frame (PNG, TIFF or JPEG; 8- or 16-bit; grey, grey+alpha, RGB or RGBA).
@@ -183,6 +194,26 @@ pub fn decode_camera_frame_within(
     budget: u64,
 ) -> Result<DecodedFrame, ImageFileError> {
     use image::DynamicImage as D;
+    if crate::raw::is_raw_path(path) {
+        let raw = crate::raw::decode_raw(bytes, path)?;
+        let needed = (raw.rgb.data().len() * 2) as u64;
+        if needed > budget {
+            return Err(ImageFileError::TooLarge {
+                path: path.to_path_buf(),
+                what: format!("a {}×{} RAW image", raw.rgb.width(), raw.rgb.height()),
+                needed,
+                budget,
+            });
+        }
+        return Ok(DecodedFrame {
+            frame: CameraFrame::U16(raw.rgb),
+            dropped_alpha: false,
+            raw: Some(RawInfo {
+                levels: raw.levels,
+                exposure_time_s: raw.exposure_time_s,
+            }),
+        });
+    }
     let image = decode_any(bytes, path, budget)?;
     let (w, h) = (image.width() as usize, image.height() as usize);
     let buf_err = |e: scatterfit_imaging::ShapeError| ImageFileError::Unsupported {
@@ -255,6 +286,7 @@ pub fn decode_camera_frame_within(
     Ok(DecodedFrame {
         frame,
         dropped_alpha,
+        raw: None,
     })
 }
 

@@ -20,6 +20,12 @@
 //! # dark = "dark.png"           # optional dark frame, subtracted before merging
 //! # center_px = [512.3, 498.7]  # optional spot centre (else found)
 //! # spot_diameter_mm = 1.0      # the light spot (default 1 mm, the paper's "under 1 mm")
+//! # spot_profile = "disk"       # disk | gaussian (spot_diameter_mm is then the 1/e² diameter)
+//! # spot_image = "spot.png"     # the spot on a thin opaque white target: the fit's kernel
+//! # flat = "flat.png"           # a frame of a uniform target: vignetting divided out
+//! # black_level = "auto"        # linear frames: auto (far corners) | none | DN | [r, g, b] DN
+//! # background = "auto"        # veiling glare: auto (fitted beyond the profile) | none
+//! # exposure_correction = "auto" # shutter times from the frames: auto | always | never
 //!
 //! [fit]                         # every key optional, defaults shown
 //! method = "proposed"           # proposed | existing
@@ -106,6 +112,63 @@ pub struct SpectroSection {
 /// replaced by the spread of repeated readings of the user's own sample (re-placed each time).
 pub const DEFAULT_SPECTRO_REPEATABILITY: f64 = 0.005;
 
+/// The light spot's radial shape (`camera.spot_profile`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpotProfileName {
+    /// Uniform irradiance over a disk of diameter `spot_diameter_mm` (the default).
+    #[default]
+    Disk,
+    /// Gaussian irradiance exp(−2ρ²/w²), `spot_diameter_mm` = 2w (the 1/e² diameter).
+    Gaussian,
+}
+
+impl SpotProfileName {
+    /// The name as written.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SpotProfileName::Disk => "disk",
+            SpotProfileName::Gaussian => "gaussian",
+        }
+    }
+}
+
+/// `auto` or `none` (`camera.background`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AutoOrNone {
+    /// Estimated from the data (the default).
+    #[default]
+    Auto,
+    /// Not done.
+    None,
+}
+
+/// When the exposure times are corrected from the frames (`camera.exposure_correction`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ExposureCorrection {
+    /// Estimated always, applied when a frame's time is off by more than the threshold (default).
+    #[default]
+    Auto,
+    /// Estimated and applied.
+    Always,
+    /// The times as given.
+    Never,
+}
+
+/// `camera.black_level`: `"auto"`, `"none"`, one number of DN, or one per channel.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum BlackLevelSetting {
+    /// `"auto"` (from a dark frame, the file's metadata, or the frames' far corners) or `"none"`.
+    Mode(AutoOrNone),
+    /// The same level [DN] for every channel.
+    One(f64),
+    /// A level [DN] per channel R, G, B.
+    PerChannel([f64; 3]),
+}
+
 /// `[camera]`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -126,6 +189,18 @@ pub struct CameraSection {
     pub center_px: Option<[f64; 2]>,
     /// Diameter of the light spot [mm].
     pub spot_diameter_mm: Option<f64>,
+    /// The spot's radial shape (default disk).
+    pub spot_profile: Option<SpotProfileName>,
+    /// An image of the spot on a thin opaque white target, radially averaged into the fit's kernel.
+    pub spot_image: Option<PathBuf>,
+    /// A frame of a uniform target (vignetting and pixel response), divided out.
+    pub flat: Option<PathBuf>,
+    /// The black level of linear frames (default auto).
+    pub black_level: Option<BlackLevelSetting>,
+    /// Veiling glare / stray light (default auto: estimated and subtracted).
+    pub background: Option<AutoOrNone>,
+    /// Shutter times estimated from the frames (default auto).
+    pub exposure_correction: Option<ExposureCorrection>,
 }
 
 /// `[fit]`.
@@ -370,6 +445,43 @@ pub fn parse_manifest(
             format!("= {}: must be a number in (0, 20] mm", num(d)),
         ));
     }
+    if m.camera.spot_image.is_some() && m.camera.spot_profile.is_some() {
+        return Err(invalid(
+            "camera.spot_image",
+            "is given together with `camera.spot_profile`: the image is the spot's profile; give \
+             one or the other"
+                .into(),
+        ));
+    }
+    match m.camera.black_level {
+        Some(BlackLevelSetting::One(v)) if !(v.is_finite() && (0.0..65535.0).contains(&v)) => {
+            return Err(invalid(
+                "camera.black_level",
+                format!(
+                    "= {v}: a black level is a raw value in [0, 65535) DN, or \"auto\"/\"none\""
+                ),
+            ));
+        }
+        Some(BlackLevelSetting::PerChannel(v))
+            if v.iter()
+                .any(|v| !(v.is_finite() && (0.0..65535.0).contains(v))) =>
+        {
+            return Err(invalid(
+                "camera.black_level",
+                format!("= {v:?}: each channel's black level must lie in [0, 65535) DN"),
+            ));
+        }
+        _ => {}
+    }
+    if m.camera.hdr.is_some()
+        && (m.camera.black_level.is_some() || m.camera.exposure_correction.is_some())
+    {
+        return Err(invalid(
+            "camera.hdr",
+            "is a merged radiance map: `black_level` and `exposure_correction` apply to a bracket"
+                .into(),
+        ));
+    }
     if let Some([x, y]) = m.camera.center_px
         && !(x.is_finite() && y.is_finite())
     {
@@ -563,6 +675,50 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     if let Some(d) = m.camera.spot_diameter_mm {
         t.push_str(&format!(
             "spot_diameter_mm = {d}        # the light spot on the sample\n"
+        ));
+    }
+    if let Some(p) = m.camera.spot_profile {
+        t.push_str(&format!("spot_profile = \"{}\"\n", p.as_str()));
+    }
+    for (key, p) in [
+        ("spot_image", &m.camera.spot_image),
+        ("flat", &m.camera.flat),
+    ] {
+        if let Some(p) = p {
+            t.push_str(&format!("{key} = {}\n", toml_path(p)));
+        }
+    }
+    match m.camera.black_level {
+        Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => {
+            t.push_str("black_level = \"auto\"\n");
+        }
+        Some(BlackLevelSetting::Mode(AutoOrNone::None)) => {
+            t.push_str("black_level = \"none\"\n");
+        }
+        Some(BlackLevelSetting::One(v)) => t.push_str(&format!("black_level = {v}\n")),
+        Some(BlackLevelSetting::PerChannel([r, g, b])) => {
+            t.push_str(&format!("black_level = [{r}, {g}, {b}]\n"));
+        }
+        None => {}
+    }
+    if let Some(b) = m.camera.background {
+        t.push_str(&format!(
+            "background = \"{}\"\n",
+            if b == AutoOrNone::Auto {
+                "auto"
+            } else {
+                "none"
+            }
+        ));
+    }
+    if let Some(e) = m.camera.exposure_correction {
+        t.push_str(&format!(
+            "exposure_correction = \"{}\"\n",
+            match e {
+                ExposureCorrection::Auto => "auto",
+                ExposureCorrection::Always => "always",
+                ExposureCorrection::Never => "never",
+            }
         ));
     }
     t.push_str("\n[fit]                         # every key optional\n");

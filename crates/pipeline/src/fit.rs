@@ -17,12 +17,28 @@ pub struct FitSettings {
     pub model: ModelName,
     /// How α′ comes from the spectrophotometer's Rd (`scatterfit_mc::albedo_family`).
     pub albedo_model: AlbedoModel,
-    /// Radius of the light spot [mm]; the model is convolved with it.
+    /// Radius of the light spot [mm]; the model is convolved with it. For a radial spot
+    /// (`spot`), the radius holding 99 % of its power (which sets the default r_min).
     pub spot_radius_mm: f64,
+    /// The spot's shape: a uniform disk of `spot_radius_mm`, or a radial profile (a Gaussian, a
+    /// measured spot image; issue 16).
+    pub spot: SpotShape,
     /// Innermost fitted radius [mm] (default: the spot's diameter).
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed only).
     pub normalise_with_spectro: bool,
+}
+
+/// The light spot's shape in [`FitSettings`].
+// Inline disks keep the settings `Copy` (see `scatterfit_fit::Spot`).
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum SpotShape {
+    /// A uniform disk of [`FitSettings::spot_radius_mm`] (the paper's).
+    #[default]
+    Disk,
+    /// A radial spot as a mixture of disks (`camera.spot_profile = "gaussian"`, `camera.spot_image`).
+    Radial(scatterfit_fit::RadialSpot),
 }
 
 impl FitSettings {
@@ -33,8 +49,11 @@ impl FitSettings {
     /// manifest and the commands check both before).
     pub fn options(&self) -> Result<FitOptions> {
         let mut o = FitOptions::new(self.method);
-        o.spot = Spot::Disk {
-            radius_mm: self.spot_radius_mm,
+        o.spot = match self.spot {
+            SpotShape::Disk => Spot::Disk {
+                radius_mm: self.spot_radius_mm,
+            },
+            SpotShape::Radial(s) => Spot::Radial(s),
         };
         let selection = scatterfit_fit::RingSelection::for_spot(self.spot_radius_mm);
         o.selection = match self.r_min_mm {

@@ -13,6 +13,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod camera;
 mod error;
 pub mod fit;
 pub mod hdr;

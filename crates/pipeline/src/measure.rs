@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use scatterfit_fit::ProfileData;
-use scatterfit_io::manifest::{SampleManifest, read_manifest};
+use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest, read_manifest};
 use scatterfit_io::result_json::{Channels, FileRef, Inputs, MeasurementResult};
 use scatterfit_mc::{albedo_family, family};
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
@@ -14,10 +14,12 @@ use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
 use crate::fit::{
-    ChannelOutcome, FitSettings, SpectroErrors, channel_result, fit_stage, propagate_spectro,
+    ChannelOutcome, FitSettings, SpectroErrors, SpotShape, channel_result, fit_stage,
+    propagate_spectro,
 };
+use crate::hdr::BlackLevel;
 use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
-use crate::profile::{ProfileSettings, ProfileStage, profile_stage};
+use crate::profile::{ProfileSettings, ProfileStage, profile_stage_with};
 use crate::spectro::{SpectroStage, spectro_stage};
 
 /// Options that override the manifest's `[fit]` (from the command line).
@@ -114,11 +116,23 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
             "normalising with the spectrophotometer applies to the proposed method only".into(),
         ));
     }
+    // The spot: a disk (the paper's), or a Gaussian of that 1/e² diameter (issue 16); a spot
+    // image replaces this once the bracket is merged (measure_sample).
+    let diameter = manifest.camera.spot_diameter_mm.unwrap_or(1.0);
+    let (spot, spot_radius_mm) = match manifest.camera.spot_profile {
+        Some(scatterfit_io::manifest::SpotProfileName::Gaussian) => {
+            let s = scatterfit_fit::RadialSpot::gaussian(0.5 * diameter)
+                .map_err(|e| PipelineError::Input(format!("camera.spot_profile: {e}")))?;
+            (SpotShape::Radial(s), s.radius_enclosing(0.99))
+        }
+        _ => (SpotShape::Disk, 0.5 * diameter),
+    };
     Ok(FitSettings {
         method,
         model,
         albedo_model,
-        spot_radius_mm: 0.5 * manifest.camera.spot_diameter_mm.unwrap_or(1.0),
+        spot,
+        spot_radius_mm,
         r_min_mm: manifest.fit.r_min_mm,
         normalise_with_spectro: normalise,
     })
@@ -166,6 +180,15 @@ pub fn measure_sample(
                 .as_ref()
                 .map(|p| manifest.resolve(p));
             inputs.dark = manifest.camera.dark.as_ref().map(|p| manifest.resolve(p));
+            // A real camera (issue 16): black level, shutter times, flat frame.
+            inputs.flat = manifest.camera.flat.as_ref().map(|p| manifest.resolve(p));
+            inputs.exposure_correction = manifest.camera.exposure_correction.unwrap_or_default();
+            inputs.black_level = match manifest.camera.black_level {
+                None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
+                Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
+                Some(BlackLevelSetting::One(v)) => BlackLevel::Given(vec![v]),
+                Some(BlackLevelSetting::PerChannel(v)) => BlackLevel::Given(v.to_vec()),
+            };
             // Pixels dark in every frame are evidence of radiance below the first code: keep them
             // as 0 so far rings are not averaged over their brighter pixels only; pixels saturated
             // everywhere are masked out by the profile stage.
@@ -177,7 +200,7 @@ pub fn measure_sample(
     };
     let t_profile = Instant::now();
     progress(Stage::Profile);
-    let profile = profile_stage(
+    let profile = profile_stage_with(
         &hdr.hdr.radiance,
         Some(&hdr.hdr.clipped),
         &hdr.detection_limit,
@@ -187,7 +210,18 @@ pub fn measure_sample(
             ring_width_px: 1.0,
             center_px: manifest.camera.center_px,
         },
+        manifest.camera.background.unwrap_or_default(),
     )?;
+    let mut settings = settings;
+    if let Some(p) = &manifest.camera.spot_image {
+        let s = crate::hdr::spot_kernel_from_image(
+            &manifest.resolve(p),
+            &hdr,
+            manifest.camera.mm_per_pixel.unwrap_or(f64::NAN),
+        )?;
+        settings.spot = SpotShape::Radial(s);
+        settings.spot_radius_mm = s.radius_enclosing(0.99);
+    }
     let profile_s = t_profile.elapsed().as_secs_f64();
     let channels = profile.profile.channels();
     if channels != 3 {
@@ -355,6 +389,10 @@ impl Measurement {
                     "spot_radius_mm": self.settings.spot_radius_mm,
                     "response": self.hdr.response_kind,
                     "detection_limit": self.profile.detection_limit,
+                    "camera": {
+                        "corrections": self.hdr.corrections,
+                        "background": self.profile.background,
+                    },
                 }),
             },
             version: env!("CARGO_PKG_VERSION").into(),

@@ -135,6 +135,7 @@ fn sigma_errors_match_refits_of_repeated_readings() {
         model: ModelName::Dipole,
         albedo_model: AlbedoModel::Diffusion,
         spot_radius_mm: 0.5,
+        spot: scatterfit_pipeline::fit::SpotShape::Disk,
         r_min_mm: Some(1.0),
         normalise_with_spectro: false,
     };

@@ -39,6 +39,110 @@ pub struct CameraModel {
     pub read_noise_e: f64,
     /// Knee b of the tone curve T(s) = (1 + b)s/(s + b) (see [`CameraModel::tone`]).
     pub tone_knee: f64,
+    /// The tone curve (default: the Naka–Rushton curve with knee `tone_knee`).
+    #[serde(default, skip_serializing_if = "ToneCurve::is_default")]
+    pub curve: ToneCurve,
+    /// What the camera writes: 8-bit tone-mapped codes (default) or linear 16-bit raw values.
+    #[serde(default, skip_serializing_if = "SensorOutput::is_default")]
+    pub output: SensorOutput,
+}
+
+/// The twin camera's tone curve, from linear signal s ∈ [0, 1] (electrons / full well) to display
+/// value [0, 1]: the curves a lab's cameras use (issue 16's sweep). Each is monotone with T(0) = 0,
+/// T(1) = 1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ToneCurve {
+    /// T(s) = (1 + b)s/(s + b), b = [`CameraModel::tone_knee`] (the twin's camera since issue 3).
+    #[default]
+    NakaRushton,
+    /// T(s) = s (a machine-vision camera with gamma off).
+    Linear,
+    /// T(s) = s^(1/2.2).
+    Gamma22,
+    /// The sRGB transfer function (IEC 61966-2-1): 12.92 s below 0.0031308, 1.055 s^(1/2.4) − 0.055
+    /// above.
+    Srgb,
+    /// A log curve (cine "log" profiles): T(s) = ln(1 + 500 s)/ln 501.
+    Log,
+    /// A filmic S-curve with a toe and a shoulder: Narkowicz's 2015 fit of the ACES reference
+    /// rendering transform, A(x) = x(2.51x + 0.03)/(x(2.43x + 0.59) + 0.14), at x = 4s, scaled so
+    /// T(1) = 1 (flat at black, compressed toward white).
+    SCurve,
+}
+
+impl ToneCurve {
+    /// Every curve, in the order of [`ToneCurve::name`]'s list.
+    pub const ALL: [ToneCurve; 6] = [
+        ToneCurve::NakaRushton,
+        ToneCurve::Linear,
+        ToneCurve::Gamma22,
+        ToneCurve::Srgb,
+        ToneCurve::Log,
+        ToneCurve::SCurve,
+    ];
+
+    fn is_default(&self) -> bool {
+        *self == ToneCurve::default()
+    }
+
+    /// The name `synth --camera` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneCurve::NakaRushton => "naka-rushton",
+            ToneCurve::Linear => "linear",
+            ToneCurve::Gamma22 => "gamma22",
+            ToneCurve::Srgb => "srgb",
+            ToneCurve::Log => "log",
+            ToneCurve::SCurve => "s-curve",
+        }
+    }
+
+    /// T(s) for s ∈ [0, 1] (clamped), with knee `b` for the Naka–Rushton curve.
+    pub fn apply(self, s: f64, b: f64) -> f64 {
+        let s = s.clamp(0.0, 1.0);
+        match self {
+            ToneCurve::NakaRushton => (1.0 + b) * s / (s + b),
+            ToneCurve::Linear => s,
+            ToneCurve::Gamma22 => s.powf(1.0 / 2.2),
+            ToneCurve::Srgb => {
+                if s <= 0.003_130_8 {
+                    12.92 * s
+                } else {
+                    1.055 * s.powf(1.0 / 2.4) - 0.055
+                }
+            }
+            ToneCurve::Log => (500.0 * s).ln_1p() / 501f64.ln(),
+            ToneCurve::SCurve => {
+                let aces = |x: f64| x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14);
+                aces(4.0 * s) / aces(4.0)
+            }
+        }
+    }
+}
+
+/// What the twin camera writes.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum SensorOutput {
+    /// 8-bit codes through the tone curve (a JPEG/PNG camera).
+    #[default]
+    Tone8,
+    /// Linear raw values: `black_level` (per channel, DN) plus electrons × (`white_level` −
+    /// black)/full well, clipped at `white_level`; no tone curve. Written as 16-bit PNG (values as
+    /// they are) or DNG (with the levels in its metadata).
+    Linear {
+        /// The sensor's black level per channel [DN] (what a raw file's pixels read in the dark).
+        black_level: [f64; 3],
+        /// The clip level [DN] (16383 for a 14-bit sensor, 65535 for full 16-bit).
+        white_level: f64,
+    },
+}
+
+impl SensorOutput {
+    fn is_default(&self) -> bool {
+        *self == SensorOutput::default()
+    }
 }
 
 impl Default for CameraModel {
@@ -49,6 +153,8 @@ impl Default for CameraModel {
             full_well_e: 20_000.0,
             read_noise_e: 3.0,
             tone_knee: 0.08,
+            curve: ToneCurve::NakaRushton,
+            output: SensorOutput::Tone8,
         }
     }
 }
@@ -58,10 +164,68 @@ impl CameraModel {
     /// [0, 1]: T(s) = (1 + b)s/(s + b), a Michaelis–Menten (Naka–Rushton) curve — monotone, smooth,
     /// linear at black and compressive towards white, T(0) = 0, T(1) = 1. Deliberately not a gamma
     /// or an sRGB curve: the tool must recover it (Debevec & Malik 1997), not assume it.
+    ///
+    /// With another [`ToneCurve`] in `curve`, that curve.
     pub fn tone(&self, s: f64) -> f64 {
-        let b = self.tone_knee;
-        let s = s.clamp(0.0, 1.0);
-        (1.0 + b) * s / (s + b)
+        self.curve.apply(s, self.tone_knee)
+    }
+
+    /// A named camera of `synth --camera NAME`: a [`ToneCurve`] name (8-bit, the default camera's
+    /// sensor), `linear16` (linear 16-bit PNG, black level 1024 DN, white 65535) or `dng` (14-bit
+    /// raw, black level 512 DN, white 16383, written as DNG).
+    pub fn named(name: &str) -> Option<Self> {
+        let base = Self::default();
+        if let Some(curve) = ToneCurve::ALL.iter().find(|c| c.name() == name) {
+            return Some(Self {
+                curve: *curve,
+                ..base
+            });
+        }
+        match name {
+            "linear16" => Some(Self {
+                output: SensorOutput::Linear {
+                    black_level: [1024.0; 3],
+                    white_level: 65535.0,
+                },
+                ..base
+            }),
+            "dng" => Some(Self {
+                output: SensorOutput::Linear {
+                    black_level: [512.0; 3],
+                    white_level: 16383.0,
+                },
+                ..base
+            }),
+            _ => None,
+        }
+    }
+
+    /// The names [`CameraModel::named`] takes.
+    pub const NAMES: [&'static str; 8] = [
+        "naka-rushton",
+        "linear",
+        "gamma22",
+        "srgb",
+        "log",
+        "s-curve",
+        "linear16",
+        "dng",
+    ];
+
+    /// The linear raw value of `electrons` ([`SensorOutput::Linear`]; for 8-bit cameras the 16-bit
+    /// scale with no black level), rounded and clipped to [0, white].
+    pub fn raw_value(&self, electrons: f64, c: usize) -> u16 {
+        let (black, white) = match self.output {
+            SensorOutput::Linear {
+                black_level,
+                white_level,
+            } => (black_level[c], white_level),
+            SensorOutput::Tone8 => (0.0, 65535.0),
+        };
+        let e = electrons.min(self.full_well_e);
+        (black + e * (white - black) / self.full_well_e)
+            .round()
+            .clamp(0.0, white) as u16
     }
 
     /// The 8-bit code of `electrons` (clipped at the full well and at 0).
@@ -97,6 +261,38 @@ pub struct RigSpec {
     /// The brightest channel's spot centre reaches this fraction of the full well in the shortest
     /// exposure (so that the bracket holds the peak unclipped once).
     pub peak_fill: f64,
+    /// What a real rig adds (issue 16): glare, vignetting, shutter errors, a Gaussian spot; all off
+    /// by default.
+    #[serde(default, skip_serializing_if = "RigEffects::is_none")]
+    pub effects: RigEffects,
+}
+
+/// What a real rig adds to the ideal one (issue 16), each a switch of the twin; all zero (off) by
+/// default.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RigEffects {
+    /// Veiling glare: stray light spread uniformly over the frame, as a fraction of the spot's
+    /// radiance at its centre (10⁻⁴–10⁻³ for a lens; the far profile is 10⁻⁵ of the peak).
+    pub glare: f64,
+    /// Vignetting: the fall-off of the image's irradiance at the frame's corner (0.3 = 30 %),
+    /// V(ρ) = (1 + kρ²)⁻² around the frame's centre (the cos⁴ law's shape); a flat frame of a
+    /// uniform target is rendered with it.
+    pub vignetting: f64,
+    /// Shutter error: each frame's true exposure is its nominal time × exp(ε), ε normal with this
+    /// standard deviation (0.03 = 3 %); the nominal times are what the files say.
+    pub exposure_error: f64,
+    /// The beam is Gaussian, I ∝ exp(−2ρ²/w²) with w = [`RigSpec::spot_radius_mm`] (the 1/e²
+    /// radius), instead of a uniform disk of that radius.
+    pub gaussian_spot: bool,
+    /// Render the spot on a thin opaque white target (what `camera.spot_image` takes).
+    pub spot_image: bool,
+}
+
+impl RigEffects {
+    fn is_none(&self) -> bool {
+        *self == RigEffects::default()
+    }
 }
 
 impl RigSpec {
@@ -120,6 +316,7 @@ impl RigSpec {
             min_photons: 100_000,
             max_photons: 2_000_000,
             peak_fill: 0.8,
+            effects: RigEffects::default(),
         }
     }
 
@@ -191,6 +388,39 @@ impl RigSpec {
                 "full well ≥ 100 e⁻, read noise ≥ 0, tone knee > 0",
             );
         }
+        if let SensorOutput::Linear {
+            black_level,
+            white_level,
+        } = c.output
+            && !(white_level <= 65535.0
+                && black_level
+                    .iter()
+                    .all(|b| (0.0..0.5 * white_level).contains(b)))
+        {
+            return bad(
+                "camera black/white level [DN]",
+                white_level,
+                "white ≤ 65535 and 0 ≤ black < white/2",
+            );
+        }
+        let e = &self.effects;
+        if !(0.0..=0.1).contains(&e.glare) {
+            return bad(
+                "glare",
+                e.glare,
+                "must lie in [0, 0.1] of the spot's radiance",
+            );
+        }
+        if !(0.0..=0.9).contains(&e.vignetting) {
+            return bad("vignetting", e.vignetting, "must lie in [0, 0.9]");
+        }
+        if !(0.0..=0.3).contains(&e.exposure_error) {
+            return bad(
+                "exposure_error",
+                e.exposure_error,
+                "must lie in [0, 0.3] (relative)",
+            );
+        }
         Ok(())
     }
 
@@ -228,8 +458,12 @@ pub struct ProfileSpec {
     pub eta: f64,
     /// Henyey–Greenstein g.
     pub g: f64,
-    /// Uniform disk beam radius [mm].
+    /// Uniform disk beam radius [mm] (the 1/e² radius of a Gaussian beam when `gaussian`).
     pub spot_radius_mm: f64,
+    /// A Gaussian beam instead of a uniform disk (absent from the JSON when false, so the cache
+    /// names of disk profiles are those made before the field existed).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub gaussian: bool,
     /// Radial bin edges [mm].
     pub edges: Vec<f64>,
     /// Photons.
@@ -267,6 +501,7 @@ impl ProfileSpec {
             eta,
             g: rig.g,
             spot_radius_mm: rig.spot_radius_mm,
+            gaussian: rig.effects.gaussian_spot,
             edges,
             photons: photons_for(sigma_s_prime, sigma_a, rig),
             seed,
@@ -320,8 +555,14 @@ impl McProfile {
             f64::INFINITY,
         )?;
         let grid = RadialGrid::from_edges(spec.edges.clone())?;
-        let beam = Beam::new(BeamProfile::Disk {
-            radius: spec.spot_radius_mm,
+        let beam = Beam::new(if spec.gaussian {
+            BeamProfile::Gaussian {
+                radius: spec.spot_radius_mm,
+            }
+        } else {
+            BeamProfile::Disk {
+                radius: spec.spot_radius_mm,
+            }
         })?;
         let sim = Simulation::new(
             Sample::slab(layer, 1.0)?,
@@ -546,18 +787,35 @@ pub struct Truth {
     pub seed: u64,
 }
 
+/// A frame the twin camera wrote: 8-bit codes or linear raw values.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Frame {
+    /// 8-bit codes through the tone curve.
+    U8(ImageBuf<u8>),
+    /// Linear raw values (black level included).
+    U16(ImageBuf<u16>),
+}
+
 /// The bracket and the truth of a synthetic sample (the spectro reading comes from
 /// [`crate::spectro::reading_for`] with the truth's totals).
 #[derive(Debug, Clone)]
 pub struct Bracket {
-    /// 8-bit RGB frames, shortest exposure first.
+    /// 8-bit RGB frames, shortest exposure first (empty for a linear camera: see `frames_u16`).
     pub frames: Vec<ImageBuf<u8>>,
-    /// Their shutter times [s].
+    /// Linear raw RGB frames of a [`SensorOutput::Linear`] camera, shortest first (else empty).
+    pub frames_u16: Vec<ImageBuf<u16>>,
+    /// Their nominal shutter times [s] (what the files say).
     pub times_s: Vec<f64>,
+    /// The true exposure times [s] (the nominal ones unless [`RigEffects::exposure_error`]).
+    pub true_times_s: Vec<f64>,
     /// The spot centre used [x, y] px.
     pub center_px: [f64; 2],
     /// Gains used per channel [e⁻ per mm⁻² per s].
     pub gains: [f64; 3],
+    /// A frame of a uniform white target through the same camera (when the rig vignettes).
+    pub flat: Option<Frame>,
+    /// The spot on a thin opaque white target (when [`RigEffects::spot_image`]).
+    pub spot_image: Option<Frame>,
 }
 
 /// Renders the exposure bracket of `profiles` (R, G, B) through the rig's camera. The spot centre
@@ -576,62 +834,218 @@ pub fn render_bracket(
         .iter()
         .map(SmoothProfile::new)
         .collect::<Result<_, _>>()?;
+    render_bracket_fn(&|c, r| smooth[c].at(r), None, rig, seed)
+}
+
+/// [`render_bracket`] for any radial profile `rd(channel, r_mm)` [mm⁻²] (e.g. a diffusion model,
+/// for tests of the imaging stage that need no Monte Carlo). `relative_gains` replaces the drawn
+/// relative channel gains (the brightest channel's peak still fills [`RigSpec::peak_fill`] of the
+/// well at the shortest exposure).
+///
+/// # Errors
+/// [`SynthError::InvalidParameter`] for a bad rig.
+pub fn render_bracket_fn(
+    rd_at: &(dyn Fn(usize, f64) -> f64 + Sync),
+    relative_gains: Option<[f64; 3]>,
+    rig: &RigSpec,
+    seed: u64,
+) -> Result<Bracket, SynthError> {
+    rig.validate()?;
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x5eed_0fc0_ffee);
     let center_px = [
         0.5 * (rig.width as f64 - 1.0) + rng.random_range(-3.0..3.0),
         0.5 * (rig.height as f64 - 1.0) + rng.random_range(-3.0..3.0),
     ];
     // Relative gains of a white LED through an RGB sensor, perturbed so the tool cannot know them.
-    let rel = [0.75, 1.0, 0.6].map(|g: f64| g * rng.random_range(0.8..1.2));
+    let drawn = [0.75, 1.0, 0.6].map(|g: f64| g * rng.random_range(0.8..1.2));
+    let rel = relative_gains.unwrap_or(drawn);
     let peak = (0..3)
-        .map(|c| rel[c] * smooth[c].at(0.0))
+        .map(|c| rel[c] * rd_at(c, 0.0))
         .fold(0.0f64, f64::max);
     let scale = rig.peak_fill * rig.camera.full_well_e / (peak * rig.times_s[0]);
     let gains = rel.map(|g| g * scale);
+    let fx = &rig.effects;
+    // Shutter errors from their own stream (the default rig draws nothing more from `rng`).
+    let true_times_s: Vec<f64> = if fx.exposure_error > 0.0 {
+        let mut r = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x7157_e55e_0e77_0a11);
+        let n = Normal::new(0.0, fx.exposure_error).ok();
+        rig.times_s
+            .iter()
+            .map(|t| t * n.as_ref().map_or(1.0, |n| n.sample(&mut r)).exp())
+            .collect()
+    } else {
+        rig.times_s.clone()
+    };
     let (w, h) = (rig.width, rig.height);
+    let vignette = vignetting(rig);
+    // Glare per channel [electrons/s]: a fraction of the spot centre's signal, uniform.
+    let glare: [f64; 3] = std::array::from_fn(|c| fx.glare * gains[c] * rd_at(c, 0.0));
     // Rd at every pixel centre, per channel (shared by all frames).
     let rd: Vec<f32> = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
-            let smooth = &smooth;
             (0..w).flat_map(move |x| {
                 let r =
                     ((x as f64 - center_px[0]).hypot(y as f64 - center_px[1])) * rig.mm_per_pixel;
-                (0..3).map(move |c| smooth[c].at(r) as f32)
+                (0..3).map(move |c| rd_at(c, r) as f32)
             })
         })
         .collect();
     let camera = rig.camera;
-    let frames = rig
-        .times_s
-        .par_iter()
-        .enumerate()
-        .map(|(j, &t)| {
-            let mut data = vec![0u8; w * h * 3];
-            data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
-                let mut rng = Xoshiro256PlusPlus::seed_from_u64(
-                    seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ ((j as u64) << 32) ^ y as u64,
-                );
-                let read = Normal::new(0.0, camera.read_noise_e.max(1e-12)).ok();
+    let linear = matches!(camera.output, SensorOutput::Linear { .. });
+    // One exposure of `t` seconds of a scene whose signal rate at pixel (x, y), channel c is
+    // rate(x, y, c) [e⁻/s]; noise stream (seed, j, row).
+    let expose = |j: usize, t: f64, rate: &(dyn Fn(usize, usize, usize) -> f64 + Sync)| -> Frame {
+        let electrons = |y: usize, k: usize, rng: &mut Xoshiro256PlusPlus| {
+            let mut e = shot(rate(k / 3, y, k % 3) * t, rng);
+            if let Ok(n) = Normal::new(0.0, camera.read_noise_e.max(1e-12)) {
+                e += n.sample(rng);
+            }
+            e
+        };
+        let stream = |y: usize| {
+            Xoshiro256PlusPlus::seed_from_u64(
+                seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ ((j as u64) << 32) ^ y as u64,
+            )
+        };
+        if linear {
+            let mut raw = vec![0u16; w * h * 3];
+            raw.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
+                let mut rng = stream(y);
                 for (k, out) in row.iter_mut().enumerate() {
-                    let c = k % 3;
-                    let mean = gains[c] * f64::from(rd[y * w * 3 + k]) * t;
-                    let mut e = shot(mean, &mut rng);
-                    if let Some(n) = &read {
-                        e += n.sample(&mut rng);
-                    }
-                    *out = camera.code(e);
+                    *out = camera.raw_value(electrons(y, k, &mut rng), k % 3);
                 }
             });
-            ImageBuf::new(w, h, 3, data).expect("w × h × 3 samples")
-        })
+            Frame::U16(ImageBuf::new(w, h, 3, raw).expect("w × h × 3 samples"))
+        } else {
+            let mut codes = vec![0u8; w * h * 3];
+            codes
+                .par_chunks_mut(w * 3)
+                .enumerate()
+                .for_each(|(y, row)| {
+                    let mut rng = stream(y);
+                    for (k, out) in row.iter_mut().enumerate() {
+                        *out = camera.code(electrons(y, k, &mut rng));
+                    }
+                });
+            Frame::U8(ImageBuf::new(w, h, 3, codes).expect("w × h × 3 samples"))
+        }
+    };
+    // Without effects the mean is gains·Rd·t exactly as before issue 16 (v = 1, glare 0).
+    let scene = |x: usize, y: usize, c: usize| {
+        vignette(x, y) * (gains[c] * f64::from(rd[(y * w + x) * 3 + c]) + glare[c])
+    };
+    let rendered: Vec<Frame> = true_times_s
+        .par_iter()
+        .enumerate()
+        .map(|(j, &t)| expose(j, t, &scene))
         .collect();
+    let (mut frames, mut frames_u16) = (Vec::new(), Vec::new());
+    for f in rendered {
+        match f {
+            Frame::U8(b) => frames.push(b),
+            Frame::U16(b) => frames_u16.push(b),
+        }
+    }
+    // The flat: a uniform white target filling half the well, through the same vignetting, the
+    // mean of 16 frames as a lab would take it (read and shot noise / 4).
+    let flat = (fx.vignetting > 0.0).then(|| {
+        let t = 1.0;
+        let level = 0.5 * camera.full_well_e / t;
+        let frames: Vec<Frame> = (0..16)
+            .map(|i| expose(1000 + i, t, &|x, y, _| vignette(x, y) * level))
+            .collect();
+        average_frames(&frames)
+    });
+    // The spot on a thin opaque white target: the beam's irradiance (a disk averaged over 4 × 4
+    // points per pixel, or the Gaussian), peak at half the well.
+    let spot_image = fx.spot_image.then(|| {
+        let a = rig.spot_radius_mm;
+        let irradiance = |r: f64| -> f64 {
+            if fx.gaussian_spot {
+                (-2.0 * r * r / (a * a)).exp()
+            } else if r < a {
+                1.0
+            } else {
+                0.0
+            }
+        };
+        let t = 1.0;
+        let level = 0.5 * camera.full_well_e / t;
+        let mut spot_rate = vec![0.0f64; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let mut sum = 0.0;
+                for sy in 0..4 {
+                    for sx in 0..4 {
+                        let px = x as f64 - 0.375 + 0.25 * sx as f64;
+                        let py = y as f64 - 0.375 + 0.25 * sy as f64;
+                        let r = (px - center_px[0]).hypot(py - center_px[1]) * rig.mm_per_pixel;
+                        sum += irradiance(r);
+                    }
+                }
+                spot_rate[y * w + x] = vignette(x, y) * level * sum / 16.0;
+            }
+        }
+        expose(2000, t, &|x, y, _| spot_rate[y * w + x])
+    });
     Ok(Bracket {
         frames,
+        frames_u16,
         times_s: rig.times_s.clone(),
+        true_times_s,
         center_px,
         gains,
+        flat,
+        spot_image,
     })
+}
+
+/// The rig's vignetting V(x, y) ∈ (0, 1]: (1 + kρ²)⁻² with ρ the distance from the frame's centre
+/// [px] and k such that V = 1 − v at the corner.
+fn vignetting(rig: &RigSpec) -> impl Fn(usize, usize) -> f64 + Sync + use<> {
+    let (cx, cy) = (
+        0.5 * (rig.width as f64 - 1.0),
+        0.5 * (rig.height as f64 - 1.0),
+    );
+    let rho_c2 = cx * cx + cy * cy;
+    let v = rig.effects.vignetting;
+    let k = ((1.0 - v).powf(-0.5) - 1.0) / rho_c2;
+    move |x, y| {
+        let (dx, dy) = (x as f64 - cx, y as f64 - cy);
+        (1.0 + k * (dx * dx + dy * dy)).powi(-2)
+    }
+}
+
+/// The pixel-wise mean of frames (rounded), as a lab averages repeated flat frames.
+fn average_frames(frames: &[Frame]) -> Frame {
+    let n = frames.len() as f64;
+    match &frames[0] {
+        Frame::U8(f0) => {
+            let mut sum = vec![0.0f64; f0.data().len()];
+            for f in frames {
+                if let Frame::U8(b) = f {
+                    for (s, v) in sum.iter_mut().zip(b.data()) {
+                        *s += f64::from(*v);
+                    }
+                }
+            }
+            let data = sum.iter().map(|s| (s / n).round() as u8).collect();
+            Frame::U8(ImageBuf::new(f0.width(), f0.height(), 3, data).expect("same shape"))
+        }
+        Frame::U16(f0) => {
+            let mut sum = vec![0.0f64; f0.data().len()];
+            for f in frames {
+                if let Frame::U16(b) = f {
+                    for (s, v) in sum.iter_mut().zip(b.data()) {
+                        *s += f64::from(*v);
+                    }
+                }
+            }
+            let data = sum.iter().map(|s| (s / n).round() as u16).collect();
+            Frame::U16(ImageBuf::new(f0.width(), f0.height(), 3, data).expect("same shape"))
+        }
+    }
 }
 
 /// Photo-electrons for a mean of `mean`: Poisson below 1000, its normal approximation above
