@@ -229,36 +229,7 @@ impl FitArgs {
     }
 }
 
-/// A path's identity for "is this output one of the inputs?": canonical folder + file name.
-pub fn identity(path: &Path) -> PathBuf {
-    if let Ok(p) = std::fs::canonicalize(path) {
-        return p;
-    }
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    match (std::fs::canonicalize(parent), path.file_name()) {
-        (Ok(dir), Some(name)) => dir.join(name),
-        _ => path.to_path_buf(),
-    }
-}
-
-/// True when `a` and `b` are the same file: the same resolved path ([`identity`]), or, for files
-/// that exist, the same device and inode (a hard link is the same file under another name).
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    if identity(a) == identity(b) {
-        return true;
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
-            return x.dev() == y.dev() && x.ino() == y.ino();
-        }
-    }
-    false
-}
+pub use scatterfit_io::inputs::{identity, same_file};
 
 /// The files `measure` (and `batch`, `compare`'s and `demo`'s measurements) write into a sample's
 /// output folder; the set manifest last.
