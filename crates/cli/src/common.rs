@@ -229,6 +229,32 @@ impl FitArgs {
     }
 }
 
+/// The sample folders of `batch` and `compare`, and how many are measured at once.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SamplesArgs {
+    /// Sample folders (each with a sample.toml), or folders holding sample folders.
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
+          help = crate::runner::JOBS_HELP)]
+    pub jobs: Option<usize>,
+}
+
+/// The Monte Carlo profile cache of the rig twin (`synth`, `demo`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct CacheArgs {
+    /// Folder for cached Monte Carlo profiles (default: $SCATTERFIT_CACHE, the XDG cache, ~/.cache).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+}
+
+impl CacheArgs {
+    /// The cache folder: the flag's, else the default ([`cache_dir`]).
+    pub fn dir(&self) -> Option<PathBuf> {
+        cache_dir(self.cache_dir.as_deref())
+    }
+}
+
 pub use scatterfit_io::inputs::{identity, same_file};
 
 /// The files `measure` (and `batch`, `compare`'s and `demo`'s measurements) write into a sample's
