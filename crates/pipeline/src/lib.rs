@@ -12,6 +12,7 @@
 //! [`measure_sample`] runs them on a sample folder (its `sample.toml`). The command-line tool's
 //! commands parse their arguments, call these functions and print; no command calls another's file.
 //! Inputs are typed (paths, options); results are typed; nothing here prints or writes files.
+//! [`study`] is the bias study's measuring and tabulating over a grid of rig-twin samples.
 
 #![forbid(unsafe_code)]
 
@@ -24,6 +25,7 @@ pub mod measure;
 pub mod port;
 pub mod profile;
 pub mod spectro;
+pub mod study;
 
 pub use error::{PipelineError, Result};
 pub use measure::{

@@ -40,6 +40,7 @@ pub mod error;
 pub mod figures;
 pub mod measurement;
 pub mod plot;
+pub mod study;
 
 pub use error::{ReportError, Result};
 pub use figures::{compare_figure, fit_figure};
