@@ -59,6 +59,9 @@ pub enum ReasonKind {
     BitDepth,
     /// The frames are not registered (the camera moved during the bracket).
     Misregistered,
+    /// Consecutive exposures too far apart for the frames' codes to overlap (a gap in the
+    /// bracket: some radiances are well exposed in no frame).
+    BracketGap,
     /// A value outside its documented range.
     OutOfRange,
     /// The fit gave no parameters or did not converge.

@@ -106,6 +106,7 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
     // (e) The codes the frames use; (f) the frames registered.
     reasons.extend(code_reasons(m));
     reasons.extend(registration_reasons(m));
+    reasons.extend(bracket_reasons(m));
     // (d) Exactly one spot.
     if let Some(msg) = second_spot(m, a_px) {
         reasons.push(suspect(ReasonKind::SecondSpot, msg));
@@ -554,6 +555,74 @@ pub fn registration_reasons(m: &Measurement) -> Vec<Reason> {
             list.join(", ")
         ),
     )]
+}
+
+/// The largest ratio of consecutive shutter times an 8-bit (tone-curved) bracket may have. Through
+/// a gamma-like curve a frame's codes above the noise floor (≈ 5–250) span two to three decades of
+/// radiance, coarsely at the bottom; measured: a 3-frame bracket with 42× steps (1/600, 0.07, 3 s)
+/// still gives σ′s within 5 % (`cli/tests/measure.rs`), a 2-frame one 1800× apart is +712 % off.
+/// 64× (6 stops) keeps every bracket that measured and flags the gap. (The demo's and the paper's
+/// brackets step by 1.9×.)
+pub const MAX_STEP_8BIT: f64 = 64.0;
+
+/// The same for linear frames of more than 8 bits (RAW, 16-bit linear): 12 usable bits and more
+/// overlap across 256× (8 stops).
+pub const MAX_STEP_LINEAR: f64 = 256.0;
+
+/// The bracket's overlap: consecutive exposures more than [`MAX_STEP_8BIT`] (8-bit frames through
+/// a recovered or given response) or [`MAX_STEP_LINEAR`] (linear frames) apart, or a recovered
+/// response from fewer than 3 frames, make every channel suspect: the merge then interpolates
+/// across radiances no frame measured (issue 17: a 2-frame bracket of 1/600 and 3 s measured
+/// +712 % and was called ok).
+pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
+    let limit = match m.hdr.response_kind {
+        "recovered" | "given" => MAX_STEP_8BIT,
+        "linear" => MAX_STEP_LINEAR,
+        _ => return Vec::new(),
+    };
+    let mut times: Vec<f64> = m.hdr.frames.iter().map(|f| f.time_s).collect();
+    times.sort_by(f64::total_cmp);
+    let mut reasons = Vec::new();
+    if m.hdr.response_kind == "recovered" && times.len() < 3 {
+        reasons.push(suspect(
+            ReasonKind::BracketGap,
+            format!(
+                "the camera response was recovered from {} frame(s): with fewer than 3 the \
+                 recovery is barely constrained — take a bracket of 5 or more exposures, at most \
+                 {MAX_STEP_8BIT:.0}× apart",
+                times.len()
+            ),
+        ));
+    }
+    let worst = times
+        .windows(2)
+        .filter(|w| w[0] > 0.0)
+        .map(|w| (w[1] / w[0], w[0], w[1]))
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((ratio, t0, t1)) = worst
+        && ratio > limit
+    {
+        reasons.push(suspect(
+            ReasonKind::BracketGap,
+            format!(
+                "consecutive exposures {} s and {} s are {ratio:.0}× apart (at most {limit:.0}× for \
+                 {} frames): radiances between them are well exposed in no frame — add exposures \
+                 in between",
+                crate::checks::short(t0),
+                crate::checks::short(t1),
+                if limit == MAX_STEP_8BIT { "8-bit" } else { "linear" }
+            ),
+        ));
+    }
+    reasons
+}
+
+/// A shutter time for a message (4 significant digits).
+fn short(t: f64) -> String {
+    format!("{t:.4}")
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .to_string()
 }
 
 #[cfg(test)]

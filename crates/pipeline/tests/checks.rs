@@ -188,6 +188,24 @@ fn a_fit_the_noise_does_not_explain_is_suspect() {
             .any(|q| q.reasons.iter().any(|r| r.kind == ReasonKind::PoorFit)),
         "{q:?}"
     );
+    // The bracket's overlap: 1800× between the two frames (and a response from 2 frames) makes
+    // every channel suspect, including the one whose residuals look fine (issue 17: R +712 %).
+    assert!(has(&q, ReasonKind::BracketGap), "{q:?}");
+    // Every other frame of the good bracket (steps of 3.5×) still overlaps.
+    let d = root.path().join("every-other");
+    let (fs, ts): (Vec<_>, Vec<_>) = f
+        .iter()
+        .zip(t)
+        .step_by(2)
+        .map(|(f, t)| (f.clone(), *t))
+        .unzip();
+    write(&d, &fs, &ts, RigSpec::quick().mm_per_pixel);
+    let (_, q) = measure("every other frame", &d);
+    assert!(
+        !q.iter()
+            .any(|q| q.reasons.iter().any(|r| r.kind == ReasonKind::BracketGap)),
+        "{q:?}"
+    );
 }
 
 #[test]
