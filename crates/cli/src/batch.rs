@@ -9,18 +9,14 @@ use std::sync::Mutex;
 use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_io::result_table::{table1_csv, table1_markdown};
 
-use crate::common::FitArgs;
+use crate::common::{FitArgs, SamplesArgs};
 use crate::output::{errln, out, outln};
 
 /// Arguments of `scatterfit batch`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Sample folders (each with a sample.toml), or folders holding sample folders.
-    #[arg(required = true)]
-    pub dirs: Vec<PathBuf>,
-    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
-          help = crate::runner::JOBS_HELP)]
-    pub jobs: Option<usize>,
+    #[command(flatten)]
+    pub samples: SamplesArgs,
     /// Where to write summary.csv and summary.md (the command's own files, replaced on each run;
     /// checked before any sample is measured). Each sample's result files (result.json, .csv, .md,
     /// profile.csv, fit.svg, fit.png) go into its own folder and are replaced, as with `measure`.
@@ -51,7 +47,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .collect();
     let (dirs, misspelt) = crate::common::samples_for(
         "batch",
-        &args.dirs,
+        &args.samples.dirs,
         &crate::common::RESULT_FILES,
         &shared,
         overrides.allow_outside_paths,
@@ -61,7 +57,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let outcomes = crate::runner::measure_many(
         &dirs,
         &overrides,
-        args.jobs.unwrap_or(0),
+        args.samples.jobs.unwrap_or(0),
         args.quiet || args.json,
         &|dir, r| {
             if let Ok(m) = r
@@ -83,11 +79,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 if !m.complete() {
                     let why: Vec<String> = r
                         .channels
-                        .as_array()
                         .iter()
                         .filter_map(|c| c.problem.clone())
                         .collect();
                     failed.push((o.dir.clone(), why.join("; ")));
+                } else if !crate::common::trusted(&r) {
+                    failed.push((o.dir.clone(), crate::common::suspect_text(&r)));
                 }
                 results.push(r);
             }
@@ -110,7 +107,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             out!("{}", scatterfit_report::summary_text(r))?;
         }
         outln!(
-            "\n{} of {} samples measured completely; summary: {} and {}",
+            "\n{} of {} samples measured completely with every check ok; summary: {} and {}",
             samples - failed.len(),
             samples,
             args.output_dir.join("summary.csv").display(),
@@ -118,7 +115,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
     }
     if !failed.is_empty() {
-        errln!("\n{} sample(s) failed or are incomplete:", failed.len());
+        errln!(
+            "\n{} sample(s) failed, are incomplete or suspect:",
+            failed.len()
+        );
         for (dir, why) in &failed {
             errln!("  {}: {why}", dir.display());
         }

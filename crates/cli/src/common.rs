@@ -229,36 +229,33 @@ impl FitArgs {
     }
 }
 
-/// A path's identity for "is this output one of the inputs?": canonical folder + file name.
-pub fn identity(path: &Path) -> PathBuf {
-    if let Ok(p) = std::fs::canonicalize(path) {
-        return p;
-    }
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    match (std::fs::canonicalize(parent), path.file_name()) {
-        (Ok(dir), Some(name)) => dir.join(name),
-        _ => path.to_path_buf(),
+/// The sample folders of `batch` and `compare`, and how many are measured at once.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SamplesArgs {
+    /// Sample folders (each with a sample.toml), or folders holding sample folders.
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
+          help = crate::runner::JOBS_HELP)]
+    pub jobs: Option<usize>,
+}
+
+/// The Monte Carlo profile cache of the rig twin (`synth`, `demo`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct CacheArgs {
+    /// Folder for cached Monte Carlo profiles (default: $SCATTERFIT_CACHE, the XDG cache, ~/.cache).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+}
+
+impl CacheArgs {
+    /// The cache folder: the flag's, else the default ([`cache_dir`]).
+    pub fn dir(&self) -> Option<PathBuf> {
+        cache_dir(self.cache_dir.as_deref())
     }
 }
 
-/// True when `a` and `b` are the same file: the same resolved path ([`identity`]), or, for files
-/// that exist, the same device and inode (a hard link is the same file under another name).
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    if identity(a) == identity(b) {
-        return true;
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
-            return x.dev() == y.dev() && x.ino() == y.ino();
-        }
-    }
-    false
-}
+pub use scatterfit_io::inputs::{identity, same_file};
 
 /// The files `measure` (and `batch`, `compare`'s and `demo`'s measurements) write into a sample's
 /// output folder; the set manifest last.
@@ -557,4 +554,33 @@ pub fn check_output_dir(dir: &Path, flag: &str) -> anyhow::Result<()> {
             probe.display()
         )
     })
+}
+
+/// True when no channel of a result has a data-check verdict other than `ok` (results without
+/// verdicts count as trusted: the checks did not run).
+pub fn trusted(r: &scatterfit_io::result_json::MeasurementResult) -> bool {
+    r.channels.iter().all(|c| {
+        c.quality
+            .as_ref()
+            .is_none_or(|q| q.verdict == scatterfit_io::quality::Verdict::Ok)
+    })
+}
+
+/// The suspect channels of a result and why, one line (`G suspect: …; B suspect: …`).
+pub fn suspect_text(r: &scatterfit_io::result_json::MeasurementResult) -> String {
+    r.channels
+        .iter_channels()
+        .filter_map(|(ch, c)| {
+            let q = c.quality.as_ref()?;
+            (q.verdict != scatterfit_io::quality::Verdict::Ok).then(|| {
+                format!(
+                    "{} {}: {}",
+                    ch.name(),
+                    q.verdict,
+                    scatterfit_io::escape::one_line(&q.summary())
+                )
+            })
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }

@@ -8,18 +8,14 @@ use std::process::ExitCode;
 
 use scatterfit_io::result_table::{table2_csv, table2_markdown};
 
-use crate::common::FitArgs;
+use crate::common::{FitArgs, SamplesArgs};
 use crate::output::{errln, out, outln};
 
 /// Arguments of `scatterfit compare`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Sample folders (each with a sample.toml), or folders holding sample folders.
-    #[arg(required = true)]
-    pub dirs: Vec<PathBuf>,
-    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
-          help = crate::runner::JOBS_HELP)]
-    pub jobs: Option<usize>,
+    #[command(flatten)]
+    pub samples: SamplesArgs,
     /// Where to write compare.csv and compare.md (the command's own files, replaced on each run;
     /// checked before any sample is measured). Each sample's plot (compare.svg, compare.png) goes
     /// into its own folder and is replaced.
@@ -50,7 +46,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .collect();
     let (dirs, misspelt) = crate::common::samples_for(
         "compare",
-        &args.dirs,
+        &args.samples.dirs,
         &["compare.svg", "compare.png"],
         &shared,
         overrides.allow_outside_paths,
@@ -59,7 +55,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (pairs, mut failed) = crate::runner::compare_dirs(
         &dirs,
         &args.fit,
-        args.jobs.unwrap_or(0),
+        args.samples.jobs.unwrap_or(0),
         args.quiet || args.json,
         false,
     )?;

@@ -20,7 +20,7 @@ use scatterfit_synth::Truth;
 use scatterfit_synth::materials::CHOI_2014;
 use serde::Serialize;
 
-use crate::common::{FitArgs, cache_dir};
+use crate::common::{CacheArgs, FitArgs};
 use crate::output::{errln, out, outln};
 use crate::twin::{Material, synthesize, write_sample};
 
@@ -51,9 +51,8 @@ pub struct Args {
     /// Use a folder that holds other files than a previous demo's.
     #[arg(long)]
     pub force: bool,
-    /// Folder for cached Monte Carlo profiles (default: $SCATTERFIT_CACHE, the XDG cache, ~/.cache).
-    #[arg(long, value_name = "DIR")]
-    pub cache_dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: CacheArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -130,7 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         b"made by `scatterfit demo`; it may replace the files in this folder\n",
     )?;
     let quiet = args.quiet || args.json;
-    let cache = cache_dir(args.cache_dir.as_deref());
+    let cache = args.cache.dir();
     if !quiet {
         errln!(
             "synthesising the 7 materials of Choi et al. 2014 with the Monte Carlo rig twin (cached in {})",
@@ -206,6 +205,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
              compare.md (Table 2), accuracy.md",
             out.display()
         )?;
+        // The data checks' verdict on the proposed method's channels (RELIABILITY.md).
+        let suspect: Vec<String> = proposed
+            .iter()
+            .filter(|r| !crate::common::trusted(r))
+            .map(|r| {
+                format!(
+                    "{}: {}",
+                    scatterfit_io::escape::one_line(&r.name),
+                    crate::common::suspect_text(r)
+                )
+            })
+            .collect();
+        if suspect.is_empty() {
+            outln!("quality: every channel of the proposed method passes the data checks (ok)")?;
+        } else {
+            outln!("quality: {}", suspect.join("; "))?;
+        }
     }
     if !failed.is_empty() {
         errln!("\n{} sample(s) failed:", failed.len());

@@ -13,27 +13,20 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use crate::output::{errln, outln};
+use crate::output::errln;
 use anyhow::{Context, bail};
-use glam::DVec3;
-use scatterfit_imaging::ImageBuf;
-use scatterfit_io::image_files::{CameraFrame, write_camera_frame, write_radiance};
-use scatterfit_io::mesh::read_mesh;
-use scatterfit_io::profile_csv::read_profile_csv;
-use scatterfit_io::result_json::{MeasurementResult, read_result_json};
-use scatterfit_optics::{ModelName, Rgb};
+use scatterfit_optics::ModelName;
 use scatterfit_render::colour::ColourParams;
-use scatterfit_render::figure::{FigureStyle, Panel, compose, compose_linear};
+use scatterfit_render::measured::{profile_path, read_measured};
+use scatterfit_render::request::{
+    MeshSummary, RenderEvent, RenderSummary, render_figure, write_figure,
+};
 use scatterfit_render::texture_space::{DipoleParams, Evaluation};
-use scatterfit_render::tonemap::{ToneMap, luminance_image, tone_map};
-use scatterfit_render::validation::{
-    SpotSetup, compare_profiles, interpolate, render_spot_profile,
-};
+use scatterfit_render::tonemap::ToneMap;
 use scatterfit_render::{
-    Light, Material, Mesh, Method, RenderOptions, RenderStats, Rendered, Shape, Timings, render,
-    studio, studio_lights,
+    FigureRequest, LightRig, MeshSource, Methods, ParameterSet, ProfileRequest, RenderError,
+    RenderOptions, Shape, StudioScene, Summary,
 };
-use serde::Serialize;
 
 /// The built-in models.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -206,14 +199,6 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Memory per pixel and panel [bytes], an upper bound: the linear image (3 × f32), its grey or
-/// composed copy and the figure grid (3 × f32 each), the tone-mapped bytes and the PNG encoder's.
-const BYTES_PER_PIXEL_PANEL: u64 = 48;
-/// Memory per triangle [bytes], an upper bound: positions, normals, indices, the BVH.
-const BYTES_PER_TRIANGLE: u64 = 256;
-/// Memory per light ray of the texture-space method [bytes]: its irradiance point and tree share.
-const BYTES_PER_LIGHT_RAY: u64 = 160;
-
 /// Checks the numbers that no library checks, then the memory the flags size, before any work.
 fn check_numbers(args: &Args, panels: usize) -> anyhow::Result<()> {
     use crate::numeric::ensure;
@@ -252,14 +237,9 @@ fn check_numbers(args: &Args, panels: usize) -> anyhow::Result<()> {
         )?;
     }
     let (w, h) = args.size;
-    let pixels = (w * h) as u64;
-    let rays = args.light_rays.unwrap_or(1 << 21) as u64 * 2;
-    let needed = pixels * BYTES_PER_PIXEL_PANEL * panels as u64
-        + args.triangles as u64 * BYTES_PER_TRIANGLE
-        + rays * BYTES_PER_LIGHT_RAY;
     crate::numeric::check_memory(
         &format!("rendering {panels} panel(s) of {w}×{h} px"),
-        needed,
+        scatterfit_render::request::memory_bytes(w, h, panels, args.triangles, args.light_rays),
         crate::numeric::memory_budget(args.max_memory_mib),
     )
 }
@@ -279,226 +259,19 @@ fn parse_size(text: &str) -> Result<(usize, usize), String> {
     Ok((w, h))
 }
 
-/// The existing method's parameters quoted with Figure 5 (σ′s, σa per R, G, B) [mm⁻¹].
-const EXISTING_2014: [(&str, [(f64, f64); 3]); 3] = [
-    (
-        "pink-plastic",
-        [(2.152, 1.152e-10), (1.522, 0.4515), (1.864, 0.007945)],
-    ),
-    (
-        "blue-coating",
-        [(1.128, 2.118), (1.484, 1.857), (1.923, 0.2809)],
-    ),
-    (
-        "brown-leather",
-        [(1.624, 1.841), (1.222, 2.529), (0.9038, 2.754)],
-    ),
-];
-
-/// One parameter set, wherever it came from.
-struct Params {
-    /// Display name.
-    name: String,
-    /// The forward model the parameters were fitted with (`dipole` for published ones).
-    model: ModelName,
-    /// `proposed`, `existing`, or the result's method.
-    method: String,
-    /// Where it came from (a path or "published …").
-    source: String,
-    eta: f64,
-    coefficients: [(f64, f64); 3],
-    /// The result file and its folder, when read from one.
-    result: Option<(MeasurementResult, PathBuf)>,
-}
-
-/// The renderer's material for `p` with its profile model (`model` overrides the fitted one), made
-/// by the one name → model factory.
-fn material_for(p: &Params, model: Option<ModelName>) -> anyhow::Result<Material> {
-    let model = model.unwrap_or(p.model);
-    let family = scatterfit_mc::family(model)?;
-    Material::new(family, Rgb::from_array(p.coefficients), p.eta, 0.0)
-        .with_context(|| p.name.clone())
-}
-
-fn load_params(spec: &str, model: Option<ModelName>) -> anyhow::Result<Params> {
-    let path = Path::new(spec);
-    if !path.exists() {
-        let key = spec.trim().to_ascii_lowercase().replace([' ', '_'], "-");
-        if let Some(base) = key.strip_suffix("-existing") {
-            if let (Some(m), Some((_, c))) = (
-                scatterfit_synth::materials::CHOI_2014
-                    .iter()
-                    .find(|m| m.name == base),
-                EXISTING_2014.iter().find(|(n, _)| *n == base),
-            ) {
-                return Ok(Params {
-                    model: ModelName::Dipole,
-                    name: base.replace('-', " "),
-                    method: "existing".into(),
-                    source: "published: Choi et al. 2014, Figure 5 (existing method; η of Table 1)"
-                        .into(),
-                    eta: m.eta,
-                    coefficients: *c,
-                    result: None,
-                });
-            }
-        } else if let Some(m) = scatterfit_synth::materials::CHOI_2014
-            .iter()
-            .find(|m| m.name == key)
-        {
-            return Ok(Params {
-                model: ModelName::Dipole,
-                name: m.name.replace('-', " "),
-                method: "proposed".into(),
-                source: "published: Choi et al. 2014, Table 1".into(),
-                eta: m.eta,
-                coefficients: std::array::from_fn(|c| (m.sigma_s_prime[c], m.sigma_a[c])),
-                result: None,
-            });
-        }
-        bail!(
-            "{spec}: no such file, and not a published material; give a result.json of \
-             `scatterfit measure` or one of: {}, and {}",
-            scatterfit_synth::materials::CHOI_2014
-                .iter()
-                .map(|m| m.name)
-                .collect::<Vec<_>>()
-                .join(", "),
-            EXISTING_2014
-                .iter()
-                .map(|(n, _)| format!("{n}-existing"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+/// A render error for `main`: a result with a failed channel is a failed measurement (exit 1), as
+/// `export` says of the same result; everything else is bad input (exit 2).
+fn cli_error(e: RenderError) -> anyhow::Error {
+    if e.is_measurement_failure() {
+        crate::common::MeasurementFailed(e.to_string()).into()
+    } else {
+        e.into()
     }
-    let result = read_result_json(path)?;
-    let fitted = match result
-        .model
-        .trim()
-        .to_ascii_lowercase()
-        .parse::<ModelName>()
-    {
-        Ok(m) => m,
-        Err(_) => match model {
-            Some(m) => m,
-            None => bail!(
-                "{spec}: the parameters were fitted with a model render does not know (`{}`); \
-                 pass --model dipole|better-dipole|pbd|mc",
-                scatterfit_io::escape::token(result.model.trim())
-            ),
-        },
-    };
-    let coefficients = result.coefficients().map_err(|ch| -> anyhow::Error {
-        let c = match ch {
-            "r" => &result.channels.r,
-            "g" => &result.channels.g,
-            _ => &result.channels.b,
-        };
-        // A measurement that failed (exit 1), as `export` says of the same result.
-        crate::common::MeasurementFailed(format!(
-            "{spec}: channel {ch} has no σ′s/σa (status {:?}{}); render needs all three channels — \
-             re-run the measurement or fix that channel",
-            c.status,
-            c.problem
-                .as_deref()
-                .map(|p| format!(": {p}"))
-                .unwrap_or_default()
-        ))
-        .into()
-    })?;
-    let folder = path
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."));
-    Ok(Params {
-        model: fitted,
-        name: result.name.clone(),
-        method: result.method.clone(),
-        source: path.display().to_string(),
-        eta: result.eta,
-        coefficients,
-        result: Some((result, folder)),
-    })
 }
 
-/// The summary printed (or written as JSON).
-#[derive(Debug, Serialize)]
-struct Summary {
-    mesh: MeshSummary,
-    renders: Vec<RenderSummary>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    profile: Option<ProfileSummary>,
-    outputs: Vec<PathBuf>,
-    threads: usize,
-}
-
-#[derive(Debug, Serialize)]
-struct MeshSummary {
-    source: String,
-    triangles: usize,
-    size_mm: [f64; 3],
-    bvh_build_s: f64,
-}
-
-#[derive(Debug, Serialize)]
-struct RenderSummary {
-    material: String,
-    parameters: String,
-    method: &'static str,
-    eta: f64,
-    sigma_s_prime: [f64; 3],
-    sigma_a: [f64; 3],
-    width: usize,
-    height: usize,
-    spp: usize,
-    seed: u64,
-    irradiance_s: f64,
-    tree_s: f64,
-    shading_s: f64,
-    light_rays: usize,
-    irradiance_points: usize,
-    mean_nodes_visited: f64,
-    hit_fraction: f64,
-    invalid_samples: usize,
-    /// Largest pixel radiance per channel.
-    max_radiance: [f32; 3],
-}
-
-#[derive(Debug, Serialize)]
-struct ProfileSummary {
-    measured: PathBuf,
-    mm_per_pixel: f64,
-    spot_radius_mm: f64,
-    r_max_mm: f64,
-    render_s: f64,
-    channels: Vec<ChannelMse>,
-}
-
-#[derive(Debug, Serialize)]
-struct ChannelMse {
-    channel: &'static str,
-    /// Table 2's quantity computed from the render [mm⁻⁴].
-    mse: f64,
-    rms_log: f64,
-    rings: usize,
-    /// The fit's own MSE from result.json, for reference [mm⁻⁴].
-    fit_mse: Option<f64>,
-}
-
-/// Runs `scatterfit render`.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let specs: Vec<String> = match (&args.params, &args.compare) {
-        (Some(p), None) => vec![p.clone()],
-        (None, Some(c)) => c.clone(),
-        _ => bail!("give --params RESULT or --compare A B"),
-    };
-    let mut inputs: Vec<PathBuf> = specs.iter().map(PathBuf::from).collect();
-    if let Some(m) = &args.mesh {
-        inputs.push(m.clone());
-    }
-    if let Some(m) = &args.measured_profile {
-        inputs.push(m.clone());
-    }
+/// Checks the outputs before any work: extension, not an input, not a link or folder, not an
+/// existing file unless --force, a writable folder.
+fn check_outputs(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
     for out in &args.output {
         let ext = out
             .extension()
@@ -533,14 +306,29 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
         crate::common::check_output_folder(out, "-o")?;
     }
+    Ok(())
+}
+
+/// Runs `scatterfit render`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let specs: Vec<String> = match (&args.params, &args.compare) {
+        (Some(p), None) => vec![p.clone()],
+        (None, Some(c)) => c.clone(),
+        _ => bail!("give --params RESULT or --compare A B"),
+    };
+    let mut inputs: Vec<PathBuf> = specs.iter().map(PathBuf::from).collect();
+    inputs.extend(args.mesh.iter().cloned());
+    inputs.extend(args.measured_profile.iter().cloned());
+    check_outputs(&args, &inputs)?;
+    let methods = match args.method {
+        MethodArg::Color => Methods::Colour,
+        MethodArg::Dipole => Methods::Dipole,
+        MethodArg::Both => Methods::Both,
+    };
     let panels = if args.profile {
         1
     } else {
-        specs.len()
-            * match args.method {
-                MethodArg::Both => 2,
-                _ => 1,
-            }
+        specs.len() * methods.list().len()
     };
     check_numbers(&args, panels)?;
     if !(args.mesh_scale.is_finite() && args.mesh_scale > 0.0) {
@@ -557,11 +345,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     {
         bail!("--light-rays {n} must lie in 1e3–1e8");
     }
-    let params: Vec<Params> = specs
+    let model = args.model.map(ModelName::from);
+    let mut params: Vec<ParameterSet> = specs
         .iter()
-        .map(|s| load_params(s, args.model.map(Into::into)))
+        .map(|s| ParameterSet::load(s, model).map_err(cli_error))
         .collect::<anyhow::Result<_>>()?;
-    let opts = RenderOptions {
+    let options = RenderOptions {
         width: args.size.0,
         height: args.size.1,
         spp: args.spp,
@@ -590,165 +379,67 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             interpolate: !args.no_interpolation,
         },
     };
-    opts.colour.validate().context("shading coefficients")?;
-    opts.dipole.validate().context("texture-space options")?;
+    options.colour.validate().context("shading coefficients")?;
+    options.dipole.validate().context("texture-space options")?;
     let tone = ToneMap {
         exposure_ev: args.exposure.unwrap_or(0.0),
         white: args.white,
     };
     if args.profile {
-        return run_profile(&args, &params[0], &opts, &tone);
+        return run_profile(&args, params.remove(0), model, options, &tone);
     }
 
-    // The scene.
+    // The scene: the object read or built, then lit (mesh warnings in between).
     let t0 = Instant::now();
-    let (mesh, source) = match &args.mesh {
-        Some(path) => {
-            let data = read_mesh(path)?;
-            let r = data.report;
-            if !args.quiet {
-                if r.boundary_edges > 0 {
-                    errln!(
-                        "warning: {}: the surface is open ({} border edges); thickness through it \
-                         is measured to the far side where there is one",
-                        path.display(),
-                        r.boundary_edges
-                    );
-                }
-                if r.inconsistent_edges > 0 {
-                    errln!(
-                        "warning: {}: {} edges join triangles wound inconsistently; computed \
-                         normals may be wrong there",
-                        path.display(),
-                        r.inconsistent_edges
-                    );
-                }
-                if r.degenerate_dropped > 0 {
-                    errln!(
-                        "note: {}: dropped {} degenerate triangles",
-                        path.display(),
-                        r.degenerate_dropped
-                    );
-                }
-            }
-            let mesh = Mesh::new(data.positions, data.normals, data.triangles)
-                .with_context(|| format!("mesh {}", path.display()))?
-                .scaled(args.mesh_scale);
-            (mesh, path.display().to_string())
-        }
-        None => {
-            let shape = match args.shape {
+    let mesh = match &args.mesh {
+        Some(path) => MeshSource::File {
+            path: path.clone(),
+            scale: args.mesh_scale,
+        },
+        None => MeshSource::Builtin {
+            shape: match args.shape {
                 ShapeArg::Sphere => Shape::Sphere,
                 ShapeArg::Slab => Shape::Slab,
                 ShapeArg::Statue => Shape::Statue,
-            };
-            let mut mesh = shape.mesh(args.triangles)?;
-            if shape == Shape::Slab {
-                // Stand the slab up a little so that its top faces the camera's side.
-                mesh = tilt(mesh, 35f64.to_radians());
-            }
-            (mesh, format!("built-in {}", shape.name()))
+            },
+            triangles: args.triangles,
+        },
+    };
+    let loaded = mesh.load()?;
+    if !args.quiet {
+        for note in loaded.notes() {
+            errln!("{note}");
         }
-    };
-    let bounds = mesh.bounds();
-    let triangles = mesh.triangles().len();
-    let scene = studio(mesh, lights(args.light, &bounds))?;
-    let bvh_build_s = t0.elapsed().as_secs_f64();
-
-    let methods: Vec<Method> = match args.method {
-        MethodArg::Color => vec![Method::Colour],
-        MethodArg::Dipole => vec![Method::Dipole],
-        MethodArg::Both => vec![Method::Colour, Method::Dipole],
-    };
-    // Figure 5's order: for each method, every parameter set.
-    let jobs: Vec<(Method, usize)> = methods
-        .iter()
-        .flat_map(|&m| (0..params.len()).map(move |k| (m, k)))
-        .collect();
-    let bar = progress_bar(&args, (jobs.len() * opts.height) as u64);
-    let materials: Vec<Material> = params
-        .iter()
-        .map(|p| material_for(p, args.model.map(Into::into)))
-        .collect::<anyhow::Result<_>>()?;
-    let mut renders = Vec::new();
-    let mut summaries = Vec::new();
-    for &(method, k) in &jobs {
-        bar.set_message(format!("{} · {}", method.name(), params[k].name));
-        let r = render(&scene, &materials[k], method, &opts, &|n| bar.inc(n as u64))?;
-        summaries.push(render_summary(&params[k], &r, &opts));
-        renders.push(r);
     }
+    let studio = StudioScene::new(loaded, light_rig(args.light), t0)?;
+    let request = FigureRequest {
+        params,
+        mesh,
+        lights: light_rig(args.light),
+        methods,
+        model,
+        options,
+    };
+    let bar = progress_bar(&args, (request.panels().len() * options.height) as u64);
+    let panels = render_figure(&studio.scene, &request, &|event| match event {
+        RenderEvent::Panel { method, material } => {
+            bar.set_message(format!("{} · {material}", method.name()));
+        }
+        RenderEvent::Rows(n) => bar.inc(n as u64),
+    })?;
     bar.finish_and_clear();
-
-    let letters = ["1", "2", "3", "4"];
-    let images: Vec<ImageBuf<f32>> = renders
-        .iter()
-        .map(|r| {
-            if args.gray {
-                luminance_image(&r.image)
-            } else {
-                Ok(r.image.clone())
-            }
-        })
-        .collect::<Result<_, _>>()?;
-    for out in &args.output {
-        let ext = out
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .unwrap_or_default();
-        if ext == "exr" {
-            let refs: Vec<&ImageBuf<f32>> = images.iter().collect();
-            let grid = compose_linear(&refs, images.len(), 8)?;
-            write_radiance(out, &grid)?;
-        } else if images.len() == 1 {
-            write_png(out, &tone_map(&images[0], &tone)?)?;
-        } else {
-            let panels: Vec<Panel> = jobs
-                .iter()
-                .zip(&images)
-                .enumerate()
-                .map(|(i, (&(method, k), img))| {
-                    let p = &params[k];
-                    let model = args.model.map(ModelName::from).unwrap_or(p.model);
-                    // The texture-space method with another profile model says which.
-                    let (title, profile) = if method == Method::Dipole && model != ModelName::Dipole
-                    {
-                        ("texture-space method (§4.2)", format!(" · {model} profile"))
-                    } else {
-                        (method.title(), String::new())
-                    };
-                    Ok(Panel {
-                        image: rgb8(tone_map(img, &tone)?),
-                        caption: vec![
-                            format!("({}) {title}", letters[i.min(3)]),
-                            format!("{} · {}{profile}", p.name, p.method),
-                        ],
-                    })
-                })
-                .collect::<anyhow::Result<_>>()?;
-            let title = (params.len() == 2).then(|| {
-                format!(
-                    "{} ({}) vs {} ({}) — Choi et al. 2014, Figure 5 layout",
-                    params[0].name, params[0].method, params[1].name, params[1].method
-                )
-            });
-            let style = FigureStyle {
-                columns: jobs.len(),
-                title,
-                ..FigureStyle::default()
-            };
-            write_png(out, &compose(&panels, &style)?)?;
-        }
-    }
+    write_figure(&request, &panels, &args.output, &tone, args.gray)?;
     let summary = Summary {
         mesh: MeshSummary {
-            source,
-            triangles,
-            size_mm: bounds.extent().to_array(),
-            bvh_build_s,
+            source: studio.source,
+            triangles: studio.triangles,
+            size_mm: studio.size_mm,
+            bvh_build_s: studio.build_s,
         },
-        renders: summaries,
+        renders: panels
+            .iter()
+            .map(|p| RenderSummary::new(&request.params[p.set], &p.rendered, &options))
+            .collect(),
         profile: None,
         outputs: args.output.clone(),
         threads: rayon::current_num_threads(),
@@ -757,121 +448,62 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn render_summary(p: &Params, r: &Rendered, opts: &RenderOptions) -> RenderSummary {
-    let Timings {
-        irradiance_s,
-        tree_s,
-        shading_s,
-    } = r.timings;
-    let RenderStats {
-        light_rays,
-        irradiance_points,
-        mean_visited,
-        hit_fraction,
-        invalid_samples,
-        ..
-    } = r.stats;
-    let mut max_radiance = [0f32; 3];
-    for px in r.image.data().chunks_exact(3) {
-        for c in 0..3 {
-            max_radiance[c] = max_radiance[c].max(px[c]);
-        }
+fn light_rig(light: LightArg) -> LightRig {
+    match light {
+        LightArg::Studio => LightRig::Studio,
+        LightArg::Key => LightRig::Key,
+        LightArg::Back => LightRig::Back,
+        LightArg::Point => LightRig::Point,
+        LightArg::Spot => LightRig::Spot,
     }
-    RenderSummary {
-        material: p.name.clone(),
-        parameters: p.source.clone(),
-        method: r.method.name(),
-        eta: p.eta,
-        sigma_s_prime: p.coefficients.map(|c| c.0),
-        sigma_a: p.coefficients.map(|c| c.1),
-        width: r.image.width(),
-        height: r.image.height(),
-        spp: opts.spp,
-        seed: opts.seed,
-        irradiance_s,
-        tree_s,
-        shading_s,
-        light_rays,
-        irradiance_points,
-        mean_nodes_visited: mean_visited,
-        hit_fraction,
-        invalid_samples,
-        max_radiance,
+}
+
+/// `--profile`: the measurement's slab and spot rendered by the texture-space method, compared ring
+/// by ring with the measured profile divided by the fitted scale k (Table 2's MSE, §4.4).
+fn run_profile(
+    args: &Args,
+    params: ParameterSet,
+    model: Option<ModelName>,
+    options: RenderOptions,
+    tone: &ToneMap,
+) -> anyhow::Result<ExitCode> {
+    let (csv, unchecked) = profile_path(
+        &params,
+        args.measured_profile.as_deref(),
+        args.allow_outside_paths,
+    )?;
+    if let Some(note) = unchecked
+        && !args.quiet
+    {
+        errln!("note: {note}");
     }
+    // The profile is an input too: no output may replace it (with --force it could).
+    for out in &args.output {
+        crate::common::refuse_overwrite(out, "-o", &[csv.as_path()])?;
+    }
+    let measured = read_measured(&params, &csv, args.spot_radius_mm)?;
+    let request = ProfileRequest {
+        params,
+        measured,
+        model,
+        options,
+    };
+    let bar = progress_bar(args, request.measured.setup().image_size() as u64);
+    bar.set_message("slab + spot, texture-space dipole");
+    let validation = request.run(&|k| bar.inc(k as u64))?;
+    bar.finish_and_clear();
+    request.write(&validation, &args.output, tone, args.exposure.is_some())?;
+    let summary = request.summary(&validation, &args.output, rayon::current_num_threads());
+    print_summary(args, &summary)?;
+    Ok(ExitCode::SUCCESS)
 }
 
 fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
     if args.json {
-        return crate::output::print_json(s);
+        crate::output::print_json(s)
+    } else {
+        crate::output::out!("{}", s.text())
     }
-    outln!(
-        "mesh     {} ({} triangles, {:.1} × {:.1} × {:.1} mm), BVH {:.3} s",
-        s.mesh.source,
-        s.mesh.triangles,
-        s.mesh.size_mm[0],
-        s.mesh.size_mm[1],
-        s.mesh.size_mm[2],
-        s.mesh.bvh_build_s
-    )?;
-    for r in &s.renders {
-        let extra = if r.method == "dipole" {
-            format!(
-                " (irradiance {:.3} s, {} rays, {} points; hierarchy {:.3} s; {:.0} nodes per \
-                 sample)",
-                r.irradiance_s, r.light_rays, r.irradiance_points, r.tree_s, r.mean_nodes_visited
-            )
-        } else {
-            String::new()
-        };
-        outln!(
-            "render   {:<6} {} ({}): {}x{}, {} spp, shading {:.3} s{extra}",
-            r.method,
-            r.material,
-            r.parameters,
-            r.width,
-            r.height,
-            r.spp,
-            r.shading_s
-        )?;
-        if r.invalid_samples > 0 {
-            outln!(
-                "warning  {} samples were non-finite or negative and were set to 0",
-                r.invalid_samples
-            )?;
-        }
-    }
-    if let Some(p) = &s.profile {
-        outln!(
-            "profile  {} : {:.4} mm/px, spot radius {:.3} mm, out to {:.2} mm; render {:.2} s",
-            p.measured.display(),
-            p.mm_per_pixel,
-            p.spot_radius_mm,
-            p.r_max_mm,
-            p.render_s
-        )?;
-        outln!(
-            "         {:<8} {:>6} {:>14} {:>10} {:>14}",
-            "channel",
-            "rings",
-            "MSE [mm⁻⁴]",
-            "rms ln",
-            "fit MSE"
-        )?;
-        for c in &p.channels {
-            outln!(
-                "         {:<8} {:>6} {:>14.4e} {:>10.4} {:>14}",
-                c.channel,
-                c.rings,
-                c.mse,
-                c.rms_log,
-                c.fit_mse.map_or("—".into(), |m| format!("{m:.4e}"))
-            )?;
-        }
-    }
-    for o in &s.outputs {
-        outln!("wrote    {}", o.display())?;
-    }
-    Ok(())
 }
 
 fn progress_bar(args: &Args, len: u64) -> indicatif::ProgressBar {
@@ -884,329 +516,4 @@ fn progress_bar(args: &Args, len: u64) -> indicatif::ProgressBar {
             .expect("valid template"),
     );
     bar
-}
-
-fn lights(kind: LightArg, bounds: &scatterfit_render::mesh::Aabb) -> Vec<Light> {
-    let studio = studio_lights();
-    match kind {
-        LightArg::Studio => studio,
-        LightArg::Key => vec![studio[0]],
-        LightArg::Back => match studio[1] {
-            Light::Directional { direction, .. } => vec![Light::Directional {
-                direction,
-                irradiance: [1.0; 3],
-            }],
-            other => vec![other],
-        },
-        LightArg::Point => {
-            let c = bounds.center();
-            let r = 0.5 * bounds.extent().length();
-            let position = c + DVec3::new(-0.55, 0.7, 0.45).normalize() * (3.0 * r);
-            let d2 = (position - c).length_squared();
-            vec![Light::Point {
-                position,
-                intensity: [d2; 3],
-            }]
-        }
-        LightArg::Spot => match studio[0] {
-            Light::Directional { direction, .. } => vec![Light::Spot {
-                center: bounds.center(),
-                direction,
-                radius: 2.0,
-                irradiance: [1.0; 3],
-            }],
-            other => vec![other],
-        },
-    }
-}
-
-/// Rotates a mesh about the x axis by `angle` (towards the camera at +z).
-fn tilt(mesh: Mesh, angle: f64) -> Mesh {
-    let rot = glam::DMat3::from_rotation_x(angle);
-    let positions = mesh
-        .positions()
-        .iter()
-        .map(|p| (rot * *p).to_array())
-        .collect();
-    let normals = mesh
-        .normals()
-        .iter()
-        .map(|n| (rot * *n).to_array())
-        .collect();
-    Mesh::new(positions, Some(normals), mesh.triangles().to_vec())
-        .expect("a rotated valid mesh is valid")
-}
-
-fn rgb8(img: ImageBuf<u8>) -> ImageBuf<u8> {
-    if img.channels() == 3 {
-        return img;
-    }
-    let data = img.data().iter().flat_map(|&v| [v, v, v]).collect();
-    ImageBuf::new(img.width(), img.height(), 3, data).expect("same size")
-}
-
-fn write_png(path: &Path, img: &ImageBuf<u8>) -> anyhow::Result<()> {
-    write_camera_frame(path, &CameraFrame::U8(img.clone()))
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// The result `json` and the profile `csv` it names, when they share a folder: listed in the
-/// folder's result set with the hashes they have now (one run's files), else refused; a folder
-/// without a set (an older scatterfit, an interrupted run) is noted on stderr.
-fn check_one_run(json: &Path, csv: &Path, quiet: bool) -> anyhow::Result<()> {
-    let folder = json.parent().unwrap_or(Path::new(""));
-    let folder = if folder.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        folder
-    };
-    let (Some(j), Some(c)) = (json.file_name(), csv.file_name()) else {
-        return Ok(());
-    };
-    if !crate::common::same_file(csv.parent().unwrap_or(Path::new(".")), folder) {
-        return Ok(());
-    }
-    let (j, c) = (j.to_string_lossy(), c.to_string_lossy());
-    match scatterfit_io::result_set::verify(folder, &[&j, &c])? {
-        scatterfit_io::result_set::SetStatus::Unknown if !quiet => errln!(
-            "note: {} has no {}: {j} and {c} cannot be checked to come from one run (results of an \
-             older scatterfit, or of a run that was interrupted — then measure again)",
-            folder.display(),
-            scatterfit_io::result_set::SET_FILE
-        ),
-        _ => {}
-    }
-    Ok(())
-}
-
-/// `--profile`: the measurement's slab and spot rendered by the texture-space method, compared ring
-/// by ring with the measured profile divided by the fitted scale k (Table 2's MSE, §4.4).
-fn run_profile(
-    args: &Args,
-    p: &Params,
-    opts: &RenderOptions,
-    tone: &ToneMap,
-) -> anyhow::Result<ExitCode> {
-    let given = args.measured_profile.as_ref();
-    let Some((result, folder)) = &p.result else {
-        bail!(
-            "--profile needs a result.json (its fitted scales and measured profile); `{}` is a \
-             published parameter set",
-            p.source
-        );
-    };
-    let csv = match given {
-        Some(path) => path.clone(),
-        None => {
-            match &result.inputs.profile {
-                Some(rel) => {
-                    let csv = folder.join(rel);
-                    // A result names files inside its folder (the input path policy), and the result
-                    // and the profile it names must come from one run (the folder's result set).
-                    scatterfit_io::inputs::InputPolicy::new(folder, args.allow_outside_paths)?
-                        .check(Path::new(&p.source), "`inputs.profile`", &csv)?;
-                    check_one_run(Path::new(&p.source), &csv, args.quiet)?;
-                    csv
-                }
-                None => bail!(
-                    "{}: no `inputs.profile`; give the measured profile with --measured-profile FILE.csv",
-                    p.source
-                ),
-            }
-        }
-    };
-    // The profile is an input too: no output may replace it (with --force it could).
-    let refs = [csv.as_path()];
-    for out in &args.output {
-        crate::common::refuse_overwrite(out, "-o", &refs)?;
-    }
-    let table = read_profile_csv(&csv)?;
-    let column = |name: &str| {
-        table
-            .channels
-            .iter()
-            .find(|c| c.name == name)
-            .ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{}: no value_{name} column; --profile compares an RGB profile \
-                     (value_r, value_g, value_b)",
-                    csv.display()
-                )
-            })
-    };
-    let cols = [column("r")?, column("g")?, column("b")?];
-    let channels = result.channels.as_ref().into_array();
-    let names = ["r", "g", "b"];
-    let mut scales = [0.0; 3];
-    for c in 0..3 {
-        scales[c] = channels[c]
-            .scale
-            .filter(|k| k.is_finite() && *k > 0.0)
-            .ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{}: `channels.{}.scale` (the fitted profile scale k) is missing or not \
-                     positive; --profile needs it to put the measured profile in mm⁻²",
-                    p.source,
-                    names[c]
-                )
-            })?;
-    }
-    let mm_per_pixel = match result.inputs.mm_per_pixel {
-        Some(v) => v,
-        None => table
-            .r_mm
-            .iter()
-            .zip(&table.r_px)
-            .rev()
-            .find(|(mm, px)| mm.is_finite() && px.is_finite() && **px > 0.0)
-            .map(|(mm, px)| mm / px)
-            .ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{}: no `inputs.mm_per_pixel` and no r_px column to derive it",
-                    p.source
-                )
-            })?,
-    };
-    let spot = match args.spot_radius_mm.or(result.inputs.spot_radius_mm) {
-        Some(v) => v,
-        None => bail!(
-            "{}: no `inputs.spot_radius_mm`; give the light spot's radius with --spot-radius-mm",
-            p.source
-        ),
-    };
-    let r_max = table
-        .r_mm
-        .iter()
-        .copied()
-        .filter(|r| r.is_finite())
-        .fold(0.0, f64::max);
-    let setup = SpotSetup {
-        mm_per_pixel,
-        r_max_mm: r_max + mm_per_pixel,
-        spot_radius_mm: spot,
-    };
-    setup.validate().context("the measurement geometry")?;
-    let material = material_for(p, args.model.map(Into::into))?;
-    let n = setup.image_size();
-    let bar = progress_bar(args, n as u64);
-    bar.set_message("slab + spot, texture-space dipole");
-    let t0 = Instant::now();
-    let popts = RenderOptions { spp: 1, ..*opts };
-    let (rendered, prof) = render_spot_profile(&material, &setup, &popts, &|k| bar.inc(k as u64))?;
-    // Rd_render = norm · L (see scatterfit_render::validation).
-    let ft = 1.0 - scatterfit_optics::fresnel::fresnel_dielectric(1.0, p.eta);
-    let norm = 1.0 / (ft * ft * std::f64::consts::PI * spot * spot) * std::f64::consts::PI;
-    let render_s = t0.elapsed().as_secs_f64();
-    bar.finish_and_clear();
-    let mut mses = Vec::new();
-    for c in 0..3 {
-        let cmp = compare_profiles(
-            &prof.r_mm,
-            &prof.rd[c],
-            &table.r_mm,
-            &cols[c].value,
-            scales[c],
-            spot,
-        )
-        .ok_or_else(|| {
-            anyhow::anyhow!(
-                "{}: no ring outside the spot ({spot} mm) with a positive value in channel {}",
-                csv.display(),
-                names[c]
-            )
-        })?;
-        mses.push(ChannelMse {
-            channel: names[c],
-            mse: cmp.mse,
-            rms_log: cmp.rms_log,
-            rings: cmp.rings,
-            fit_mse: channels[c].mse,
-        });
-    }
-    for out in &args.output {
-        let ext = out
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .unwrap_or_default();
-        match ext.as_str() {
-            "csv" => {
-                // At the measured rings: measured/k and the render interpolated there.
-                let mut text = String::from(
-                    "r_mm,rendered_r,rendered_g,rendered_b,measured_over_k_r,measured_over_k_g,\
-                     measured_over_k_b\n",
-                );
-                for (k, &r) in table.r_mm.iter().enumerate() {
-                    let cell = |v: Option<f64>| {
-                        v.filter(|v| v.is_finite())
-                            .map_or(String::new(), |v| v.to_string())
-                    };
-                    let rendered: Vec<String> = (0..3)
-                        .map(|c| cell(interpolate(&prof.r_mm, &prof.rd[c], r)))
-                        .collect();
-                    let measured: Vec<String> = (0..3)
-                        .map(|c| cell(cols[c].value.get(k).map(|v| v / scales[c])))
-                        .collect();
-                    text.push_str(&format!(
-                        "{r},{},{},{},{},{},{}\n",
-                        rendered[0],
-                        rendered[1],
-                        rendered[2],
-                        measured[0],
-                        measured[1],
-                        measured[2]
-                    ));
-                }
-                scatterfit_io::atomic::write_atomic(out, text.as_bytes())
-                    .with_context(|| format!("writing {}", out.display()))?;
-            }
-            "exr" => write_radiance(out, &rendered.image)?,
-            _ => {
-                // Expose the spot's glow: the profile at twice the spot radius shows as white.
-                let tone = match args.exposure {
-                    Some(_) => *tone,
-                    None => {
-                        let w = scatterfit_render::tonemap::luminance_weights();
-                        let k = ((2.0 * spot / mm_per_pixel) as usize).min(prof.r_mm.len() - 1);
-                        let y: f64 = (0..3).map(|c| w[c] * prof.rd[c][k]).sum::<f64>() / norm;
-                        ToneMap {
-                            exposure_ev: if y > 0.0 {
-                                (tone.white / (std::f64::consts::PI * y))
-                                    .log2()
-                                    .clamp(-60.0, 60.0)
-                            } else {
-                                0.0
-                            },
-                            ..*tone
-                        }
-                    }
-                };
-                write_png(out, &tone_map(&rendered.image, &tone)?)?
-            }
-        }
-    }
-    let summary = Summary {
-        mesh: MeshSummary {
-            source: "built-in slab (measurement geometry)".into(),
-            triangles: 12,
-            size_mm: {
-                let side = setup.image_size() as f64 * mm_per_pixel + 20.0;
-                [side, 50.0, side]
-            },
-            bvh_build_s: 0.0,
-        },
-        renders: vec![render_summary(p, &rendered, &popts)],
-        profile: Some(ProfileSummary {
-            measured: csv,
-            mm_per_pixel,
-            spot_radius_mm: spot,
-            r_max_mm: r_max,
-            render_s,
-            channels: mses,
-        }),
-        outputs: args.output.clone(),
-        threads: rayon::current_num_threads(),
-    };
-    print_summary(args, &summary)?;
-    Ok(ExitCode::SUCCESS)
 }

@@ -7,18 +7,15 @@
 //! all (default 2 mm⁻¹, a mean free path of 0.5 mm, like the paper's materials), so σ′s = α′σ′t and
 //! σa = (1 − α′)σ′t. The study owns its output folder (a `.scatterfit-study` marker).
 
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
 use rayon::prelude::*;
-use scatterfit_optics::{AlbedoModel, Method, ModelName};
-use scatterfit_pipeline::fit::FitSettings;
-use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
-use scatterfit_report::{Figure, Panel, Series, SeriesStyle};
-use serde::Serialize;
+use scatterfit_pipeline::study::{
+    Row, StudySample, combos, dedup, rows_csv, samples, study_sample, summary_markdown,
+};
 
 use crate::common::cache_dir;
 use crate::output::{errln, out, outln};
@@ -70,75 +67,7 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// One fit configuration of the study.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Combo {
-    model: ModelName,
-    albedo: AlbedoModel,
-    method: Method,
-}
-
-impl Combo {
-    fn label(self) -> String {
-        format!(
-            "{} + {} α′, {}",
-            self.model.name(),
-            self.albedo.name(),
-            self.method.name()
-        )
-    }
-}
-
-/// One grid point fitted one way.
-#[derive(Debug, Clone, Serialize)]
-pub struct Row {
-    eta: f64,
-    albedo_prime: f64,
-    model: &'static str,
-    albedo_model: &'static str,
-    method: &'static str,
-    status: String,
-    sigma_s_prime_error: Option<f64>,
-    sigma_a_error: Option<f64>,
-    albedo_prime_error: Option<f64>,
-}
-
 const MARKER: &str = ".scatterfit-study";
-
-fn combos(no_pbd: bool) -> Vec<Combo> {
-    let mut v = Vec::new();
-    for model in [
-        ModelName::Dipole,
-        ModelName::BetterDipole,
-        ModelName::Pbd,
-        ModelName::Mc,
-    ] {
-        if no_pbd && model == ModelName::Pbd {
-            continue;
-        }
-        let albedo = AlbedoModel::default_for(model);
-        for method in [Method::Proposed, Method::Existing] {
-            v.push(Combo {
-                model,
-                albedo,
-                method,
-            });
-        }
-    }
-    // The two biases apart: the dipole's profile with an exact α′, and the exact profile with the
-    // dipole's α′.
-    v.push(Combo {
-        model: ModelName::Dipole,
-        albedo: AlbedoModel::Mc,
-        method: Method::Proposed,
-    });
-    v.push(Combo {
-        model: ModelName::Mc,
-        albedo: AlbedoModel::Diffusion,
-        method: Method::Proposed,
-    });
-    v
-}
 
 fn check_args(args: &Args) -> anyhow::Result<()> {
     if args.etas.is_empty() || args.albedos.is_empty() {
@@ -191,21 +120,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let quiet = args.quiet || args.json;
     let cache = cache_dir(args.cache_dir.as_deref());
     // Samples: three albedos per η each (the last triple padded with its last albedo).
-    let mut samples: Vec<(PathBuf, f64, [f64; 3])> = Vec::new();
-    for &eta in &args.etas {
-        for chunk in args.albedos.chunks(3) {
-            let a: [f64; 3] = std::array::from_fn(|c| chunk[c.min(chunk.len() - 1)]);
-            let name = format!(
-                "eta{eta:.2}-a{}",
-                chunk
-                    .iter()
-                    .map(|a| format!("{a}"))
-                    .collect::<Vec<_>>()
-                    .join("_")
-            );
-            samples.push((out.join("samples").join(name), eta, a));
-        }
-    }
+    let samples: Vec<StudySample> = samples(out, &args.etas, &args.albedos);
     if !quiet {
         errln!(
             "study: {} samples ({} η × {} α′) on the {} rig, Monte Carlo cached in {}",
@@ -218,18 +133,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .map_or("no cache".into(), |p| p.display().to_string())
         );
     }
-    for (dir, eta, a) in &samples {
-        let st = args.sigma_t_prime;
+    for sample in &samples {
         let m = Material {
-            name: dir
-                .file_name()
-                .map_or_else(|| "sample".into(), |n| n.to_string_lossy().into_owned()),
-            sigma_s_prime: a.map(|a| a * st),
-            sigma_a: a.map(|a| (1.0 - a) * st),
-            eta: *eta,
+            name: sample.name(),
+            sigma_s_prime: sample.sigma_s_prime(args.sigma_t_prime),
+            sigma_a: sample.sigma_a(args.sigma_t_prime),
+            eta: sample.eta,
         };
         let s = synthesize(&m, args.seed, cache.as_deref(), quiet, args.quick)?;
-        write_sample(dir, &s)?;
+        write_sample(&sample.dir, &s)?;
     }
     let synth_s = t0.elapsed().as_secs_f64();
     let combos = combos(args.no_pbd);
@@ -244,8 +156,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let results: Vec<anyhow::Result<Vec<Row>>> = pool.install(|| {
         samples
             .par_iter()
-            .map(|(dir, eta, a)| {
-                let r = study_sample(dir, *eta, a, &combos);
+            .map(|sample| {
+                let r = study_sample(sample, &combos).map_err(anyhow::Error::from);
                 bar.inc(1);
                 r
             })
@@ -254,7 +166,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let mut rows = Vec::new();
     let mut failed = Vec::new();
-    for (r, (dir, ..)) in results.into_iter().zip(&samples) {
+    for (r, StudySample { dir, .. }) in results.into_iter().zip(&samples) {
         match r {
             Ok(v) => rows.extend(v),
             Err(e) => failed.push(format!(
@@ -265,13 +177,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     // A padded triple repeats its last albedo: keep one row per grid point and configuration.
-    let mut seen = std::collections::HashSet::new();
-    rows.retain(|r| {
-        seen.insert(format!(
-            "{}|{}|{}|{}|{}",
-            r.eta, r.albedo_prime, r.model, r.albedo_model, r.method
-        ))
-    });
+    dedup(&mut rows);
     let summary = summary_markdown(&rows, &combos);
     let csv = rows_csv(&rows);
     for (name, text) in [("study.csv", csv), ("study.md", summary.clone())] {
@@ -280,7 +186,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("writing {}", p.display()))?;
     }
     scatterfit_report::write_figure(
-        &figure(&rows, &combos),
+        &scatterfit_report::study::study_figure(&rows, &combos),
         Some(&out.join("study.svg")),
         Some(&out.join("study.png")),
     )?;
@@ -302,245 +208,4 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Measures one sample and fits it every way.
-fn study_sample(
-    dir: &Path,
-    eta: f64,
-    albedos: &[f64; 3],
-    combos: &[Combo],
-) -> anyhow::Result<Vec<Row>> {
-    let truth: serde_json::Value = serde_json::from_str(
-        &scatterfit_io::text::read_text_file(&dir.join("truth.json"))
-            .context("reading truth.json")?
-            .text,
-    )?;
-    // At η = 1 there is no specular reflection to measure η from (SCI = SCE): the study gives it.
-    let overrides = Overrides {
-        eta: (eta < 1.02).then_some(eta),
-        ..Overrides::default()
-    };
-    let base: Measurement = measure_sample(dir, &overrides, &|_| {})?;
-    let mut rows = Vec::new();
-    for combo in combos {
-        let settings = FitSettings {
-            method: combo.method,
-            model: combo.model,
-            albedo_model: combo.albedo,
-            normalise_with_spectro: false,
-            ..base.settings
-        };
-        let m = base.refit_values_only(settings)?;
-        let result = m.to_result(None);
-        for (c, ch) in result.channels.as_ref().into_array().iter().enumerate() {
-            let t = &truth["channels"][c];
-            let (sp, sa) = (
-                t["sigma_s_prime"].as_f64().unwrap_or(f64::NAN),
-                t["sigma_a"].as_f64().unwrap_or(f64::NAN),
-            );
-            let rel = |v: Option<f64>, truth: f64| v.map(|v| v / truth - 1.0);
-            rows.push(Row {
-                eta,
-                albedo_prime: albedos[c],
-                model: combo.model.name(),
-                albedo_model: combo.albedo.name(),
-                method: combo.method.name(),
-                status: format!("{:?}", ch.status).to_lowercase(),
-                sigma_s_prime_error: rel(ch.sigma_s_prime, sp),
-                sigma_a_error: rel(ch.sigma_a, sa),
-                albedo_prime_error: ch.albedo_prime.map(|a| a - albedos[c]),
-            });
-        }
-    }
-    Ok(rows)
-}
-
-fn rows_csv(rows: &[Row]) -> String {
-    let mut t = String::from(
-        "eta,albedo_prime,model,albedo_model,method,status,sigma_s_prime_error,sigma_a_error,albedo_prime_error\n",
-    );
-    let f = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.6}"));
-    for r in rows {
-        let _ = writeln!(
-            t,
-            "{},{},{},{},{},{},{},{},{}",
-            r.eta,
-            r.albedo_prime,
-            r.model,
-            r.albedo_model,
-            r.method,
-            r.status,
-            f(r.sigma_s_prime_error),
-            f(r.sigma_a_error),
-            f(r.albedo_prime_error)
-        );
-    }
-    t
-}
-
-fn stats(v: impl Iterator<Item = Option<f64>>) -> Option<(f64, f64, usize)> {
-    let mut v: Vec<f64> = v.map(|x| x.map_or(f64::INFINITY, f64::abs)).collect();
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    Some((v[v.len() / 2], v[v.len() - 1], v.len()))
-}
-
-fn pct(s: Option<(f64, f64, usize)>) -> String {
-    match s {
-        Some((m, w, _)) if w.is_finite() => format!("{:.2} % / {:.1} %", 100.0 * m, 100.0 * w),
-        Some((m, _, _)) if m.is_finite() => format!("{:.2} % / failed", 100.0 * m),
-        _ => "failed".into(),
-    }
-}
-
-/// Per configuration: median / worst |error| over the grid; per model: where it is usable.
-fn summary_markdown(rows: &[Row], combos: &[Combo]) -> String {
-    let mut t = String::from(
-        "| model + albedo model, method | points | σ′s median / worst | σa median / worst | α′ error median / worst |\n\
-         |---|---|---|---|---|\n",
-    );
-    let of = |c: &Combo| {
-        rows.iter()
-            .filter(|r| {
-                r.model == c.model.name()
-                    && r.albedo_model == c.albedo.name()
-                    && r.method == c.method.name()
-            })
-            .collect::<Vec<_>>()
-    };
-    for c in combos {
-        let rs = of(c);
-        let a = stats(rs.iter().map(|r| r.albedo_prime_error));
-        let _ = writeln!(
-            t,
-            "| {} | {} | {} | {} | {} |",
-            c.label(),
-            rs.len(),
-            pct(stats(rs.iter().map(|r| r.sigma_s_prime_error))),
-            pct(stats(rs.iter().map(|r| r.sigma_a_error))),
-            a.map_or("—".into(), |(m, w, _)| format!("{m:.2e} / {w:.1e}")),
-        );
-    }
-    // Where each model's proposed method gets σ′s and σa within 5 %: per η, the albedos.
-    t.push_str("\nWhere each configuration (proposed method) has σ′s and σa within 5 % (✓), per η and α′:\n\n");
-    let etas: Vec<f64> = {
-        let mut e: Vec<f64> = rows.iter().map(|r| r.eta).collect();
-        e.sort_by(f64::total_cmp);
-        e.dedup();
-        e
-    };
-    let albedos: Vec<f64> = {
-        let mut a: Vec<f64> = rows.iter().map(|r| r.albedo_prime).collect();
-        a.sort_by(f64::total_cmp);
-        a.dedup();
-        a
-    };
-    for c in combos.iter().filter(|c| c.method == Method::Proposed) {
-        let rs = of(c);
-        let _ = writeln!(t, "**{}**\n", c.label());
-        let _ = write!(t, "| η \\ α′ |");
-        for a in &albedos {
-            let _ = write!(t, " {a} |");
-        }
-        t.push('\n');
-        t.push_str(&"|---".repeat(albedos.len() + 1));
-        t.push_str("|\n");
-        for e in &etas {
-            let _ = write!(t, "| {e} |");
-            for a in &albedos {
-                let cell = rs
-                    .iter()
-                    .find(|r| r.eta == *e && r.albedo_prime == *a)
-                    .map_or("", |r| {
-                        let ok = |v: Option<f64>| v.is_some_and(|v| v.abs() <= 0.05);
-                        if ok(r.sigma_s_prime_error) && ok(r.sigma_a_error) {
-                            "✓"
-                        } else {
-                            "✗"
-                        }
-                    });
-                let _ = write!(t, " {cell} |");
-            }
-            t.push('\n');
-        }
-        t.push('\n');
-    }
-    t
-}
-
-/// Per configuration (proposed method), |σ′s error| against −log₁₀(1 − α′), one line per η.
-fn figure(rows: &[Row], combos: &[Combo]) -> Figure {
-    let etas: Vec<f64> = {
-        let mut e: Vec<f64> = rows.iter().map(|r| r.eta).collect();
-        e.sort_by(f64::total_cmp);
-        e.dedup();
-        e
-    };
-    let panels = combos
-        .iter()
-        .filter(|c| c.method == Method::Proposed && c.albedo == AlbedoModel::default_for(c.model))
-        .map(|c| {
-            let n = etas.len().max(2) as f64 - 1.0;
-            let base = match c.model {
-                ModelName::Dipole => (200.0, 30.0, 30.0),
-                ModelName::BetterDipole => (200.0, 120.0, 0.0),
-                ModelName::Pbd => (20.0, 140.0, 40.0),
-                ModelName::Mc => (30.0, 70.0, 200.0),
-            };
-            let series = etas
-                .iter()
-                .enumerate()
-                .map(|(k, &e)| {
-                    // Light (η small) to dark (η large) shades of the model's colour.
-                    let t = 0.75 - 0.75 * k as f64 / n;
-                    let shade = |v: f64| (v + (255.0 - v) * t).round() as u8;
-                    let mut pts: Vec<(f64, f64)> = rows
-                        .iter()
-                        .filter(|r| {
-                            r.eta == e
-                                && r.model == c.model.name()
-                                && r.albedo_model == c.albedo.name()
-                                && r.method == "proposed"
-                        })
-                        .filter_map(|r| {
-                            r.sigma_s_prime_error.map(|v| {
-                                (-(1.0 - r.albedo_prime).log10(), (100.0 * v.abs()).max(1e-3))
-                            })
-                        })
-                        .collect();
-                    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                    Series {
-                        label: format!("η = {e}"),
-                        points: pts,
-                        errors: None,
-                        style: SeriesStyle::Line,
-                        colour: Some((shade(base.0), shade(base.1), shade(base.2))),
-                    }
-                })
-                .collect();
-            Panel {
-                title: c.label(),
-                colour: match c.model {
-                    ModelName::Dipole => (200, 30, 30),
-                    ModelName::BetterDipole => (200, 120, 0),
-                    ModelName::Pbd => (20, 140, 40),
-                    ModelName::Mc => (30, 70, 200),
-                },
-                series,
-                note: Some("x: −log₁₀(1 − α′) (1 = 0.9, 2 = 0.99, 3 = 0.999)".into()),
-            }
-        })
-        .collect();
-    Figure {
-        title: "Bias study: |σ′s error| of the proposed method on Monte Carlo rig-twin samples"
-            .into(),
-        x_label: "−log₁₀(1 − α′)".into(),
-        y_label: "|σ′s error| [%]".into(),
-        panels,
-        log_y: true,
-        log_x: false,
-    }
 }

@@ -10,7 +10,7 @@ use scatterfit_io::sample_folder::file_names;
 use scatterfit_synth::{RigSpec, materials};
 use serde::Serialize;
 
-use crate::common::{cache_dir, check_output_files, parse_rgb, shutter};
+use crate::common::{CacheArgs, check_output_files, parse_rgb, shutter};
 use crate::output::outln;
 use crate::twin::{Material, synthesize_on, write_sample_with};
 
@@ -85,9 +85,8 @@ pub struct Args {
     /// Overwrite existing files in the folder.
     #[arg(long)]
     pub force: bool,
-    /// Folder for cached Monte Carlo profiles (default: $SCATTERFIT_CACHE, the XDG cache, ~/.cache).
-    #[arg(long, value_name = "DIR")]
-    pub cache_dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: CacheArgs,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -211,7 +210,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         names.push("spot.png".into());
     }
     check_output_files(&args.output_dir, &names, args.force)?;
-    let cache = cache_dir(args.cache_dir.as_deref());
+    let cache = args.cache.dir();
     let sample = synthesize_on(
         &m,
         &rig,

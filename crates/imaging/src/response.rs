@@ -85,7 +85,7 @@ impl ResponseCurve {
     }
 
     /// A response from linear exposures X(z) = f⁻¹(z) = exp g(z), the form OpenCV's
-    /// `CalibrateDebevec` returns (physics.md §7.2). Every value must be finite and > 0.
+    /// `CalibrateDebevec` returns (docs/physics.md §7.2). Every value must be finite and > 0.
     ///
     /// # Errors
     /// [`ImagingError::InvalidResponse`] as for [`ResponseCurve::from_log_exposure`], or a value ≤ 0.
@@ -229,7 +229,7 @@ pub struct Calibration {
 }
 
 /// Solves Debevec & Malik's least-squares system for one channel (the paper's appendix `gsolve`,
-/// physics.md §7.1): unknowns g(0..=255) and ln E_i; data rows w(Z_ij)(g(Z_ij) − ln E_i) = w(Z_ij) ln Δt_j,
+/// docs/physics.md §7.1): unknowns g(0..=255) and ln E_i; data rows w(Z_ij)(g(Z_ij) − ln E_i) = w(Z_ij) ln Δt_j,
 /// the gauge row g(128) = 0, and smoothness rows λ w(z)(g(z−1) − 2g(z) + g(z+1)) = 0 for z = 1..=254,
 /// with the hat weight [`hat_weight`].
 ///

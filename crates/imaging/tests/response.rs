@@ -5,7 +5,7 @@ use scatterfit_imaging::{
     gsolve, merge, recover_response,
 };
 
-/// The deterministic gsolve vector of physics.md §7.1: 70 pixels with ln E linearly spaced in
+/// The deterministic gsolve vector of docs/physics.md §7.1: 70 pixels with ln E linearly spaced in
 /// [ln 1e-3, 0], Δt = 2^k for k = −4..=2, Z = round(255·clip(E·Δt, 0, 1)^(1/2.2)), λ = 10.
 fn physics_vector() -> (Vec<u8>, Vec<f64>, Vec<f64>) {
     let n = 70;
@@ -24,7 +24,7 @@ fn physics_vector() -> (Vec<u8>, Vec<f64>, Vec<f64>) {
     (z, ln_dt, ln_e)
 }
 
-/// gsolve reproduces the table of physics.md §7.1 (computed there with a numpy port of the paper's
+/// gsolve reproduces the table of docs/physics.md §7.1 (computed there with a numpy port of the paper's
 /// MATLAB appendix solving the full (NP + 257) × (256 + N) system with lstsq): our eliminated-ln E QR
 /// solve must give the same least-squares minimiser.
 #[test]
@@ -45,7 +45,7 @@ fn gsolve_matches_physics_sheet_table() {
         let got = sol.g[zz];
         assert!(
             (got - expected).abs() < 1e-3,
-            "g({zz}) = {got:.5}, physics.md §7.1 says {expected}"
+            "g({zz}) = {got:.5}, docs/physics.md §7.1 says {expected}"
         );
     }
     // Pixel 35's ln E in the g(128) = 0 gauge (same sheet): −1.8899.
@@ -57,7 +57,7 @@ fn gsolve_matches_physics_sheet_table() {
 }
 
 /// With the true gauge offset 2.2 ln(128/255) added back, ln E_35 is close to the truth −3.4038
-/// (physics.md: Δ = 0.0024), i.e. the solution means what it says.
+/// (docs/physics.md: Δ = 0.0024), i.e. the solution means what it says.
 #[test]
 fn gsolve_ln_e_is_truth_up_to_gauge() {
     let (z, ln_dt, ln_e) = physics_vector();

@@ -139,6 +139,38 @@ fn resolve(path: &Path) -> Option<PathBuf> {
     Some(dir.join(path.file_name()?))
 }
 
+/// A path's identity for "is this one of the inputs?": the canonical path when it exists, else its
+/// canonical folder joined with its name, else the path as given.
+pub fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let parent = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (std::fs::canonicalize(parent), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// True when `a` and `b` are the same file: the same resolved path ([`identity`]), or, for files
+/// that exist, the same device and inode (a hard link is the same file under another name).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    if identity(a) == identity(b) {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return x.dev() == y.dev() && x.ino() == y.ino();
+        }
+    }
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -16,6 +16,7 @@ pub mod inputs;
 pub mod manifest;
 pub mod mesh;
 pub mod profile_csv;
+pub mod quality;
 pub mod raw;
 pub mod response_csv;
 pub mod result_json;

@@ -10,6 +10,8 @@
 //! # lab_observer = 10           # 10 (the instrument default) or 2
 //! # eta = 1.45                  # a known η instead of the one from SCI − SCE (matte samples)
 //! # repeatability = 0.005       # relative standard deviation of a reading (default 0.5 %)
+//! # aperture_mm = 8             # the measured area's diameter: corrects the port's edge loss
+//! # illuminated_mm = 14         # the lit area's diameter (default: aperture_mm)
 //!
 //! [camera]
 //! exposures = "exposures.csv"   # header: file,time_s ; or omit and read ExposureTime from EXIF
@@ -106,6 +108,14 @@ pub struct SpectroSection {
     /// wavelength (a re-placed sample, the calibration): what the uncertainties of η, α′ and,
     /// through them, σ′s and σa are propagated from. Default [`DEFAULT_SPECTRO_REPEATABILITY`].
     pub repeatability: Option<f64>,
+    /// Diameter of the instrument's measured area [mm] (its port, e.g. 4, 8 or 25 mm). Given, the
+    /// reading's edge loss (light that enters inside the lit area and leaves beyond the measured
+    /// one) is corrected from the fitted profile (issue 15; `scatterfit_optics::port`); absent, the
+    /// reading is taken as loss-free and the result says so.
+    pub aperture_mm: Option<f64>,
+    /// Diameter of the illuminated area [mm] when the instrument lights a different area than it
+    /// measures (default: `aperture_mm`). Only with `aperture_mm`.
+    pub illuminated_mm: Option<f64>,
 }
 
 /// The default relative repeatability of a spectrophotometer reading (0.5 %): an assumption, to be
@@ -403,6 +413,31 @@ pub fn parse_manifest(
             ),
         ));
     }
+    for (key, d) in [
+        ("spectro.aperture_mm", m.spectro.aperture_mm),
+        ("spectro.illuminated_mm", m.spectro.illuminated_mm),
+    ] {
+        if let Some(d) = d
+            && !(d.is_finite() && (0.5..=100.0).contains(&d))
+        {
+            return Err(invalid(
+                key,
+                format!(
+                    "= {}: a port diameter in mm must lie in [0.5, 100] (d/8 instruments use 4, 8 \
+                     or 25 mm)",
+                    num(d)
+                ),
+            ));
+        }
+    }
+    if m.spectro.illuminated_mm.is_some() && m.spectro.aperture_mm.is_none() {
+        return Err(invalid(
+            "spectro.illuminated_mm",
+            "is given without spectro.aperture_mm: give the measured area's diameter too (or \
+             remove illuminated_mm to take the reading as loss-free)"
+                .to_string(),
+        ));
+    }
     match m.camera.mm_per_pixel {
         None => {
             return Err(invalid(
@@ -644,6 +679,12 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     if let Some(r) = m.spectro.repeatability {
         t.push_str(&format!("repeatability = {r}\n"));
     }
+    if let Some(d) = m.spectro.aperture_mm {
+        t.push_str(&format!("aperture_mm = {d}\n"));
+    }
+    if let Some(d) = m.spectro.illuminated_mm {
+        t.push_str(&format!("illuminated_mm = {d}\n"));
+    }
     t.push_str("\n[camera]\n");
     if let Some(f) = &m.camera.exposures {
         t.push_str(&format!(
@@ -798,6 +839,8 @@ r_max_px = 300
         );
         let mut m = m;
         m.spectro.repeatability = Some(0.01);
+        m.spectro.aperture_mm = Some(8.0);
+        m.spectro.illuminated_mm = Some(14.0);
         m.camera.center_px = Some([101.5, 99.25]);
         m.fit = FitSection {
             method: Some(Method::Existing),

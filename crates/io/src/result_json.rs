@@ -383,6 +383,10 @@ pub struct ChannelResult {
     /// Why the channel failed or what to watch out for.
     #[serde(default)]
     pub problem: Option<String>,
+    /// The data checks' verdict on the channel (`crate::quality`); `None` in files written before
+    /// the checks, or where no check ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quality: Option<crate::quality::Quality>,
 }
 
 impl ChannelResult {
@@ -545,6 +549,28 @@ pub struct MeasurementResult {
     /// L*a*b* or the result predates the field; never written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rd_spectrum: Option<RdSpectrum>,
+    /// The spectrophotometer port's edge-loss correction (issue 15; `spectro.aperture_mm` in the
+    /// manifest): the channels' `rd_total` and `albedo_prime` are then the corrected values. Absent:
+    /// the reading was taken as loss-free (no port given). Never written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectro_port: Option<PortResult>,
+}
+
+/// What the port correction did ([`MeasurementResult::spectro_port`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PortResult {
+    /// Diameter of the measured aperture [mm].
+    pub aperture_mm: f64,
+    /// Diameter of the lit disc [mm].
+    pub illuminated_mm: f64,
+    /// Rd per channel as the instrument read it.
+    pub rd_read: scatterfit_optics::Rgb<f64>,
+    /// The fraction of the true Rd the instrument read, per channel (`None`: the channel was left
+    /// uncorrected, see `problems`).
+    pub reading_fraction: scatterfit_optics::Rgb<Option<f64>>,
+    /// Why a channel was left uncorrected.
+    #[serde(default)]
+    pub problems: scatterfit_optics::Rgb<Option<String>>,
 }
 
 /// A measured diffuse reflectance spectrum ([`MeasurementResult::rd_spectrum`]).
@@ -788,6 +814,7 @@ mod tests {
             rings_below_detection: 40,
             rings_invalid: 0,
             problem: None,
+            quality: None,
         }
     }
 
@@ -809,6 +836,7 @@ mod tests {
             inputs: Inputs::default(),
             version: "0.1.0".into(),
             rd_spectrum: None,
+            spectro_port: None,
         }
     }
 

@@ -101,6 +101,53 @@ pub fn errors_note(results: &[MeasurementResult]) -> String {
     )
 }
 
+/// The lines under a table that say how the spectrophotometer's port was handled (issue 15): per
+/// result with a port, what it read of Rd per channel (the correction applied); when no result
+/// names a port, one line saying the readings were taken as loss-free.
+pub fn port_note(results: &[MeasurementResult]) -> String {
+    let mut t = String::new();
+    for r in results {
+        if let Some(p) = &r.spectro_port {
+            let pct = p
+                .reading_fraction
+                .iter()
+                .map(|f| f.map_or("—".into(), |f| format!("{:.1}", 100.0 * f)))
+                .collect::<Vec<_>>()
+                .join(" / ");
+            t.push_str(&format!(
+                "Spectrophotometer port ({}): {} mm aperture lit over {} mm read {pct} % of Rd (R / G \
+                 / B); Rd and α′ corrected from the fitted profile.\n",
+                crate::escape::one_line(&r.name),
+                diameter(p.aperture_mm),
+                diameter(p.illuminated_mm)
+            ));
+            for (ch, problem) in p.problems.iter_channels() {
+                if let Some(problem) = problem {
+                    t.push_str(&format!(
+                        "  {} left as read: {}\n",
+                        ch.name(),
+                        crate::escape::one_line(problem)
+                    ));
+                }
+            }
+        }
+    }
+    if t.is_empty() && !results.is_empty() {
+        t.push_str(
+            "Spectrophotometer readings taken as loss-free (no spectro.aperture_mm): a port \
+             under-reads Rd of materials whose light travels millimetres, and σa then comes out \
+             high.\n",
+        );
+    }
+    t
+}
+
+/// A port diameter as written (up to 4 significant digits, no trailing zeros).
+fn diameter(v: f64) -> String {
+    let s = format!("{v:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// Table 1 as CSV: one row per material and channel.
 pub fn table1_csv(results: &[MeasurementResult]) -> String {
     let mut t = String::from(
@@ -212,6 +259,11 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
     if !errors.is_empty() {
         t.push('\n');
         t.push_str(&errors);
+    }
+    let port = port_note(results);
+    if !port.is_empty() {
+        t.push('\n');
+        t.push_str(&port);
     }
     if !notes.is_empty() {
         t.push('\n');

@@ -110,6 +110,22 @@ pub enum SpectroCsvError {
         /// What is missing.
         message: String,
     },
+    /// Percent columns (`sci_pct`, `sce_pct`) whose values are all at most 1: fractions, which
+    /// read as percent would make every reflectance 100× too small (α′ far off).
+    #[error(
+        "{path}: every value in `{sci}` and `{sce}` is at most 1 (largest {max}): these are \
+         fractions 0..1, not percent — name the columns `sci` and `sce`, or give percentages"
+    )]
+    FractionsInPercent {
+        /// The file.
+        path: PathBuf,
+        /// The SCI column's name as found.
+        sci: String,
+        /// The SCE column's name as found.
+        sce: String,
+        /// The largest value in them.
+        max: f64,
+    },
     /// SCI below SCE beyond measurement noise.
     #[error(
         "{path}: line {line}: SCI {} is below SCE {} at {} nm by more than the noise tolerance \
@@ -315,6 +331,17 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
     }
     check_coverage(&wavelengths)
         .map_err(|message| SpectroCsvError::Coverage { path: p(), message })?;
+    // Percent columns holding fractions (issue 17 §3): no reflectance reaches 1 %, where a real
+    // sample's SCI (specular included) is several percent somewhere in 400–700 nm.
+    let max = sci.iter().chain(&sce).copied().fold(0.0f64, f64::max) / scale;
+    if scale != 1.0 && max <= 1.0 {
+        return Err(SpectroCsvError::FractionsInPercent {
+            path: p(),
+            sci: sci_name.to_owned(),
+            sce: sce_name.to_owned(),
+            max,
+        });
+    }
     SpectroReading::new(wavelengths, sci, sce)
         .map_err(|source| SpectroCsvError::Reading { path: p(), source })
 }
@@ -459,6 +486,13 @@ mod tests {
         );
         let pct = csv_with(|w| format!("{w},101,50"), "wavelength_nm,sci_pct,sce_pct");
         assert!(err(&pct).contains("outside 0..100"));
+        // Fractions in percent columns: refused, not read 100× too small.
+        let fractions = csv_with(
+            |w| format!("{w},0.55,0.51"),
+            "wavelength_nm,sci_pct,sce_pct",
+        );
+        let e = err(&fractions);
+        assert!(e.contains("fractions 0..1, not percent"), "{e}");
     }
 
     #[test]

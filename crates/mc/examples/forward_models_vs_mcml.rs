@@ -1,5 +1,5 @@
 //! Every forward model against exact transport: MCML's independent radial profiles
-//! (`reference/mcml_profiles.csv`, physics.md §4.5; σ′t = 1 mm⁻¹, g = 0, 2·10⁶ photons per case).
+//! (`data/reference/mcml_profiles.csv`, docs/physics.md §4.5; σ′t = 1 mm⁻¹, g = 0, 2·10⁶ photons per case).
 //! For each (η, α′): the median and largest |relative difference| of the model's bin average from
 //! MCML over r ∈ [1, 20] mean free paths (bins whose MCML relative noise, 1/√(N·2πr·dr·Rd), is below
 //! 10 %; the last bin, which collects everything beyond 20 mm, is skipped) and the relative difference

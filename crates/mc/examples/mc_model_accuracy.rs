@@ -1,5 +1,5 @@
 //! Accuracy of the `mc` forward model (the shipped tables, or those in TABLE_DIR):
-//! 1. against MCML's independent profiles (`reference/mcml_profiles.csv`, physics.md §4.5) at its
+//! 1. against MCML's independent profiles (`data/reference/mcml_profiles.csv`, docs/physics.md §4.5) at its
 //!    15 (η, α′) points (η = 1.0, 1.4, 2.0 are table nodes; α′ 0.3 … 0.999 lie between albedo nodes):
 //!    weighted mean relative difference ± standard error (MCML noise 1/√(N·2πr·dr·Rd)) and χ²/bins
 //!    in radial windows, and the totals;

@@ -1,4 +1,4 @@
-//! The photon tracer: MCML's physics (Wang, Jacques & Zheng 1995; physics.md §4.1) in mm units, run
+//! The photon tracer: MCML's physics (Wang, Jacques & Zheng 1995; docs/physics.md §4.1) in mm units, run
 //! in fixed-size chunks of photons with one random stream per chunk, so that a seed gives the same
 //! result bit for bit whatever the number of threads.
 
@@ -15,9 +15,9 @@ use crate::phase::{HgSampler, scatter_hg};
 use crate::rng::{PhotonRng, stream};
 use crate::sample::Sample;
 
-/// MCML's roulette threshold `WEIGHT` (physics.md §4.1).
+/// MCML's roulette threshold `WEIGHT` (docs/physics.md §4.1).
 pub const ROULETTE_THRESHOLD: f64 = 1e-4;
-/// MCML's roulette survival chance `CHANCE` (physics.md §4.1).
+/// MCML's roulette survival chance `CHANCE` (docs/physics.md §4.1).
 pub const ROULETTE_CHANCE: f64 = 0.1;
 /// Photons per chunk: the unit of work with its own random stream. Fixed, so that results do not
 /// depend on the thread count; 2048 photons are 0.1–20 ms of work, large against rayon's overhead.

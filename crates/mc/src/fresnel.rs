@@ -17,7 +17,7 @@ pub struct FresnelSample {
 /// Unpolarised Fresnel reflectance for light going from index `n_i` into index `n_t` with incidence
 /// cosine `cos_i` ∈ [0, 1], and the transmitted cosine from Snell's law.
 ///
-/// Wang, Jacques & Zheng 1995 (MCML), `RFresnel` in `mcmlgo.c` (physics.md §4.1): the average of the
+/// Wang, Jacques & Zheng 1995 (MCML), `RFresnel` in `mcmlgo.c` (docs/physics.md §4.1): the average of the
 /// s and p reflectances written with the sum and difference angles a± = θi ± θt,
 /// R = ½ sin²(a−)[cos²(a−) + cos²(a+)] / [sin²(a+) cos²(a−)], which is Hecht's
 /// ½[sin²(θi−θt)/sin²(θi+θt) + tan²(θi−θt)/tan²(θi+θt)]. Normal incidence uses ((n_t−n_i)/(n_t+n_i))².
@@ -100,7 +100,7 @@ mod tests {
 
     #[test]
     fn normal_incidence_and_critical_angle() {
-        // ((1.4−1)/(2.4))² = 0.02777…, physics.md §4.3's R_sp for n = 1.4.
+        // ((1.4−1)/(2.4))² = 0.02777…, docs/physics.md §4.3's R_sp for n = 1.4.
         assert!((fresnel_mcml(1.0, 1.4, 1.0).reflectance - 0.027_777_777_777_777_8).abs() < 1e-15);
         // From 1.4 into air the critical cosine is sqrt(1 − 1/1.96) ≈ 0.69985.
         assert_eq!(fresnel_mcml(1.4, 1.0, 0.699).reflectance, 1.0);

@@ -3,7 +3,7 @@
 //! name becomes a model ([`family()`], [`albedo_family()`]).
 //!
 //! The engine follows Wang, Jacques & Zheng 1995 (MCML; the algorithm is summarised in
-//! `reference/physics.md` §4.1) in millimetres: a collimated beam enters a stack of plane-parallel
+//! `docs/physics.md` §4.1) in millimetres: a collimated beam enters a stack of plane-parallel
 //! layers (a slab, or a half-space when the last layer is infinitely thick); photons take
 //! exponentially distributed steps, lose weight σa/σt at each interaction (implicit capture),
 //! scatter with the Henyey–Greenstein phase function, are reflected or transmitted at the faces with
@@ -19,7 +19,7 @@
 //!
 //! ```
 //! use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation};
-//! // The standard slab (physics.md §4.2): σa = 1, σs = 9 mm⁻¹, g = 0.75, n = 1, d = 0.2 mm.
+//! // The standard slab (docs/physics.md §4.2): σa = 1, σs = 9 mm⁻¹, g = 0.75, n = 1, d = 0.2 mm.
 //! let slab = Sample::slab(Layer::new(1.0, 9.0, 0.75, 1.0, 0.2)?, 1.0)?;
 //! let sim = Simulation::new(slab, Beam::pencil(), RadialGrid::uniform(0.1, 20)?, 10_000, 1)?;
 //! let result = sim.run();

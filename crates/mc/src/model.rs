@@ -11,7 +11,7 @@
 //!   [`scatterfit_optics::ProfileModel`]; the set is the `mc` [`scatterfit_optics::ModelFamily`]
 //!   (the [`family`](mod@crate::family) module).
 //!
-//! Similarity (pbrt's `TabulatedBSSRDF::Sr`, physics.md §2.3): with σs = σ′s/(1 − g), σt = σa + σs and
+//! Similarity (pbrt's `TabulatedBSSRDF::Sr`, docs/physics.md §2.3): with σs = σ′s/(1 − g), σt = σa + σs and
 //! a = σs/σt, Rd(r) = σt² R̂(σt r; a) exactly (same η, g). For g = 0, σt = σ′t and a = α′.
 //!
 //! Interpolation: between albedos, Catmull-Rom (pbrt's `CatmullRomWeights`) in x = −√(1 − a) on the
@@ -545,7 +545,7 @@ fn dot4(w: &[f64; 4], f: impl Fn(usize) -> f64) -> f64 {
 }
 
 /// Catmull-Rom weights at `x` over the `n` strictly increasing nodes `node(k)` (pbrt-v3's
-/// `CatmullRomWeights`, physics.md §2.3): returns (i, w) with x ∈ [node(i), node(i + 1)] and the
+/// `CatmullRomWeights`, docs/physics.md §2.3): returns (i, w) with x ∈ [node(i), node(i + 1)] and the
 /// interpolant Σₖ w[k]·f(i − 1 + k); the end derivatives are one-sided (w[0] or w[3] is then 0).
 /// Cubic Hermite with finite-difference derivatives on non-uniform nodes; exact at the nodes.
 fn catmull_rom_weights(n: usize, node: impl Fn(usize) -> f64, x: f64) -> (usize, [f64; 4]) {

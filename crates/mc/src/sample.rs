@@ -112,7 +112,7 @@ impl Layer {
     }
 
     /// A layer from graphics parameters: reduced scattering σ′s [mm⁻¹], σa [mm⁻¹], g and n; the
-    /// scattering coefficient is σs = σ′s / (1 − g) (the similarity relation, physics.md conventions).
+    /// scattering coefficient is σs = σ′s / (1 − g) (the similarity relation, docs/physics.md conventions).
     ///
     /// # Errors
     /// As [`Layer::new`]; σ′s is checked before the division.

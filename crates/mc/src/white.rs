@@ -1,7 +1,7 @@
 //! "White" Monte Carlo for a half-space: one photon run serves every albedo.
 //!
 //! At σt = 1 the photon paths in a homogeneous half-space do not depend on the single-scattering
-//! albedo a: with MCML's implicit capture (physics.md §4.1, `Drop`) a photon that leaves the surface
+//! albedo a: with MCML's implicit capture (docs/physics.md §4.1, `Drop`) a photon that leaves the surface
 //! after n interactions carries the weight (1 − R_sp)·aⁿ, whatever else happened. So we trace
 //! non-absorbing photons once and score each escape with aₖⁿ for every albedo aₖ of the table — the
 //! "white Monte Carlo" of Pifferi et al. 1998 (Appl. Opt. 37:2774) and Alerstam, Andersson-Engels &

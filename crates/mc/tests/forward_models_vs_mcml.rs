@@ -1,12 +1,12 @@
-//! Every forward model against exact transport: MCML's independent radial profiles (physics.md §4.5;
+//! Every forward model against exact transport: MCML's independent radial profiles (docs/physics.md §4.5;
 //! `data/reference/mcml_profiles.csv`, the project's copy of the shared reference:
 //! η ∈ {1.0, 1.4, 2.0} × α′ ∈ {0.3, 0.6, 0.9, 0.99, 0.999}, g = 0, σ′t = 1 mm⁻¹, 2·10⁶ photons per
-//! case, 0.05 mm bins) and adding-doubling totals (physics.md §4.3).
+//! case, 0.05 mm bins) and adding-doubling totals (docs/physics.md §4.3).
 //!
 //! * The `mc` model (the shipped tables) must agree with MCML within the noise plus its own stated
 //!   tolerance, 0.5 % of Rd(r): in radial windows, the weighted mean relative difference within
 //!   3 standard errors + 0.5 %; per bin within 5 standard errors + 0.5 %. MCML's bin noise is
-//!   1/√(N·2πr·dr·Rd) relative (physics.md §4.5). Its totals must match adding-doubling within 3 of
+//!   1/√(N·2πr·dr·Rd) relative (docs/physics.md §4.5). Its totals must match adding-doubling within 3 of
 //!   its standard errors + 3e-4 (η interpolation, for η = 1.5 between tables).
 //! * The diffusion models (dipole, better dipole, PBD) are far from exact transport in places; these
 //!   tests pin where BENCHMARKS.md says each one stops being usable (median |Δ| over r ∈ [1, 20] mean
@@ -129,7 +129,7 @@ fn mc_model_matches_mcml_profiles_within_noise_and_half_a_percent() {
             }
         }
         // MCML's own totals carry noise √(Rd(1 − Rd)/N) and, at high albedo, sit ~1e-3 below
-        // adding-doubling (physics.md §4.3 vs §4.5); the adding-doubling test below is the tight one.
+        // adding-doubling (docs/physics.md §4.3 vs §4.5); the adding-doubling test below is the tight one.
         let se = (c.total * (1.0 - c.total) / PHOTONS).sqrt();
         assert!(
             (m.rd_total() - c.total).abs() <= 4.0 * se + 1.5e-3,
@@ -143,7 +143,7 @@ fn mc_model_matches_mcml_profiles_within_noise_and_half_a_percent() {
     assert!(checked >= 60, "only {checked} windows");
 }
 
-/// Totals against adding-doubling (physics.md §4.3: iadpython, semi-infinite, g = 0; R_d = UR1 −
+/// Totals against adding-doubling (docs/physics.md §4.3: iadpython, semi-infinite, g = 0; R_d = UR1 −
 /// R_sp; quadrature uncertainty ≤ 5e-5), at node η (1.0, 1.4) and between tables (1.5), and the
 /// α′ inversion of those totals.
 #[test]

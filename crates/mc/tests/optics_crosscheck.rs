@@ -1,6 +1,6 @@
 //! Cross-checks with the optics crate (written independently): MCML's rearranged Fresnel formula in
 //! the tracer against `fresnel_dielectric` (Born & Wolf), and the optics dipole against the classical
-//! dipole values of physics.md §1.4 that the far-field test also uses.
+//! dipole values of docs/physics.md §1.4 that the far-field test also uses.
 
 use scatterfit_mc::fresnel_mcml;
 use scatterfit_optics::OpticalProperties;

@@ -4,7 +4,7 @@
 //! through `McProfile`, against direct simulations of the MCML engine (an independent tracer: implicit
 //! capture and roulette instead of the white run's albedo weights) at off-node α′ and on radial grids
 //! whose bins fall between the table's; and its total Rd and α′ inversion against adding-doubling
-//! (physics.md §4.3). Fixed seeds; tolerances in standard errors plus a stated interpolation
+//! (docs/physics.md §4.3). Fixed seeds; tolerances in standard errors plus a stated interpolation
 //! tolerance.
 
 use std::sync::OnceLock;
@@ -17,7 +17,7 @@ use scatterfit_optics::{OpticalProperties, ProfileModel};
 const ETA: f64 = 1.4;
 
 /// Relative standard error of a table lookup: the smoothed model's own noise, 0.1–0.2 % RMS
-/// (BENCHMARKS.md, "mc model noise"); taken at its upper end.
+/// (BENCHMARKS.md, "Model noise"); taken at its upper end.
 const LOOKUP_REL_SE: f64 = 0.002;
 
 /// The shipped η = 1.4 table.
@@ -209,7 +209,7 @@ fn profile_between_radii_matches_direct_simulation() {
 
 /// Total Rd at off-node α′ (0.5, 0.8, 0.9, 0.95, 0.99: each at least a tenth of a node interval
 /// from the nodes) against adding-doubling,
-/// n = 1.4, g = 0 (physics.md §4.3: iadpython Q = 40 UR1 − R_sp, quadrature uncertainty 5e-5),
+/// n = 1.4, g = 0 (docs/physics.md §4.3: iadpython Q = 40 UR1 − R_sp, quadrature uncertainty 5e-5),
 /// within 3 s.e. (the larger s.e. of the two bracketing nodes) + an interpolation tolerance of 5e-4;
 /// and α′ from that Rd (the table's inversion, as `--albedo-model mc` runs it) within the same
 /// tolerance divided by the slope dRd/dα′ (central difference of the table's Rd(α′)).

@@ -1,6 +1,6 @@
 //! Validation of the photon tracer against independent values: van de Hulst / adding-doubling
-//! (physics.md §4.2–4.4), the Chandrasekhar H-function column, the classical dipole far from the
-//! source (physics.md §1), conservation, the similarity law and determinism. Every statistical check
+//! (docs/physics.md §4.2–4.4), the Chandrasekhar H-function column, the classical dipole far from the
+//! source (docs/physics.md §1), conservation, the similarity law and determinism. Every statistical check
 //! states its tolerance in standard errors and uses a fixed seed.
 
 use scatterfit_mc::{
@@ -25,7 +25,7 @@ fn within(x: f64, se: f64, reference: f64, ref_se: f64, k: f64) -> bool {
 }
 
 /// The standard slab (μa = 10/cm, μs = 90/cm, g = 0.75, n = 1, d = 0.02 cm = 0.2 mm): van de Hulst's
-/// Rd = 0.09739, Tt = 0.66096 (physics.md §4.2, quoted and reproduced by iadpython Q = 24), within 3 s.e.
+/// Rd = 0.09739, Tt = 0.66096 (docs/physics.md §4.2, quoted and reproduced by iadpython Q = 24), within 3 s.e.
 #[test]
 fn standard_slab_matches_van_de_hulst() {
     let slab = Sample::slab(Layer::new(1.0, 9.0, 0.75, 1.0, 0.2).unwrap(), 1.0).unwrap();
@@ -49,7 +49,7 @@ fn standard_slab_matches_van_de_hulst() {
     );
 }
 
-/// Semi-infinite half-space, g = 0, normal incidence: Rd (without R_sp) against physics.md §4.3
+/// Semi-infinite half-space, g = 0, normal incidence: Rd (without R_sp) against docs/physics.md §4.3
 /// (n = 1: iadpython Q = 16, equal to the H-function solution to 6 decimals; n = 1.4: iadpython
 /// Q = 40 UR1 − 0.027778, quadrature uncertainty ≈ 5e-5, taken as the reference's s.e.), within 3 s.e.
 #[test]
@@ -85,7 +85,7 @@ fn semi_infinite_totals_match_adding_doubling() {
     }
 }
 
-/// Slabs with index mismatch on both faces (physics.md §4.4, iadpython; UR1 includes R_sp):
+/// Slabs with index mismatch on both faces (docs/physics.md §4.4, iadpython; UR1 includes R_sp):
 /// tissue-like a = 0.990099, τ = 10.1, g = 0.9, n = 1.4: UR1 0.26041, UT1 0.46122 (Q = 32);
 /// thin isotropic a = 0.95, τ = 1, g = 0, n = 1.5: UR1 0.27452, UT1 0.55758 (Q = 32). Reference
 /// s.e. taken as the Q = 16…32 spread (≤ 1.3e-4 and 7e-5). Within 3 s.e.
@@ -264,7 +264,7 @@ fn total_reflectance_independent_of_beam_profile() {
     }
 }
 
-/// Classical dipole, Jensen et al. 2001 eq. (4)–(5) with Fdr of physics.md §1.1 (written here
+/// Classical dipole, Jensen et al. 2001 eq. (4)–(5) with Fdr of docs/physics.md §1.1 (written here
 /// independently of the optics crate).
 fn dipole_rd(r: f64, sigma_a: f64, sigma_s_prime: f64, eta: f64) -> f64 {
     let st = sigma_a + sigma_s_prime;
@@ -281,7 +281,7 @@ fn dipole_rd(r: f64, sigma_a: f64, sigma_s_prime: f64, eta: f64) -> f64 {
 }
 
 /// Far from the source (r ≥ 3/σ′t at α′ = 0.99) the Monte Carlo profile approaches the dipole; near
-/// it (r < 0.1/σ′t) it must not: the dipole has no single-scattering peak. Parameters of physics.md
+/// it (r < 0.1/σ′t) it must not: the dipole has no single-scattering peak. Parameters of docs/physics.md
 /// §1.4 (σa = 0.01, σ′s = 1 mm⁻¹, η = 1.3, g = 0, whose dipole values check `dipole_rd` first).
 /// Tolerances: diffusion theory with the extrapolated boundary is expected to hold to ~10 % in the
 /// far field (Farrell, Patterson & Wilson 1992 report few-percent agreement beyond ~1 mfp), so each

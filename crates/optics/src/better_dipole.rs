@@ -1,9 +1,9 @@
 //! d'Eon 2012, "A better dipole" (Eugene d'Eon, technical report; abstract: "modified diffusion
-//! asymptotics, improved exitance calculations and consistent boundary conditions"), as physics.md §3
-//! writes it. The paper itself was not retrievable; the formulas are physics.md's reconstruction from
+//! asymptotics, improved exitance calculations and consistent boundary conditions"), as docs/physics.md §3
+//! writes it. The paper itself was not retrievable; the formulas are docs/physics.md's reconstruction from
 //! pbrt-v4's `BeamDiffusionMS` integrand (Habel et al. 2013 build on d'Eon's improved diffusion) and a
 //! third-party `BetterDipole` class, so the α′² factor and the exact constants are *unverified against
-//! the paper* (physics.md §3, §10 item 2). The model is pbrt's photon-beam integrand evaluated at the
+//! the paper* (docs/physics.md §3, §10 item 2). The model is pbrt's photon-beam integrand evaluated at the
 //! single depth zr = 1/σ′t with κ = 1.
 //!
 //! Parameters and domains: σ′s > 0, σa ≥ 0 [mm⁻¹], 1 ≤ η ≤ [`crate::fresnel::FRESNEL_MOMENT_MAX_ETA`] (the Fresnel
@@ -23,7 +23,7 @@
 //! ```text
 //! Rd = (α′²/2)·[C_E(e^{−σtr zr} + e^{−σtr|zv|}) + C_φ/D·(e^{−σtr zr} − e^{−σtr|zv|})/σtr]
 //! ```
-//! which is 1 at α′ = 1 for every η (4AC_φ + 2C_E = 2) and matches physics.md §3's numerically
+//! which is 1 at α′ = 1 for every η (4AC_φ + 2C_E = 2) and matches docs/physics.md §3's numerically
 //! integrated column.
 //!
 //! Derivatives in σ′s and σa are analytic: forward-mode duals for the parameter chain and analytic
@@ -37,7 +37,7 @@ use crate::error::Result;
 use crate::family::{ProfileModel, ProfileSample};
 use crate::properties::OpticalProperties;
 
-/// The boundary coefficient A(η) = (1 + 3C₂)/(1 − 2C₁) of d'Eon's boundary condition (physics.md §3;
+/// The boundary coefficient A(η) = (1 + 3C₂)/(1 − 2C₁) of d'Eon's boundary condition (docs/physics.md §3;
 /// 2.949348 at η = 1.4, against the classical dipole's 3.250697).
 ///
 /// # Errors
@@ -190,7 +190,7 @@ mod tests {
         OpticalProperties::new(sigma_s_prime, sigma_a, eta).unwrap()
     }
 
-    /// physics.md §3 profile vector (σa = 0.01, σ′s = 1, η = 1.3) and A(1.4) = 2.949348.
+    /// docs/physics.md §3 profile vector (σa = 0.01, σ′s = 1, η = 1.3) and A(1.4) = 2.949348.
     #[test]
     fn profile_matches_reference_vector() {
         let m = BetterDipole::new(&props(0.01, 1.0, 1.3)).unwrap();
@@ -209,7 +209,7 @@ mod tests {
         assert!((a_coefficient(1.4).unwrap() - 2.949348).abs() < 5e-7);
     }
 
-    /// physics.md §3's numerically integrated totals (σ′t = 1, η = 1.0 and 1.4; computed with the
+    /// docs/physics.md §3's numerically integrated totals (σ′t = 1, η = 1.0 and 1.4; computed with the
     /// raw Fresnel-moment polynomials, as here), against the closed form and against a quadrature of
     /// the profile (log-spaced trapezoid), which checks the closed form's derivation.
     #[test]

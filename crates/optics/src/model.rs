@@ -24,9 +24,9 @@ pub enum DiffusionModel {
     /// Classical dipole, Jensen et al. 2001 (the paper's model): `dipole`. Depends on σ′s only
     /// (g is ignored).
     Dipole,
-    /// d'Eon 2012 "A better dipole" (physics.md §3): `better-dipole`. Depends on σ′s only.
+    /// d'Eon 2012 "A better dipole" (docs/physics.md §3): `better-dipole`. Depends on σ′s only.
     BetterDipole,
-    /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (physics.md §2): `pbd`.
+    /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (docs/physics.md §2): `pbd`.
     /// Its single scattering uses σs = σ′s/(1 − g).
     Pbd,
 }

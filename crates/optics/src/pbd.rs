@@ -1,6 +1,6 @@
 //! Photon beam diffusion (Habel, Christensen & Jarosz 2013, "Photon Beam Diffusion: A Hybrid Monte
 //! Carlo Method for Subsurface Scattering", EGSR) exactly as pbrt-v4 evaluates it
-//! (`src/pbrt/bssrdf.cpp`: `BeamDiffusionMS` + `BeamDiffusionSS`; physics.md §2.1), in millimetres.
+//! (`src/pbrt/bssrdf.cpp`: `BeamDiffusionMS` + `BeamDiffusionSS`; docs/physics.md §2.1), in millimetres.
 //!
 //! Parameters and domains: σ′s > 0, σa ≥ 0 [mm⁻¹], 1 ≤ η ≤ [`FRESNEL_MOMENT_MAX_ETA`], Henyey–Greenstein
 //! g ∈ (−1, 1), 0 by default (then σs = σ′s; otherwise σs = σ′s/(1 − g)). pbrt tabulates this at
@@ -31,7 +31,7 @@
 //! dipole's, [`crate::better_dipole`]), the κ correction (which decays like e^{−2σ′t r}) and the single
 //! scattering (like e^{−σt r}) by 8-point Gauss–Legendre on 16 doubling panels from 2⁻¹⁰ to 32 mean
 //! free paths. PBD is not exactly energy conserving: at α′ = 1, η = 1.33 the total is 1.0326
-//! (pbrt's tabulated ρ_eff, which stops at 202.85 mean free paths, gives 1.0193; physics.md §2.4).
+//! (pbrt's tabulated ρ_eff, which stops at 202.85 mean free paths, gives 1.0193; docs/physics.md §2.4).
 //!
 //! Derivatives in σ′s and σa: forward-mode duals through every parameter-dependent quantity (depth
 //! samples included) and analytic partials of each depth's source-pair term
@@ -366,7 +366,7 @@ mod tests {
         OpticalProperties::new(sigma_s_prime, sigma_a, eta).unwrap()
     }
 
-    /// physics.md §2.1 test vectors (σs = 0.9, σa = 0.1, g = 0, η = 1.33; float64 port of pbrt).
+    /// docs/physics.md §2.1 test vectors (σs = 0.9, σa = 0.1, g = 0, η = 1.33; float64 port of pbrt).
     #[test]
     fn ms_and_ss_match_reference_vectors() {
         let m = Pbd::new(&props(0.1, 0.9, 1.33)).unwrap();
@@ -408,7 +408,7 @@ mod tests {
         }
     }
 
-    /// pbrt's σt = 1 table geometry (physics.md §2.2): radii r₀ = 0, r₁ = 2.5e-3, rᵢ = 1.2 rᵢ₋₁
+    /// pbrt's σt = 1 table geometry (docs/physics.md §2.2): radii r₀ = 0, r₁ = 2.5e-3, rᵢ = 1.2 rᵢ₋₁
     /// (64), integrated by pbrt's `IntegrateCatmullRom` (re-implemented here from its description:
     /// Hermite segments with finite-difference slopes, one-sided at the ends).
     fn pbrt_rho_eff(albedo: f64, eta: f64) -> f64 {
@@ -443,7 +443,7 @@ mod tests {
         (1.0 - (-8.0 * i as f64 / 99.0).exp()) / (1.0 - (-8.0f64).exp())
     }
 
-    /// physics.md §2.4's ρ_eff table (η = 1.33, g = 0): pbrt's Catmull-Rom integral over its own
+    /// docs/physics.md §2.4's ρ_eff table (η = 1.33, g = 0): pbrt's Catmull-Rom integral over its own
     /// radius grid reproduced to its 6 printed digits; and our exact total ∫₀^∞ 2πr Rd dr against
     /// scipy `quad` of the same integrand (split at 0.00125·2ᵏ out to 1.7e5 mean free paths,
     /// epsabs 1e-13; a Python port of pbrt's functions, not this code; at ρ = 1, where Rd ∝ r⁻³ far
@@ -475,7 +475,7 @@ mod tests {
         }
     }
 
-    /// physics.md §2.4's inversion vectors (pbrt's `InvertCatmullRom` on its ρ_eff table) are for
+    /// docs/physics.md §2.4's inversion vectors (pbrt's `InvertCatmullRom` on its ρ_eff table) are for
     /// pbrt's truncated integral; our inversion uses the exact total, so we check the round trip
     /// and that pbrt's inverted ρ reproduces its Kd through pbrt's integral.
     #[test]

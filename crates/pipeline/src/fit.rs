@@ -332,6 +332,7 @@ pub fn channel_result(
             rings_below_detection: 0,
             rings_invalid: 0,
             problem: Some(problem.clone()),
+            quality: None,
         },
         ChannelOutcome::Fitted(f) => {
             let r = &f.report;
@@ -388,6 +389,7 @@ pub fn channel_result(
                 rings_below_detection: r.rings_below_detection,
                 rings_invalid: r.rings_invalid,
                 problem,
+                quality: None,
             }
         }
     }

@@ -82,6 +82,13 @@ pub struct Corrections {
     pub exposure_applied: bool,
     /// The flat frame divided out, with its smoothed fall-off (min and max of the divisor).
     pub flat: Option<(PathBuf, f64, f64)>,
+    /// The codes 16-bit frames use and the saturation found ([`crate::checks::code_range`]; not
+    /// written: the quality verdict reports what matters).
+    #[serde(skip)]
+    pub codes: Option<crate::checks::CodeRange>,
+    /// The spot's centroid per frame ([`crate::checks::registration`]; not written).
+    #[serde(skip)]
+    pub registration: Option<crate::checks::Registration>,
 }
 
 /// The 8-bit code at which a pixel counts as detected in the longest exposure. Below it the tone
@@ -390,6 +397,13 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             .collect();
         scatterfit_imaging::check_bracket_order(&bufs, &times, u8::MAX)
             .map_err(imaging(&order_context()))?;
+        corrections.registration = Some(crate::checks::registration(
+            bufs.len(),
+            bufs[0].width(),
+            bufs[0].height(),
+            bufs[0].channels(),
+            &|j, i| f64::from(bufs[j].data()[i]) / 255.0,
+        ));
         let samples = inputs
             .samples
             .unwrap_or_else(|| default_response_samples(bufs.len()));
@@ -530,8 +544,21 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             Some(r) => (r.levels.white.min(f64::from(u16::MAX)) as u16).max(2),
             None => inputs.saturation,
         };
+        // The codes the frames use (8- or 12-bit data in 16-bit files; crate::checks).
+        let code_range = raw
+            .is_none()
+            .then(|| crate::checks::code_range(&bufs, saturation))
+            .transpose()?;
+        let saturation = code_range.as_ref().map_or(saturation, |c| c.saturation);
         scatterfit_imaging::check_bracket_order(&bufs, &times, saturation)
             .map_err(imaging(&order_context()))?;
+        corrections.registration = Some(crate::checks::registration(
+            bufs.len(),
+            bufs[0].width(),
+            bufs[0].height(),
+            bufs[0].channels(),
+            &|j, i| f64::from(bufs[j].data()[i]) / f64::from(saturation),
+        ));
         let dark = dark.and_then(|d| match d {
             CameraFrame::U16(b) => Some(b),
             CameraFrame::U8(_) => None,
@@ -622,6 +649,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             corrections.flat = Some(divide_flat(&mut hdr, path, f.width(), f.height(), ch, lin)?);
         }
         corrections.black_level = black;
+        corrections.codes = code_range;
         let t_max = times_used.iter().copied().fold(0.0f64, f64::max);
         let detection_limit = vec![DETECTION_DN_16BIT / t_max; hdr.radiance.channels()];
         HdrStage {

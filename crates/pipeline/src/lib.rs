@@ -6,7 +6,9 @@
 //!    (in two halves, [`hdr::read_frames`] and [`hdr::merge_frames`], for a caller that reports
 //!    between them);
 //! 3. [`profile::profile_stage`] — spot centre and radial profile Rd(r);
-//! 4. [`fit::fit_stage`] — σ′s and σa per channel, and [`fit::propagate_spectro`], the
+//! 4. [`port::correct_port`] — the spectrophotometer port's edge loss, when the manifest gives the
+//!    port (`spectro.aperture_mm`): Rd and α′ corrected from the fitted profile;
+//! 5. [`fit::fit_stage`] — σ′s and σa per channel, and [`fit::propagate_spectro`], the
 //!    spectrophotometer's part of their uncertainty.
 //!
 //! [`measure_sample`] runs them on a sample folder (its `sample.toml`) and returns a
@@ -32,21 +34,25 @@
 //! # Ok::<(), scatterfit_pipeline::PipelineError>(())
 //! ```
 //! `crates/pipeline/examples/` has the whole of it: `measure_folder.rs` (one folder) and
-//! `batch_report.rs` (many folders, with the report files).
+//! `batch_report.rs` (many folders, with the report files). [`study`] is the bias study's measuring
+//! and tabulating over a grid of rig-twin samples.
 
 #![forbid(unsafe_code)]
 
 pub mod batch;
 pub mod camera;
+pub mod checks;
 pub mod compare;
 mod error;
 pub mod fit;
 pub mod hdr;
 pub mod measure;
+pub mod port;
 pub mod profile;
 pub mod profile_fit;
 pub mod samples;
 pub mod spectro;
+pub mod study;
 
 pub use batch::{
     BatchError, BatchEvent, BatchOutcome, BatchRequest, BatchSample, JobPlan, SampleOutcome,

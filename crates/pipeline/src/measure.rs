@@ -137,6 +137,10 @@ pub struct Measurement {
     /// Per channel: σ′s, σa and α′ with their uncertainty terms, the solver's report, or why the
     /// channel was not fitted.
     pub fits: Rgb<ChannelOutcome>,
+    /// The port's edge-loss correction (`spectro.aperture_mm` given; `spectro` is then the
+    /// corrected stage and the correction keeps the reading), or `None`: the reading was taken as
+    /// loss-free.
+    pub port: Option<crate::port::PortCorrection>,
     /// Wall times per stage \[s\].
     pub timings: Timings,
 }
@@ -314,6 +318,17 @@ fn measure_from(
     let data = profile.rgb_data()?;
     progress(Stage::Fit);
     let t_fit = Instant::now();
+    let port = crate::port::port_of(
+        manifest.spectro.aperture_mm,
+        manifest.spectro.illuminated_mm,
+    )?;
+    let (spectro, port) = match port {
+        Some(p) => {
+            let (s, c) = crate::port::correct_port(&data, &spectro, &settings, model, albedo, p);
+            (s, Some(c))
+        }
+        None => (spectro, None),
+    };
     let fits = fit_and_propagate(&data, &spectro, &settings, model);
     let fit_s = t_fit.elapsed().as_secs_f64();
     let timings = Timings {
@@ -331,6 +346,7 @@ fn measure_from(
         hdr,
         profile,
         fits,
+        port,
         timings,
     })
 }
@@ -374,9 +390,22 @@ impl Measurement {
     fn refit_inner(&self, settings: FitSettings, propagate: bool) -> Result<Measurement> {
         let model = family(settings.model)?;
         let albedo = albedo_family(settings.albedo_model, settings.model)?;
-        let spectro = self.spectro.with_albedo_model(albedo);
         let t = Instant::now();
         let data = self.profile.rgb_data()?;
+        // The port correction depends on the model: start again from the reading.
+        let (spectro, port) = match &self.port {
+            Some(p) => {
+                let port = scatterfit_optics::port::Port::new(p.illuminated_mm, p.aperture_mm)
+                    .map_err(|e| {
+                        PipelineError::Input(format!("the spectrophotometer port: {e}"))
+                    })?;
+                let read = p.read.with_albedo_model(albedo);
+                let (s, c) =
+                    crate::port::correct_port(&data, &read, &settings, model, albedo, port);
+                (s, Some(c))
+            }
+            None => (self.spectro.with_albedo_model(albedo), None),
+        };
         let fits = if propagate {
             fit_and_propagate(&data, &spectro, &settings, model)
         } else {
@@ -391,6 +420,7 @@ impl Measurement {
             hdr: self.hdr.clone(),
             profile: self.profile.clone(),
             fits,
+            port,
             timings,
         })
     }
@@ -403,6 +433,11 @@ impl Measurement {
     /// η with the spectrophotometer's standard error (none when η was given).
     pub fn eta(&self) -> Estimate {
         self.spectro.eta_estimate()
+    }
+
+    /// The data checks' verdict per channel ([`crate::checks`]).
+    pub fn quality(&self) -> Rgb<crate::checks::Quality> {
+        crate::checks::quality(self)
     }
 
     /// The result file's content. `profile_file` is the profile CSV's name as written beside the
@@ -431,10 +466,12 @@ impl Measurement {
                 file_ref(&rel)
             })
             .collect();
-        let channels = self
-            .fits
-            .as_ref()
-            .map_with_channel(|c, outcome| channel_result(outcome, &self.spectro, c));
+        let quality = crate::checks::quality(self);
+        let channels = self.fits.as_ref().map_with_channel(|c, outcome| {
+            let mut r = channel_result(outcome, &self.spectro, c);
+            r.quality = Some(quality[c].clone());
+            r
+        });
         let s = &self.settings;
         MeasurementResult {
             name: m.display_name(),
@@ -481,6 +518,16 @@ impl Measurement {
             },
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()),
+            spectro_port: self
+                .port
+                .as_ref()
+                .map(|p| scatterfit_io::result_json::PortResult {
+                    aperture_mm: p.aperture_mm,
+                    illuminated_mm: p.illuminated_mm,
+                    rd_read: p.read.rd,
+                    reading_fraction: p.reading_fraction,
+                    problems: p.problems.clone(),
+                }),
         }
     }
 }

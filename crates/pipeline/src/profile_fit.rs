@@ -101,10 +101,14 @@ impl ProfileFit {
             method: s.method,
             model: s.model,
             albedo_model: Some(AlbedoSource::Given),
-            channels: self
-                .fits
-                .as_ref()
-                .map_with_channel(|c, outcome| channel_result(outcome, &self.spectro, c)),
+            channels: self.fits.as_ref().map_with_channel(|c, outcome| {
+                // The fit's own checks (no image here: the residuals and the ranges).
+                let mut r = channel_result(outcome, &self.spectro, c);
+                r.quality = Some(crate::checks::Quality::from_reasons(
+                    crate::checks::fit_reasons(outcome, self.request.eta),
+                ));
+                r
+            }),
             inputs: Inputs {
                 profile: self.request.profile_file.clone(),
                 spot_radius_mm: Some(s.spot_radius_mm),
@@ -119,6 +123,7 @@ impl ProfileFit {
             },
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: None,
+            spectro_port: None,
         }
     }
 }

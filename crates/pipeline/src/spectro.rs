@@ -112,11 +112,18 @@ impl SpectroStage {
 
     /// The same reading with α′ from another model's total Rd(α′, η).
     pub fn with_albedo_model(&self, albedo: &dyn ModelFamily) -> SpectroStage {
+        self.with_rd(self.rd, albedo)
+    }
+
+    /// The same reading with Rd replaced per channel (the port correction, `crate::port`): α′ and
+    /// the uncertainty's perturbed readings follow from the new Rd (the reading's relative error ε
+    /// applies to it unchanged, the correction being a factor).
+    pub fn with_rd(&self, rd: Rgb<f64>, albedo: &dyn ModelFamily) -> SpectroStage {
         from_rd(
             Reading {
                 file: self.file.clone(),
                 analysis: self.analysis.clone(),
-                rd: self.rd,
+                rd,
                 eta: self.eta,
                 eta_source: self.eta_source,
                 warnings: self.warnings.clone(),

@@ -14,9 +14,13 @@
 //! - **Radiance** in relative units: an irradiance of 1 on a white Lambertian surface facing the
 //!   light gives 1/π. Linear sRGB, D65; [`tonemap`] makes an 8-bit sRGB picture of it.
 //!
-//! Units: mm and mm⁻¹. Geometry and physics in f64, pixels in f32. No file IO here: meshes come in
-//! as vertex and index arrays (`scatterfit_io::mesh` reads OBJ and PLY), images go out as
-//! [`scatterfit_imaging::ImageBuf`]. Parallel over image rows with rayon; every random stream is
+//! Units: mm and mm⁻¹. Geometry and physics in f64, pixels in f32. The renderer does no file IO:
+//! meshes come in as vertex and index arrays, images go out as [`scatterfit_imaging::ImageBuf`].
+//! The request layer above it does, through `scatterfit_io`: [`params`] (parameters from a
+//! result.json or a published set, the material through `scatterfit_mc::family`), [`measured`]
+//! (the measured profile a validation compares with), [`setup`] (a mesh file or built-in shape,
+//! the lights) and [`request`] (`scatterfit render`'s figure and validation as typed requests, the
+//! files they write). Parallel over image rows with rayon; every random stream is
 //! keyed by (seed, pixel or sample row), so a render is identical for a seed on any thread count.
 
 #![forbid(unsafe_code)]
@@ -25,19 +29,26 @@ pub mod bvh;
 pub mod colour;
 pub mod error;
 pub mod figure;
+pub mod measured;
 pub mod mesh;
+pub mod params;
 pub mod profile;
 pub mod render;
+pub mod request;
 mod rng;
 pub mod scene;
 pub mod scenes;
+pub mod setup;
 pub mod texture_space;
 pub mod tonemap;
 pub mod validation;
 
 pub use error::{RenderError, Result};
 pub use mesh::Mesh;
+pub use params::ParameterSet;
 pub use profile::{Material, RdTable};
 pub use render::{Method, RenderOptions, RenderStats, Rendered, Timings, render};
+pub use request::{FigureRequest, Methods, ProfileRequest, RenderEvent, Summary};
 pub use scene::{Camera, Light, Projection, Scene};
 pub use scenes::{Shape, studio, studio_lights};
+pub use setup::{LightRig, MeshSource, StudioScene};

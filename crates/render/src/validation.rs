@@ -19,6 +19,8 @@ use crate::profile::Material;
 use crate::render::{Method, RenderOptions, Rendered, render};
 use crate::scene::{Camera, Light, Projection, Scene};
 use crate::texture_space::DipoleParams;
+use crate::tonemap::{ToneMap, luminance_weights};
+use scatterfit_optics::{Channel, Rgb};
 
 /// The measurement geometry to reproduce.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -141,9 +143,7 @@ pub fn render_spot_profile(
         setup.mm_per_pixel,
         &ProfileOptions::new(1.0, setup.r_max_mm / setup.mm_per_pixel)?,
     )?;
-    let ft = 1.0 - fresnel_dielectric(1.0, material.eta());
-    let norm =
-        std::f64::consts::PI / (ft * ft * std::f64::consts::PI * setup.spot_radius_mm.powi(2));
+    let norm = rd_per_radiance(material.eta(), setup.spot_radius_mm);
     let r_mm = (0..profile.rings.len())
         .map(|k| profile.r_mm(k).unwrap_or(f64::NAN))
         .collect();
@@ -157,6 +157,169 @@ pub fn render_spot_profile(
     let rd = [0, 1, 2].map(|c| column(c, |s| s.mean));
     let stderr = [0, 1, 2].map(|c| column(c, |s| s.std_err));
     Ok((rendered, RenderedProfile { r_mm, rd, stderr }))
+}
+
+/// Rd_render per unit of rendered radiance: π / (Ft(η, 0°)² · E · π a²) with E = 1 (see the module
+/// docs) [mm⁻² per radiance unit].
+pub fn rd_per_radiance(eta: f64, spot_radius_mm: f64) -> f64 {
+    let ft = 1.0 - fresnel_dielectric(1.0, eta);
+    std::f64::consts::PI / (ft * ft * std::f64::consts::PI * spot_radius_mm.powi(2))
+}
+
+/// A measured profile to validate against (read by [`crate::measured`]): the rings and their
+/// values, the fitted scale k per channel that puts them in mm⁻², and the measurement's geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredProfile {
+    /// The profile's file (for messages).
+    pub file: std::path::PathBuf,
+    /// Ring radius [mm].
+    pub r_mm: Vec<f64>,
+    /// Measured value per channel and ring (the profile's units: k × mm⁻²).
+    pub values: Rgb<Vec<f64>>,
+    /// The fitted scale k per channel (finite, > 0).
+    pub scales: Rgb<f64>,
+    /// The fit's own MSE per channel, for reference [mm⁻⁴].
+    pub fit_mse: Rgb<Option<f64>>,
+    /// Image scale [mm per pixel].
+    pub mm_per_pixel: f64,
+    /// Light-spot radius [mm].
+    pub spot_radius_mm: f64,
+}
+
+impl MeasuredProfile {
+    /// The largest finite ring radius [mm].
+    pub fn r_max_mm(&self) -> f64 {
+        self.r_mm
+            .iter()
+            .copied()
+            .filter(|r| r.is_finite())
+            .fold(0.0, f64::max)
+    }
+
+    /// The geometry to render: the measurement's scale and spot, one pixel beyond the last ring.
+    pub fn setup(&self) -> SpotSetup {
+        SpotSetup {
+            mm_per_pixel: self.mm_per_pixel,
+            r_max_mm: self.r_max_mm() + self.mm_per_pixel,
+            spot_radius_mm: self.spot_radius_mm,
+        }
+    }
+}
+
+/// A validation against a measured profile (§4.4, Table 2): the slab render, its profile and the
+/// comparison per channel.
+#[derive(Debug, Clone)]
+pub struct ProfileValidation {
+    /// The slab render.
+    pub rendered: Rendered,
+    /// Its radial profile [mm⁻²].
+    pub profile: RenderedProfile,
+    /// The geometry rendered.
+    pub setup: SpotSetup,
+    /// Table 2's quantities per channel.
+    pub channels: Rgb<ProfileComparison>,
+    /// Rd_render per unit of rendered radiance ([`rd_per_radiance`] of the material's η and the
+    /// spot).
+    pub rd_per_radiance: f64,
+    /// Wall time of the render and its profile [s].
+    pub render_s: f64,
+}
+
+/// Renders the measurement's slab and spot with `material` (one sample per pixel) and compares the
+/// profile with `measured`/k at every measured ring outside the spot (Table 2's MSE, §4.4).
+/// `progress` is called with rows finished.
+///
+/// # Errors
+/// As [`SpotSetup::validate`] (named as the measurement geometry) and [`render_spot_profile`];
+/// [`crate::RenderError::Measurement`] when a channel has no ring to compare outside the spot.
+pub fn validate_profile(
+    material: &Material,
+    measured: &MeasuredProfile,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<ProfileValidation> {
+    let setup = measured.setup();
+    setup
+        .validate()
+        .map_err(|e| crate::RenderError::Geometry(Box::new(e)))?;
+    let t0 = std::time::Instant::now();
+    let opts = RenderOptions { spp: 1, ..*opts };
+    let (rendered, profile) = render_spot_profile(material, &setup, &opts, progress)?;
+    let rd_per_radiance = rd_per_radiance(material.eta(), measured.spot_radius_mm);
+    let render_s = t0.elapsed().as_secs_f64();
+    let spot = measured.spot_radius_mm;
+    let channels = Rgb::from_array([0, 1, 2].map(|c| {
+        compare_profiles(
+            &profile.r_mm,
+            &profile.rd[c],
+            &measured.r_mm,
+            &measured.values[Channel::ALL[c]],
+            measured.scales[Channel::ALL[c]],
+            spot,
+        )
+        .ok_or_else(|| crate::RenderError::Measurement {
+            file: measured.file.clone(),
+            detail: format!(
+                "no ring outside the spot ({spot} mm) with a positive value in channel {}",
+                Channel::ALL[c].key()
+            ),
+        })
+    }))
+    .transpose()?;
+    Ok(ProfileValidation {
+        rendered,
+        profile,
+        setup,
+        channels,
+        rd_per_radiance,
+        render_s,
+    })
+}
+
+impl ProfileValidation {
+    /// The comparison at the measured rings as CSV: `r_mm`, the render interpolated there and
+    /// measured/k per channel (empty cells where either is missing).
+    pub fn comparison_csv(&self, measured: &MeasuredProfile) -> String {
+        let mut text = String::from(
+            "r_mm,rendered_r,rendered_g,rendered_b,measured_over_k_r,measured_over_k_g,\
+             measured_over_k_b\n",
+        );
+        let cell = |v: Option<f64>| {
+            v.filter(|v| v.is_finite())
+                .map_or(String::new(), |v| v.to_string())
+        };
+        for (k, &r) in measured.r_mm.iter().enumerate() {
+            let rendered =
+                [0, 1, 2].map(|c| cell(interpolate(&self.profile.r_mm, &self.profile.rd[c], r)));
+            let over_k = Channel::ALL
+                .map(|c| cell(measured.values[c].get(k).map(|v| v / measured.scales[c])));
+            text.push_str(&format!(
+                "{r},{},{},{},{},{},{}\n",
+                rendered[0], rendered[1], rendered[2], over_k[0], over_k[1], over_k[2]
+            ));
+        }
+        text
+    }
+
+    /// `tone` exposed so that the glow at twice the spot radius shows as white (the slab picture's
+    /// default exposure), clamped to ±60 EV; EV 0 where the render is black there.
+    pub fn glow_exposure(&self, tone: &ToneMap) -> ToneMap {
+        let w = luminance_weights();
+        let norm = self.rd_per_radiance;
+        let k = ((2.0 * self.setup.spot_radius_mm / self.setup.mm_per_pixel) as usize)
+            .min(self.profile.r_mm.len() - 1);
+        let y: f64 = (0..3).map(|c| w[c] * self.profile.rd[c][k]).sum::<f64>() / norm;
+        ToneMap {
+            exposure_ev: if y > 0.0 {
+                (tone.white / (std::f64::consts::PI * y))
+                    .log2()
+                    .clamp(-60.0, 60.0)
+            } else {
+                0.0
+            },
+            ..*tone
+        }
+    }
 }
 
 /// Table 2's quantity for one channel.

@@ -40,8 +40,9 @@ pub mod error;
 pub mod figures;
 pub mod measurement;
 pub mod plot;
+pub mod study;
 
 pub use error::{ReportError, Result};
 pub use figures::{compare_figure, fit_figure};
-pub use measurement::{WrittenReport, summary_text, write_measurement};
+pub use measurement::{WrittenReport, quality_line, summary_text, write_measurement};
 pub use plot::{Figure, Panel, Series, SeriesStyle, render_png, render_svg, write_figure};

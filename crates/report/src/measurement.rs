@@ -6,7 +6,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use scatterfit_io::result_json::{MeasurementResult, write_result_json};
-use scatterfit_io::result_table::{errors_note, sig4, sigma_cells, table1_csv, table1_markdown};
+use scatterfit_io::result_table::{
+    errors_note, port_note, sig4, sigma_cells, table1_csv, table1_markdown,
+};
 use scatterfit_pipeline::Measurement;
 
 use crate::error::{ReportError, Result};
@@ -79,8 +81,24 @@ pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
     })
 }
 
+/// `quality: R ok · G suspect · B ok` (the data checks' verdict per channel), `None` for a result
+/// without verdicts (written before the checks, or by a command that makes none).
+pub fn quality_line(r: &MeasurementResult) -> Option<String> {
+    let cells: Vec<String> = r
+        .channels
+        .iter_channels()
+        .filter_map(|(ch, c)| {
+            c.quality
+                .as_ref()
+                .map(|q| format!("{} {}", ch.name(), q.verdict))
+        })
+        .collect();
+    (!cells.is_empty()).then(|| format!("quality: {}", cells.join(" · ")))
+}
+
 /// A human summary of one result, as `scatterfit measure` prints it: η and, per channel,
-/// σ′s ± error, σa ± error, α′, MSE, fit time and rings used.
+/// σ′s ± error, σa ± error, α′, MSE, fit time and rings used, the data checks' findings and
+/// their verdict per channel ([`quality_line`]).
 pub fn summary_text(r: &MeasurementResult) -> String {
     let mut t = String::new();
     let eta = match r.eta_stderr {
@@ -114,10 +132,24 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         if let Some(p) = &c.problem {
             let _ = writeln!(t, "      note: {}", scatterfit_io::escape::one_line(p));
         }
+        for reason in c.quality.iter().flat_map(|q| &q.reasons) {
+            let _ = writeln!(
+                t,
+                "      {}: {}",
+                reason.severity,
+                scatterfit_io::escape::one_line(&reason.message)
+            );
+        }
+    }
+    if let Some(line) = quality_line(r) {
+        let _ = writeln!(t, "  {line}");
     }
     let errors = errors_note(std::slice::from_ref(r));
     if !errors.is_empty() {
         let _ = write!(t, "  {errors}");
+    }
+    if r.spectro_port.is_some() {
+        let _ = write!(t, "  {}", port_note(std::slice::from_ref(r)));
     }
     t
 }

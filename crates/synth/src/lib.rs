@@ -9,6 +9,7 @@
 #![forbid(unsafe_code)]
 
 pub mod materials;
+pub mod mishaps;
 pub mod rig;
 pub mod spectro;
 

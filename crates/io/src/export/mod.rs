@@ -351,14 +351,9 @@ pub struct Provenance {
     pub measured_with: String,
 }
 
-/// The measured diffuse reflectance spectrum (the spectrophotometer's SCE) carried into an export.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ReflectanceSpectrum {
-    /// Wavelengths [nm], increasing.
-    pub wavelength_nm: Vec<f64>,
-    /// Rd at each wavelength (fraction).
-    pub rd: Vec<f64>,
-}
+/// The measured diffuse reflectance spectrum (the spectrophotometer's SCE) carried into an export:
+/// the result file's own type.
+pub use crate::result_json::RdSpectrum as ReflectanceSpectrum;
 
 /// The renderer-neutral export ([`Format::Json`]): every quantity a renderer may want, per channel, in
 /// the scene's unit.
@@ -444,10 +439,7 @@ fn checked_spectrum(
         last = wl;
         in_range(format!("rd_spectrum.rd[{k}]"), rd, (0.0, 1.0), "")?;
     }
-    Ok(Some(ReflectanceSpectrum {
-        wavelength_nm: s.wavelength_nm.clone(),
-        rd: s.rd.clone(),
-    }))
+    Ok(Some(s.clone()))
 }
 
 impl RendererParameters {
@@ -1301,6 +1293,7 @@ mod fixtures {
             rings_below_detection: 40,
             rings_invalid: 0,
             problem: None,
+            quality: None,
         }
     }
 
@@ -1324,6 +1317,7 @@ mod fixtures {
             inputs: Inputs::default(),
             version: "0.1.0".into(),
             rd_spectrum: None,
+            spectro_port: None,
         }
     }
 

@@ -1,0 +1,140 @@
+//! A channel's quality verdict in `result.json`: what the data checks a careful experimentalist
+//! makes found (RELIABILITY.md, "Numbers that look right and are not"). `status` says whether the
+//! fit gave parameters; `quality` says whether the data and the fit can be trusted to give them.
+//!
+//! ```json
+//! "quality": { "verdict": "suspect",
+//!              "reasons": [ { "kind": "poor_fit", "severity": "suspect",
+//!                             "message": "rms log residual 0.95 > 0.40: …" } ] }
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+/// The verdict on a channel, worst first in severity: `ok` < `suspect` < `failed`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Every check passed: the values are measurements.
+    #[default]
+    Ok,
+    /// Values were found, but a check says a lab must look before trusting them (exit 1).
+    Suspect,
+    /// No value to trust (the fit failed, or a check found the data unusable).
+    Failed,
+}
+
+impl Verdict {
+    /// `ok`, `suspect`, `failed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Suspect => "suspect",
+            Verdict::Failed => "failed",
+        }
+    }
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Which check found a problem.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum ReasonKind {
+    /// The fit's residuals are beyond what the noise and the model's known error explain.
+    PoorFit,
+    /// The spot is near the frame's edge: rings the fit used are cut by the frame asymmetrically.
+    IncompleteRings,
+    /// The spot centre (given) is away from the spot found in the image.
+    CenterOffSpot,
+    /// The spot's size in the image disagrees with `spot_diameter_mm / mm_per_pixel`.
+    SpotSize,
+    /// More than one spot in the frame.
+    SecondSpot,
+    /// The frames' codes do not use the range their bit depth claims (8-in-16, 12-in-16).
+    BitDepth,
+    /// The frames are not registered (the camera moved during the bracket).
+    Misregistered,
+    /// Consecutive exposures too far apart for the frames' codes to overlap (a gap in the
+    /// bracket: some radiances are well exposed in no frame).
+    BracketGap,
+    /// A value outside its documented range.
+    OutOfRange,
+    /// The fit gave no parameters or did not converge.
+    FitFailed,
+    /// The data do not constrain a parameter.
+    Unconstrained,
+}
+
+/// One finding of a check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Reason {
+    /// The check.
+    pub kind: ReasonKind,
+    /// How bad it is.
+    pub severity: Verdict,
+    /// What was found, with the numbers, and what to do.
+    pub message: String,
+}
+
+/// A channel's verdict and the reasons for it (none when `ok`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Quality {
+    /// The worst severity among the reasons (`ok` without one).
+    pub verdict: Verdict,
+    /// What the checks found.
+    #[serde(default)]
+    pub reasons: Vec<Reason>,
+}
+
+impl Quality {
+    /// A verdict from its reasons: the worst severity among them.
+    pub fn from_reasons(reasons: Vec<Reason>) -> Self {
+        let verdict = reasons
+            .iter()
+            .map(|r| r.severity)
+            .max()
+            .unwrap_or(Verdict::Ok);
+        Self { verdict, reasons }
+    }
+
+    /// The reasons' messages, `; `-joined (empty when ok).
+    pub fn summary(&self) -> String {
+        self.reasons
+            .iter()
+            .map(|r| r.message.as_str())
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_verdict_is_the_worst_reason_and_round_trips() {
+        let q = Quality::from_reasons(vec![
+            Reason {
+                kind: ReasonKind::SpotSize,
+                severity: Verdict::Suspect,
+                message: "a".into(),
+            },
+            Reason {
+                kind: ReasonKind::FitFailed,
+                severity: Verdict::Failed,
+                message: "b".into(),
+            },
+        ]);
+        assert_eq!(q.verdict, Verdict::Failed);
+        assert_eq!(q.summary(), "a; b");
+        let s = serde_json::to_string(&q).unwrap();
+        assert!(s.contains(r#""kind":"spot_size""#), "{s}");
+        assert_eq!(serde_json::from_str::<Quality>(&s).unwrap(), q);
+        assert_eq!(Quality::default().verdict, Verdict::Ok);
+    }
+}

@@ -1,0 +1,639 @@
+//! The data checks a careful experimentalist makes before calling a value a measurement
+//! (issue 17 §2, RELIABILITY.md "Numbers that look right and are not"), and the per-channel
+//! [`Quality`] verdict they give.
+//!
+//! Each check is a function of what the stages produced (the radiance map, the profile, the fits,
+//! the manifest); none changes a number. A finding is a [`Reason`] with a typed kind, a severity
+//! and a message with the numbers and what to do; the verdict of a channel is the worst severity
+//! among its reasons ([`Quality::from_reasons`]). `status` in `result.json` is unchanged (did the
+//! fit give parameters); `quality` says whether they can be trusted.
+//!
+//! The thresholds are set against the demo (the paper rig's twins of the seven materials, dipole
+//! fits: rms log residual ≤ 0.24, spot-size ratio 1.02–1.04, frame shifts ≤ 0.18 px; every channel
+//! `ok`) and the quick twins the tests use, with the bad cases of `scatterfit_synth::mishaps` on the
+//! other side (`tests/checks.rs`).
+
+use scatterfit_fit::FitReport;
+use scatterfit_imaging::{CenterOptions, find_spot_center};
+pub use scatterfit_io::quality::{Quality, Reason, ReasonKind, Verdict};
+use scatterfit_io::result_json::ResponseKind;
+use scatterfit_optics::Rgb;
+
+use crate::fit::ChannelOutcome;
+use crate::measure::Measurement;
+
+/// A fit whose rms log residual exceeds this is suspect: the profile differs from the model by
+/// more than e^0.4 − 1 ≈ 50 % on average. The model's own error on the demo's twins (dipole on
+/// Monte Carlo data) reaches 0.24 (blue-coating, B); the noise of a quick twin's rings 0.13. χ² is
+/// reported but not judged: with the diffusion models its model-error part dominates (26–2300 on
+/// the demo), so no noise-based threshold separates a good sample from a bad one.
+pub const MAX_RMS_LOG_RESIDUAL: f64 = 0.4;
+
+/// The spot's half width at half maximum in the image, over the light spot's radius
+/// (`spot_diameter_mm / 2 / mm_per_pixel`), outside this range makes every channel suspect: the
+/// scale or the spot's diameter is wrong (a 10× typo gives 0.1 or 10). Good samples give 1.02–1.04
+/// (demo) and 1.02–1.19 (quick twins; the blur of subsurface scattering widens the spot, never shrinks it much).
+pub const SPOT_SIZE_RATIO: (f64, f64) = (0.6, 2.5);
+
+/// A pixel at least this many times its ring's median and [`SECOND_SPOT_Z`] robust standard
+/// deviations above it, with 6 of its 8 neighbours at least 60 % as far above, is part of a second
+/// spot (a reflection, a second light). A ghost of a tenth of the spot's power 63 px away on pink
+/// plastic's long tail stands 1.4× above its ring (σ′s −8 %); the good twins' rings hold no pixel
+/// group above 1.1×.
+pub const SECOND_SPOT_RATIO: f64 = 1.25;
+
+/// See [`SECOND_SPOT_RATIO`].
+pub const SECOND_SPOT_Z: f64 = 8.0;
+
+/// The documented ranges a value must lie in before it is called a measurement [mm⁻¹]
+/// (ARCHITECTURE.md, "The measurement, as files").
+pub const SIGMA_S_PRIME_RANGE: (f64, f64) = (1e-3, 1e3);
+/// σa's documented range [mm⁻¹].
+pub const SIGMA_A_RANGE: (f64, f64) = (0.0, 1e3);
+/// η's documented range.
+pub const ETA_RANGE: (f64, f64) = (1.0, 3.0);
+
+/// Checks that concern the whole sample (the image, the manifest), made once per measurement.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SampleChecks {
+    /// Findings that apply to every channel.
+    pub reasons: Vec<Reason>,
+}
+
+fn suspect(kind: ReasonKind, message: String) -> Reason {
+    Reason {
+        kind,
+        severity: Verdict::Suspect,
+        message,
+    }
+}
+
+/// The image-level checks: the spot inside the frame with its fitted rings complete (or cut
+/// symmetrically), a given centre on the spot, one spot, the spot's size against the manifest's
+/// scale.
+pub fn sample_checks(m: &Measurement) -> SampleChecks {
+    let mut reasons = Vec::new();
+    let radiance = &m.hdr.hdr.radiance;
+    let [cx, cy] = m.profile.center.xy();
+    let mmpp = m.profile.profile.mm_per_pixel;
+    let a_px = m.settings.spot_radius_mm / mmpp;
+    // (b) Rings complete to the fitted radius, or cut by the frame the same on both sides.
+    let r_fit_px = m
+        .fits
+        .iter()
+        .filter_map(ChannelOutcome::report)
+        .flat_map(|r| r.fitted.iter().map(|f| f.r_mm / mmpp))
+        .fold(0.0f64, f64::max);
+    if let Some(msg) = incomplete_rings(radiance.width(), radiance.height(), [cx, cy], r_fit_px) {
+        reasons.push(suspect(ReasonKind::IncompleteRings, msg));
+    }
+    // A given centre must lie on the spot the image shows.
+    if m.profile.center_source == crate::profile::CenterSource::Given
+        && let Ok(found) = find_spot_center(radiance, &CenterOptions::default())
+    {
+        let [fx, fy] = found.xy();
+        let d = (fx - cx).hypot(fy - cy);
+        let tol = (0.5 * a_px).max(3.0);
+        if d > tol {
+            reasons.push(suspect(
+                ReasonKind::CenterOffSpot,
+                format!(
+                    "the given spot centre ({cx:.1}, {cy:.1}) px is {d:.0} px from the spot the \
+                     image shows at ({fx:.1}, {fy:.1}) px (more than {tol:.0} px): correct \
+                     camera.center_px or drop it"
+                ),
+            ));
+        }
+    }
+    // (e) The codes the frames use; (f) the frames registered.
+    reasons.extend(code_reasons(m));
+    reasons.extend(registration_reasons(m));
+    reasons.extend(bracket_reasons(m));
+    // (d) Exactly one spot.
+    if let Some(msg) = second_spot(m, a_px) {
+        reasons.push(suspect(ReasonKind::SecondSpot, msg));
+    }
+    // (c) The spot's size in the image against the manifest's scale and spot diameter.
+    if let Some(hwhm) = spot_hwhm_px(m)
+        && a_px.is_finite()
+        && a_px > 0.0
+    {
+        let ratio = hwhm / a_px;
+        if !(SPOT_SIZE_RATIO.0..=SPOT_SIZE_RATIO.1).contains(&ratio) {
+            reasons.push(suspect(
+                ReasonKind::SpotSize,
+                format!(
+                    "the spot's half width in the image is {hwhm:.1} px, but spot_diameter_mm / 2 / \
+                     mm_per_pixel = {:.3} / {mmpp} = {a_px:.1} px (ratio {ratio:.2}, expected \
+                     {}–{}): check camera.mm_per_pixel and camera.spot_diameter_mm (a scale {:.2}× \
+                     off makes σ′s and σa as many times off)",
+                    m.settings.spot_radius_mm,
+                    SPOT_SIZE_RATIO.0,
+                    SPOT_SIZE_RATIO.1,
+                    ratio
+                ),
+            ));
+        }
+    }
+    SampleChecks { reasons }
+}
+
+/// Whether rings to `r_fit_px` around `c` in a `w × h` frame are cut by its edges on one side
+/// more than on the other (a spot near an edge or a corner). A centred spot whose outer rings are
+/// cut the same on both sides keeps an unbiased ring mean; an off-centre one does not (its centre
+/// is also found from a truncated image). Tolerance: 10 % of the nearer margin + 2 px.
+pub fn incomplete_rings(w: usize, h: usize, c: [f64; 2], r_fit_px: f64) -> Option<String> {
+    let [cx, cy] = c;
+    let mut bad = Vec::new();
+    for (axis, lo, hi) in [
+        ("left/right", cx + 0.5, w as f64 - 0.5 - cx),
+        ("top/bottom", cy + 0.5, h as f64 - 0.5 - cy),
+    ] {
+        let near = lo.min(hi);
+        if r_fit_px > near && (lo - hi).abs() > 0.1 * near + 2.0 {
+            bad.push(format!("{axis} margins {lo:.0} and {hi:.0} px"));
+        }
+    }
+    (!bad.is_empty()).then(|| {
+        format!(
+            "the spot at ({cx:.1}, {cy:.1}) px lies off the frame's centre ({}) and the fit used \
+             rings to {r_fit_px:.0} px, which the frame cuts on one side only: centre the spot \
+             in the frame, or lower fit.r_max_px below the nearer margin",
+            bad.join(", ")
+        )
+    })
+}
+
+/// The profile's half width at half maximum [px], on the channel sum (the first ring where the
+/// sum falls below half the maximum of the first rings, linearly interpolated).
+pub fn spot_hwhm_px(m: &Measurement) -> Option<f64> {
+    let rings = &m.profile.profile.rings;
+    let sum = |k: usize| -> f64 { rings[k].channels.iter().map(|c| c.mean).sum() };
+    let peak = (0..rings.len().min(4))
+        .map(sum)
+        .filter(|v| v.is_finite())
+        .fold(f64::NAN, f64::max);
+    if peak.is_nan() || peak <= 0.0 {
+        return None;
+    }
+    for k in 1..rings.len() {
+        let (u, v) = (sum(k - 1), sum(k));
+        if v.is_finite() && v < 0.5 * peak {
+            let (r0, r1) = (rings[k - 1].r_px, rings[k].r_px);
+            let t = if u.is_finite() && u > v {
+                ((u - 0.5 * peak) / (u - v)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            return Some(r0 + t * (r1 - r0));
+        }
+    }
+    None
+}
+
+/// A second spot: pixels (channel sum) well above their ring's median (a spot on a ring leaves its
+/// median alone; [`SECOND_SPOT_RATIO`], [`SECOND_SPOT_Z`]), away from the spot (beyond 3 spot
+/// radii), on rings whose median is well above the detection limit, with at least 6 of their 8
+/// neighbours nearly as far above (not a hot pixel). Returns the message for the brightest.
+fn second_spot(m: &Measurement, a_px: f64) -> Option<String> {
+    let img = &m.hdr.hdr.radiance;
+    let prof = &m.profile.profile;
+    let width = prof.options.ring_width_px();
+    let n_rings = prof.rings.len();
+    let [cx, cy] = m.profile.center.xy();
+    let ch = img.channels();
+    let (w, h) = (img.width(), img.height());
+    let limit: f64 = m
+        .profile
+        .detection_limit
+        .iter()
+        .map(|l| if l.is_finite() { *l } else { 0.0 })
+        .sum();
+    let ring_of =
+        |x: usize, y: usize| -> usize { ((x as f64 - cx).hypot(y as f64 - cy) / width) as usize };
+    let value = |x: usize, y: usize| -> f64 {
+        img.pixel(x, y).map_or(f64::NAN, |p| {
+            p.iter().take(ch).map(|&v| f64::from(v)).sum::<f64>()
+        })
+    };
+    let mut per_ring: Vec<Vec<f64>> = vec![Vec::new(); n_rings];
+    for y in 0..h {
+        for x in 0..w {
+            let k = ring_of(x, y);
+            let v = value(x, y);
+            if k < n_rings && v.is_finite() {
+                per_ring[k].push(v);
+            }
+        }
+    }
+    // Per ring: the median and the robust spread (1.4826 × the median absolute deviation).
+    let stats: Vec<(f64, f64)> = per_ring
+        .into_iter()
+        .map(|mut v| {
+            if v.len() < 8 {
+                return (f64::NAN, f64::NAN);
+            }
+            let mid = v.len() / 2;
+            let med = *v.select_nth_unstable_by(mid, f64::total_cmp).1;
+            let mut dev: Vec<f64> = v.iter().map(|x| (x - med).abs()).collect();
+            let mad = *dev.select_nth_unstable_by(mid, f64::total_cmp).1;
+            if med > 3.0 * limit && med > 0.0 {
+                (med, 1.4826 * mad)
+            } else {
+                (f64::NAN, f64::NAN)
+            }
+        })
+        .collect();
+    // (ratio to the ring's median, robust z-score) of a pixel.
+    let score = |x: usize, y: usize| -> (f64, f64) {
+        stats
+            .get(ring_of(x, y))
+            .map_or((f64::NAN, f64::NAN), |&(med, spread)| {
+                let v = value(x, y);
+                (v / med, (v - med) / spread.max(1e-3 * med))
+            })
+    };
+    let spot_like = |(q, z): (f64, f64), strict: bool| -> bool {
+        if strict {
+            q >= SECOND_SPOT_RATIO && z >= SECOND_SPOT_Z
+        } else {
+            q >= 1.0 + 0.6 * (SECOND_SPOT_RATIO - 1.0) && z >= 0.6 * SECOND_SPOT_Z
+        }
+    };
+    let r_min = (3.0 * a_px).max(6.0);
+    let mut best: Option<(f64, usize, usize)> = None;
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            if (x as f64 - cx).hypot(y as f64 - cy) < r_min {
+                continue;
+            }
+            let sc = score(x, y);
+            if !spot_like(sc, true) || best.is_some_and(|(b, ..)| sc.0 <= b) {
+                continue;
+            }
+            let bright = [
+                (0, 0),
+                (1, 0),
+                (2, 0),
+                (0, 1),
+                (2, 1),
+                (0, 2),
+                (1, 2),
+                (2, 2),
+            ]
+            .iter()
+            .filter(|&&(dx, dy)| spot_like(score(x + dx - 1, y + dy - 1), false))
+            .count();
+            if bright >= 6 {
+                best = Some((sc.0, x, y));
+            }
+        }
+    }
+    best.map(|(q, x, y)| {
+        let d = (x as f64 - cx).hypot(y as f64 - cy);
+        format!(
+            "a second bright spot at ({x}, {y}) px, {d:.0} px from the spot centre ({cx:.1}, \
+             {cy:.1}): {q:.1}× its ring's median (a reflection off the rig, a second light?); \
+             the rings through it are not the sample's profile — remove it and measure again"
+        )
+    })
+}
+
+/// The fit's own checks on one channel: converged, constrained, residuals the model's error and
+/// the noise explain, values in their documented ranges.
+pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
+    let mut reasons = Vec::new();
+    let r: &FitReport = match outcome {
+        ChannelOutcome::NotFitted { problem } => {
+            return vec![Reason {
+                kind: ReasonKind::FitFailed,
+                severity: Verdict::Failed,
+                message: problem.clone(),
+            }];
+        }
+        ChannelOutcome::Fitted(f) => &f.report,
+    };
+    if !r.converged {
+        reasons.push(Reason {
+            kind: ReasonKind::FitFailed,
+            severity: Verdict::Failed,
+            message: format!("the fit did not converge: {}", r.termination),
+        });
+    }
+    if !r.unconstrained.is_empty() {
+        reasons.push(suspect(
+            ReasonKind::Unconstrained,
+            format!(
+                "the profile does not constrain {}",
+                r.unconstrained.join(" and ")
+            ),
+        ));
+    }
+    // (a) Fit quality.
+    if r.rms_log_residual.is_finite() && r.rms_log_residual > MAX_RMS_LOG_RESIDUAL {
+        reasons.push(suspect(
+            ReasonKind::PoorFit,
+            format!(
+                "rms log residual {:.2} > {MAX_RMS_LOG_RESIDUAL} (χ²/dof {:.0}): the profile \
+                 differs from the model by more than the noise and the model's known error \
+                 explain — look at fit.png (a second spot, a bumped camera, wrong exposure \
+                 times, clipped or mis-scaled codes)",
+                r.rms_log_residual, r.chi2_reduced
+            ),
+        ));
+    }
+    // (g) Values in their documented ranges.
+    let mut out = Vec::new();
+    let check = |name: &str, v: f64, (lo, hi): (f64, f64), out: &mut Vec<String>| {
+        if !(v.is_finite() && v >= lo && v <= hi) {
+            out.push(format!("{name} = {v:.4e} outside [{lo:e}, {hi:e}]"));
+        }
+    };
+    check("σ′s", r.sigma_s_prime.value, SIGMA_S_PRIME_RANGE, &mut out);
+    check("σa", r.sigma_a.value, SIGMA_A_RANGE, &mut out);
+    check("α′", r.albedo_prime, (0.0, 1.0), &mut out);
+    check("η", eta, ETA_RANGE, &mut out);
+    if !out.is_empty() {
+        reasons.push(suspect(
+            ReasonKind::OutOfRange,
+            format!(
+                "{} (the documented ranges): not a measurement this rig can make",
+                out.join(", ")
+            ),
+        ));
+    }
+    reasons
+}
+
+/// The verdict on each channel (R, G, B): the fit's checks and the sample's.
+pub fn quality(m: &Measurement) -> Rgb<Quality> {
+    let sample = sample_checks(m);
+    m.fits.as_ref().map(|o| {
+        let mut reasons = fit_reasons(o, m.spectro.eta);
+        // A failed channel has no value the sample's findings could qualify.
+        if !reasons.iter().any(|r| r.severity == Verdict::Failed) {
+            reasons.extend(sample.reasons.iter().cloned());
+        }
+        Quality::from_reasons(reasons)
+    })
+}
+
+/// The codes 16-bit frames use: the largest, the clipping plateau found below the nominal
+/// saturation, and the bits that implies. A camera of 12 bits writing 16-bit files (values
+/// 0…4095, or shifted to the top bits) clips at 4095 (or 65520), where a 65535 saturation would
+/// take clipped pixels for light.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct CodeRange {
+    /// The largest code in any frame.
+    pub max_code: u16,
+    /// Samples at `max_code` in the frame holding most of them.
+    pub at_max: usize,
+    /// Bits the codes span: ⌈log2(max_code + 1)⌉ (after removing a common power-of-two factor).
+    pub bits: u32,
+    /// The saturation the merge uses: the nominal one, or the plateau found below it.
+    pub saturation: u16,
+    /// True when the plateau replaced the nominal saturation.
+    pub plateau_found: bool,
+}
+
+/// Samples at one code below the nominal saturation that make it a clipping plateau: at least
+/// this many, and at least 10⁻⁴ of a frame's samples (a linear sensor's unclipped maximum is held
+/// by a handful of samples; a clipped spot by hundreds).
+pub const PLATEAU_MIN_SAMPLES: usize = 16;
+
+/// Finds the codes 16-bit frames use ([`CodeRange`]).
+///
+/// # Errors
+/// [`PipelineError::Input`] for 8-bit frames scaled into 16 bits (every code a multiple of 257,
+/// as an image editor converts): their tone curve is not linear, and merging them as linear data
+/// would give wrong radiances.
+pub fn code_range(
+    frames: &[scatterfit_imaging::ImageBuf<u16>],
+    saturation: u16,
+) -> crate::Result<CodeRange> {
+    let mut max_code = 0u16;
+    let mut all_257 = true;
+    let mut or_bits = 0u16;
+    for f in frames {
+        for &v in f.data() {
+            max_code = max_code.max(v);
+            all_257 &= v % 257 == 0;
+            or_bits |= v;
+        }
+    }
+    if all_257 && max_code > 255 {
+        return Err(crate::PipelineError::Input(
+            "the 16-bit frames hold 8-bit codes scaled by 257 (every value a multiple of 257: an \
+             image editor's conversion): their tone curve is not linear and cannot be merged as \
+             16-bit linear data — give the camera's 8-bit frames (or its 16-bit linear ones)"
+                .into(),
+        ));
+    }
+    let at_max = frames
+        .iter()
+        .map(|f| f.data().iter().filter(|&&v| v == max_code).count())
+        .max()
+        .unwrap_or(0);
+    let samples = frames.first().map_or(0, |f| f.data().len());
+    let plateau_found = max_code < saturation
+        && max_code > 0
+        && at_max >= PLATEAU_MIN_SAMPLES.max(samples / 10_000);
+    let shift = or_bits.trailing_zeros().min(15);
+    let bits = 16 - (max_code >> shift).leading_zeros();
+    Ok(CodeRange {
+        max_code,
+        at_max,
+        bits,
+        saturation: if plateau_found { max_code } else { saturation },
+        plateau_found,
+    })
+}
+
+/// The bracket's codes as a finding: frames of 16-bit files holding 8 bits or fewer are suspect
+/// (the detection limit and the noise model assume more); a plateau found and used is not.
+pub fn code_reasons(m: &Measurement) -> Vec<Reason> {
+    let Some(c) = m.hdr.corrections.codes else {
+        return Vec::new();
+    };
+    if c.bits <= 8 {
+        return vec![suspect(
+            ReasonKind::BitDepth,
+            format!(
+                "the 16-bit frames use {} bits (largest code {}): 8-bit data in 16-bit files \
+                 lose the range and precision the linear merge assumes — give the camera's own \
+                 frames",
+                c.bits, c.max_code
+            ),
+        )];
+    }
+    Vec::new()
+}
+
+/// Where the spot is in each frame of a bracket, to see whether the camera moved.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Registration {
+    /// Per frame (shortest first), the centroid [x, y] px of the pixels at least half the
+    /// saturation (a radially symmetric spot's half-saturated disk is centred on the spot in every
+    /// frame); `None` where fewer than [`REGISTRATION_MIN_PIXELS`] pixels are, or the disk touches
+    /// the frame's edge.
+    pub centroids: Vec<Option<[f64; 2]>>,
+    /// The largest shift between two frames' centroids [px].
+    pub max_shift_px: f64,
+}
+
+/// Pixels a frame's half-saturated disk needs for its centroid to count.
+pub const REGISTRATION_MIN_PIXELS: usize = 12;
+
+/// A shift between frames beyond this [px] makes every channel suspect: the rings of the merged
+/// map then average light from two positions. The demo's frames agree to 0.18 px.
+pub const MAX_FRAME_SHIFT_PX: f64 = 1.5;
+
+/// The spot's centroid in each frame ([`Registration`]); `level(j, i)` is sample `i` of frame `j`
+/// as a fraction of its saturation, `w × h` pixels of `ch` channels.
+pub fn registration(
+    frames: usize,
+    w: usize,
+    h: usize,
+    ch: usize,
+    level: &dyn Fn(usize, usize) -> f64,
+) -> Registration {
+    let centroids: Vec<Option<[f64; 2]>> = (0..frames)
+        .map(|j| {
+            let (mut n, mut sx, mut sy) = (0usize, 0.0, 0.0);
+            let mut edge = false;
+            for y in 0..h {
+                for x in 0..w {
+                    let i = (y * w + x) * ch;
+                    let v = (0..ch).map(|c| level(j, i + c)).sum::<f64>() / ch as f64;
+                    if v >= 0.5 {
+                        n += 1;
+                        sx += x as f64;
+                        sy += y as f64;
+                        edge |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+                    }
+                }
+            }
+            (n >= REGISTRATION_MIN_PIXELS && !edge).then(|| [sx / n as f64, sy / n as f64])
+        })
+        .collect();
+    let found: Vec<[f64; 2]> = centroids.iter().flatten().copied().collect();
+    let mut max_shift_px = 0.0f64;
+    for a in &found {
+        for b in &found {
+            max_shift_px = max_shift_px.max((a[0] - b[0]).hypot(a[1] - b[1]));
+        }
+    }
+    Registration {
+        centroids,
+        max_shift_px,
+    }
+}
+
+/// The frames' registration as a finding: suspect beyond [`MAX_FRAME_SHIFT_PX`].
+pub fn registration_reasons(m: &Measurement) -> Vec<Reason> {
+    let Some(r) = &m.hdr.corrections.registration else {
+        return Vec::new();
+    };
+    if r.max_shift_px <= MAX_FRAME_SHIFT_PX {
+        return Vec::new();
+    }
+    let list: Vec<String> = r
+        .centroids
+        .iter()
+        .enumerate()
+        .filter_map(|(j, c)| c.map(|[x, y]| format!("{j}: ({x:.1}, {y:.1})")))
+        .collect();
+    vec![suspect(
+        ReasonKind::Misregistered,
+        format!(
+            "the spot moves by up to {:.1} px between the frames (its centre per frame, shortest \
+             first: {}): the camera or the sample moved during the bracket — fix the rig and take \
+             the bracket again",
+            r.max_shift_px,
+            list.join(", ")
+        ),
+    )]
+}
+
+/// The largest ratio of consecutive shutter times an 8-bit (tone-curved) bracket may have. Through
+/// a gamma-like curve a frame's codes above the noise floor (≈ 5–250) span two to three decades of
+/// radiance, coarsely at the bottom; measured: a 3-frame bracket with 42× steps (1/600, 0.07, 3 s)
+/// still gives σ′s within 5 % (`cli/tests/measure.rs`), a 2-frame one 1800× apart is +712 % off.
+/// 64× (6 stops) keeps every bracket that measured and flags the gap. (The demo's and the paper's
+/// brackets step by 1.9×.)
+pub const MAX_STEP_8BIT: f64 = 64.0;
+
+/// The same for linear frames of more than 8 bits (RAW, 16-bit linear): 12 usable bits and more
+/// overlap across 256× (8 stops).
+pub const MAX_STEP_LINEAR: f64 = 256.0;
+
+/// The bracket's overlap: consecutive exposures more than [`MAX_STEP_8BIT`] (8-bit frames through
+/// a recovered or given response) or [`MAX_STEP_LINEAR`] (linear frames) apart, or a recovered
+/// response from fewer than 3 frames, make every channel suspect: the merge then interpolates
+/// across radiances no frame measured (issue 17: a 2-frame bracket of 1/600 and 3 s measured
+/// +712 % and was called ok).
+pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
+    let limit = match m.hdr.response_kind {
+        ResponseKind::Recovered | ResponseKind::Given => MAX_STEP_8BIT,
+        ResponseKind::Linear => MAX_STEP_LINEAR,
+        _ => return Vec::new(),
+    };
+    let mut times: Vec<f64> = m.hdr.frames.iter().map(|f| f.time_s).collect();
+    times.sort_by(f64::total_cmp);
+    let mut reasons = Vec::new();
+    if m.hdr.response_kind == ResponseKind::Recovered && times.len() < 3 {
+        reasons.push(suspect(
+            ReasonKind::BracketGap,
+            format!(
+                "the camera response was recovered from {} frame(s): with fewer than 3 the \
+                 recovery is barely constrained — take a bracket of 5 or more exposures, at most \
+                 {MAX_STEP_8BIT:.0}× apart",
+                times.len()
+            ),
+        ));
+    }
+    let worst = times
+        .windows(2)
+        .filter(|w| w[0] > 0.0)
+        .map(|w| (w[1] / w[0], w[0], w[1]))
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((ratio, t0, t1)) = worst
+        && ratio > limit
+    {
+        reasons.push(suspect(
+            ReasonKind::BracketGap,
+            format!(
+                "consecutive exposures {} s and {} s are {ratio:.0}× apart (at most {limit:.0}× for \
+                 {} frames): radiances between them are well exposed in no frame — add exposures \
+                 in between",
+                crate::checks::short(t0),
+                crate::checks::short(t1),
+                if limit == MAX_STEP_8BIT { "8-bit" } else { "linear" }
+            ),
+        ));
+    }
+    reasons
+}
+
+/// A shutter time for a message (4 significant digits).
+fn short(t: f64) -> String {
+    format!("{t:.4}")
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_centred_spot_cut_on_both_sides_is_complete_an_off_centre_one_is_not() {
+        assert!(incomplete_rings(256, 256, [130.2, 128.8], 180.0).is_none());
+        assert!(incomplete_rings(1024, 1024, [512.0, 511.0], 300.0).is_none());
+        assert!(incomplete_rings(158, 158, [32.2, 30.8], 170.0).is_some());
+        assert!(incomplete_rings(143, 256, [18.0, 128.8], 100.0).is_some());
+        // Rings inside the nearer margin are complete wherever the spot is.
+        assert!(incomplete_rings(143, 256, [18.0, 128.8], 15.0).is_none());
+    }
+}

@@ -1,0 +1,181 @@
+//! Stage 3½ (issue 15): the spectrophotometer port's edge loss, corrected from the measurement
+//! itself.
+//!
+//! A d/8 instrument lights a disc and measures through a concentric aperture; light that enters
+//! inside the lit disc and leaves beyond the aperture is lost, so it reads F·Rd with F < 1 for a
+//! material whose light travels millimetres (`scatterfit_optics::port`, docs/physics.md §12).
+//! The fit gives the length scale: starting from the reading, each round fits the channel, takes F
+//! of the fitted material through the same port from the fit's forward model
+//! ([`Port::reading_of`]), sets Rd = Rd_read / F, inverts α′ again with the albedo model, and refits,
+//! until Rd moves by less than 10⁻⁶ relatively (a fixed point: F depends on σ′t, which α′ moves
+//! only slightly, so it converges in a few rounds). The correction is only as exact as the forward
+//! model: with `--model mc` the profile is exact transport's; with a diffusion model it carries
+//! that model's near-source error.
+
+use scatterfit_fit::{ChannelInput, ProfileData};
+use scatterfit_optics::port::Port;
+use scatterfit_optics::{Channel, ModelFamily, OpticalProperties, Rgb};
+use serde::Serialize;
+
+use crate::fit::FitSettings;
+use crate::spectro::SpectroStage;
+
+/// Rounds before giving up on a channel (it converges in 3–10 on the rig twin).
+const MAX_ROUNDS: usize = 60;
+
+/// Relative change of Rd between rounds that ends the iteration.
+const TOLERANCE: f64 = 1e-6;
+
+/// What the port correction did, per channel.
+#[derive(Debug, Clone, Serialize)]
+pub struct PortCorrection {
+    /// Diameter of the lit disc [mm].
+    pub illuminated_mm: f64,
+    /// Diameter of the measured aperture [mm].
+    pub aperture_mm: f64,
+    /// The stage as read, before the correction (a refit with another model starts again here).
+    #[serde(skip)]
+    pub read: SpectroStage,
+    /// F per channel: the fraction of the true Rd the instrument read (`None` where the channel
+    /// could not be fitted, and its Rd was left as read).
+    pub reading_fraction: Rgb<Option<f64>>,
+    /// Rounds of fit → F → α′ per channel.
+    pub rounds: Rgb<usize>,
+    /// Why a channel was left uncorrected.
+    pub problems: Rgb<Option<String>>,
+}
+
+/// The port of the manifest's `spectro.aperture_mm` / `spectro.illuminated_mm` (`None` when no
+/// aperture is given: the reading is then taken as loss-free).
+///
+/// # Errors
+/// A diameter the port refuses (the manifest checks both before).
+pub fn port_of(
+    aperture_mm: Option<f64>,
+    illuminated_mm: Option<f64>,
+) -> crate::error::Result<Option<Port>> {
+    let Some(aperture) = aperture_mm else {
+        return Ok(None);
+    };
+    Port::new(illuminated_mm.unwrap_or(aperture), aperture)
+        .map(Some)
+        .map_err(|e| crate::error::PipelineError::Input(format!("the spectrophotometer port: {e}")))
+}
+
+/// Corrects the stage's Rd (hence α′ and its uncertainty) for the port's edge loss, by iterating
+/// fit ↔ F per channel (module docs). Returns the corrected stage and what was done; a channel
+/// that cannot be fitted keeps its reading, with the reason.
+pub fn correct_port(
+    data: &Rgb<ProfileData>,
+    read: &SpectroStage,
+    settings: &FitSettings,
+    model: &dyn ModelFamily,
+    albedo: &dyn ModelFamily,
+    port: Port,
+) -> (SpectroStage, PortCorrection) {
+    let opts = settings.options();
+    let mut fraction = Rgb::from_fn(|_| None);
+    let mut rounds = Rgb::from_fn(|_| 0);
+    let mut problems: Rgb<Option<String>> = Rgb::from_fn(|_| None);
+    let mut rd = read.rd;
+    for ch in Channel::ALL {
+        let data = &data[ch];
+        let Ok(opts) = &opts else {
+            problems[ch] = Some("no fit options".into());
+            continue;
+        };
+        let rd_read = read.rd[ch];
+        let mut rd_c = rd_read;
+        let mut albedo_prime = match albedo.albedo_from_rd(rd_c, read.eta, 0.0) {
+            Ok(a) => a,
+            Err(e) => {
+                problems[ch] = Some(format!("α′ from Rd = {rd_c:.4}: {e}"));
+                continue;
+            }
+        };
+        for round in 1..=MAX_ROUNDS {
+            rounds[ch] = round;
+            let input = ChannelInput {
+                eta: read.eta,
+                albedo_prime: Some(albedo_prime),
+                rd_total: Some(rd_c),
+            };
+            let report = match scatterfit_fit::fit_channel(data, &input, model, opts) {
+                Ok(r) if r.converged => r,
+                Ok(_) => {
+                    problems[ch] = Some("the fit did not converge".into());
+                    break;
+                }
+                Err(e) => {
+                    problems[ch] = Some(e.to_string());
+                    break;
+                }
+            };
+            let f =
+                OpticalProperties::new(report.sigma_s_prime.value, report.sigma_a.value, read.eta)
+                    .and_then(|p| model.profile(&p))
+                    .map(|m| port.reading_of(&*m).reading_fraction);
+            let f = match f {
+                Ok(f) if f.is_finite() && f > 0.0 && f <= 1.0 + 1e-9 => f.min(1.0),
+                Ok(f) => {
+                    problems[ch] =
+                        Some(format!("the port's reading fraction {f} is not in (0, 1]"));
+                    break;
+                }
+                Err(e) => {
+                    problems[ch] = Some(e.to_string());
+                    break;
+                }
+            };
+            let target = rd_read / f;
+            fraction[ch] = Some(f);
+            if ((target - rd_c) / rd_c).abs() < TOLERANCE {
+                break;
+            }
+            // Step towards the target, halving the step while its Rd lies beyond what the albedo
+            // model can invert (an early round's F, from a fit at a too-low α′, can overshoot;
+            // damped, the next rounds approach the fixed point from inside the model's range).
+            let mut step = target - rd_c;
+            let mut next = None;
+            for _ in 0..40 {
+                if let Ok(a) = albedo.albedo_from_rd(rd_c + step, read.eta, 0.0) {
+                    next = Some((rd_c + step, a));
+                    break;
+                }
+                step *= 0.5;
+            }
+            let Some((rd_next, a_next)) = next else {
+                problems[ch] = Some(format!(
+                    "the corrected Rd ({target:.4}) lies beyond what the {} albedo model can \
+                     invert at η = {:.4}",
+                    albedo.name(),
+                    read.eta
+                ));
+                break;
+            };
+            rd_c = rd_next;
+            albedo_prime = a_next;
+            if round == MAX_ROUNDS {
+                problems[ch] = Some(format!(
+                    "not converged in {MAX_ROUNDS} rounds (Rd {rd_c:.4}, the port's F asks for \
+                     {target:.4}: beyond the albedo model's range?)"
+                ));
+            }
+        }
+        if problems[ch].is_none() {
+            rd[ch] = rd_c;
+        } else {
+            fraction[ch] = None;
+        }
+    }
+    let corrected = read.with_rd(rd, albedo);
+    let correction = PortCorrection {
+        illuminated_mm: port.illuminated_mm(),
+        aperture_mm: port.aperture_mm(),
+        read: read.clone(),
+        reading_fraction: fraction,
+        rounds,
+        problems,
+    };
+    (corrected, correction)
+}

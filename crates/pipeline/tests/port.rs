@@ -1,0 +1,209 @@
+//! The spectrophotometer port's edge loss (issue 15), on rig-twin samples whose spectrophotometer
+//! reading is what a d/8 instrument with an 8 mm aperture reads: the engine lights a disc
+//! uniformly and tallies what leaves inside the aperture (`scatterfit_mc::port`, a Monte Carlo run
+//! of its own: the correction, which integrates the fitted model's profile against the two-disc
+//! kernel, never made these numbers). Measured with the exact model (`mc` / `mc`), σa is far off
+//! when the reading is taken as loss-free and back near the truth once the manifest names the port.
+//! Fixed seeds; tolerances below.
+
+use scatterfit_io::manifest::FitSection;
+use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
+use scatterfit_mc::port::simulate_port_reading;
+use scatterfit_mc::{Layer, Sample};
+use scatterfit_optics::port::Port;
+use scatterfit_optics::{AlbedoModel, ModelName};
+use scatterfit_pipeline::{Overrides, measure_sample};
+use scatterfit_synth::materials::by_name;
+use scatterfit_synth::spectro::reading_for;
+use scatterfit_synth::{RigSpec, synthesize};
+
+/// σa's relative error per channel of `name`: the port's reading taken as loss-free, the port's
+/// reading corrected (the manifest names the port), and the loss-free reading (the twin's baseline).
+fn errors(name: &str, illuminated_mm: f64, aperture_mm: f64, seed: u64) -> [[f64; 3]; 3] {
+    errors_both(name, illuminated_mm, aperture_mm, seed).map(|run| run.map(|(_, sa)| sa))
+}
+
+/// σ′s's and σa's relative errors per channel, as [`errors`].
+fn errors_both(
+    name: &str,
+    illuminated_mm: f64,
+    aperture_mm: f64,
+    seed: u64,
+) -> [[(f64, f64); 3]; 3] {
+    let m = by_name(name).unwrap();
+    let rig = RigSpec::quick();
+    let s = synthesize(
+        m.name,
+        m.sigma_s_prime,
+        m.sigma_a,
+        m.eta,
+        &rig,
+        seed,
+        None,
+        &|_, _, _| {},
+    )
+    .unwrap();
+    let port = Port::new(illuminated_mm, aperture_mm).unwrap();
+    let read: [f64; 3] = std::array::from_fn(|c| {
+        let layer =
+            Layer::new(m.sigma_a[c], m.sigma_s_prime[c], 0.0, m.eta, f64::INFINITY).unwrap();
+        let sample = Sample::new(vec![layer], 1.0, 1.0).unwrap();
+        let r = simulate_port_reading(sample, &port, 400_000, seed * 10 + c as u64).unwrap();
+        eprintln!(
+            "{name} {c}: Monte Carlo reading fraction {:.4} ± {:.4} (Rd {:.4}, twin's {:.4})",
+            r.reading_fraction.value,
+            r.reading_fraction.stderr,
+            r.rd_total.value,
+            s.truth.channels[c].rd_total
+        );
+        r.rd_read.value
+    });
+    let reading = reading_for(read, m.eta).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut out = [[(0.0, 0.0); 3]; 3];
+    for (k, with_port) in [false, true, false].into_iter().enumerate() {
+        let folder = dir.path().join(format!("{name}-{k}"));
+        write_sample_folder(
+            &folder,
+            &SampleFiles {
+                name: m.name,
+                reading: if k == 2 { &s.reading } else { &reading },
+                lab10: None,
+                frames: &s.bracket.frames,
+                times_s: &s.bracket.times_s,
+                mm_per_pixel: rig.mm_per_pixel,
+                spot_diameter_mm: 2.0 * rig.spot_radius_mm,
+                truth_json: None,
+                provenance: "test",
+                fit: FitSection {
+                    model: Some(ModelName::Mc),
+                    albedo_model: Some(AlbedoModel::Mc),
+                    ..Default::default()
+                },
+            },
+        )
+        .unwrap();
+        if with_port {
+            let toml = folder.join("sample.toml");
+            let text = std::fs::read_to_string(&toml).unwrap().replacen(
+                "[spectro]\n",
+                &format!(
+                    "[spectro]\naperture_mm = {aperture_mm}\nilluminated_mm = {illuminated_mm}\n"
+                ),
+                1,
+            );
+            std::fs::write(&toml, text).unwrap();
+        }
+        let meas = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
+        assert_eq!(meas.port.is_some(), with_port);
+        let result = meas.to_result(None);
+        out[k] = std::array::from_fn(|c| {
+            let ch = &result.channels[scatterfit_optics::Channel::ALL[c]];
+            (
+                ch.sigma_s_prime
+                    .map_or(f64::NAN, |v| v / m.sigma_s_prime[c] - 1.0),
+                ch.sigma_a.map_or(f64::NAN, |v| v / m.sigma_a[c] - 1.0),
+            )
+        });
+        if let Some(p) = &meas.port {
+            eprintln!(
+                "{name}: port {illuminated_mm}/{aperture_mm} mm, reading fraction {:?}, rounds {:?}",
+                p.reading_fraction, p.rounds
+            );
+        }
+    }
+    eprintln!(
+        "{name}: σa error loss-free {:?}, corrected {:?}, no port {:?}",
+        out[0], out[1], out[2]
+    );
+    out
+}
+
+/// An 8 mm aperture lit over 14 mm (issue 15's first case), two materials whose light travels
+/// millimetres (skin, α′ 0.93–0.99; wood tile, 0.91–0.99). Each sample is measured three times from
+/// the same frames: with the port's reading taken as loss-free, with the port corrected, and with
+/// the loss-free reading (the twin's own error on the quick rig, up to 8 % in skin's red channel,
+/// whose light spreads beyond the quick rig's 12.8 mm field). Against that baseline: the port's
+/// bias in σa is large (+49 % and +11 % in the most transparent channel, skin's and wood's red),
+/// and after the correction every channel is within 8 % of the baseline and the largest bias
+/// shrinks by at least 70 % (measured: 6.0 % and 1.0 % left). What is left: the fit's own error
+/// feeds back through F, the port's reading of the *fitted* material (skin's red: σa +8 % on the
+/// quick rig gives F 0.887 against the truth's 0.871, and α′ 0.988 amplifies that), and the
+/// Monte Carlo noise of the port reading, 0.3 % in Rd, is ≈ 1 % in σa at α′ 0.99.
+#[test]
+fn an_8_mm_port_lit_over_14_mm_is_corrected() {
+    for (name, seed) in [("skin2", 3), ("wood-tile", 5)] {
+        let [raw, corrected, base] = errors(name, 14.0, 8.0, seed);
+        let bias = |e: [f64; 3]| -> [f64; 3] { std::array::from_fn(|c| e[c] - base[c]) };
+        let worst = |e: [f64; 3]| e.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let (raw_bias, left) = (worst(bias(raw)), worst(bias(corrected)));
+        assert!(
+            raw_bias > 0.1,
+            "{name}: the port should matter: {raw:?} vs {base:?}"
+        );
+        assert!(left < 0.08, "{name}: corrected {corrected:?} vs {base:?}");
+        assert!(
+            left < 0.3 * raw_bias,
+            "{name}: {raw:?} → {corrected:?} (baseline {base:?})"
+        );
+    }
+}
+
+/// The port study behind BENCHMARKS.md "The spectrophotometer port: the correction on the twin":
+/// materials from α′ 0.35 to 0.9995, an 8 mm aperture lit over 14 mm and over 8 mm; per channel
+/// σ′s and σa as read (loss-free), corrected, and the twin's baseline (the loss-free reading).
+/// Prints a Markdown table; about 3 min on 2 cores.
+#[test]
+#[ignore = "study: prints BENCHMARKS.md's table (cargo test -p scatterfit-pipeline --test port -- --ignored --nocapture)"]
+fn port_study() {
+    let materials = [
+        "ketchup",
+        "skin1",
+        "brown-leather",
+        "skin2",
+        "potato",
+        "wood-tile",
+        "apple",
+        "sulfur",
+        "pink-plastic",
+        "marble",
+    ];
+    println!(
+        "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let pct = |x: f64| format!("{:+.1} %", 100.0 * x);
+    for (ill, ap) in [(14.0, 8.0), (8.0, 8.0)] {
+        let mut left = Vec::new();
+        for (k, name) in materials.iter().enumerate() {
+            let m = by_name(name).unwrap();
+            let [raw, cor, base] = errors_both(name, ill, ap, 20 + k as u64);
+            for c in 0..3 {
+                println!(
+                    "| {ill} / {ap} mm | {name} | {} | {:.4} | {} / {} / {} | {} / {} / {} |",
+                    ["R", "G", "B"][c],
+                    m.albedo_prime()[c],
+                    pct(raw[c].0),
+                    pct(cor[c].0),
+                    pct(base[c].0),
+                    pct(raw[c].1),
+                    pct(cor[c].1),
+                    pct(base[c].1)
+                );
+                left.push(((cor[c].0 - base[c].0).abs(), (cor[c].1 - base[c].1).abs()));
+            }
+        }
+        let mut sp: Vec<f64> = left.iter().map(|l| l.0).filter(|v| v.is_finite()).collect();
+        let mut sa: Vec<f64> = left.iter().map(|l| l.1).filter(|v| v.is_finite()).collect();
+        sp.sort_by(f64::total_cmp);
+        sa.sort_by(f64::total_cmp);
+        println!(
+            "port {ill}/{ap} mm: corrected − baseline, median / worst: σ′s {:.2} % / {:.2} %, σa {:.2} % / {:.2} % ({} channels)",
+            100.0 * sp[sp.len() / 2],
+            100.0 * sp[sp.len() - 1],
+            100.0 * sa[sa.len() / 2],
+            100.0 * sa[sa.len() - 1],
+            sa.len()
+        );
+    }
+}
