@@ -253,8 +253,8 @@ fn accuracy_rows(
                     .map(|c| {
                         let (tc, pc, ec) = (
                             &t.channels[c],
-                            p.channels.as_array()[c],
-                            e.channels.as_array()[c],
+                            p.channels.as_ref().into_array()[c],
+                            e.channels.as_ref().into_array()[c],
                         );
                         ChannelRow {
                             channel: names[c],
@@ -271,13 +271,18 @@ fn accuracy_rows(
                             existing_sigma_s_prime_error: rel(ec.sigma_s_prime, tc.sigma_s_prime),
                             existing_sigma_a_error: rel(ec.sigma_a, tc.sigma_a),
                             exact_sigma_s_prime: x
-                                .and_then(|x| x.channels.as_array()[c].sigma_s_prime),
-                            exact_sigma_a: x.and_then(|x| x.channels.as_array()[c].sigma_a),
+                                .and_then(|x| x.channels.as_ref().into_array()[c].sigma_s_prime),
+                            exact_sigma_a: x
+                                .and_then(|x| x.channels.as_ref().into_array()[c].sigma_a),
                             exact_sigma_s_prime_error: x.and_then(|x| {
-                                rel(x.channels.as_array()[c].sigma_s_prime, tc.sigma_s_prime)
+                                rel(
+                                    x.channels.as_ref().into_array()[c].sigma_s_prime,
+                                    tc.sigma_s_prime,
+                                )
                             }),
-                            exact_sigma_a_error: x
-                                .and_then(|x| rel(x.channels.as_array()[c].sigma_a, tc.sigma_a)),
+                            exact_sigma_a_error: x.and_then(|x| {
+                                rel(x.channels.as_ref().into_array()[c].sigma_a, tc.sigma_a)
+                            }),
                         }
                     })
                     .collect(),
