@@ -20,7 +20,7 @@ use scatterfit_synth::Truth;
 use scatterfit_synth::materials::CHOI_2014;
 use serde::Serialize;
 
-use crate::common::{CacheArgs, FitArgs};
+use crate::common::CacheArgs;
 use crate::output::{errln, out, outln};
 use crate::twin::{Material, synthesize, write_sample};
 
@@ -155,16 +155,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let synth_s = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let fit = FitArgs {
-        method: None,
-        model: None,
-        albedo_model: None,
-        eta: None,
-        normalise_with_spectro: false,
-        allow_outside_paths: false,
-    };
-    let (pairs, exacts, failed) =
-        crate::runner::compare_dirs_exact(&dirs, &fit, args.jobs.unwrap_or(0), quiet, true, true)?;
+    let (pairs, exacts, failed) = crate::runner::compare_dirs(
+        &dirs,
+        &scatterfit_pipeline::Overrides::default(),
+        args.jobs.unwrap_or(0),
+        quiet,
+        true,
+        true,
+    )?;
     let measure_s = t1.elapsed().as_secs_f64();
     let rows = accuracy_rows(&pairs, &exacts, &truths);
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
