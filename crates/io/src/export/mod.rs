@@ -115,7 +115,7 @@ pub const ETA_RANGE: (f64, f64) = (1.0, 4.0);
 pub const SIGMA_S_RANGE: (f64, f64) = (1e-6, 1e6);
 /// Documented range of σa [mm⁻¹].
 pub const SIGMA_A_RANGE: (f64, f64) = (0.0, 1e6);
-/// Documented range of a reflectance spectrum's wavelengths [nm].
+/// Documented range of a reflectance spectrum's wavelengths \[nm\].
 pub const WAVELENGTH_RANGE: (f64, f64) = (300.0, 1000.0);
 
 /// A target format of `scatterfit export`.
@@ -272,7 +272,7 @@ impl ExportOptions {
 /// at the measured spectrum's wavelengths, extended to [`SPECTRAL_RANGE`] with the end values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SpectralMedium {
-    /// Wavelengths [nm], increasing.
+    /// Wavelengths \[nm\], increasing.
     pub wavelength_nm: Vec<f64>,
     /// Single-scattering albedo σs/σt (g = 0) whose exact-transport Rd is the measured Rd(λ).
     pub albedo: Vec<f64>,
@@ -281,11 +281,11 @@ pub struct SpectralMedium {
     pub sigma_t: Vec<f64>,
 }
 
-/// The wavelengths [nm] at which the spectral medium takes each channel's σ′t (R, G, B): near the
+/// The wavelengths \[nm\] at which the spectral medium takes each channel's σ′t (R, G, B): near the
 /// dominant wavelengths of the sRGB primaries (611, 549, 464 nm, CIE 1931, D65 white).
 pub const CHANNEL_WAVELENGTHS: [f64; 3] = [611.0, 549.0, 464.0];
 
-/// The span [nm] spectral exports cover: renderers sample 360–830 nm, and a piecewise-linear spectrum
+/// The span \[nm\] spectral exports cover: renderers sample 360–830 nm, and a piecewise-linear spectrum
 /// is zero outside its points in pbrt, so the measured spectrum is extended with its end values.
 pub const SPECTRAL_RANGE: (f64, f64) = (360.0, 830.0);
 
@@ -1174,7 +1174,7 @@ fn unsafe_char(c: char) -> bool {
 
 /// Free text as one line safe in every format's comments and strings of this module: whitespace
 /// controls (tab, newline, carriage return, form feed, NEL, line and paragraph separators) become a
-/// space, every other [`unsafe_char`] U+FFFD (�).
+/// space, every other `unsafe_char` U+FFFD (�).
 pub fn one_line(text: &str) -> String {
     text.chars()
         .map(|c| match c {
