@@ -4,7 +4,9 @@
 use scatterfit_pipeline::{ModelName, Overrides, measure_sample};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = std::env::args().nth(1).ok_or("usage: measure_folder SAMPLE_DIR")?;
+    let dir = std::env::args()
+        .nth(1)
+        .ok_or("usage: measure_folder SAMPLE_DIR")?;
     // The manifest's [fit] choices, with the Monte Carlo model instead of the paper's dipole.
     let overrides = Overrides::default().model(ModelName::Mc);
     let m = measure_sample(dir.as_ref(), &overrides, &|_stage| {})?;
