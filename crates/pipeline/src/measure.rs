@@ -275,6 +275,10 @@ fn measure_from(
             // A real camera (issue 16): black level, shutter times, flat frame.
             inputs.flat = manifest.camera.flat.as_ref().map(|p| manifest.resolve(p));
             inputs.exposure_correction = manifest.camera.exposure_correction.unwrap_or_default();
+            if let Some(s) = manifest.camera.saturation {
+                inputs.saturation = s;
+                inputs.saturation_given = true;
+            }
             inputs.black_level = match manifest.camera.black_level {
                 None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
                 Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
