@@ -521,7 +521,13 @@ impl Measurement {
                 },
             },
             version: env!("CARGO_PKG_VERSION").into(),
-            rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()),
+            // The spectrum as the port let the instrument read it, corrected like the channels.
+            rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()).map(|s| {
+                self.port
+                    .as_ref()
+                    .and_then(|p| crate::port::correct_spectrum(&s, &p.reading_fraction))
+                    .unwrap_or(s)
+            }),
             spectro_port: self
                 .port
                 .as_ref()
