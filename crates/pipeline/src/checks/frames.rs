@@ -1,0 +1,250 @@
+//! The checks on the bracket's frames (issue 17 §2): the codes they use (8- or 12-bit data in
+//! 16-bit files, the clipping plateau), their registration (the spot's centroid per frame) and the
+//! bracket's overlap (consecutive exposures, frames for a recovered response).
+
+use super::*;
+
+/// The codes 16-bit frames use: the largest, the clipping plateau found below the nominal
+/// saturation, and the bits that implies. A camera of 12 bits writing 16-bit files (values
+/// 0…4095, or shifted to the top bits) clips at 4095 (or 65520), where a 65535 saturation would
+/// take clipped pixels for light.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct CodeRange {
+    /// The largest code in any frame.
+    pub max_code: u16,
+    /// Samples at `max_code` in the frame holding most of them.
+    pub at_max: usize,
+    /// Bits the codes span: ⌈log2(max_code + 1)⌉ (after removing a common power-of-two factor).
+    pub bits: u32,
+    /// The saturation the merge uses: the nominal one, or the plateau found below it.
+    pub saturation: u16,
+    /// True when the plateau replaced the nominal saturation.
+    pub plateau_found: bool,
+}
+
+/// Samples at one code below the nominal saturation that make it a clipping plateau: at least
+/// this many, and at least 10⁻⁴ of a frame's samples (a linear sensor's unclipped maximum is held
+/// by a handful of samples; a clipped spot by hundreds).
+pub const PLATEAU_MIN_SAMPLES: usize = 16;
+
+/// Finds the codes 16-bit frames use ([`CodeRange`]).
+///
+/// # Errors
+/// [`crate::PipelineError::Input`] for 8-bit frames scaled into 16 bits (every code a multiple of 257,
+/// as an image editor converts): their tone curve is not linear, and merging them as linear data
+/// would give wrong radiances.
+pub fn code_range(
+    frames: &[scatterfit_imaging::ImageBuf<u16>],
+    saturation: u16,
+) -> crate::Result<CodeRange> {
+    let mut max_code = 0u16;
+    let mut all_257 = true;
+    let mut or_bits = 0u16;
+    for f in frames {
+        for &v in f.data() {
+            max_code = max_code.max(v);
+            all_257 &= v % 257 == 0;
+            or_bits |= v;
+        }
+    }
+    if all_257 && max_code > 255 {
+        return Err(crate::PipelineError::Input(
+            "the 16-bit frames hold 8-bit codes scaled by 257 (every value a multiple of 257: an \
+             image editor's conversion): their tone curve is not linear and cannot be merged as \
+             16-bit linear data — give the camera's 8-bit frames (or its 16-bit linear ones)"
+                .into(),
+        ));
+    }
+    let at_max = frames
+        .iter()
+        .map(|f| f.data().iter().filter(|&&v| v == max_code).count())
+        .max()
+        .unwrap_or(0);
+    let samples = frames.first().map_or(0, |f| f.data().len());
+    let plateau_found = max_code < saturation
+        && max_code > 0
+        && at_max >= PLATEAU_MIN_SAMPLES.max(samples / 10_000);
+    let shift = or_bits.trailing_zeros().min(15);
+    let bits = 16 - (max_code >> shift).leading_zeros();
+    Ok(CodeRange {
+        max_code,
+        at_max,
+        bits,
+        saturation: if plateau_found { max_code } else { saturation },
+        plateau_found,
+    })
+}
+
+/// The bracket's codes as a finding: frames of 16-bit files holding 8 bits or fewer are suspect
+/// (the detection limit and the noise model assume more); a plateau found and used is not.
+pub fn code_reasons(m: &Measurement) -> Vec<Reason> {
+    let Some(c) = m.hdr.corrections.codes else {
+        return Vec::new();
+    };
+    if c.bits <= 8 {
+        return vec![suspect(
+            ReasonKind::BitDepth,
+            format!(
+                "the 16-bit frames use {} bits (largest code {}): 8-bit data in 16-bit files \
+                 lose the range and precision the linear merge assumes — give the camera's own \
+                 frames",
+                c.bits, c.max_code
+            ),
+        )];
+    }
+    Vec::new()
+}
+
+/// Where the spot is in each frame of a bracket, to see whether the camera moved.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Registration {
+    /// Per frame (shortest first), the centroid [x, y] px of the pixels at least half the
+    /// saturation (a radially symmetric spot's half-saturated disk is centred on the spot in every
+    /// frame); `None` where fewer than [`REGISTRATION_MIN_PIXELS`] pixels are, or the disk touches
+    /// the frame's edge.
+    pub centroids: Vec<Option<[f64; 2]>>,
+    /// The largest shift between two frames' centroids \[px\].
+    pub max_shift_px: f64,
+}
+
+/// Pixels a frame's half-saturated disk needs for its centroid to count.
+pub const REGISTRATION_MIN_PIXELS: usize = 12;
+
+/// A shift between frames beyond this \[px\] makes every channel suspect: the rings of the merged
+/// map then average light from two positions. The demo's frames agree to 0.18 px.
+pub const MAX_FRAME_SHIFT_PX: f64 = 1.5;
+
+/// The spot's centroid in each frame ([`Registration`]); `level(j, i)` is sample `i` of frame `j`
+/// as a fraction of its saturation, `w × h` pixels of `ch` channels.
+pub fn registration(
+    frames: usize,
+    w: usize,
+    h: usize,
+    ch: usize,
+    level: &dyn Fn(usize, usize) -> f64,
+) -> Registration {
+    let centroids: Vec<Option<[f64; 2]>> = (0..frames)
+        .map(|j| {
+            let (mut n, mut sx, mut sy) = (0usize, 0.0, 0.0);
+            let mut edge = false;
+            for y in 0..h {
+                for x in 0..w {
+                    let i = (y * w + x) * ch;
+                    let v = (0..ch).map(|c| level(j, i + c)).sum::<f64>() / ch as f64;
+                    if v >= 0.5 {
+                        n += 1;
+                        sx += x as f64;
+                        sy += y as f64;
+                        edge |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+                    }
+                }
+            }
+            (n >= REGISTRATION_MIN_PIXELS && !edge).then(|| [sx / n as f64, sy / n as f64])
+        })
+        .collect();
+    let found: Vec<[f64; 2]> = centroids.iter().flatten().copied().collect();
+    let mut max_shift_px = 0.0f64;
+    for a in &found {
+        for b in &found {
+            max_shift_px = max_shift_px.max((a[0] - b[0]).hypot(a[1] - b[1]));
+        }
+    }
+    Registration {
+        centroids,
+        max_shift_px,
+    }
+}
+
+/// The frames' registration as a finding: suspect beyond [`MAX_FRAME_SHIFT_PX`].
+pub fn registration_reasons(m: &Measurement) -> Vec<Reason> {
+    let Some(r) = &m.hdr.corrections.registration else {
+        return Vec::new();
+    };
+    if r.max_shift_px <= MAX_FRAME_SHIFT_PX {
+        return Vec::new();
+    }
+    let list: Vec<String> = r
+        .centroids
+        .iter()
+        .enumerate()
+        .filter_map(|(j, c)| c.map(|[x, y]| format!("{j}: ({x:.1}, {y:.1})")))
+        .collect();
+    vec![suspect(
+        ReasonKind::Misregistered,
+        format!(
+            "the spot moves by up to {:.1} px between the frames (its centre per frame, shortest \
+             first: {}): the camera or the sample moved during the bracket — fix the rig and take \
+             the bracket again",
+            r.max_shift_px,
+            list.join(", ")
+        ),
+    )]
+}
+
+/// The largest ratio of consecutive shutter times an 8-bit (tone-curved) bracket may have. Through
+/// a gamma-like curve a frame's codes above the noise floor (≈ 5–250) span two to three decades of
+/// radiance, coarsely at the bottom; measured: a 3-frame bracket with 42× steps (1/600, 0.07, 3 s)
+/// still gives σ′s within 5 % (`cli/tests/measure.rs`), a 2-frame one 1800× apart is +712 % off.
+/// 64× (6 stops) keeps every bracket that measured and flags the gap. (The demo's and the paper's
+/// brackets step by 1.9×.)
+pub const MAX_STEP_8BIT: f64 = 64.0;
+
+/// The same for linear frames of more than 8 bits (RAW, 16-bit linear): 12 usable bits and more
+/// overlap across 256× (8 stops).
+pub const MAX_STEP_LINEAR: f64 = 256.0;
+
+/// The bracket's overlap: consecutive exposures more than [`MAX_STEP_8BIT`] (8-bit frames through
+/// a recovered or given response) or [`MAX_STEP_LINEAR`] (linear frames) apart, or a recovered
+/// response from fewer than 3 frames, make every channel suspect: the merge then interpolates
+/// across radiances no frame measured (issue 17: a 2-frame bracket of 1/600 and 3 s measured
+/// +712 % and was called ok).
+pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
+    let limit = match m.hdr.response_kind {
+        ResponseKind::Recovered | ResponseKind::Given => MAX_STEP_8BIT,
+        ResponseKind::Linear => MAX_STEP_LINEAR,
+        _ => return Vec::new(),
+    };
+    let mut times: Vec<f64> = m.hdr.frames.iter().map(|f| f.time_s).collect();
+    times.sort_by(f64::total_cmp);
+    let mut reasons = Vec::new();
+    if m.hdr.response_kind == ResponseKind::Recovered && times.len() < 3 {
+        reasons.push(suspect(
+            ReasonKind::BracketGap,
+            format!(
+                "the camera response was recovered from {} frame(s): with fewer than 3 the \
+                 recovery is barely constrained — take a bracket of 5 or more exposures, at most \
+                 {MAX_STEP_8BIT:.0}× apart",
+                times.len()
+            ),
+        ));
+    }
+    let worst = times
+        .windows(2)
+        .filter(|w| w[0] > 0.0)
+        .map(|w| (w[1] / w[0], w[0], w[1]))
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some((ratio, t0, t1)) = worst
+        && ratio > limit
+    {
+        reasons.push(suspect(
+            ReasonKind::BracketGap,
+            format!(
+                "consecutive exposures {} s and {} s are {ratio:.0}× apart (at most {limit:.0}× for \
+                 {} frames): radiances between them are well exposed in no frame — add exposures \
+                 in between",
+                short(t0),
+                short(t1),
+                if limit == MAX_STEP_8BIT { "8-bit" } else { "linear" }
+            ),
+        ));
+    }
+    reasons
+}
+
+/// A shutter time for a message (4 significant digits).
+pub(super) fn short(t: f64) -> String {
+    format!("{t:.4}")
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .to_string()
+}
