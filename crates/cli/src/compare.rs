@@ -16,7 +16,7 @@ use crate::output::{errln, out, outln};
 pub struct Args {
     #[command(flatten)]
     pub samples: SamplesArgs,
-    /// Where to write compare.csv and compare.md (the command's own files, replaced on each run;
+    /// Where to write compare.csv, compare.md and index.html (the command's own files, replaced on each run;
     /// checked before any sample is measured). Each sample's plot (compare.svg, compare.png) goes
     /// into its own folder and is replaced.
     #[arg(
@@ -40,10 +40,14 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let shared: Vec<PathBuf> = ["compare.csv", "compare.md"]
-        .iter()
-        .map(|f| args.output_dir.join(f))
-        .collect();
+    let shared: Vec<PathBuf> = [
+        "compare.csv",
+        "compare.md",
+        scatterfit_report::html::INDEX_PAGE,
+    ]
+    .iter()
+    .map(|f| args.output_dir.join(f))
+    .collect();
     let (dirs, misspelt) = crate::common::samples_for(
         "compare",
         &args.samples.dirs,
@@ -52,7 +56,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         overrides.allow_outside_paths,
         args.quiet || args.json,
     )?;
-    let (pairs, mut failed) = crate::runner::compare_dirs(
+    let crate::runner::Compared {
+        pairs,
+        dirs: pair_dirs,
+        mut failed,
+        ..
+    } = crate::runner::compare_dirs(
         &dirs,
         &args.fit,
         args.samples.jobs.unwrap_or(0),
@@ -69,6 +78,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .map_err(|e| anyhow::anyhow!("writing {}: {e}", p.display()))?;
     }
+    let proposed: Vec<_> = pairs.iter().map(|(_, p)| p.clone()).collect();
+    let index = crate::common::write_index(
+        &args.output_dir,
+        "scatterfit compare",
+        "One row per sample, the proposed method's values (α′ from the spectrophotometer, σ′s \
+         fitted); Figure 6 compares them with the existing method's fit; compare.md has both.",
+        &proposed,
+        &pair_dirs,
+        &failed,
+        &["compare.csv", "compare.md"],
+    )?;
     if args.json {
         crate::output::print_json(&pairs)?;
     } else {
@@ -78,6 +98,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.output_dir.join("compare.csv").display(),
             args.output_dir.join("compare.md").display()
         )?;
+        outln!("index: {}", index.display())?;
     }
     if !failed.is_empty() {
         errln!("\n{} sample(s) failed:", failed.len());

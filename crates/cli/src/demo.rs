@@ -163,8 +163,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         normalise_with_spectro: false,
         allow_outside_paths: false,
     };
-    let (pairs, exacts, failed) =
-        crate::runner::compare_dirs_exact(&dirs, &fit, args.jobs.unwrap_or(0), quiet, true, true)?;
+    let crate::runner::Compared {
+        pairs,
+        dirs: pair_dirs,
+        exacts,
+        failed,
+    } = crate::runner::compare_dirs_exact(&dirs, &fit, args.jobs.unwrap_or(0), quiet, true, true)?;
     let measure_s = t1.elapsed().as_secs_f64();
     let rows = accuracy_rows(&pairs, &exacts, &truths);
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
@@ -185,6 +189,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
     }
+    let index = crate::common::write_index(
+        out,
+        "scatterfit demo: the seven materials of Choi, Lee & Chin (2014)",
+        "Monte Carlo rig-twin samples of the paper's seven materials, measured with the proposed \
+         method (dipole); the truth is in each sample's truth.json, the errors against it in \
+         accuracy.md. The sample's name opens its report: verdict, Table 1, Figures 4 and 6, the \
+         evidence and the inputs.",
+        &proposed,
+        &pair_dirs,
+        &failed,
+        &[
+            "summary.md",
+            "summary.csv",
+            "compare.md",
+            "compare.csv",
+            "accuracy.md",
+            "demo-summary.json",
+        ],
+    )?;
     if args.json {
         crate::output::print_json(&rows)?;
     } else {
@@ -201,8 +224,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
              samples with both methods"
         )?;
         outln!(
-            "files: {0}/<material>/result.json, fit.png, compare.png; {0}/summary.md (Table 1), \
-             compare.md (Table 2), accuracy.md",
+            "files: {0}/<material>/result.json, report.html, fit.png, compare.png; {0}/summary.md \
+             (Table 1), compare.md (Table 2), accuracy.md",
             out.display()
         )?;
         // The data checks' verdict on the proposed method's channels (RELIABILITY.md).
@@ -222,6 +245,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         } else {
             outln!("quality: {}", suspect.join("; "))?;
         }
+        // Last: the page a person opens (every sample's verdict and numbers, a link to each report).
+        outln!("index: {}", index.display())?;
     }
     if !failed.is_empty() {
         errln!("\n{} sample(s) failed:", failed.len());

@@ -144,9 +144,21 @@ pub type Failures = Vec<(PathBuf, String)>;
 /// One sample compared: (existing, proposed).
 pub type Pair = (MeasurementResult, MeasurementResult);
 
+/// What [`compare_dirs_exact`] gives.
+pub struct Compared {
+    /// The samples compared: (existing, proposed).
+    pub pairs: Vec<Pair>,
+    /// Each pair's folder.
+    pub dirs: Vec<PathBuf>,
+    /// Per pair, the exact fit (when asked for).
+    pub exacts: Vec<Option<MeasurementResult>>,
+    /// The samples that failed, with why.
+    pub failed: Failures,
+}
+
 /// Measures `dirs` once and fits each both ways; writes compare.svg/png into each sample folder
-/// (and, with `write_results`, the proposed measurement's result files as `measure` does).
-/// Returns the pairs and the samples that failed.
+/// (and, with `write_results`, the proposed measurement's result files as `measure` does, its
+/// report.html with Figure 6). Returns the pairs, their folders and the samples that failed.
 ///
 /// # Errors
 /// Only when the worker threads cannot start.
@@ -156,9 +168,8 @@ pub fn compare_dirs(
     jobs: usize,
     quiet: bool,
     write_results: bool,
-) -> anyhow::Result<(Vec<Pair>, Failures)> {
-    let (pairs, _, failed) = compare_dirs_exact(dirs, fit, jobs, quiet, write_results, false)?;
-    Ok((pairs, failed))
+) -> anyhow::Result<Compared> {
+    compare_dirs_exact(dirs, fit, jobs, quiet, write_results, false)
 }
 
 /// [`compare_dirs`], and with `exact` each sample also fitted beyond the paper: the Monte Carlo
@@ -173,11 +184,12 @@ pub fn compare_dirs_exact(
     quiet: bool,
     write_results: bool,
     exact: bool,
-) -> anyhow::Result<(Vec<Pair>, Vec<Option<MeasurementResult>>, Failures)> {
+) -> anyhow::Result<Compared> {
     let mut overrides = fit.overrides()?;
     overrides.method = Some(Method::Proposed);
     let outcomes = measure_many(dirs, &overrides, jobs, quiet, &|_, _| {})?;
     let mut pairs = Vec::new();
+    let mut pair_dirs = Vec::new();
     let mut exacts = Vec::new();
     let mut failed = Vec::new();
     for o in outcomes {
@@ -195,7 +207,10 @@ pub fn compare_dirs_exact(
                 continue;
             }
         };
-        if write_results && let Err(e) = scatterfit_report::write_measurement(&o.dir, &proposed) {
+        if write_results
+            && let Err(e) =
+                scatterfit_report::write_measurement_with(&o.dir, &proposed, Some(&existing))
+        {
             let e = anyhow::Error::from(e);
             failed.push((o.dir.clone(), format!("writing the results: {e:#}")));
         }
@@ -226,6 +241,12 @@ pub fn compare_dirs_exact(
             existing.to_result(Some("profile.csv")),
             proposed.to_result(Some("profile.csv")),
         ));
+        pair_dirs.push(o.dir);
     }
-    Ok((pairs, exacts, failed))
+    Ok(Compared {
+        pairs,
+        dirs: pair_dirs,
+        exacts,
+        failed,
+    })
 }

@@ -209,6 +209,41 @@ pub struct HdrStage {
     pub merge_s: f64,
     /// What was found and corrected of a real camera (black level, exposure times, flat).
     pub corrections: Corrections,
+    /// The frames as read, shortest first, reduced to at most [`THUMBNAIL_SIDE`] pixels (8-bit
+    /// RGB, point-sampled): what a report shows of the bracket without reading it again. Empty
+    /// for a given radiance map.
+    pub thumbnails: Vec<ImageBuf<u8>>,
+}
+
+/// Longest side of [`HdrStage::thumbnails`] [px].
+pub const THUMBNAIL_SIDE: usize = 96;
+
+/// `frame` point-sampled at the centres of a grid of at most [`THUMBNAIL_SIDE`] pixels, as 8-bit
+/// RGB (16-bit samples keep their top 8 bits; grey is repeated): cheap (a few thousand samples per
+/// frame), enough to see the spot, clipping and misalignment.
+fn thumbnail(frame: &CameraFrame) -> Option<ImageBuf<u8>> {
+    let (w, h) = (frame.width(), frame.height());
+    let step = w.max(h).div_ceil(THUMBNAIL_SIDE).max(1);
+    let (tw, th) = (w.div_ceil(step), h.div_ceil(step));
+    let mut data = Vec::with_capacity(tw * th * 3);
+    for ty in 0..th {
+        let y = (ty * step + step / 2).min(h - 1);
+        for tx in 0..tw {
+            let x = (tx * step + step / 2).min(w - 1);
+            let px: [u8; 3] = match frame {
+                CameraFrame::U8(b) => {
+                    let p = b.pixel(x, y)?;
+                    std::array::from_fn(|c| p[c.min(p.len() - 1)])
+                }
+                CameraFrame::U16(b) => {
+                    let p = b.pixel(x, y)?;
+                    std::array::from_fn(|c| (p[c.min(p.len() - 1)] >> 8) as u8)
+                }
+            };
+            data.extend_from_slice(&px);
+        }
+    }
+    ImageBuf::new(tw, th, 3, data).ok()
 }
 
 /// The bracket (and dark frame) read and checked, before any pixel work: the first half of
@@ -382,6 +417,11 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
         )
     };
     let mut corrections = Corrections::default();
+    let thumbnails: Vec<ImageBuf<u8>> = bracket
+        .frames()
+        .iter()
+        .filter_map(|f| thumbnail(&f.frame))
+        .collect();
     let depth = bracket.frames()[0].frame.bit_depth();
     let mut stage = if depth == 8 {
         let bufs: Vec<ImageBuf<u8>> = bracket
@@ -520,6 +560,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             read_s,
             merge_s: 0.0,
             corrections: Corrections::default(),
+            thumbnails,
         }
     } else {
         if let Some(path) = &inputs.response {
@@ -661,6 +702,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             read_s,
             merge_s: 0.0,
             corrections: Corrections::default(),
+            thumbnails,
         }
     };
     if let Some((path, f)) = &flat
@@ -800,6 +842,7 @@ pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
         read_s: t0.elapsed().as_secs_f64(),
         merge_s: 0.0,
         corrections: Corrections::default(),
+        thumbnails: Vec::new(),
     })
 }
 

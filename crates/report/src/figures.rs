@@ -12,7 +12,9 @@ use scatterfit_pipeline::fit::ChannelOutcome;
 use crate::plot::{Figure, Panel, Series, SeriesStyle};
 
 const NAMES: [&str; 3] = ["R", "G", "B"];
-const COLOURS: [(u8, u8, u8); 3] = [(200, 30, 30), (20, 140, 40), (30, 70, 200)];
+/// The channels' colours: Okabe & Ito's (2008) vermillion, bluish green and blue, told apart with
+/// the common colour-vision deficiencies (each panel is also titled with its channel).
+const COLOURS: [(u8, u8, u8); 3] = crate::html::CHANNEL_COLOURS;
 
 /// The measured rings of channel `c`: used ones with error bars, excluded ones apart.
 fn measured_series(m: &Measurement, c: usize, report: Option<&FitReport>) -> Vec<Series> {
