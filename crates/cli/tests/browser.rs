@@ -261,6 +261,11 @@ fn demo_pages_load_and_draw_in_chromium() {
     let img = image::open(&png).unwrap().to_rgba8();
     assert_eq!(img.width(), WIDTH);
     let names: Vec<&str> = boxes.iter().map(|b| b.what.as_str()).collect();
+    let _ = writeln!(
+        std::io::stderr(),
+        "browser test: {} pictures and figures on the sample page, {height} px tall: {names:?}",
+        boxes.len()
+    );
     for want in [
         "Figure 4",
         "Figure 6",

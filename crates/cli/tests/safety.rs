@@ -96,6 +96,7 @@ fn planted_links_never_redirect_a_write() {
         "fit.png",
         "profile.csv",
         "result.md",
+        "report.html",
         "result-files.json",
     ] {
         let s = sample(d, &format!("s-{out}"));

@@ -21,9 +21,9 @@ use super::markup::{inline_svg, name, png_data_uri};
 use crate::plot::{Figure, Panel, Series, SeriesStyle};
 
 /// Longest side of the false-colour map [px].
-pub(crate) const MAP_SIDE: usize = 360;
+pub(crate) const MAP_SIDE: usize = 320;
 /// Side of the rendered swatch [px].
-pub(crate) const SWATCH_SIDE: usize = 160;
+pub(crate) const SWATCH_SIDE: usize = 128;
 
 /// Okabe & Ito's vermillion, bluish green and blue: the channels R, G, B in every figure of the
 /// report, Figures 4 and 6 included (distinct for the common colour-vision deficiencies; the lines also
@@ -83,8 +83,8 @@ fn fitted_span_px(m: &Measurement) -> Option<(f64, f64)> {
     span
 }
 
-/// The radiance map in false colour (log10 of the mean over channels of each block's valid
-/// pixels; viridis over the decades shown; white where every exposure clipped high), with the
+/// The radiance map in false colour (log10 of the mean of the valid channels at each map
+/// pixel's centre; viridis over the decades shown; white where every exposure clipped high), with the
 /// centre, the spot, the fitted rings and the cut-off drawn over it as SVG, and its colour scale.
 pub(crate) fn radiance_map(m: &Measurement, spot_radius_mm: Option<f64>) -> Option<String> {
     let hdr = &m.hdr.hdr;
@@ -95,30 +95,30 @@ pub(crate) fn radiance_map(m: &Measurement, spot_radius_mm: Option<f64>) -> Opti
     );
     let step = w.max(h).div_ceil(MAP_SIDE).max(1);
     let (tw, th) = (w.div_ceil(step), h.div_ceil(step));
-    // Per block: mean radiance of the valid pixel-channels, or the clip state.
+    // Per block, its centre pixel (point sampling: the map is smooth at this scale, and a
+    // quarter-megapixel read instead of the whole frame keeps the page cheap): the mean radiance of
+    // its valid channels, or its clip state.
     let mut values = vec![f64::NAN; tw * th];
     let mut high = vec![false; tw * th];
     let (data, clip) = (hdr.radiance.data(), hdr.clipped.data());
     for by in 0..th {
+        let y = (by * step + step / 2).min(h - 1);
         for bx in 0..tw {
-            let (mut sum, mut n, mut hi) = (0.0f64, 0usize, 0usize);
-            for y in by * step..((by + 1) * step).min(h) {
-                for x in bx * step..((bx + 1) * step).min(w) {
-                    let i = (y * w + x) * nc;
-                    for c in 0..nc {
-                        if clip[i + c] == 0 {
-                            sum += f64::from(data[i + c]);
-                            n += 1;
-                        } else if clip[i + c] & CLIPPED_HIGH != 0 {
-                            hi += 1;
-                        }
-                    }
+            let x = (bx * step + step / 2).min(w - 1);
+            let i = (y * w + x) * nc;
+            let (mut sum, mut n, mut hi) = (0.0f64, 0usize, false);
+            for c in 0..nc {
+                if clip[i + c] == 0 {
+                    sum += f64::from(data[i + c]);
+                    n += 1;
+                } else if clip[i + c] & CLIPPED_HIGH != 0 {
+                    hi = true;
                 }
             }
             if n > 0 {
                 values[by * tw + bx] = sum / n as f64;
-            } else if hi > 0 {
-                high[by * tw + bx] = true;
+            } else {
+                high[by * tw + bx] = hi;
             }
         }
     }
@@ -154,7 +154,9 @@ pub(crate) fn radiance_map(m: &Measurement, spot_radius_mm: Option<f64>) -> Opti
     let (vw, vh) = (tw as f64 + bar_w, th as f64);
     let mut svg = format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{vw}\" height=\"{vh}\">\
-         <image x=\"0\" y=\"0\" width=\"{tw}\" height=\"{th}\" href=\"{}\"/>",
+         <image x=\"0\" y=\"0\" width=\"{tw}\" height=\"{th}\" href=\"{}\"/>\
+         <clipPath id=\"map-clip\"><rect width=\"{tw}\" height=\"{th}\"/></clipPath>\
+         <g clip-path=\"url(#map-clip)\">",
         png_data_uri(&png)
     );
     let circle = |svg: &mut String, r_px: f64, dash: &str, label: &str| {
@@ -191,6 +193,7 @@ pub(crate) fn radiance_map(m: &Measurement, spot_radius_mm: Option<f64>) -> Opti
         cy - 7.0,
         cy + 7.0
     );
+    svg.push_str("</g>");
     // The colour scale: one block per decade, labelled.
     let x0 = tw as f64 + 10.0;
     let decades = (hi_log - lo_log) as usize;
@@ -215,13 +218,17 @@ pub(crate) fn radiance_map(m: &Measurement, spot_radius_mm: Option<f64>) -> Opti
         vh - 6.0,
         lo_log as i64
     );
+    let sampling = if step == 1 {
+        "every image pixel".to_string()
+    } else {
+        format!("one image pixel of every {step}×{step} block")
+    };
     let caption = format!(
         "The merged radiance map ({}) in false colour, log scale (relative radiance; white: \
-         clipped in every exposure, black: below every exposure or no data), {} px per map pixel. \
+         clipped in every exposure, black: below every exposure or no data), {sampling}. \
          Cross: the spot centre ({:.1}, {:.1}) px, {}. Solid circles: the innermost and outermost \
          ring the fits used ({}); dashed: the light spot; dotted: the profile's cut-off {:.0} px = {:.2} mm.",
         name(&m.hdr.image),
-        step,
         m.profile.profile.center_px[0],
         m.profile.profile.center_px[1],
         name(&format!("{:?}", m.profile.center_source).to_lowercase()),
@@ -284,7 +291,7 @@ pub(crate) fn response_figure(m: &Measurement) -> Option<Figure> {
 }
 
 /// The material rendered on `scatterfit-render`'s 10 mm sphere by the subsurface colour method
-/// (Choi et al. 2014 §4.1; the studio's lights, default tone map) at [`SWATCH_SIDE`] pixels, with
+/// (Choi et al. 2014 §4.1; the studio's lights; one sample per pixel) at [`SWATCH_SIDE`] pixels, with
 /// what it is; `None` when the parameters cannot be rendered.
 pub(crate) fn swatch(coefficients: [(f64, f64); 3], eta: f64) -> Option<(Vec<u8>, String)> {
     use scatterfit_render::tonemap::{ToneMap, tone_map};
@@ -292,20 +299,16 @@ pub(crate) fn swatch(coefficients: [(f64, f64); 3], eta: f64) -> Option<(Vec<u8>
         Material, Method, RenderOptions, Shape, render, studio, studio_lights,
     };
     let material = Material::dipole(scatterfit_optics::Rgb::from_array(coefficients), eta).ok()?;
-    let scene = studio(Shape::Sphere.mesh(1200).ok()?, studio_lights()).ok()?;
+    // One sample per pixel and a coarse sphere: ~5 ms, a small part of a measurement.
+    let scene = studio(Shape::Sphere.mesh(400).ok()?, studio_lights()).ok()?;
     let opts = RenderOptions {
         width: SWATCH_SIDE,
         height: SWATCH_SIDE,
-        spp: 4,
+        spp: 1,
         ..RenderOptions::default()
     };
     let rendered = render(&scene, &material, Method::Colour, &opts, &|_| {}).ok()?;
-    // One stop brighter than the renders' reference white: a small picture reads better bright.
-    let tm = ToneMap {
-        exposure_ev: 1.0,
-        ..ToneMap::default()
-    };
-    let img = tone_map(&rendered.image, &tm).ok()?;
+    let img = tone_map(&rendered.image, &ToneMap::default()).ok()?;
     let png = encode_png(img.width(), img.height(), img.data())?;
     Some((
         png,

@@ -168,10 +168,10 @@ pub(crate) fn index_page(page: &IndexPage<'_>) -> String {
             .collect();
         let _ = writeln!(
             p,
-            "<td>{} / {}</td><td>{}</td></tr>",
+            "<td>{} / {}</td><td class=\"links\">{}</td></tr>",
             name(&v.method),
             name(&v.model),
-            links.join(" · ")
+            links.join("<br>")
         );
     }
     p.push_str("</tbody></table></div></section>\n");

@@ -107,7 +107,9 @@ figcaption { color: var(--muted); font-size: .9em; margin-top: .3rem; }
 figure.swatchbox { width: 200px; }
 .scroll { overflow-x: auto; }
 td.rgbv { white-space: nowrap; font-size: .9em; }
-td.sample { min-width: 12rem; }
+td.sample { min-width: 11rem; }
+#samples-table { font-size: .92em; }
+td.links { white-space: nowrap; }
 td.sample .path { font-size: .75em; }
 pre { background: #f6f6f6; padding: .5rem; overflow-x: auto; font-size: .85em; white-space: pre-wrap; word-break: break-all; }
 code, .path { font-family: "DejaVu Sans Mono", monospace; font-size: .9em; word-break: break-all; }
