@@ -167,8 +167,27 @@ pub(crate) fn inline_svg(svg: &str, label: &str) -> String {
         (None, Some(w), Some(h)) => format!(" viewBox=\"0 0 {w} {h}\""),
         _ => String::new(),
     };
+    // The drawing's text came from files too (a sample's name in a title): XML's escaping made it
+    // markup-safe; the controls XML allows (CR, C1) and the bidirectional overrides go here.
+    let rest: String = rest
+        .chars()
+        .map(|c| {
+            if c == '\r' || is_hidden_control(c) {
+                '\u{fffd}'
+            } else {
+                c
+            }
+        })
+        .collect();
     format!(
         "<svg role=\"img\" aria-label=\"{}\"{view_box}{rest}",
         name(label)
     )
+}
+
+/// C1 controls and the bidirectional overrides and isolates: allowed in XML, acted on (not shown)
+/// by text layout.
+fn is_hidden_control(c: char) -> bool {
+    matches!(c, '\u{7f}'..='\u{9f}' | '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}'
+        | '\u{2066}'..='\u{2069}')
 }

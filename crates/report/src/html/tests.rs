@@ -121,12 +121,22 @@ fn inline_svg_drops_the_declaration_and_scales() {
     assert!(s.starts_with("<svg role=\"img\" aria-label=\"a &quot;label&quot;\" viewBox=\"0 0 300 100\" width=\"300\""), "{s}");
     assert!(!s.contains("<?xml"));
     assert_eq!(inline_svg("not svg", "x"), "");
+    // Controls XML allows but text layout acts on are replaced.
+    let s = inline_svg("<svg><text>a\u{9b}b\u{202e}c</text></svg>", "x");
+    assert!(s.ends_with("<text>a\u{fffd}b\u{fffd}c</text></svg>"), "{s}");
 }
 
 #[test]
 fn sample_page_escapes_every_field_from_a_file() {
     let r = hostile_result();
+    let svg = format!(
+        "<svg width=\"10\" height=\"10\"><text>{}</text></svg>",
+        scatterfit_io::escape::xml_text(HOSTILE)
+    );
     let extras = SampleExtras {
+        fit_svg: Some(svg.clone()),
+        compare_svg: Some(svg),
+        response_svg: None,
         thumbnails: vec![(HOSTILE.into(), 0.01, vec![1, 2, 3])],
         files: vec![HOSTILE.into(), "result.json".into()],
         swatch: Some((vec![0], HOSTILE.into())),
