@@ -106,10 +106,10 @@ pub(crate) fn index_page(page: &IndexPage<'_>) -> String {
         .map(|e| ResultView::new(e.result))
         .collect();
     let count = |v: &str| views.iter().filter(|r| r.verdict == v).count();
-    let _ = write!(
+    let _ = writeln!(
         p,
         "<header><h1>{}</h1><p>{}</p><p class=\"meta\">{} sample(s): {} ok, {} suspect, {} \
-         failed in a channel; {} could not be measured.</p></header>\n",
+         failed in a channel; {} could not be measured.</p></header>",
         name(&page.title),
         text(&page.intro),
         views.len() + page.failures.len(),
@@ -203,6 +203,6 @@ pub(crate) fn index_page(page: &IndexPage<'_>) -> String {
             links.join(", ")
         );
     }
-    let _ = write!(p, "<script>{SORT_JS}</script>\n</body>\n</html>\n");
+    let _ = writeln!(p, "<script>{SORT_JS}</script>\n</body>\n</html>");
     p
 }

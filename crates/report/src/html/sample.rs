@@ -51,12 +51,12 @@ fn opt(v: Option<f64>) -> String {
 /// The page for `view` with `extras`.
 pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
     let mut p = head(&format!("{} — scatterfit report", view.name));
-    let _ = write!(
+    let _ = writeln!(
         p,
         "<header><h1>{}</h1><p class=\"meta\">overall {} · method {} · model {} · α′ from {} · \
          scatterfit {}</p><nav><a href=\"#verdict\">Verdict</a><a href=\"#table1\">Table 1</a>\
          <a href=\"#fig4\">Figure 4</a>{}<a href=\"#evidence\">Evidence</a>\
-         <a href=\"#inputs\">Inputs</a></nav></header>\n",
+         <a href=\"#inputs\">Inputs</a></nav></header>",
         name(&view.name),
         badge(view.verdict),
         name(&view.method),
@@ -99,14 +99,14 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
     );
 
     // Table 1.
-    let _ = write!(
+    let _ = writeln!(
         p,
         "<section id=\"table1\"><h2>Table 1: parameters</h2><p>η = {} <span class=\"err\">{}</span> \
          (from {})</p><div class=\"scroll\"><table><thead><tr><th rowspan=\"2\">channel</th>\
          <th colspan=\"3\">σ′s [mm⁻¹]</th><th colspan=\"3\">σa [mm⁻¹]</th><th colspan=\"2\">α′</th>\
          <th rowspan=\"2\">Rd (spectro)</th></tr><tr><th>value</th><th>± fit</th><th>± spectro</th>\
          <th>value</th><th>± fit</th><th>± spectro</th><th>value</th><th>± spectro</th></tr>\
-         </thead><tbody>\n",
+         </thead><tbody>",
         view.eta.value_text(),
         view.eta.error_text(),
         name(&view.eta_source)
@@ -154,13 +154,13 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
     p.push_str("</section>\n");
 
     // Figures 4 and 6.
-    let _ = write!(
+    let _ = writeln!(
         p,
         "<section id=\"fig4\"><h2>Figure 4: profile and fit</h2><figure>{}<figcaption>The \
          measured radial profile Rd(r) per channel (log scale) and the fitted {} model. Filled \
          markers: rings the fit used, with one-standard-error bars; hollow grey markers: rings \
          not fitted (inside the light spot, below the bracket's detection limit).</figcaption>\
-         </figure></section>\n",
+         </figure></section>",
         extras
             .fit_svg
             .as_deref()
@@ -168,12 +168,12 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
         name(&view.model)
     );
     if let Some(svg) = &extras.compare_svg {
-        let _ = write!(
+        let _ = writeln!(
             p,
             "<section id=\"fig6\"><h2>Figure 6: existing and proposed methods</h2><figure>{}\
              <figcaption>The measured profile with the existing method's fit (σ′s and σa \
              fitted; dashed) and the proposed method's (α′ from the spectrophotometer; solid).\
-             </figcaption></figure></section>\n",
+             </figcaption></figure></section>",
             inline_svg(svg, "Figure 6")
         );
     }
