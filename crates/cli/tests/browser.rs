@@ -131,7 +131,7 @@ fn measure_boxes(chrome: &Path, profile: &Path, dir: &Path, page: &Path) -> (u32
             "<!DOCTYPE html><html><body style=\"margin:0\"><iframe id=\"f\" src=\"{}\" \
              style=\"border:0;width:{WIDTH}px;height:30000px\" scrolling=\"no\"></iframe>\
              <pre id=\"out\"></pre><script>document.getElementById('f').onload=function(){{\
-             var d=this.contentDocument,o=[];o.push('height '+d.documentElement.scrollHeight);\
+             var d=this.contentDocument,o=[];o.push('height '+Math.ceil(d.body.getBoundingClientRect().bottom+16));\
              d.querySelectorAll('figure svg, figure img, figure .swatch').forEach(function(e,i){{\
              var r=e.getBoundingClientRect();o.push('box '+(e.getAttribute('aria-label')||\
              e.getAttribute('alt')||e.className||e.tagName)+'|'+r.left+'|'+r.top+'|'+r.width+'|'+r.height);}});\
@@ -169,6 +169,39 @@ fn measure_boxes(chrome: &Path, profile: &Path, dir: &Path, page: &Path) -> (u32
         }
     }
     (height, boxes)
+}
+
+/// The index's η column (its `data-sort` values) as loaded, after one click on its header and
+/// after a second: clicks made by a wrapper page that frames the index.
+fn sorted_by_clicks(chrome: &Path, profile: &Path, dir: &Path, index: &Path) -> [Vec<f64>; 3] {
+    let wrapper = dir.join("sort-check.html");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "<!DOCTYPE html><html><body><iframe id=\"f\" src=\"{}\" style=\"width:1200px;\
+             height:800px\"></iframe><pre id=\"out\"></pre><script>\
+             document.getElementById('f').onload=function(){{var d=this.contentDocument,o=[];\
+             var t=d.getElementById('samples-table'),th=t.tHead.rows[0].cells[3];\
+             function col(){{return Array.prototype.map.call(t.tBodies[0].rows,function(r){{\
+             return r.cells[3].getAttribute('data-sort');}}).join(' ');}}\
+             o.push(col());th.click();o.push(col());th.click();o.push(col());\
+             document.getElementById('out').textContent=o.join('\\n');}};</script></body></html>",
+            file_url(index)
+        ),
+    )
+    .unwrap();
+    let (dom, _) = browse(chrome, profile, &["--dump-dom"], &file_url(&wrapper));
+    let out = dom
+        .split("<pre id=\"out\">")
+        .nth(1)
+        .and_then(|s| s.split("</pre>").next())
+        .unwrap_or_else(|| panic!("the sort wrapper wrote nothing:\n{dom}"));
+    let cols: Vec<Vec<f64>> = out
+        .lines()
+        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(cols.len(), 3, "{out}");
+    [cols[0].clone(), cols[1].clone(), cols[2].clone()]
 }
 
 /// Screenshot of `page` (full height) into `png`.
@@ -241,6 +274,14 @@ fn demo_pages_load_and_draw_in_chromium() {
     );
     assert!(dom.contains("<th class=\"sortable\""), "no sort headers");
     assert_eq!(dom.matches("/report.html\">report</a>").count(), 7, "{dom}");
+    // Sorting by η: a click sorts ascending, a second descending.
+    let [loaded, once, twice] = sorted_by_clicks(&chrome, &profile, temp.path(), &index);
+    assert_eq!(loaded.len(), 7);
+    let mut up = loaded.clone();
+    up.sort_by(f64::total_cmp);
+    assert_eq!(once, up, "one click");
+    up.reverse();
+    assert_eq!(twice, up, "two clicks");
     let (h, _) = measure_boxes(&chrome, &profile, temp.path(), &index);
     let stderr = screenshot(
         &chrome,

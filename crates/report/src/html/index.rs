@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 
 use scatterfit_io::result_json::MeasurementResult;
 
-use super::markup::{badge, head, href, name, text};
+use super::markup::{badge, head_with, href, name, text};
 use super::view::ResultView;
 
 /// One measured sample on the index.
@@ -89,6 +89,10 @@ fn num_cell(v: Option<f64>, err: Option<f64>) -> String {
     format!("<td class=\"num\" data-sort=\"{key}\">{shown}{e}</td>")
 }
 
+/// Most characters of a reason shown in the index's row (the whole is its tooltip and on the
+/// sample's page).
+const WHY_CHARS: usize = 140;
+
 fn verdict_rank(v: &str) -> u8 {
     match v {
         "ok" => 0,
@@ -99,7 +103,7 @@ fn verdict_rank(v: &str) -> u8 {
 
 /// The index page.
 pub(crate) fn index_page(page: &IndexPage<'_>) -> String {
-    let mut p = head(&page.title);
+    let mut p = head_with(&page.title, "wide");
     let views: Vec<ResultView> = page
         .samples
         .iter()
@@ -136,10 +140,34 @@ pub(crate) fn index_page(page: &IndexPage<'_>) -> String {
             .iter()
             .map(|c| format!("{} {}", c.name, c.verdict))
             .collect();
+        // The reasons, each once (the same check often speaks for every channel), shortened.
+        let mut why: Vec<&str> = Vec::new();
+        for r in v.channels.iter().flat_map(|c| &c.reasons) {
+            if !why.contains(&r.message.as_str()) {
+                why.push(&r.message);
+            }
+        }
+        let why: String = why
+            .iter()
+            .map(|m| {
+                let short: String = m.chars().take(WHY_CHARS).collect();
+                let more = if m.chars().count() > WHY_CHARS {
+                    "…"
+                } else {
+                    ""
+                };
+                format!(
+                    "<span class=\"why\" title=\"{}\">{}{more}</span>",
+                    name(m),
+                    name(&short)
+                )
+            })
+            .collect();
         let _ = write!(
             p,
             "<tr><td class=\"sample\" data-sort=\"{}\">{sample}<br><span class=\"path muted\">{}\
-             </span></td><td data-sort=\"{}\">{}</td><td class=\"rgbv\">{}</td>{}",
+             </span></td><td data-sort=\"{}\">{}</td><td class=\"rgbv\"><span class=\"nowrap\">{}\
+             </span>{why}</td>{}",
             name(&v.name),
             name(&e.folder),
             verdict_rank(v.verdict),

@@ -106,7 +106,10 @@ figcaption { color: var(--muted); font-size: .9em; margin-top: .3rem; }
 .swatch { width: 160px; height: 160px; border: 1px solid var(--rule); }
 figure.swatchbox { width: 200px; }
 .scroll { overflow-x: auto; }
-td.rgbv { white-space: nowrap; font-size: .9em; }
+td.rgbv { min-width: 13rem; font-size: .9em; }
+.nowrap { white-space: nowrap; }
+.why { display: block; font-size: .85em; color: var(--muted); margin-top: .2rem; }
+body.wide { max-width: none; }
 td.sample { min-width: 11rem; }
 #samples-table { font-size: .92em; }
 td.links { white-space: nowrap; }
@@ -123,13 +126,19 @@ nav a { margin-right: 1rem; }
 
 /// The page's start: doctype, `<head>` with the title (escaped here) and the style.
 pub(crate) fn head(title: &str) -> String {
+    head_with(title, "")
+}
+
+/// [`head`] with a class on `<body>` (`wide`: no maximum width, for the index's table).
+pub(crate) fn head_with(title: &str, body_class: &str) -> String {
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
          <meta name=\"generator\" content=\"scatterfit {}\">\n<title>{}</title>\n<style>{STYLE}</style>\n\
-         </head>\n<body>\n",
+         </head>\n<body class=\"{}\">\n",
         env!("CARGO_PKG_VERSION"),
-        name(title)
+        name(title),
+        name(body_class)
     )
 }
 
