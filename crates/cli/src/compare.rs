@@ -56,16 +56,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         overrides.allow_outside_paths,
         args.quiet || args.json,
     )?;
-    let crate::runner::Compared {
+    let crate::runner::Comparison {
         pairs,
         dirs: pair_dirs,
         mut failed,
         ..
     } = crate::runner::compare_dirs(
         &dirs,
-        &args.fit,
+        &overrides,
         args.samples.jobs.unwrap_or(0),
         args.quiet || args.json,
+        false,
         false,
     )?;
     failed.extend(misspelt);

@@ -16,6 +16,8 @@
 use scatterfit_fit::FitReport;
 use scatterfit_imaging::{CenterOptions, find_spot_center};
 pub use scatterfit_io::quality::{Quality, Reason, ReasonKind, Verdict};
+use scatterfit_io::result_json::ResponseKind;
+use scatterfit_optics::Rgb;
 
 use crate::fit::ChannelOutcome;
 use crate::measure::Measurement;
@@ -309,7 +311,7 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
                 message: problem.clone(),
             }];
         }
-        ChannelOutcome::Fitted(r) => r,
+        ChannelOutcome::Fitted(f) => &f.report,
     };
     if !r.converged {
         reasons.push(Reason {
@@ -364,14 +366,10 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
 }
 
 /// The verdict on each channel (R, G, B): the fit's checks and the sample's.
-pub fn quality(m: &Measurement) -> [Quality; 3] {
+pub fn quality(m: &Measurement) -> Rgb<Quality> {
     let sample = sample_checks(m);
-    std::array::from_fn(|c| {
-        let mut reasons = m
-            .fits
-            .get(c)
-            .map(|o| fit_reasons(o, m.spectro.eta))
-            .unwrap_or_default();
+    m.fits.as_ref().map(|o| {
+        let mut reasons = fit_reasons(o, m.spectro.eta);
         // A failed channel has no value the sample's findings could qualify.
         if !reasons.iter().any(|r| r.severity == Verdict::Failed) {
             reasons.extend(sample.reasons.iter().cloned());
@@ -576,14 +574,14 @@ pub const MAX_STEP_LINEAR: f64 = 256.0;
 /// +712 % and was called ok).
 pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
     let limit = match m.hdr.response_kind {
-        "recovered" | "given" => MAX_STEP_8BIT,
-        "linear" => MAX_STEP_LINEAR,
+        ResponseKind::Recovered | ResponseKind::Given => MAX_STEP_8BIT,
+        ResponseKind::Linear => MAX_STEP_LINEAR,
         _ => return Vec::new(),
     };
     let mut times: Vec<f64> = m.hdr.frames.iter().map(|f| f.time_s).collect();
     times.sort_by(f64::total_cmp);
     let mut reasons = Vec::new();
-    if m.hdr.response_kind == "recovered" && times.len() < 3 {
+    if m.hdr.response_kind == ResponseKind::Recovered && times.len() < 3 {
         reasons.push(suspect(
             ReasonKind::BracketGap,
             format!(

@@ -23,6 +23,9 @@ use serde::Serialize;
 use crate::camera::{ExposureEstimate, estimate_black_level, estimate_exposures, flat_divisor};
 use crate::error::{PipelineError, Result};
 
+/// How the bracket became radiance (the name `result.json` records).
+pub use scatterfit_io::result_json::ResponseKind;
+
 /// Exposure corrections estimated from the frames are applied automatically
 /// ([`ExposureCorrection::Auto`]) when some frame's time is off by more than this (1 %): a good
 /// shutter's scatter and the estimate's own (about 0.1 % on the twin) stay below it.
@@ -191,8 +194,8 @@ pub struct HdrStage {
     pub hdr: HdrImage,
     /// The response used (8-bit), `None` for a linear 16-bit merge or a given radiance map.
     pub response: Option<ResponseCurve>,
-    /// `recovered`, `given`, `linear` or `merged` (a radiance map from the manifest).
-    pub response_kind: &'static str,
+    /// Recovered, given, linear or merged (a radiance map from the manifest).
+    pub response_kind: ResponseKind,
     /// RMS residual of the response recovery per channel (recovered responses only).
     pub rms: Vec<f64>,
     /// The frames, shortest first.
@@ -454,16 +457,16 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             Ok((cal.response, rms))
         };
         let (mut response, kind, mut rms) = match &inputs.response {
-            Some(path) => (load_response(path)?, "given", Vec::new()),
+            Some(path) => (load_response(path)?, ResponseKind::Given, Vec::new()),
             None => {
                 let (r, rms) = recover(&times)?;
-                (r, "recovered", rms)
+                (r, ResponseKind::Recovered, rms)
             }
         };
         // Exposure times from the frames: ratios of linearised codes in the well-exposed range.
         let mut times_used = times.clone();
         if inputs.exposure_correction != ExposureCorrection::Never {
-            let recovered = kind == "recovered";
+            let recovered = kind == ResponseKind::Recovered;
             let ch = bufs[0].channels();
             let n = bufs[0].data().len();
             for round in 0..if recovered { 4 } else { 1 } {
@@ -693,7 +696,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
         HdrStage {
             hdr,
             response: None,
-            response_kind: "linear",
+            response_kind: ResponseKind::Linear,
             rms: Vec::new(),
             frames,
             image,
@@ -833,7 +836,7 @@ pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
             clipped_count: 0,
         },
         response: None,
-        response_kind: "merged",
+        response_kind: ResponseKind::Merged,
         rms: Vec::new(),
         frames: Vec::new(),
         image: format!("{w}×{h} {}", if ch == 1 { "grey" } else { "RGB" }),

@@ -58,8 +58,8 @@ fn hostile_result() -> MeasurementResult {
         })
     };
     serde_json::from_value(serde_json::json!({
-        "name": HOSTILE, "eta": 1.3, "eta_source": HOSTILE, "method": HOSTILE, "model": HOSTILE,
-        "albedo_model": HOSTILE,
+        "name": HOSTILE, "eta": 1.3, "eta_source": "spectro", "method": "proposed",
+        "model": "dipole", "albedo_model": "diffusion",
         "channels": { "r": channel("ok"), "g": channel("suspect"), "b": channel("failed") },
         "inputs": {
             "sample_dir": HOSTILE,

@@ -195,15 +195,13 @@ fn channel(name: &'static str, c: &ChannelResult) -> ChannelView {
 impl ResultView {
     /// The view of `r`.
     pub fn new(r: &MeasurementResult) -> Self {
-        let [cr, cg, cb] = r.channels.as_array();
+        let [cr, cg, cb] = [&r.channels.r, &r.channels.g, &r.channels.b];
         let channels = [
             channel(CHANNELS[0], cr),
             channel(CHANNELS[1], cg),
             channel(CHANNELS[2], cb),
         ];
-        let verdict = r
-            .channels
-            .as_array()
+        let verdict = [cr, cg, cb]
             .iter()
             .map(|c| verdict_of(c))
             .max()
@@ -248,10 +246,12 @@ impl ResultView {
                 fit: None,
                 spectro: r.eta_stderr,
             },
-            eta_source: r.eta_source.clone(),
-            method: r.method.clone(),
-            model: r.model.clone(),
-            albedo_model: r.albedo_model.clone(),
+            eta_source: r.eta_source.map_or_else(|| "—".into(), |e| e.name().into()),
+            method: r.method.to_string(),
+            model: r.model.to_string(),
+            albedo_model: r
+                .albedo_model
+                .map_or_else(|| "—".into(), |a| a.name().into()),
             channels,
             verdict,
             files,
