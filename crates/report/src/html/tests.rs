@@ -208,3 +208,24 @@ fn index_sort_keys_are_numbers() {
     assert!(html.contains("data-sort=\"1.3e0\">1.300</td>"), "{html}");
     assert!(html.contains("data-sort=\"1.25e0\">1.250<br><span class=\"err\">± "));
 }
+
+#[test]
+fn sample_page_sections_come_in_a_readers_order() {
+    let r = hostile_result();
+    let svg = "<svg width=\"10\" height=\"10\"></svg>".to_string();
+    let extras = SampleExtras {
+        fit_svg: Some(svg.clone()),
+        compare_svg: Some(svg),
+        ..SampleExtras::default()
+    };
+    let page = sample_html(&r, &extras);
+    let at = |id: &str| {
+        page.find(&format!("<section id=\"{id}\""))
+            .unwrap_or_else(|| panic!("no section {id}"))
+    };
+    let order = ["verdict", "table1", "fig4", "fig6", "evidence", "inputs"].map(at);
+    assert!(order.windows(2).all(|w| w[0] < w[1]), "{order:?}");
+    // Without the existing method's fit there is no Figure 6, nor a link to it.
+    let page = sample_html(&r, &SampleExtras::default());
+    assert!(!page.contains("id=\"fig6\"") && !page.contains("href=\"#fig6\""));
+}
