@@ -218,7 +218,7 @@ pub struct HdrStage {
     pub thumbnails: Vec<ImageBuf<u8>>,
 }
 
-/// Longest side of [`HdrStage::thumbnails`] [px].
+/// Longest side of [`HdrStage::thumbnails`] \[px\].
 pub const THUMBNAIL_SIDE: usize = 96;
 
 /// `frame` point-sampled at the centres of a grid of at most [`THUMBNAIL_SIDE`] pixels, as 8-bit

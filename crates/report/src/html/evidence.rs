@@ -20,9 +20,9 @@ use scatterfit_pipeline::fit::ChannelOutcome;
 use super::markup::{inline_svg, name, png_data_uri};
 use crate::plot::{Figure, Panel, Series, SeriesStyle};
 
-/// Longest side of the false-colour map [px].
+/// Longest side of the false-colour map \[px\].
 pub(crate) const MAP_SIDE: usize = 320;
-/// Side of the rendered swatch [px].
+/// Side of the rendered swatch \[px\].
 pub(crate) const SWATCH_SIDE: usize = 128;
 
 /// Okabe & Ito's vermillion, bluish green and blue: the channels R, G, B in every figure of the
@@ -67,7 +67,7 @@ pub(crate) fn viridis(t: f64) -> [u8; 3] {
     std::array::from_fn(|c| (a[c] + f * (b[c] - a[c])).round() as u8)
 }
 
-/// The rings the fits used, as (innermost inner radius, outermost outer radius) [px], over the
+/// The rings the fits used, as (innermost inner radius, outermost outer radius) \[px\], over the
 /// channels that were fitted.
 fn fitted_span_px(m: &Measurement) -> Option<(f64, f64)> {
     let rings = &m.profile.profile.rings;

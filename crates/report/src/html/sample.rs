@@ -23,7 +23,7 @@ pub struct SampleExtras {
     pub radiance_map: Option<String>,
     /// The camera response figure, SVG text.
     pub response_svg: Option<String>,
-    /// The bracket's frames: (file name, shutter time [s], PNG thumbnail).
+    /// The bracket's frames: (file name, shutter time \[s\], PNG thumbnail).
     pub thumbnails: Vec<(String, f64, Vec<u8>)>,
     /// Frames of the bracket (for the caption when there are no thumbnails).
     pub frame_count: usize,

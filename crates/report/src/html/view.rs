@@ -63,15 +63,15 @@ pub(crate) struct ChannelView {
     pub verdict: &'static str,
     /// The checks' reasons, and the fit's problem note.
     pub reasons: Vec<ReasonView>,
-    /// σ′s [mm⁻¹].
+    /// σ′s \[mm⁻¹\].
     pub sigma_s_prime: Valued,
-    /// σa [mm⁻¹].
+    /// σa \[mm⁻¹\].
     pub sigma_a: Valued,
     /// α′ (its spectro term only).
     pub albedo_prime: Valued,
     /// Total diffuse reflectance of the channel from the spectrophotometer (linear sRGB).
     pub rd_total: Option<f64>,
-    /// MSE [mm⁻⁴].
+    /// MSE \[mm⁻⁴\].
     pub mse: Option<f64>,
     /// RMS of ln(measured/model).
     pub rms_log_residual: Option<f64>,
@@ -81,7 +81,7 @@ pub(crate) struct ChannelView {
     pub rings: [usize; 4],
     /// Iterations and the solver's reason to stop.
     pub solver: String,
-    /// Fit time [s].
+    /// Fit time \[s\].
     pub fit_time_s: f64,
 }
 
@@ -119,9 +119,9 @@ pub(crate) struct ResultView {
     pub files: Vec<FileView>,
     /// The sample folder.
     pub sample_dir: String,
-    /// mm per pixel, spot radius [mm], centre [px].
+    /// mm per pixel, spot radius \[mm\], centre \[px\].
     pub mm_per_pixel: Option<f64>,
-    /// Radius of the light spot [mm].
+    /// Radius of the light spot \[mm\].
     pub spot_radius_mm: Option<f64>,
     /// The options as given, pretty JSON.
     pub options: String,
