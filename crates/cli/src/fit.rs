@@ -37,10 +37,10 @@ pub struct Args {
     /// The forward model.
     #[arg(long, value_enum, default_value_t = ModelArg::Dipole)]
     pub model: ModelArg,
-    /// Diameter of the light spot [mm], in (0, 20]; the model is convolved with it.
+    /// Diameter of the light spot \[mm\], in (0, 20]; the model is convolved with it.
     #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub spot_diameter_mm: f64,
-    /// Innermost fitted radius [mm], in [0, 1000) (default: the spot diameter).
+    /// Innermost fitted radius \[mm\], in [0, 1000) (default: the spot diameter).
     #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub r_min_mm: Option<f64>,
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd.

@@ -349,7 +349,7 @@ pub struct ChannelResult {
     /// Parameters the data do not constrain (empty when every parameter is measured).
     #[serde(default)]
     pub unconstrained: Vec<String>,
-    /// Wall time of the fit [s].
+    /// Wall time of the fit \[s\].
     #[serde(default)]
     pub fit_time_s: f64,
     /// Levenberg–Marquardt iterations (residual evaluations).
@@ -453,7 +453,7 @@ pub struct Inputs {
     pub profile: Option<String>,
     /// Image scale on the sample [mm per pixel].
     pub mm_per_pixel: Option<f64>,
-    /// Radius of the light spot the model was convolved with [mm].
+    /// Radius of the light spot the model was convolved with \[mm\].
     pub spot_radius_mm: Option<f64>,
     /// Spot centre [x, y] in pixels.
     pub center_px: Option<[f64; 2]>,
@@ -488,16 +488,16 @@ pub struct RunOptions {
     /// Whether the profile's scale was fixed by the spectrophotometer.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normalise_with_spectro: Option<bool>,
-    /// Outermost ring [px].
+    /// Outermost ring \[px\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub r_max_px: Option<f64>,
-    /// Innermost fitted radius [mm].
+    /// Innermost fitted radius \[mm\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub r_min_mm: Option<f64>,
     /// How the bracket became radiance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub response: Option<ResponseKind>,
-    /// Radius of the light spot [mm].
+    /// Radius of the light spot \[mm\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spot_radius_mm: Option<f64>,
 }
@@ -559,9 +559,9 @@ pub struct MeasurementResult {
 /// What the port correction did ([`MeasurementResult::spectro_port`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PortResult {
-    /// Diameter of the measured aperture [mm].
+    /// Diameter of the measured aperture \[mm\].
     pub aperture_mm: f64,
-    /// Diameter of the lit disc [mm].
+    /// Diameter of the lit disc \[mm\].
     pub illuminated_mm: f64,
     /// Rd per channel as the instrument read it.
     pub rd_read: scatterfit_optics::Rgb<f64>,
@@ -576,7 +576,7 @@ pub struct PortResult {
 /// A measured diffuse reflectance spectrum ([`MeasurementResult::rd_spectrum`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RdSpectrum {
-    /// Wavelengths [nm], increasing.
+    /// Wavelengths \[nm\], increasing.
     pub wavelength_nm: Vec<f64>,
     /// The diffuse reflectance (SCE, fraction 0–1) at each wavelength.
     pub rd: Vec<f64>,

@@ -164,7 +164,7 @@ pub fn incomplete_rings(w: usize, h: usize, c: [f64; 2], r_fit_px: f64) -> Optio
     })
 }
 
-/// The profile's half width at half maximum [px], on the channel sum (the first ring where the
+/// The profile's half width at half maximum \[px\], on the channel sum (the first ring where the
 /// sum falls below half the maximum of the first rings, linearly interpolated).
 pub fn spot_hwhm_px(m: &Measurement) -> Option<f64> {
     let rings = &m.profile.profile.rings;
@@ -404,7 +404,7 @@ pub const PLATEAU_MIN_SAMPLES: usize = 16;
 /// Finds the codes 16-bit frames use ([`CodeRange`]).
 ///
 /// # Errors
-/// [`PipelineError::Input`] for 8-bit frames scaled into 16 bits (every code a multiple of 257,
+/// [`crate::PipelineError::Input`] for 8-bit frames scaled into 16 bits (every code a multiple of 257,
 /// as an image editor converts): their tone curve is not linear, and merging them as linear data
 /// would give wrong radiances.
 pub fn code_range(
@@ -477,14 +477,14 @@ pub struct Registration {
     /// frame); `None` where fewer than [`REGISTRATION_MIN_PIXELS`] pixels are, or the disk touches
     /// the frame's edge.
     pub centroids: Vec<Option<[f64; 2]>>,
-    /// The largest shift between two frames' centroids [px].
+    /// The largest shift between two frames' centroids \[px\].
     pub max_shift_px: f64,
 }
 
 /// Pixels a frame's half-saturated disk needs for its centroid to count.
 pub const REGISTRATION_MIN_PIXELS: usize = 12;
 
-/// A shift between frames beyond this [px] makes every channel suspect: the rings of the merged
+/// A shift between frames beyond this \[px\] makes every channel suspect: the rings of the merged
 /// map then average light from two positions. The demo's frames agree to 0.18 px.
 pub const MAX_FRAME_SHIFT_PX: f64 = 1.5;
 

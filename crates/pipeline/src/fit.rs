@@ -17,13 +17,13 @@ pub struct FitSettings {
     pub model: ModelName,
     /// How α′ comes from the spectrophotometer's Rd (`scatterfit_mc::albedo_family`).
     pub albedo_model: AlbedoModel,
-    /// Radius of the light spot [mm]; the model is convolved with it. For a radial spot
+    /// Radius of the light spot \[mm\]; the model is convolved with it. For a radial spot
     /// (`spot`), the radius holding 99 % of its power (which sets the default r_min).
     pub spot_radius_mm: f64,
     /// The spot's shape: a uniform disk of `spot_radius_mm`, or a radial profile (a Gaussian, a
     /// measured spot image; issue 16).
     pub spot: SpotShape,
-    /// Innermost fitted radius [mm] (default: the spot's diameter).
+    /// Innermost fitted radius \[mm\] (default: the spot's diameter).
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed only).
     pub normalise_with_spectro: bool,
@@ -65,7 +65,7 @@ impl FitSettings {
         Ok(o)
     }
 
-    /// The innermost fitted radius [mm]: the given one, else the spot's diameter.
+    /// The innermost fitted radius \[mm\]: the given one, else the spot's diameter.
     pub fn r_min_mm(&self) -> f64 {
         self.r_min_mm.unwrap_or(2.0 * self.spot_radius_mm)
     }

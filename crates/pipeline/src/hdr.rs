@@ -66,7 +66,7 @@ pub enum BlackLevel {
     Auto,
     /// None (the frames are black-subtracted already).
     None,
-    /// Given per channel [DN] (one value for all channels is repeated).
+    /// Given per channel \[DN\] (one value for all channels is repeated).
     Given(Vec<f64>),
 }
 
@@ -183,7 +183,7 @@ impl HdrInputs {
 pub struct FrameInfo {
     /// The file.
     pub file: PathBuf,
-    /// Shutter time [s].
+    /// Shutter time \[s\].
     pub time_s: f64,
 }
 
@@ -206,9 +206,9 @@ pub struct HdrStage {
     pub detection_limit: Vec<f64>,
     /// Frames whose alpha channel was dropped.
     pub dropped_alpha: Vec<PathBuf>,
-    /// Wall time reading [s].
+    /// Wall time reading \[s\].
     pub read_s: f64,
-    /// Wall time recovering and merging [s].
+    /// Wall time recovering and merging \[s\].
     pub merge_s: f64,
     /// What was found and corrected of a real camera (black level, exposure times, flat).
     pub corrections: Corrections,
@@ -264,7 +264,7 @@ pub struct FramesRead {
     pub image: String,
     /// Frames whose alpha channel was dropped.
     pub dropped_alpha: Vec<PathBuf>,
-    /// Wall time reading [s].
+    /// Wall time reading \[s\].
     pub read_s: f64,
 }
 

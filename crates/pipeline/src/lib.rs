@@ -39,6 +39,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod accuracy;
 pub mod batch;
 pub mod camera;
 pub mod checks;

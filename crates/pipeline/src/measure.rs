@@ -145,7 +145,7 @@ pub struct Measurement {
     pub timings: Timings,
 }
 
-/// Wall times per stage [s].
+/// Wall times per stage \[s\].
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct Timings {
     /// Spectro stage.

@@ -29,9 +29,9 @@ const TOLERANCE: f64 = 1e-6;
 /// What the port correction did, per channel.
 #[derive(Debug, Clone, Serialize)]
 pub struct PortCorrection {
-    /// Diameter of the lit disc [mm].
+    /// Diameter of the lit disc \[mm\].
     pub illuminated_mm: f64,
-    /// Diameter of the measured aperture [mm].
+    /// Diameter of the measured aperture \[mm\].
     pub aperture_mm: f64,
     /// The stage as read, before the correction (a refit with another model starts again here).
     #[serde(skip)]

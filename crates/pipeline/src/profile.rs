@@ -48,9 +48,9 @@ pub struct ProfileStage {
 pub struct ProfileSettings {
     /// Image scale on the sample [mm per pixel].
     pub mm_per_pixel: f64,
-    /// Outermost ring [px] (the paper's 300).
+    /// Outermost ring \[px\] (the paper's 300).
     pub r_max_px: f64,
-    /// Ring width [px].
+    /// Ring width \[px\].
     pub ring_width_px: f64,
     /// A given spot centre [x, y] px.
     pub center_px: Option<[f64; 2]>,

@@ -39,6 +39,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod accuracy;
 pub mod error;
 pub mod figures;
 pub mod html;
@@ -46,6 +47,7 @@ pub mod measurement;
 pub mod plot;
 pub mod study;
 
+pub use accuracy::accuracy_markdown;
 pub use error::{ReportError, Result};
 pub use figures::{compare_figure, fit_figure};
 pub use measurement::{
