@@ -10,7 +10,9 @@
 //!   by the browser's layout, `getBoundingClientRect` in a wrapper page that frames the report at
 //!   the screenshot's width) holds many pixels of more than one colour.
 //!
-//! The screenshots are kept as artefacts: `$SCATTERFIT_ARTEFACTS/browser/` (default
+//! The page also prints (`--print-to-pdf`: a PDF of more than 100 kB).
+//!
+//! The screenshots and the PDF are kept as artefacts: `$SCATTERFIT_ARTEFACTS/browser/` (default
 //! `target/ci-artefacts/browser/`); the test prints the folder.
 //!
 //! The browser is `$SCATTERFIT_CHROMIUM`, else `chromium` on the PATH (Debian's package; `.ci/run`
@@ -316,6 +318,27 @@ fn demo_pages_load_and_draw_in_chromium() {
     ] {
         assert!(names.contains(&want), "no {want} among {names:?}");
     }
+    // Printable: Chromium prints the page to a PDF (kept with the screenshots).
+    let pdf = out.join("wood-tile-report.pdf");
+    let _ = std::fs::remove_file(&pdf);
+    let (_, stderr) = browse(
+        &chrome,
+        &profile,
+        &[
+            &format!("--print-to-pdf={}", pdf.display()),
+            "--no-pdf-header-footer",
+        ],
+        &file_url(&sample),
+    );
+    let bytes = std::fs::read(&pdf).unwrap_or_else(|e| panic!("no PDF ({e}):\n{stderr}"));
+    assert!(bytes.starts_with(b"%PDF"), "not a PDF");
+    assert!(bytes.len() > 100_000, "a {} byte PDF", bytes.len());
+    let _ = writeln!(
+        std::io::stderr(),
+        "browser test: printed to {} ({} bytes)",
+        pdf.display(),
+        bytes.len()
+    );
     for b in &boxes {
         let (drawn, total) = drawn_pixels(&img, b);
         assert!(total > 1000, "{b:?}: a box of {total} px");
