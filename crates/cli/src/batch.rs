@@ -1,6 +1,7 @@
 //! `scatterfit batch`: many sample folders, measured in parallel; every good sample's result files
 //! are written into its folder as soon as it is done, failures are listed at the end (exit 1 if
-//! any), and summary.csv / summary.md (Table 1's shape) gather the good ones.
+//! any), and summary.csv / summary.md (Table 1's shape) gather the good ones; index.html shows them
+//! all, linked to their report.html, with the failures and their messages.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -17,9 +18,10 @@ use crate::output::{errln, out, outln};
 pub struct Args {
     #[command(flatten)]
     pub samples: SamplesArgs,
-    /// Where to write summary.csv, summary.md and index.html (the command's own files, replaced on each run;
-    /// checked before any sample is measured). Each sample's result files (result.json, .csv, .md,
-    /// profile.csv, fit.svg, fit.png) go into its own folder and are replaced, as with `measure`.
+    /// Where to write summary.csv, summary.md and index.html (the command's own files, replaced on
+    /// each run; checked before any sample is measured). Each sample's result files (result.json,
+    /// .csv, .md, profile.csv, fit.svg, fit.png, report.html) go into its own folder and are
+    /// replaced, as with `measure`.
     #[arg(
         short = 'o',
         long = "output-dir",

@@ -1,7 +1,8 @@
 //! `scatterfit compare`: both methods on the same data — the proposed (α′ from the
 //! spectrophotometer, σ′s fitted) and the existing (σ′s and σa fitted) — per channel: parameters,
 //! fit time and MSE (the paper's Table 2 shape), and a plot per sample shaped like its Figure 6
-//! (compare.svg, compare.png in the sample folder).
+//! (compare.svg, compare.png in the sample folder); index.html lists the samples with links to
+//! their plots.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -16,9 +17,9 @@ use crate::output::{errln, out, outln};
 pub struct Args {
     #[command(flatten)]
     pub samples: SamplesArgs,
-    /// Where to write compare.csv, compare.md and index.html (the command's own files, replaced on each run;
-    /// checked before any sample is measured). Each sample's plot (compare.svg, compare.png) goes
-    /// into its own folder and is replaced.
+    /// Where to write compare.csv, compare.md and index.html (the command's own files, replaced
+    /// on each run; checked before any sample is measured). Each sample's plot (compare.svg,
+    /// compare.png) goes into its own folder and is replaced.
     #[arg(
         short = 'o',
         long = "output-dir",

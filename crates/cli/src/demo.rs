@@ -2,7 +2,8 @@
 //! (`scatterfit-synth`, Monte Carlo) synthesises the seven materials of Choi, Lee & Chin (2014,
 //! Table 1) as sample folders — spectro reading, 13-exposure bracket, manifest, truth — then every
 //! folder is measured with the proposed method and compared with the existing one, and the
-//! recovered σ′s, σa and η are printed beside the truth with their errors.
+//! recovered σ′s, σa and η are printed beside the truth with their errors. Each folder gets its
+//! report.html; the last line printed is the path of index.html, the page that lists them.
 //!
 //! The demo owns its output folder: it writes a `.scatterfit-demo` marker there and refuses a
 //! folder holding anything else unless `--force`. Monte Carlo profiles are cached (the second run
