@@ -213,7 +213,7 @@ pub struct HdrStage {
     /// What was found and corrected of a real camera (black level, exposure times, flat).
     pub corrections: Corrections,
     /// The frames as read, shortest first, reduced to at most [`THUMBNAIL_SIDE`] pixels (8-bit
-    /// RGB, point-sampled): what a report shows of the bracket without reading it again. Empty
+    /// RGB, point-sampled; 16-bit linear frames through the sRGB curve): what a report shows of the bracket without reading it again. Empty
     /// for a given radiance map.
     pub thumbnails: Vec<ImageBuf<u8>>,
 }
@@ -222,7 +222,7 @@ pub struct HdrStage {
 pub const THUMBNAIL_SIDE: usize = 96;
 
 /// `frame` point-sampled at the centres of a grid of at most [`THUMBNAIL_SIDE`] pixels, as 8-bit
-/// RGB (16-bit samples keep their top 8 bits; grey is repeated): cheap (a few thousand samples per
+/// RGB (16-bit samples, linear, through the sRGB curve; grey is repeated): cheap (a few thousand samples per
 /// frame), enough to see the spot, clipping and misalignment.
 fn thumbnail(frame: &CameraFrame) -> Option<ImageBuf<u8>> {
     let (w, h) = (frame.width(), frame.height());
@@ -239,8 +239,12 @@ fn thumbnail(frame: &CameraFrame) -> Option<ImageBuf<u8>> {
                     std::array::from_fn(|c| p[c.min(p.len() - 1)])
                 }
                 CameraFrame::U16(b) => {
+                    // 16-bit frames are linear: encoded with the sRGB curve for display.
                     let p = b.pixel(x, y)?;
-                    std::array::from_fn(|c| (p[c.min(p.len() - 1)] >> 8) as u8)
+                    std::array::from_fn(|c| {
+                        let v = f64::from(p[c.min(p.len() - 1)]) / f64::from(u16::MAX);
+                        (scatterfit_optics::colour::srgb_encode(v) * 255.0).round() as u8
+                    })
                 }
             };
             data.extend_from_slice(&px);

@@ -229,3 +229,13 @@ fn sample_page_sections_come_in_a_readers_order() {
     let page = sample_html(&r, &SampleExtras::default());
     assert!(!page.contains("id=\"fig6\"") && !page.contains("href=\"#fig6\""));
 }
+
+#[test]
+fn spectro_colour_is_srgb_of_the_channels_rd() {
+    // IEC 61966-2-1: linear 0.5 → 1.055 · 0.5^(1/2.4) − 0.055 = 0.7354 → code 188 (0xbc).
+    assert_eq!(super::view::srgb8(0.5), 188);
+    assert_eq!(super::view::srgb8(0.0), 0);
+    assert_eq!(super::view::srgb8(1.5), 255);
+    let page = sample_html(&hostile_result(), &SampleExtras::default());
+    assert!(page.contains("background:rgb(188,188,188)") && page.contains("sRGB #bcbcbc"));
+}

@@ -284,13 +284,8 @@ impl ResultView {
     }
 }
 
-/// A linear value in [0, 1] as an 8-bit sRGB code (IEC 61966-2-1).
+/// A linear value in \[0, 1\] as an 8-bit sRGB code (IEC 61966-2-1, `optics::colour::srgb_encode`).
 pub(crate) fn srgb8(linear: f64) -> u8 {
-    let v = linear.clamp(0.0, 1.0);
-    let s = if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
+    let s = scatterfit_optics::colour::srgb_encode(linear.clamp(0.0, 1.0));
     (s * 255.0).round().clamp(0.0, 255.0) as u8
 }
