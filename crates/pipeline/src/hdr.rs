@@ -880,3 +880,31 @@ pub fn load_response(path: &Path) -> Result<ResponseCurve> {
         source,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thumbnails_keep_the_aspect_and_sample_block_centres() {
+        // 8-bit, 1000 × 500, value = x / 4 in R, y / 2 in G, 7 in B.
+        let (w, h) = (1000usize, 500usize);
+        let data: Vec<u8> = (0..h)
+            .flat_map(|y| (0..w).flat_map(move |x| [(x / 4) as u8, (y / 2) as u8, 7]))
+            .collect();
+        let frame = CameraFrame::U8(ImageBuf::new(w, h, 3, data).unwrap());
+        let t = thumbnail(&frame).unwrap();
+        // step = ceil(1000 / 96) = 11: 91 × 46 samples at the centres 5, 16, 27, …
+        assert_eq!((t.width(), t.height(), t.channels()), (91, 46, 3));
+        assert_eq!(t.pixel(0, 0).unwrap(), &[1, 2, 7]);
+        assert_eq!(t.pixel(2, 3).unwrap(), &[(27 / 4) as u8, (38 / 2) as u8, 7]);
+        // 16-bit linear grey: full scale → 255, half → sRGB 0.7354 → 188, zero → 0.
+        let grey = |v: u16| {
+            let f = CameraFrame::U16(ImageBuf::filled(4, 4, 1, v).unwrap());
+            thumbnail(&f).unwrap().pixel(1, 1).unwrap().to_vec()
+        };
+        assert_eq!(grey(u16::MAX), [255, 255, 255]);
+        assert_eq!(grey(32768), [188, 188, 188]);
+        assert_eq!(grey(0), [0, 0, 0]);
+    }
+}
