@@ -187,7 +187,12 @@ pub(crate) fn index_page(page: &IndexPage<'_>) -> String {
         let links: Vec<String> = e
             .page
             .iter()
-            .map(|h| format!("<a href=\"{}\">report</a>", href(h)))
+            .flat_map(|h| {
+                [
+                    format!("<a href=\"{}\">report</a>", href(h)),
+                    format!("<a href=\"{}#evidence\">evidence</a>", href(h)),
+                ]
+            })
             .chain(
                 e.links
                     .iter()

@@ -181,6 +181,12 @@ fn index_escapes_names_folders_links_and_failure_messages() {
     check_page(&html, 1);
     assert!(!html.contains("href=\"javascript:"));
     assert!(html.contains("javascript%3Aalert%281%29"));
+    // One click to the sample's page and to its evidence.
+    assert!(
+        html.contains("/report.html\">report</a><br><a href=\"%3Cscript%3E"),
+        "{html}"
+    );
+    assert!(html.contains("/report.html#evidence\">evidence</a>"));
     // One row, its verdict (the worst channel's) and its sort key.
     assert_eq!(
         html.matches("<tr><td class=\"sample\" data-sort=").count(),
