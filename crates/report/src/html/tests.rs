@@ -245,3 +245,9 @@ fn spectro_colour_is_srgb_of_the_channels_rd() {
     let page = sample_html(&hostile_result(), &SampleExtras::default());
     assert!(page.contains("background:rgb(188,188,188)") && page.contains("sRGB #bcbcbc"));
 }
+
+#[test]
+fn the_sample_page_is_a_result_file_the_outputs_check_protects() {
+    // pipeline::outputs guards (links, inputs, other samples' results) the files it lists.
+    assert!(scatterfit_pipeline::outputs::RESULT_FILES.contains(&super::SAMPLE_PAGE));
+}
