@@ -1,6 +1,7 @@
 //! `scatterfit batch`: many sample folders, measured in parallel; every good sample's result files
 //! are written into its folder as soon as it is done, failures are listed at the end (exit 1 if
-//! any), and summary.csv / summary.md (Table 1's shape) gather the good ones.
+//! any), and summary.csv / summary.md (Table 1's shape) gather the good ones; index.html shows them
+//! all, linked to their report.html, with the failures and their messages.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -17,9 +18,10 @@ use crate::output::{errln, out, outln};
 pub struct Args {
     #[command(flatten)]
     pub samples: SamplesArgs,
-    /// Where to write summary.csv and summary.md (the command's own files, replaced on each run;
-    /// checked before any sample is measured). Each sample's result files (result.json, .csv, .md,
-    /// profile.csv, fit.svg, fit.png) go into its own folder and are replaced, as with `measure`.
+    /// Where to write summary.csv, summary.md and index.html (the command's own files, replaced on
+    /// each run; checked before any sample is measured). Each sample's result files (result.json,
+    /// .csv, .md, profile.csv, fit.svg, fit.png, report.html) go into its own folder and are
+    /// replaced, as with `measure`.
     #[arg(
         short = 'o',
         long = "output-dir",
@@ -41,10 +43,14 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let shared: Vec<PathBuf> = ["summary.csv", "summary.md"]
-        .iter()
-        .map(|f| args.output_dir.join(f))
-        .collect();
+    let shared: Vec<PathBuf> = [
+        "summary.csv",
+        "summary.md",
+        scatterfit_report::html::INDEX_PAGE,
+    ]
+    .iter()
+    .map(|f| args.output_dir.join(f))
+    .collect();
     let (dirs, misspelt) = crate::common::samples_for(
         "batch",
         &args.samples.dirs,
@@ -69,7 +75,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         },
     )?;
     let mut results: Vec<MeasurementResult> = Vec::new();
+    let mut result_dirs: Vec<PathBuf> = Vec::new();
     let mut failed: Vec<(PathBuf, String)> = write_errors.into_inner().unwrap_or_default();
+    // The samples without a result (not measured, or their files not written), for the index.
+    let mut not_measured: Vec<(PathBuf, String)> = failed.clone();
+    not_measured.extend(misspelt.iter().cloned());
     let samples = dirs.len() + misspelt.len();
     failed.extend(misspelt);
     for o in &outcomes {
@@ -87,8 +97,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     failed.push((o.dir.clone(), crate::common::suspect_text(&r)));
                 }
                 results.push(r);
+                result_dirs.push(o.dir.clone());
             }
-            Err(e) => failed.push((o.dir.clone(), crate::common::error_text(e))),
+            Err(e) => {
+                let why = crate::common::error_text(e);
+                not_measured.push((o.dir.clone(), why.clone()));
+                failed.push((o.dir.clone(), why));
+            }
         }
     }
     std::fs::create_dir_all(&args.output_dir)?;
@@ -100,6 +115,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .map_err(|e| anyhow::anyhow!("writing {}: {e}", p.display()))?;
     }
+    let index = crate::common::write_index(
+        &args.output_dir,
+        "scatterfit batch",
+        "One row per sample: its verdict (the data checks per channel), η, σ′s and σa per channel; \
+         the sample's name opens its report.",
+        &results,
+        &result_dirs,
+        &not_measured,
+        &["summary.csv", "summary.md"],
+    )?;
     if args.json {
         crate::output::print_json(&results)?;
     } else {
@@ -113,6 +138,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.output_dir.join("summary.csv").display(),
             args.output_dir.join("summary.md").display()
         )?;
+        outln!("index: {}", index.display())?;
     }
     if !failed.is_empty() {
         errln!(

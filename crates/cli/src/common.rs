@@ -324,3 +324,50 @@ pub fn suspect_text(r: &scatterfit_io::result_json::MeasurementResult) -> String
         .collect::<Vec<_>>()
         .join("; ")
 }
+
+/// Writes `index.html` into `dir`: one row per result (its folder from `dirs`, linked to its
+/// report.html when there is one, and to its compare.svg when there is one), the samples of
+/// `failures` with their message, and links to `files` (names in `dir`). Returns its path.
+///
+/// # Errors
+/// When the page cannot be written.
+pub fn write_index(
+    dir: &Path,
+    title: &str,
+    intro: &str,
+    results: &[scatterfit_io::result_json::MeasurementResult],
+    dirs: &[PathBuf],
+    failures: &[(PathBuf, String)],
+    files: &[&str],
+) -> anyhow::Result<PathBuf> {
+    use scatterfit_report::html::{IndexEntry, IndexPage, SAMPLE_PAGE, link_from};
+    let samples = results
+        .iter()
+        .zip(dirs)
+        .map(|(result, d)| {
+            let page = d.join(SAMPLE_PAGE);
+            let compare = d.join("compare.svg");
+            IndexEntry {
+                result,
+                folder: d.display().to_string(),
+                page: page.exists().then(|| link_from(dir, &page)),
+                links: if compare.exists() {
+                    vec![("Figure 6".into(), link_from(dir, &compare))]
+                } else {
+                    Vec::new()
+                },
+            }
+        })
+        .collect();
+    let page = IndexPage {
+        title: title.into(),
+        intro: intro.into(),
+        samples,
+        failures: failures
+            .iter()
+            .map(|(d, why)| (d.display().to_string(), why.clone()))
+            .collect(),
+        files: files.iter().map(|f| (*f).to_string()).collect(),
+    };
+    Ok(scatterfit_report::html::write_index(dir, &page)?)
+}

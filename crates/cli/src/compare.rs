@@ -1,7 +1,8 @@
 //! `scatterfit compare`: both methods on the same data — the proposed (α′ from the
 //! spectrophotometer, σ′s fitted) and the existing (σ′s and σa fitted) — per channel: parameters,
 //! fit time and MSE (the paper's Table 2 shape), and a plot per sample shaped like its Figure 6
-//! (compare.svg, compare.png in the sample folder).
+//! (compare.svg, compare.png in the sample folder); index.html lists the samples with links to
+//! their plots.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -16,9 +17,9 @@ use crate::output::{errln, out, outln};
 pub struct Args {
     #[command(flatten)]
     pub samples: SamplesArgs,
-    /// Where to write compare.csv and compare.md (the command's own files, replaced on each run;
-    /// checked before any sample is measured). Each sample's plot (compare.svg, compare.png) goes
-    /// into its own folder and is replaced.
+    /// Where to write compare.csv, compare.md and index.html (the command's own files, replaced
+    /// on each run; checked before any sample is measured). Each sample's plot (compare.svg,
+    /// compare.png) goes into its own folder and is replaced.
     #[arg(
         short = 'o',
         long = "output-dir",
@@ -40,10 +41,14 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let shared: Vec<PathBuf> = ["compare.csv", "compare.md"]
-        .iter()
-        .map(|f| args.output_dir.join(f))
-        .collect();
+    let shared: Vec<PathBuf> = [
+        "compare.csv",
+        "compare.md",
+        scatterfit_report::html::INDEX_PAGE,
+    ]
+    .iter()
+    .map(|f| args.output_dir.join(f))
+    .collect();
     let (dirs, misspelt) = crate::common::samples_for(
         "compare",
         &args.samples.dirs,
@@ -52,7 +57,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         overrides.allow_outside_paths,
         args.quiet || args.json,
     )?;
-    let (pairs, _, mut failed) = crate::runner::compare_dirs(
+    let crate::runner::Comparison {
+        pairs,
+        dirs: pair_dirs,
+        mut failed,
+        ..
+    } = crate::runner::compare_dirs(
         &dirs,
         &overrides,
         args.samples.jobs.unwrap_or(0),
@@ -70,6 +80,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .map_err(|e| anyhow::anyhow!("writing {}: {e}", p.display()))?;
     }
+    let proposed: Vec<_> = pairs.iter().map(|(_, p)| p.clone()).collect();
+    let index = crate::common::write_index(
+        &args.output_dir,
+        "scatterfit compare",
+        "One row per sample, the proposed method's values (α′ from the spectrophotometer, σ′s \
+         fitted); Figure 6 compares them with the existing method's fit; compare.md has both.",
+        &proposed,
+        &pair_dirs,
+        &failed,
+        &["compare.csv", "compare.md"],
+    )?;
     if args.json {
         crate::output::print_json(&pairs)?;
     } else {
@@ -79,6 +100,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.output_dir.join("compare.csv").display(),
             args.output_dir.join("compare.md").display()
         )?;
+        outln!("index: {}", index.display())?;
     }
     if !failed.is_empty() {
         errln!("\n{} sample(s) failed:", failed.len());

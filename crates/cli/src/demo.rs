@@ -2,7 +2,8 @@
 //! (`scatterfit-synth`, Monte Carlo) synthesises the seven materials of Choi, Lee & Chin (2014,
 //! Table 1) as sample folders — spectro reading, 13-exposure bracket, manifest, truth — then every
 //! folder is measured with the proposed method and compared with the existing one, and the
-//! recovered σ′s, σa and η are printed beside the truth with their errors.
+//! recovered σ′s, σa and η are printed beside the truth with their errors. Each folder gets its
+//! report.html; the last line printed is the path of index.html, the page that lists them.
 //!
 //! The demo owns its output folder: it writes a `.scatterfit-demo` marker there and refuses a
 //! folder holding anything else unless `--force`. Monte Carlo profiles are cached (the second run
@@ -116,7 +117,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let synth_s = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let (pairs, exacts, failed) = crate::runner::compare_dirs(
+    let crate::runner::Comparison {
+        pairs,
+        dirs: pair_dirs,
+        exacts,
+        failed,
+    } = crate::runner::compare_dirs(
         &dirs,
         &scatterfit_pipeline::Overrides::default(),
         args.jobs.unwrap_or(0),
@@ -144,6 +150,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
     }
+    let index = crate::common::write_index(
+        out,
+        "scatterfit demo: the seven materials of Choi, Lee & Chin (2014)",
+        "Monte Carlo rig-twin samples of the paper's seven materials, measured with the proposed \
+         method (dipole); the truth is in each sample's truth.json, the errors against it in \
+         accuracy.md. The sample's name opens its report: verdict, Table 1, Figures 4 and 6, the \
+         evidence and the inputs.",
+        &proposed,
+        &pair_dirs,
+        &failed,
+        &[
+            "summary.md",
+            "summary.csv",
+            "compare.md",
+            "compare.csv",
+            "accuracy.md",
+            "demo-summary.json",
+        ],
+    )?;
     if args.json {
         crate::output::print_json(&rows)?;
     } else {
@@ -160,8 +185,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
              samples with both methods"
         )?;
         outln!(
-            "files: {0}/<material>/result.json, fit.png, compare.png; {0}/summary.md (Table 1), \
-             compare.md (Table 2), accuracy.md",
+            "files: {0}/<material>/result.json, report.html, fit.png, compare.png; {0}/summary.md \
+             (Table 1), compare.md (Table 2), accuracy.md",
             out.display()
         )?;
         // The data checks' verdict on the proposed method's channels (RELIABILITY.md).
@@ -181,6 +206,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         } else {
             outln!("quality: {}", suspect.join("; "))?;
         }
+        // Last: the page a person opens (every sample's verdict and numbers, a link to each report).
+        outln!("index: {}", index.display())?;
     }
     if !failed.is_empty() {
         errln!("\n{} sample(s) failed:", failed.len());

@@ -16,10 +16,10 @@ use crate::output::{errln, out, outln};
 pub struct Args {
     /// The sample folder (holding sample.toml).
     pub dir: PathBuf,
-    /// Where to write result.json, result.csv, result.md, profile.csv, fit.svg, fit.png and, last,
-    /// result-files.json (default: the sample folder; these files are the command's own and are
-    /// replaced). A folder holding another sample's results, or another sample's folder, is refused
-    /// without --force.
+    /// Where to write result.json, result.csv, result.md, profile.csv, fit.svg, fit.png, the page
+    /// report.html and, last, result-files.json (default: the sample folder; these files are the
+    /// command's own and are replaced). A folder holding another sample's results, or another
+    /// sample's folder, is refused without --force.
     #[arg(short = 'o', long = "output-dir", value_name = "DIR")]
     pub output_dir: Option<PathBuf>,
     /// Write into an -o folder that holds another sample's results (or is another sample's folder).

@@ -117,11 +117,24 @@ pub type Pair = (MeasurementResult, MeasurementResult);
 /// What one sample's comparison gave the command.
 type Compared = Result<(Pair, Option<MeasurementResult>, Vec<String>), String>;
 
+/// What [`compare_dirs`] gives.
+pub struct Comparison {
+    /// The samples compared: (existing, proposed).
+    pub pairs: Vec<Pair>,
+    /// Each pair's folder.
+    pub dirs: Vec<PathBuf>,
+    /// Per pair, the exact fit (empty without `exact`).
+    pub exacts: Vec<Option<MeasurementResult>>,
+    /// The samples that failed, with why.
+    pub failed: Failures,
+}
+
 /// Measures `dirs` once and fits each both ways ([`scatterfit_pipeline::compare`]); writes
 /// compare.svg/png into each sample folder (and, with `write_results`, the proposed measurement's
-/// result files as `measure` does); with `exact` each sample is also fitted beyond the paper (the
-/// Monte Carlo forward model with α′ from the Monte Carlo total; `None` where that fit cannot
-/// run). Returns the pairs, the exact fits (empty without `exact`) and the samples that failed.
+/// result files as `measure` does, its report.html with Figure 6); with `exact` each sample is also
+/// fitted beyond the paper (the Monte Carlo forward model with α′ from the Monte Carlo total; `None`
+/// where that fit cannot run). Returns the pairs with their folders, the exact fits (empty without
+/// `exact`) and the samples that failed.
 ///
 /// # Errors
 /// Only when the worker threads cannot start.
@@ -132,7 +145,7 @@ pub fn compare_dirs(
     quiet: bool,
     write_results: bool,
     exact: bool,
-) -> anyhow::Result<(Vec<Pair>, Vec<Option<MeasurementResult>>, Failures)> {
+) -> anyhow::Result<Comparison> {
     let bar = progress(dirs.len(), quiet);
     let request = BatchRequest::new(dirs.iter().cloned(), *overrides).jobs(jobs);
     let batch = compare_batch_with(
@@ -144,7 +157,9 @@ pub fn compare_dirs(
                 crate::common::error_text(&e)
             })?;
             let mut problems = Vec::new();
-            if write_results && let Err(e) = scatterfit_report::write_measurement(dir, &c.proposed)
+            if write_results
+                && let Err(e) =
+                    scatterfit_report::write_measurement_with(dir, &c.proposed, Some(&c.existing))
             {
                 let e = anyhow::Error::from(e);
                 problems.push(format!("writing the results: {e:#}"));
@@ -173,11 +188,13 @@ pub fn compare_dirs(
     )?;
     bar.finish_and_clear();
     let (mut pairs, mut exacts, mut failed) = (Vec::new(), Vec::new(), Vec::new());
+    let mut pair_dirs = Vec::new();
     for s in batch.samples {
         match s.outcome {
             Ok((pair, exact_fit, problems)) => {
                 failed.extend(problems.into_iter().map(|p| (s.dir.clone(), p)));
                 pairs.push(pair);
+                pair_dirs.push(s.dir);
                 if exact {
                     exacts.push(exact_fit);
                 }
@@ -185,5 +202,10 @@ pub fn compare_dirs(
             Err(e) => failed.push((s.dir, e)),
         }
     }
-    Ok((pairs, exacts, failed))
+    Ok(Comparison {
+        pairs,
+        dirs: pair_dirs,
+        exacts,
+        failed,
+    })
 }

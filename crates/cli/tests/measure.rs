@@ -33,6 +33,7 @@ fn synth_then_measure() {
         "profile.csv",
         "fit.svg",
         "fit.png",
+        "report.html",
     ] {
         assert!(dir.path().join("wood").join(f).exists(), "{f}");
     }
@@ -199,6 +200,22 @@ fn batch_survives_a_bad_sample_and_failures_exit_1() {
     assert!(summary.contains("sulfur,R,ok"), "{summary}");
     assert!(d.join("samples/sulfur/result.json").exists());
     assert!(d.join("report/summary.md").exists());
+    // The batch's page: the good sample linked to its report, the broken one with its message.
+    assert!(d.join("samples/sulfur/report.html").exists());
+    let index = read_text(&d.join("report/index.html"));
+    assert!(
+        index.contains("<a href=\"../samples/sulfur/report.html\">sulfur</a>"),
+        "{index}"
+    );
+    assert!(
+        index.contains("broken") && index.contains("spectro.file"),
+        "{index}"
+    );
+    assert!(
+        out.stdout.contains("index: report/index.html"),
+        "{}",
+        out.stdout
+    );
 
     // Matte: SCI = SCE, so η cannot be measured: exit 1 and the reason.
     let spectro = read_text(&d.join("samples/sulfur/spectro.csv"));
@@ -241,6 +258,11 @@ fn compare_synth_safety_and_quick_demo() {
         "{table}"
     );
     assert!(d.join("n/compare.png").exists());
+    let index = read_text(&d.join("cmp/index.html"));
+    assert!(
+        index.contains("nephrite") && index.contains("../n/compare.svg"),
+        "{index}"
+    );
 
     let out = run_cached(
         d,
@@ -272,6 +294,8 @@ fn compare_synth_safety_and_quick_demo() {
         "accuracy.md",
         "pink-plastic/fit.png",
         "pink-plastic/compare.png",
+        "pink-plastic/report.html",
+        "index.html",
     ] {
         assert!(d.join("demo").join(f).exists(), "{f}");
     }

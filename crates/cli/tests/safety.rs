@@ -96,6 +96,7 @@ fn planted_links_never_redirect_a_write() {
         "fit.png",
         "profile.csv",
         "result.md",
+        "report.html",
         "result-files.json",
     ] {
         let s = sample(d, &format!("s-{out}"));
@@ -439,6 +440,15 @@ fn hostile_names_are_escaped_everywhere() {
     assert!(!md.contains("<b>") && !md.contains('\u{1b}'), "{md}");
     let svg = fs::read_to_string(s.join("fit.svg")).unwrap();
     roxmltree::Document::parse(&svg).expect("fit.svg is well-formed XML");
+    // The page: the name shown escaped (title, heading, Figure 4's inline SVG), never as markup
+    // or a control.
+    let page = fs::read_to_string(s.join("report.html")).unwrap();
+    assert!(!page.contains("<b>"), "raw markup in report.html");
+    assert!(page.contains("&lt;b&gt;"), "the name is not shown");
+    if let Some(i) = page.find(['\u{1b}', '\u{7}', '\r', '\u{1}', '\u{9b}']) {
+        let around: String = page[i.saturating_sub(200)..].chars().take(260).collect();
+        panic!("a control in report.html: {around:?}");
+    }
 }
 
 /// A folder holding files of two runs is not taken for one run's results: render --profile

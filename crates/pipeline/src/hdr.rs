@@ -216,6 +216,45 @@ pub struct HdrStage {
     pub merge_s: f64,
     /// What was found and corrected of a real camera (black level, exposure times, flat).
     pub corrections: Corrections,
+    /// The frames as read, shortest first, reduced to at most [`THUMBNAIL_SIDE`] pixels (8-bit
+    /// RGB, point-sampled; 16-bit linear frames through the sRGB curve): what a report shows of the bracket without reading it again. Empty
+    /// for a given radiance map.
+    pub thumbnails: Vec<ImageBuf<u8>>,
+}
+
+/// Longest side of [`HdrStage::thumbnails`] \[px\].
+pub const THUMBNAIL_SIDE: usize = 96;
+
+/// `frame` point-sampled at the centres of a grid of at most [`THUMBNAIL_SIDE`] pixels, as 8-bit
+/// RGB (16-bit samples, linear, through the sRGB curve; grey is repeated): cheap (a few thousand samples per
+/// frame), enough to see the spot, clipping and misalignment.
+fn thumbnail(frame: &CameraFrame) -> Option<ImageBuf<u8>> {
+    let (w, h) = (frame.width(), frame.height());
+    let step = w.max(h).div_ceil(THUMBNAIL_SIDE).max(1);
+    let (tw, th) = (w.div_ceil(step), h.div_ceil(step));
+    let mut data = Vec::with_capacity(tw * th * 3);
+    for ty in 0..th {
+        let y = (ty * step + step / 2).min(h - 1);
+        for tx in 0..tw {
+            let x = (tx * step + step / 2).min(w - 1);
+            let px: [u8; 3] = match frame {
+                CameraFrame::U8(b) => {
+                    let p = b.pixel(x, y)?;
+                    std::array::from_fn(|c| p[c.min(p.len() - 1)])
+                }
+                CameraFrame::U16(b) => {
+                    // 16-bit frames are linear: encoded with the sRGB curve for display.
+                    let p = b.pixel(x, y)?;
+                    std::array::from_fn(|c| {
+                        let v = f64::from(p[c.min(p.len() - 1)]) / f64::from(u16::MAX);
+                        (scatterfit_optics::colour::srgb_encode(v) * 255.0).round() as u8
+                    })
+                }
+            };
+            data.extend_from_slice(&px);
+        }
+    }
+    ImageBuf::new(tw, th, 3, data).ok()
 }
 
 /// The bracket (and dark frame) read and checked, before any pixel work: the first half of
@@ -389,6 +428,11 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
         )
     };
     let mut corrections = Corrections::default();
+    let thumbnails: Vec<ImageBuf<u8>> = bracket
+        .frames()
+        .iter()
+        .filter_map(|f| thumbnail(&f.frame))
+        .collect();
     let depth = bracket.frames()[0].frame.bit_depth();
     if depth == 8 && inputs.saturation_given {
         return Err(PipelineError::Input(format!(
@@ -534,6 +578,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             read_s,
             merge_s: 0.0,
             corrections: Corrections::default(),
+            thumbnails,
         }
     } else {
         if let Some(path) = &inputs.response {
@@ -689,6 +734,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             read_s,
             merge_s: 0.0,
             corrections: Corrections::default(),
+            thumbnails,
         }
     };
     if let Some((path, f)) = &flat
@@ -828,6 +874,7 @@ pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
         read_s: t0.elapsed().as_secs_f64(),
         merge_s: 0.0,
         corrections: Corrections::default(),
+        thumbnails: Vec::new(),
     })
 }
 
@@ -857,4 +904,32 @@ pub fn load_response(path: &Path) -> Result<ResponseCurve> {
         context: format!("camera response {}", path.display()),
         source,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thumbnails_keep_the_aspect_and_sample_block_centres() {
+        // 8-bit, 1000 × 500, value = x / 4 in R, y / 2 in G, 7 in B.
+        let (w, h) = (1000usize, 500usize);
+        let data: Vec<u8> = (0..h)
+            .flat_map(|y| (0..w).flat_map(move |x| [(x / 4) as u8, (y / 2) as u8, 7]))
+            .collect();
+        let frame = CameraFrame::U8(ImageBuf::new(w, h, 3, data).unwrap());
+        let t = thumbnail(&frame).unwrap();
+        // step = ceil(1000 / 96) = 11: 91 × 46 samples at the centres 5, 16, 27, …
+        assert_eq!((t.width(), t.height(), t.channels()), (91, 46, 3));
+        assert_eq!(t.pixel(0, 0).unwrap(), &[1, 2, 7]);
+        assert_eq!(t.pixel(2, 3).unwrap(), &[(27 / 4) as u8, (38 / 2) as u8, 7]);
+        // 16-bit linear grey: full scale → 255, half → sRGB 0.7354 → 188, zero → 0.
+        let grey = |v: u16| {
+            let f = CameraFrame::U16(ImageBuf::filled(4, 4, 1, v).unwrap());
+            thumbnail(&f).unwrap().pixel(1, 1).unwrap().to_vec()
+        };
+        assert_eq!(grey(u16::MAX), [255, 255, 255]);
+        assert_eq!(grey(32768), [188, 188, 188]);
+        assert_eq!(grey(0), [0, 0, 0]);
+    }
 }

@@ -12,14 +12,16 @@ pub use scatterfit_io::inputs::same_file;
 use scatterfit_io::{atomic, escape, manifest, result_set};
 
 /// The files a measurement writes into a sample's output folder
-/// (`scatterfit_report::write_measurement`), the set manifest last.
-pub const RESULT_FILES: [&str; 7] = [
+/// (`scatterfit_report::write_measurement`, `report.html` being its `html::SAMPLE_PAGE`, which a
+/// report test checks is listed here), the set manifest last.
+pub const RESULT_FILES: [&str; 8] = [
     "profile.csv",
     "result.json",
     "result.csv",
     "result.md",
     "fit.svg",
     "fit.png",
+    "report.html",
     result_set::SET_FILE,
 ];
 

@@ -10,13 +10,10 @@ use scatterfit_pipeline::Measurement;
 
 use crate::plot::{Figure, Panel, Series, SeriesStyle};
 
-/// A channel's colour in the plots.
+/// A channel's colour in the plots: Okabe & Ito's (2008) vermillion, bluish green and blue, told
+/// apart with the common colour-vision deficiencies (each panel is also titled with its channel).
 fn colour(c: Channel) -> (u8, u8, u8) {
-    match c {
-        Channel::R => (200, 30, 30),
-        Channel::G => (20, 140, 40),
-        Channel::B => (30, 70, 200),
-    }
+    crate::html::CHANNEL_COLOURS[c.index()]
 }
 
 /// The measured rings of channel `c`: used ones with error bars, excluded ones apart.

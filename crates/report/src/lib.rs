@@ -4,7 +4,10 @@
 //! sample through `scatterfit-pipeline`:
 //! - **result files** ([`write_measurement`]): `result.json` (every value, uncertainty and input
 //!   file hash), `result.csv` and `result.md` (the row of Choi, Lee & Chin 2014's Table 1),
-//!   `profile.csv` (the measured radial profile), and the fit plot `fit.svg` / `fit.png`;
+//!   `profile.csv` (the measured radial profile), the fit plot `fit.svg` / `fit.png`, and the
+//!   sample page `report.html` ([`html`]: verdict, Table 1, Figures 4 and 6, the evidence, the
+//!   inputs; one self-contained file);
+//! - **the batch page** ([`html::write_index`]): `index.html`, one sortable row per sample;
 //! - **figures** ([`fit_figure`]: the measured profile and the fitted model per RGB channel, the
 //!   shape of the paper's Figure 4; [`compare_figure`]: measured, existing and proposed method, its
 //!   Figure 6), drawn by [`write_figure`] as SVG and/or PNG;
@@ -39,6 +42,7 @@
 pub mod accuracy;
 pub mod error;
 pub mod figures;
+pub mod html;
 pub mod measurement;
 pub mod plot;
 pub mod study;
@@ -46,5 +50,7 @@ pub mod study;
 pub use accuracy::accuracy_markdown;
 pub use error::{ReportError, Result};
 pub use figures::{compare_figure, fit_figure};
-pub use measurement::{WrittenReport, quality_line, summary_text, write_measurement};
+pub use measurement::{
+    WrittenReport, quality_line, summary_text, write_measurement, write_measurement_with,
+};
 pub use plot::{Figure, Panel, Series, SeriesStyle, render_png, render_svg, write_figure};

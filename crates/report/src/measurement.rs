@@ -1,5 +1,5 @@
 //! Writing and printing a measurement: result.json, result.csv and result.md (Table 1's shape),
-//! profile.csv, and the fit plot (fit.svg, fit.png; Figure 4's shape). The CLI's `measure`, `batch`,
+//! profile.csv, the fit plot (fit.svg, fit.png; Figure 4's shape) and the sample page report.html. The CLI's `measure`, `batch`,
 //! `compare` and `demo` write through here.
 
 use std::fmt::Write as _;
@@ -19,20 +19,33 @@ pub struct WrittenReport {
     /// The measurement's result, as written to result.json.
     pub result: MeasurementResult,
     /// The files written, in order: profile.csv, result.json, result.csv, result.md, fit.svg,
-    /// fit.png and last the set's manifest, result-files.json (`scatterfit_io::result_set`).
+    /// fit.png, report.html and last the set's manifest, result-files.json (`scatterfit_io::result_set`).
     pub files: Vec<PathBuf>,
 }
 
 /// Writes every result file of `m` into `dir` (created if missing): profile.csv, result.json,
-/// result.csv, result.md, fit.svg and fit.png, then result-files.json, which lists them with their
-/// hashes (a folder without it holds an incomplete set). Each file is written atomically; files of
-/// an earlier run are replaced.
+/// result.csv, result.md, fit.svg, fit.png and the sample page report.html (`crate::html`), then
+/// result-files.json, which lists them with their hashes (a folder without it holds an incomplete
+/// set). Each file is written atomically; files of an earlier run are replaced.
 ///
 /// # Errors
 /// The first file that cannot be written, named in the error: [`ReportError::CreateDir`],
 /// [`ReportError::ProfileCsv`], [`ReportError::ResultJson`], [`ReportError::Write`],
 /// [`ReportError::WritePlot`].
 pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
+    write_measurement_with(dir, m, None)
+}
+
+/// [`write_measurement`], and when `existing` (the same sample fitted by the existing method) is
+/// given, the sample page also shows Figure 6 (existing and proposed).
+///
+/// # Errors
+/// As [`write_measurement`].
+pub fn write_measurement_with(
+    dir: &Path,
+    m: &Measurement,
+    existing: Option<&Measurement>,
+) -> Result<WrittenReport> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateDir {
         path: dir.to_path_buf(),
         source,
@@ -61,13 +74,34 @@ pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
         })?;
         written.push(p);
     }
+    // The fit figure is drawn once: fit.svg and the page's Figure 4 are the same text.
     let (svg, png) = (dir.join("fit.svg"), dir.join("fit.png"));
-    crate::plot::write_figure(
-        &crate::figures::fit_figure(m, &result),
-        Some(&svg),
-        Some(&png),
-    )?;
+    let figure = crate::figures::fit_figure(m, &result);
+    let fit_svg = crate::plot::render_svg(&figure)?;
+    scatterfit_io::atomic::write_atomic(&svg, fit_svg.as_bytes()).map_err(|source| {
+        ReportError::WritePlot {
+            path: svg.clone(),
+            source,
+        }
+    })?;
+    crate::plot::write_figure(&figure, None, Some(&png))?;
     written.extend([svg, png]);
+    let compare_svg = existing
+        .map(|e| crate::plot::render_svg(&crate::figures::compare_figure(e, m, &result.name)))
+        .transpose()?;
+    let beside: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    let beside: Vec<&str> = beside.iter().map(String::as_str).collect();
+    written.push(crate::html::write_sample_page(
+        dir,
+        m,
+        &result,
+        Some(fit_svg),
+        compare_svg,
+        &beside,
+    )?);
     let names: Vec<String> = written
         .iter()
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))

@@ -61,7 +61,7 @@ fn count(img: &image::RgbImage, c: [u8; 3]) -> usize {
 }
 
 /// The channel colours of `figures.rs` (R, G, B).
-const COLOURS: [[u8; 3]; 3] = [[200, 30, 30], [20, 140, 40], [30, 70, 200]];
+const COLOURS: [[u8; 3]; 3] = [[213, 94, 0], [0, 158, 115], [0, 114, 178]];
 
 #[test]
 fn a_measured_sample_gets_its_report_files() {
@@ -85,6 +85,7 @@ fn a_measured_sample_gets_its_report_files() {
             "result.md",
             "fit.svg",
             "fit.png",
+            "report.html",
             "result-files.json"
         ]
     );
@@ -127,6 +128,26 @@ fn a_measured_sample_gets_its_report_files() {
         "SVG title"
     );
 
+    // report.html: self-contained (no external reference), Figure 4 inline with its title as
+    // text, the radiance map, one thumbnail per frame, the swatch beside the spectro colour.
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("<h1>wood-tile</h1>"));
+    assert!(
+        page.contains("wood-tile — radial profile and dipole fit"),
+        "Figure 4"
+    );
+    assert!(!page.contains("src=\"http") && !page.contains("href=\"http"));
+    assert!(page.contains("aria-label=\"false-colour radiance map\""));
+    assert_eq!(
+        page.matches("<img alt=\"frame ").count(),
+        m.hdr.frames.len(),
+        "one thumbnail per frame"
+    );
+    assert!(page.contains("alt=\"rendered swatch\""));
+    assert!(page.contains("spectrophotometer: Rd as sRGB #"));
+    assert!(page.contains("camera response"));
+    assert!(!page.contains("id=\"fig6\""), "no Figure 6 from one method");
+
     // The same picture in memory, and the Figure 6 comparison of both methods.
     let fig = fit_figure(&m, &written.result);
     assert_eq!(
@@ -148,6 +169,13 @@ fn a_measured_sample_gets_its_report_files() {
     let png = temp.path().join("compare.png");
     write_figure(&compare, None, Some(&png)).unwrap();
     assert_eq!(decode(&png).dimensions(), (1500, 520));
+    // With the existing method's fit, the page shows Figure 6 too.
+    let both = temp.path().join("both");
+    scatterfit_report::write_measurement_with(&both, &m, Some(&existing)).unwrap();
+    let page = std::fs::read_to_string(both.join("report.html")).unwrap();
+    assert!(
+        page.contains("id=\"fig6\"") && page.contains("measured profile, existing and proposed")
+    );
 
     // Written again: replaced in place, same picture.
     let again = write_measurement(&out, &m).unwrap();
