@@ -5,6 +5,7 @@
 //! cargo run -p scatterfit-mc --example g_model_check -- mcml [MAX_G_STEP]
 //! cargo run -p scatterfit-mc --example g_model_check -- eta-loo
 //! cargo run -p scatterfit-mc --example g_model_check -- table TABLE.json [MAX_G_STEP]
+//! cargo run --release -p scatterfit-mc --example g_model_check -- cost
 //! ```
 //! * `mcml`: the shipped grid (or with `MAX_G_STEP` = 1, interpolating across the gap from g = 0 to
 //!   0.8) against MCML's profiles and totals (`data/reference/mcml_profiles_g.csv`, σ′t = 1 mm⁻¹):
@@ -18,6 +19,8 @@
 //!   difference of Rd(r) over reduced-radius windows per α′, and of the total.
 //! * `table`: the grid interpolated to the g and η of a table file (e.g. a 10⁵-photon study table at
 //!   g = 0.85 or 0.7, η = 1.4), against that table, by α′ and window.
+//! * `cost`: parsing the shipped grid, and one `eval` (the fit's hot path: model + 300 radii) at
+//!   g = 0, at a node g = 0.9 and between nodes (g = 0.85).
 
 use scatterfit_mc::grid_g::albedo_from_reduced;
 use scatterfit_mc::model::{McProfile, McTable, McTableSet};
@@ -32,6 +35,7 @@ fn main() {
     match args.first().map(String::as_str) {
         Some("mcml") => mcml(args.get(1).map(|s| s.parse().expect("MAX_G_STEP"))),
         Some("eta-loo") => eta_loo(),
+        Some("cost") => cost(),
         Some("table") => table(
             &args[1],
             args.get(2).map(|s| s.parse().expect("MAX_G_STEP")),
@@ -295,5 +299,37 @@ fn table(path: &str, max_step: Option<f64>) {
         let (w, dt) = compare(&ma, &mb);
         let cells: Vec<String> = w.iter().map(|x| format!("{:.2} %", 100.0 * x)).collect();
         println!("| {ap} | {} | {dt:+.1e} |", cells.join(" | "));
+    }
+}
+
+fn cost() {
+    let t = std::time::Instant::now();
+    let grid = McGridSet::bundled().unwrap();
+    println!(
+        "McGridSet::bundled: {:.1} ms",
+        1e3 * t.elapsed().as_secs_f64()
+    );
+    let t = std::time::Instant::now();
+    let _ = McTableSet::bundled().unwrap();
+    println!(
+        "McTableSet::bundled (g = 0 only): {:.1} ms",
+        1e3 * t.elapsed().as_secs_f64()
+    );
+    let radii: Vec<f64> = (0..300).map(|i| 0.5 + 0.05 * i as f64).collect();
+    let mut out = vec![scatterfit_optics::ProfileSample::ZERO; radii.len()];
+    for g in [0.0, 0.9, 0.85] {
+        let n = 20_000;
+        let t = std::time::Instant::now();
+        for i in 0..n {
+            let p = OpticalProperties::new(1.0 + 1e-6 * i as f64, 0.02, 1.45)
+                .unwrap()
+                .with_g(g)
+                .unwrap();
+            ModelFamily::eval(&grid, &p, &radii, &mut out);
+        }
+        println!(
+            "eval, 300 radii, g = {g}: {:.1} µs",
+            1e6 * t.elapsed().as_secs_f64() / n as f64
+        );
     }
 }

@@ -66,7 +66,8 @@ pub trait ModelFamily: Send + Sync {
     /// # Errors
     /// Where the model does not cover the parameters: `InvalidParameter` (η > 2.5 for the improved
     /// diffusion models), `OutOfTable` (α′ or η outside the Monte Carlo tables),
-    /// `AnisotropyMismatch` (a g the tables were not made for).
+    /// `AnisotropyMismatch` (a g the tables were not made for), `AnisotropyNotTabulated` (a g the
+    /// Monte Carlo grid neither holds nor interpolates).
     fn profile(&self, props: &OpticalProperties) -> Result<Box<dyn ProfileModel>>;
 
     /// Rd and ∂Rd/∂σ′s, ∂Rd/∂σa for `props` at every radius of `radii_mm`, into `out`; NaN
