@@ -152,6 +152,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         spot: scatterfit_pipeline::fit::SpotShape::Disk,
         r_min_mm: args.r_min_mm,
         normalise_with_spectro: args.normalise_with_spectro,
+        g: 0.0,
     };
     let fits = fit_stage(&data, &spectro, &settings, model);
     let result = MeasurementResult {

@@ -45,7 +45,7 @@ mod properties;
 mod roots;
 
 pub use error::{OpticsError, Result};
-pub use family::{ModelFamily, ProfileModel, ProfileSample};
+pub use family::{AtG, ModelFamily, ProfileModel, ProfileSample};
 pub use model::DiffusionModel;
 pub use names::{AlbedoModel, Method, ModelName};
 pub use properties::OpticalProperties;

@@ -8,7 +8,7 @@ use scatterfit_fit::ProfileData;
 use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest, read_manifest};
 use scatterfit_io::result_json::{Channels, FileRef, Inputs, MeasurementResult};
 use scatterfit_mc::{albedo_family, family};
-use scatterfit_optics::{AlbedoModel, Method, ModelName, Rgb};
+use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
@@ -131,7 +131,7 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         }
         _ => (SpotShape::Disk, 0.5 * diameter),
     };
-    Ok(FitSettings {
+    let settings = FitSettings {
         method,
         model,
         albedo_model,
@@ -139,7 +139,28 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         spot_radius_mm,
         r_min_mm: manifest.fit.r_min_mm,
         normalise_with_spectro: normalise,
-    })
+        g: manifest.fit.g.unwrap_or(0.0),
+    };
+    families(&settings)?;
+    Ok(settings)
+}
+
+/// The profile model and the albedo model of `settings`, both at its g (issue 15).
+///
+/// # Errors
+/// [`PipelineError::Input`] for a g the Monte Carlo tables do not cover when either model is `mc`.
+fn families(settings: &FitSettings) -> Result<(AtG<'static>, AtG<'static>)> {
+    let at = |f| AtG::new(f, settings.g).map_err(|e| PipelineError::Input(format!("fit.g: {e}")));
+    let (model, albedo) = (
+        at(family(settings.model)?)?,
+        at(albedo_family(settings.albedo_model, settings.model)?)?,
+    );
+    if settings.model == ModelName::Mc || settings.albedo_model == AlbedoModel::Mc {
+        scatterfit_mc::bundled_grid()?
+            .albedo_prime_range(settings.g)
+            .map_err(|e| PipelineError::Input(format!("fit.g: {e}")))?;
+    }
+    Ok((model, albedo))
 }
 
 /// Measures the sample in folder `dir` (its `sample.toml`).
@@ -156,9 +177,9 @@ pub fn measure_sample(
     let t0 = Instant::now();
     let manifest = sample_inputs(dir, overrides.allow_outside_paths)?.manifest;
     let settings = fit_settings(&manifest, overrides)?;
-    let model = family(settings.model)?;
+    let (model, albedo) = families(&settings)?;
+    let (model, albedo) = (&model, &albedo);
     progress(Stage::Spectro);
-    let albedo = albedo_family(settings.albedo_model, settings.model)?;
     let spectro = spectro_stage(&manifest, overrides.eta, albedo)?;
     let spectro_s = t0.elapsed().as_secs_f64();
     let hdr = match &manifest.camera.hdr {
@@ -309,8 +330,8 @@ impl Measurement {
     }
 
     fn refit_inner(&self, settings: FitSettings, propagate: bool) -> Result<Measurement> {
-        let model = family(settings.model)?;
-        let albedo = albedo_family(settings.albedo_model, settings.model)?;
+        let (model, albedo) = families(&settings)?;
+        let (model, albedo) = (&model, &albedo);
         let t = Instant::now();
         let data: Vec<ProfileData> = (0..3)
             .map(|c| self.profile.channel_data(c))
