@@ -79,7 +79,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 if !m.complete() {
                     let why: Vec<String> = r
                         .channels
-                        .as_array()
                         .iter()
                         .filter_map(|c| c.problem.clone())
                         .collect();

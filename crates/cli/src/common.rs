@@ -559,7 +559,7 @@ pub fn check_output_dir(dir: &Path, flag: &str) -> anyhow::Result<()> {
 /// True when no channel of a result has a data-check verdict other than `ok` (results without
 /// verdicts count as trusted: the checks did not run).
 pub fn trusted(r: &scatterfit_io::result_json::MeasurementResult) -> bool {
-    r.channels.as_array().iter().all(|c| {
+    r.channels.iter().all(|c| {
         c.quality
             .as_ref()
             .is_none_or(|q| q.verdict == scatterfit_io::quality::Verdict::Ok)
@@ -568,14 +568,14 @@ pub fn trusted(r: &scatterfit_io::result_json::MeasurementResult) -> bool {
 
 /// The suspect channels of a result and why, one line (`G suspect: …; B suspect: …`).
 pub fn suspect_text(r: &scatterfit_io::result_json::MeasurementResult) -> String {
-    ["R", "G", "B"]
-        .iter()
-        .zip(r.channels.as_array())
-        .filter_map(|(name, c)| {
+    r.channels
+        .iter_channels()
+        .filter_map(|(ch, c)| {
             let q = c.quality.as_ref()?;
             (q.verdict != scatterfit_io::quality::Verdict::Ok).then(|| {
                 format!(
-                    "{name} {}: {}",
+                    "{} {}: {}",
+                    ch.name(),
                     q.verdict,
                     scatterfit_io::escape::one_line(&q.summary())
                 )

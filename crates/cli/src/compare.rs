@@ -52,11 +52,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         overrides.allow_outside_paths,
         args.quiet || args.json,
     )?;
-    let (pairs, mut failed) = crate::runner::compare_dirs(
+    let (pairs, _, mut failed) = crate::runner::compare_dirs(
         &dirs,
-        &args.fit,
+        &overrides,
         args.samples.jobs.unwrap_or(0),
         args.quiet || args.json,
+        false,
         false,
     )?;
     failed.extend(misspelt);

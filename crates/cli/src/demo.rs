@@ -20,7 +20,7 @@ use scatterfit_synth::Truth;
 use scatterfit_synth::materials::CHOI_2014;
 use serde::Serialize;
 
-use crate::common::{CacheArgs, FitArgs};
+use crate::common::CacheArgs;
 use crate::output::{errln, out, outln};
 use crate::twin::{Material, synthesize, write_sample};
 
@@ -155,16 +155,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let synth_s = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let fit = FitArgs {
-        method: None,
-        model: None,
-        albedo_model: None,
-        eta: None,
-        normalise_with_spectro: false,
-        allow_outside_paths: false,
-    };
-    let (pairs, exacts, failed) =
-        crate::runner::compare_dirs_exact(&dirs, &fit, args.jobs.unwrap_or(0), quiet, true, true)?;
+    let (pairs, exacts, failed) = crate::runner::compare_dirs(
+        &dirs,
+        &scatterfit_pipeline::Overrides::default(),
+        args.jobs.unwrap_or(0),
+        quiet,
+        true,
+        true,
+    )?;
     let measure_s = t1.elapsed().as_secs_f64();
     let rows = accuracy_rows(&pairs, &exacts, &truths);
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
@@ -253,8 +251,8 @@ fn accuracy_rows(
                     .map(|c| {
                         let (tc, pc, ec) = (
                             &t.channels[c],
-                            p.channels.as_array()[c],
-                            e.channels.as_array()[c],
+                            p.channels.as_ref().into_array()[c],
+                            e.channels.as_ref().into_array()[c],
                         );
                         ChannelRow {
                             channel: names[c],
@@ -271,13 +269,18 @@ fn accuracy_rows(
                             existing_sigma_s_prime_error: rel(ec.sigma_s_prime, tc.sigma_s_prime),
                             existing_sigma_a_error: rel(ec.sigma_a, tc.sigma_a),
                             exact_sigma_s_prime: x
-                                .and_then(|x| x.channels.as_array()[c].sigma_s_prime),
-                            exact_sigma_a: x.and_then(|x| x.channels.as_array()[c].sigma_a),
+                                .and_then(|x| x.channels.as_ref().into_array()[c].sigma_s_prime),
+                            exact_sigma_a: x
+                                .and_then(|x| x.channels.as_ref().into_array()[c].sigma_a),
                             exact_sigma_s_prime_error: x.and_then(|x| {
-                                rel(x.channels.as_array()[c].sigma_s_prime, tc.sigma_s_prime)
+                                rel(
+                                    x.channels.as_ref().into_array()[c].sigma_s_prime,
+                                    tc.sigma_s_prime,
+                                )
                             }),
-                            exact_sigma_a_error: x
-                                .and_then(|x| rel(x.channels.as_array()[c].sigma_a, tc.sigma_a)),
+                            exact_sigma_a_error: x.and_then(|x| {
+                                rel(x.channels.as_ref().into_array()[c].sigma_a, tc.sigma_a)
+                            }),
                         }
                     })
                     .collect(),

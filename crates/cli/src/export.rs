@@ -162,11 +162,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// or a channel has no coefficients (the export then refuses it anyway).
 fn exact_transport_rd(result: &MeasurementResult) -> Option<[f64; 3]> {
     let mc = scatterfit_mc::family(scatterfit_optics::ModelName::Mc).ok()?;
-    let [r, g, b] = result.coefficients().ok()?.map(|(sp, sa)| {
+    let rd = result.coefficients().ok()?.map(|(sp, sa)| {
         let rd = mc.rd_total(sp / (sp + sa), result.eta, 0.0).ok()?;
         (rd.is_finite() && (0.0..=1.0).contains(&rd)).then_some(rd)
     });
-    Some([r?, g?, b?])
+    Some(rd.transpose()?.into_array())
 }
 
 /// The single-scattering albedo whose exact-transport total Rd is the measured Rd(λ), at each

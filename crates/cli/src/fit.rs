@@ -6,13 +6,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use scatterfit_fit::ProfileData;
 use scatterfit_io::profile_csv::read_profile_csv;
-use scatterfit_io::result_json::{Channels, Inputs, MeasurementResult, write_result_json};
-use scatterfit_optics::{AlbedoModel, Method, ModelName};
-use scatterfit_pipeline::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage};
+use scatterfit_io::result_json::write_result_json;
+use scatterfit_optics::{Method, Rgb};
 use scatterfit_pipeline::profile::channel_from_table;
-use scatterfit_pipeline::spectro::SpectroStage;
+use scatterfit_pipeline::profile_fit::{ProfileFitRequest, fit_profile};
 
 use crate::common::parse_rgb;
 use crate::common::{MethodArg, ModelArg};
@@ -39,10 +37,10 @@ pub struct Args {
     /// The forward model.
     #[arg(long, value_enum, default_value_t = ModelArg::Dipole)]
     pub model: ModelArg,
-    /// Diameter of the light spot [mm], in (0, 20]; the model is convolved with it.
+    /// Diameter of the light spot \[mm\], in (0, 20]; the model is convolved with it.
     #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub spot_diameter_mm: f64,
-    /// Innermost fitted radius [mm], in [0, 1000) (default: the spot diameter).
+    /// Innermost fitted radius \[mm\], in [0, 1000) (default: the spot diameter).
     #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub r_min_mm: Option<f64>,
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd.
@@ -117,79 +115,27 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.force,
         )?;
     }
-    let model_name: ModelName = args.model.into();
-    let model = scatterfit_mc::family(model_name)?;
     let table = read_profile_csv(&args.profile)?;
-    let data: Vec<ProfileData> = ["r", "g", "b"]
-        .iter()
-        .map(|c| channel_from_table(&table, c))
-        .collect::<Result<_, _>>()
+    let data = Rgb::from_fn(|c| channel_from_table(&table, c.key()))
+        .transpose()
         .with_context(|| format!("{}", args.profile.display()))?;
-    let albedo = args.albedo.map_or([None; 3], |a| a.map(Some));
-    let rd = args.rd.unwrap_or_else(|| {
-        albedo.map(|a| {
-            a.map_or(f64::NAN, |a| {
-                model.rd_total(a, args.eta, 0.0).unwrap_or(f64::NAN)
-            })
-        })
-    });
-    let spectro = SpectroStage {
-        file: None,
-        analysis: None,
-        eta: args.eta,
-        eta_source: "given",
-        rd,
-        albedo_prime: albedo,
-        problems: Default::default(),
-        warnings: Vec::new(),
-        uncertainty: scatterfit_pipeline::spectro::SpectroUncertainty::none(args.eta, rd, albedo),
-    };
-    let settings = FitSettings {
-        method,
-        model: model_name,
-        albedo_model: AlbedoModel::Diffusion,
-        spot_radius_mm: 0.5 * args.spot_diameter_mm,
-        spot: scatterfit_pipeline::fit::SpotShape::Disk,
-        r_min_mm: args.r_min_mm,
-        normalise_with_spectro: args.normalise_with_spectro,
-        g: 0.0,
-    };
-    let fits = fit_stage(&data, &spectro, &settings, model);
-    let result = MeasurementResult {
+    let request = ProfileFitRequest {
         name: args
             .profile
             .file_stem()
             .map_or_else(|| "profile".into(), |s| s.to_string_lossy().into_owned()),
+        profile_file: Some(args.profile.to_string_lossy().into_owned()),
         eta: args.eta,
-        eta_source: "given".into(),
-        eta_stderr: None,
-        spectro_repeatability: None,
-        method: method.name().into(),
-        model: model_name.name().into(),
-        albedo_model: "given".into(),
-        channels: Channels::from_array(std::array::from_fn(|c| {
-            // The fit's own checks (no image here: the residuals and the ranges).
-            let mut r = channel_result(&fits[c], &spectro, c, None);
-            r.quality = Some(scatterfit_pipeline::checks::Quality::from_reasons(
-                scatterfit_pipeline::checks::fit_reasons(&fits[c], args.eta),
-            ));
-            r
-        })),
-        inputs: Inputs {
-            profile: Some(args.profile.to_string_lossy().into_owned()),
-            spot_radius_mm: Some(settings.spot_radius_mm),
-            options: serde_json::json!({
-                "method": method.name(),
-                "model": model_name.name(),
-                "normalise_with_spectro": args.normalise_with_spectro,
-                "r_min_mm": settings.r_min_mm(),
-            }),
-            ..Inputs::default()
-        },
-        version: env!("CARGO_PKG_VERSION").into(),
-        rd_spectrum: None,
-        spectro_port: None,
+        albedo_prime: args.albedo.map(Rgb::from_array),
+        rd: args.rd.map(Rgb::from_array),
+        method,
+        model: args.model.into(),
+        spot_diameter_mm: args.spot_diameter_mm,
+        r_min_mm: args.r_min_mm,
+        normalise_with_spectro: args.normalise_with_spectro,
     };
+    let fitted = fit_profile(&data, &request)?;
+    let result = fitted.to_result();
     if let Some(out) = &args.output {
         write_result_json(out, &result)?;
     }
@@ -198,7 +144,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         out!("{}", scatterfit_report::summary_text(&result))?;
     }
-    Ok(if fits.iter().all(ChannelOutcome::is_measurement) {
+    Ok(if fitted.complete() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

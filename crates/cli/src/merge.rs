@@ -97,9 +97,9 @@ pub struct Summary {
     pub frames: Vec<FrameInfo>,
     /// Image size and kind, e.g. `6000×4000 RGB 8-bit`.
     pub image: String,
-    /// Width [px].
+    /// Width \[px\].
     pub width: usize,
-    /// Height [px].
+    /// Height \[px\].
     pub height: usize,
     /// `recovered`, `given` (file) or `linear` (16-bit).
     pub response: String,
@@ -119,9 +119,9 @@ pub struct Summary {
     pub output: PathBuf,
     /// The response CSV written (none for a linear 16-bit merge).
     pub response_out: Option<PathBuf>,
-    /// Wall time for reading the frames [s].
+    /// Wall time for reading the frames \[s\].
     pub read_s: f64,
-    /// Wall time for response recovery and merge [s].
+    /// Wall time for response recovery and merge \[s\].
     pub merge_s: f64,
 }
 
@@ -132,7 +132,7 @@ fn default_response_out(output: &Path) -> PathBuf {
     output.with_file_name(format!("{stem}.response.csv"))
 }
 
-/// The pipeline's inputs for these flags and the memory budget [bytes] (the sample count is set
+/// The pipeline's inputs for these flags and the memory budget \[bytes\] (the sample count is set
 /// once the frames are counted).
 fn hdr_inputs(args: &Args, budget: u64) -> HdrInputs {
     let mut inputs = HdrInputs::new(args.exposures.clone(), args.images.clone());

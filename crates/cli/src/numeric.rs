@@ -107,7 +107,7 @@ pub fn parse_finite(text: &str) -> Result<f64, String> {
     }
 }
 
-/// The memory budget [bytes]: the flag's MiB, else [`MEMORY_BUDGET_ENV`], else
+/// The memory budget \[bytes\]: the flag's MiB, else [`MEMORY_BUDGET_ENV`], else
 /// [`DEFAULT_MEMORY_BUDGET_MIB`].
 pub fn memory_budget(flag_mib: Option<u64>) -> u64 {
     flag_mib.map_or_else(scatterfit_io::budget::memory_budget_bytes, |m| {

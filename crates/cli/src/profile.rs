@@ -30,11 +30,11 @@ pub struct Args {
     /// automatically if omitted.
     #[arg(long, value_name = "X,Y", value_parser = parse_center)]
     pub center: Option<[f64; 2]>,
-    /// Outer radius of the profile [px], in (0, 10⁶] (the paper's cut-off is 300); at most 10⁶
+    /// Outer radius of the profile \[px\], in (0, 10⁶] (the paper's cut-off is 300); at most 10⁶
     /// rings (r_max / ring width).
     #[arg(long, default_value_t = 300.0, value_name = "PX", value_parser = crate::numeric::parse_finite)]
     pub r_max_px: f64,
-    /// Ring width [px], > 0, with at most 10⁶ rings (r_max / ring width; 1 px gives the paper's
+    /// Ring width \[px\], > 0, with at most 10⁶ rings (r_max / ring width; 1 px gives the paper's
     /// profile).
     #[arg(long, default_value_t = 1.0, value_name = "PX", value_parser = crate::numeric::parse_finite)]
     pub ring_width_px: f64,
@@ -57,10 +57,10 @@ pub struct Args {
     pub json: bool,
 }
 
-/// The largest ring radius accepted [px]: beyond any camera sensor's diagonal.
+/// The largest ring radius accepted \[px\]: beyond any camera sensor's diagonal.
 const MAX_R_PX: f64 = 1e6;
 
-/// Memory per ring and channel of the profile and its CSV row [bytes] (the ring's statistics, its
+/// Memory per ring and channel of the profile and its CSV row \[bytes\] (the ring's statistics, its
 /// share of the table, and the text), an upper bound.
 const BYTES_PER_RING_CHANNEL: u64 = 160;
 
@@ -133,7 +133,7 @@ fn parse_center(text: &str) -> Result<[f64; 2], String> {
 pub struct Summary {
     /// The radiance map read.
     pub radiance: PathBuf,
-    /// Spot centre `[x, y]` [px].
+    /// Spot centre `[x, y]` \[px\].
     pub center_px: [f64; 2],
     /// `found` or `given`.
     pub center_source: String,
@@ -145,7 +145,7 @@ pub struct Summary {
     pub empty_rings: usize,
     /// Image scale [mm/px].
     pub mm_per_pixel: f64,
-    /// Outermost ring radius [mm].
+    /// Outermost ring radius \[mm\].
     pub r_max_mm: f64,
     /// The CSV written.
     pub output: PathBuf,

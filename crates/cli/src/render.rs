@@ -118,7 +118,7 @@ pub struct Args {
     /// (default: a spacing of a third of the profile's half-width over the model, 65 536–2 097 152).
     #[arg(long, value_parser = crate::numeric::parse_size, value_name = "N")]
     pub light_rays: Option<usize>,
-    /// Hierarchy threshold: a node is used whole below this angular size [rad], in (0, 1).
+    /// Hierarchy threshold: a node is used whole below this angular size \[rad\], in (0, 1).
     #[arg(long, default_value_t = 0.5, value_name = "RAD", value_parser = crate::numeric::parse_finite)]
     pub max_angle: f64,
     /// Evaluate eq. 6 as a direct sum over every irradiance point (exact, slow).
@@ -156,7 +156,7 @@ pub struct Args {
     /// Henyey–Greenstein g of P(g) in eqs. 3–4, in (−1, 1).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub g: f64,
-    /// Exposure [EV], in [−60, 60]; at 0 a white diffuser facing a light of irradiance 1 is the
+    /// Exposure \[EV\], in [−60, 60]; at 0 a white diffuser facing a light of irradiance 1 is the
     /// reference white.
     /// Default 0, except with --profile, where the slab image is exposed so that the glow at twice
     /// the spot radius shows as white.
@@ -177,7 +177,7 @@ pub struct Args {
     /// folder (`../x.csv`, an absolute path, a link that leaves it); refused otherwise.
     #[arg(long, requires = "profile")]
     pub allow_outside_paths: bool,
-    /// Light-spot radius for --profile [mm], in (0, 10] (default: the result's
+    /// Light-spot radius for --profile \[mm\], in (0, 10] (default: the result's
     /// `inputs.spot_radius_mm`).
     #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub spot_radius_mm: Option<f64>,

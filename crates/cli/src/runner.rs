@@ -1,13 +1,16 @@
-//! Measuring many sample folders in parallel with one progress bar (`batch`, `compare`, `demo`).
-//! A failed sample never stops the others; each outcome is kept with its folder.
+//! Many sample folders with one progress bar (`batch`, `compare`, `demo`): the scheduling is the
+//! library's ([`scatterfit_pipeline::batch`], [`scatterfit_pipeline::compare`]); this file turns
+//! its events into the progress bar and its outcomes into the commands' error texts. A failed
+//! sample never stops the others; each outcome is kept with its folder.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use rayon::prelude::*;
+use indicatif::ProgressBar;
 use scatterfit_io::result_json::MeasurementResult;
-use scatterfit_optics::Method;
-use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
+use scatterfit_pipeline::batch::{BatchEvent, BatchRequest, measure_batch_with};
+use scatterfit_pipeline::compare::compare_batch_with;
+use scatterfit_pipeline::{Measurement, Overrides};
 
 /// One sample's outcome.
 pub struct Outcome {
@@ -36,67 +39,41 @@ pub fn parse_jobs(text: &str) -> Result<usize, String> {
     }
 }
 
-/// A sample's peak memory [bytes], estimated from its frames' headers: the decoded bracket, and as
-/// much again for the radiance map, its mask and the decoders' copies. 0 when unknown (the sample's
-/// own reading reports what is wrong with it).
-fn sample_memory(dir: &Path) -> u64 {
-    let Ok(m) = scatterfit_io::manifest::read_manifest(dir) else {
-        return 0;
-    };
-    let images: Vec<PathBuf> = m
-        .camera
-        .images
-        .iter()
-        .flatten()
-        .map(|p| m.resolve(p))
-        .collect();
-    let exposures = m.camera.exposures.as_ref().map(|p| m.resolve(p));
-    if let Some(hdr) = &m.camera.hdr {
-        // A float map: decoded ≈ 3 × the file (PIZ) at most; with the copy made on reading.
-        return std::fs::metadata(m.resolve(hdr)).map_or(0, |md| md.len().saturating_mul(6));
-    }
-    match scatterfit_io::bracket::planned_frames(&images, exposures.as_deref()) {
-        Ok(frames) => {
-            let (total, _, _) =
-                scatterfit_io::bracket::decoded_size(frames.iter().map(PathBuf::as_path));
-            total.saturating_mul(2)
-        }
-        Err(_) => 0,
-    }
-}
-
-/// How many of `dirs` to measure at once: `requested` (0: one per core), fewer when that many of
-/// the largest samples would not fit the memory budget (checked from the frames' headers before
-/// any is read), never below one.
-pub fn jobs_within_budget(dirs: &[PathBuf], requested: usize, quiet: bool) -> usize {
-    let want = if requested == 0 {
-        rayon::current_num_threads()
-    } else {
-        requested
-    }
-    .clamp(1, dirs.len().max(1));
-    let mut sizes: Vec<u64> = dirs.iter().map(|d| sample_memory(d)).collect();
-    sizes.sort_unstable_by(|a, b| b.cmp(a));
-    let budget = scatterfit_io::budget::memory_budget_bytes();
-    let mut jobs = want;
-    while jobs > 1 && sizes.iter().take(jobs).sum::<u64>() > budget {
-        jobs -= 1;
-    }
-    if jobs < want && !quiet {
-        crate::output::errln!(
-            "note: measuring {jobs} sample(s) at a time instead of {want}: {want} of these samples \
-             would need about {} of memory, more than the budget of {} ({}=<MiB> raises it)",
-            scatterfit_io::budget::describe_bytes(sizes.iter().take(want).sum()),
-            scatterfit_io::budget::describe_bytes(budget),
+/// The progress bar's view of a batch: the plan (a note on stderr when the memory budget runs
+/// fewer samples at once than asked) and each finished sample.
+fn on_event(event: BatchEvent<'_>, bar: &ProgressBar, quiet: bool) {
+    match event {
+        BatchEvent::Started(plan) if plan.reduced() && !quiet => crate::output::errln!(
+            "note: measuring {} sample(s) at a time instead of {}: {} of these samples would \
+             need about {} of memory, more than the budget of {} ({}=<MiB> raises it)",
+            plan.jobs,
+            plan.requested,
+            plan.requested,
+            scatterfit_io::budget::describe_bytes(plan.memory_needed),
+            scatterfit_io::budget::describe_bytes(plan.memory_budget),
             scatterfit_io::budget::MEMORY_BUDGET_ENV
-        );
+        ),
+        BatchEvent::Finished { dir, .. } => {
+            bar.inc(1);
+            if let Some(name) = dir.file_name() {
+                bar.set_message(name.to_string_lossy().into_owned());
+            }
+        }
+        _ => {}
     }
-    jobs
 }
 
-/// Measures every folder of `dirs` with `jobs` samples at a time (0: one per core), calling
-/// `done` for each as soon as it is finished (from a worker thread) so results can be written
-/// before the others end.
+fn progress(len: usize, quiet: bool) -> ProgressBar {
+    crate::common::bar(
+        len as u64,
+        "measuring {bar:30} {pos}/{len} samples {elapsed} (eta {eta}) {msg}",
+        quiet,
+    )
+}
+
+/// Measures every folder of `dirs` with `jobs` samples at a time (0: one per core, fewer when the
+/// memory budget says so), calling `done` for each as soon as it is finished (from a worker
+/// thread) so results can be written before the others end.
 ///
 /// # Errors
 /// Only when the thread pool cannot be built.
@@ -107,35 +84,28 @@ pub fn measure_many(
     quiet: bool,
     done: &(dyn Fn(&Path, &anyhow::Result<Measurement>) + Sync),
 ) -> anyhow::Result<Vec<Outcome>> {
-    let jobs = jobs_within_budget(dirs, jobs, quiet);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs)
-        .build()
-        .context("starting the worker threads")?;
-    let bar = crate::common::bar(
-        dirs.len() as u64,
-        "measuring {bar:30} {pos}/{len} samples {elapsed} (eta {eta}) {msg}",
-        quiet,
-    );
-    let outcomes = pool.install(|| {
-        dirs.par_iter()
-            .map(|dir| {
-                let result = measure_sample(dir, overrides, &|_| {})
-                    .with_context(|| format!("measuring {}", dir.display()));
-                done(dir, &result);
-                bar.inc(1);
-                if let Some(name) = dir.file_name() {
-                    bar.set_message(name.to_string_lossy().into_owned());
-                }
-                Outcome {
-                    dir: dir.clone(),
-                    result,
-                }
-            })
-            .collect::<Vec<_>>()
-    });
+    let bar = progress(dirs.len(), quiet);
+    let request = BatchRequest::new(dirs.iter().cloned(), *overrides).jobs(jobs);
+    let batch = measure_batch_with(
+        request,
+        &|dir, measured| {
+            let result = measured
+                .map_err(anyhow::Error::from)
+                .with_context(|| format!("measuring {}", dir.display()));
+            done(dir, &result);
+            result
+        },
+        &|e| on_event(e, &bar, quiet),
+    )?;
     bar.finish_and_clear();
-    Ok(outcomes)
+    Ok(batch
+        .samples
+        .into_iter()
+        .map(|s| Outcome {
+            dir: s.dir,
+            result: s.outcome,
+        })
+        .collect())
 }
 
 /// Samples that failed, with why.
@@ -144,88 +114,76 @@ pub type Failures = Vec<(PathBuf, String)>;
 /// One sample compared: (existing, proposed).
 pub type Pair = (MeasurementResult, MeasurementResult);
 
-/// Measures `dirs` once and fits each both ways; writes compare.svg/png into each sample folder
-/// (and, with `write_results`, the proposed measurement's result files as `measure` does).
-/// Returns the pairs and the samples that failed.
+/// What one sample's comparison gave the command.
+type Compared = Result<(Pair, Option<MeasurementResult>, Vec<String>), String>;
+
+/// Measures `dirs` once and fits each both ways ([`scatterfit_pipeline::compare`]); writes
+/// compare.svg/png into each sample folder (and, with `write_results`, the proposed measurement's
+/// result files as `measure` does); with `exact` each sample is also fitted beyond the paper (the
+/// Monte Carlo forward model with α′ from the Monte Carlo total; `None` where that fit cannot
+/// run). Returns the pairs, the exact fits (empty without `exact`) and the samples that failed.
 ///
 /// # Errors
 /// Only when the worker threads cannot start.
 pub fn compare_dirs(
     dirs: &[PathBuf],
-    fit: &crate::common::FitArgs,
-    jobs: usize,
-    quiet: bool,
-    write_results: bool,
-) -> anyhow::Result<(Vec<Pair>, Failures)> {
-    let (pairs, _, failed) = compare_dirs_exact(dirs, fit, jobs, quiet, write_results, false)?;
-    Ok((pairs, failed))
-}
-
-/// [`compare_dirs`], and with `exact` each sample also fitted beyond the paper: the Monte Carlo
-/// forward model with α′ from the Monte Carlo total (`None` where that fit cannot run).
-///
-/// # Errors
-/// Only when the worker threads cannot start.
-pub fn compare_dirs_exact(
-    dirs: &[PathBuf],
-    fit: &crate::common::FitArgs,
+    overrides: &Overrides,
     jobs: usize,
     quiet: bool,
     write_results: bool,
     exact: bool,
 ) -> anyhow::Result<(Vec<Pair>, Vec<Option<MeasurementResult>>, Failures)> {
-    let mut overrides = fit.overrides()?;
-    overrides.method = Some(Method::Proposed);
-    let outcomes = measure_many(dirs, &overrides, jobs, quiet, &|_, _| {})?;
-    let mut pairs = Vec::new();
-    let mut exacts = Vec::new();
-    let mut failed = Vec::new();
-    for o in outcomes {
-        let proposed = match o.result {
-            Ok(m) => m,
-            Err(e) => {
-                failed.push((o.dir, crate::common::error_text(&e)));
-                continue;
+    let bar = progress(dirs.len(), quiet);
+    let request = BatchRequest::new(dirs.iter().cloned(), *overrides).jobs(jobs);
+    let batch = compare_batch_with(
+        request,
+        exact,
+        &|dir, compared| -> Compared {
+            let c = compared.map_err(|e| {
+                let e = anyhow::Error::from(e).context(format!("measuring {}", dir.display()));
+                crate::common::error_text(&e)
+            })?;
+            let mut problems = Vec::new();
+            if write_results && let Err(e) = scatterfit_report::write_measurement(dir, &c.proposed)
+            {
+                let e = anyhow::Error::from(e);
+                problems.push(format!("writing the results: {e:#}"));
             }
-        };
-        let existing = match proposed.refit(Method::Existing) {
-            Ok(m) => m,
-            Err(e) => {
-                failed.push((o.dir, e.to_string()));
-                continue;
+            let name = c.proposed.manifest.display_name();
+            let fig = scatterfit_report::compare_figure(&c.existing, &c.proposed, &name);
+            if let Err(e) = scatterfit_report::write_figure(
+                &fig,
+                Some(&dir.join("compare.svg")),
+                Some(&dir.join("compare.png")),
+            ) {
+                let e = anyhow::Error::from(e);
+                problems.push(format!("writing the plot: {e:#}"));
             }
-        };
-        if write_results && let Err(e) = scatterfit_report::write_measurement(&o.dir, &proposed) {
-            let e = anyhow::Error::from(e);
-            failed.push((o.dir.clone(), format!("writing the results: {e:#}")));
-        }
-        let name = proposed.manifest.display_name();
-        let fig = scatterfit_report::compare_figure(&existing, &proposed, &name);
-        if let Err(e) = scatterfit_report::write_figure(
-            &fig,
-            Some(&o.dir.join("compare.svg")),
-            Some(&o.dir.join("compare.png")),
-        ) {
-            let e = anyhow::Error::from(e);
-            failed.push((o.dir.clone(), format!("writing the plot: {e:#}")));
-        }
-        if exact {
-            let settings = scatterfit_pipeline::fit::FitSettings {
-                model: scatterfit_optics::ModelName::Mc,
-                albedo_model: scatterfit_optics::AlbedoModel::Mc,
-                ..proposed.settings
-            };
-            exacts.push(
-                proposed
-                    .refit_with(settings)
-                    .ok()
-                    .map(|m| m.to_result(Some("profile.csv"))),
+            let exact = c
+                .exact
+                .and_then(Result::ok)
+                .map(|m| m.to_result(Some("profile.csv")));
+            let pair = (
+                c.existing.to_result(Some("profile.csv")),
+                c.proposed.to_result(Some("profile.csv")),
             );
+            Ok((pair, exact, problems))
+        },
+        &|e| on_event(e, &bar, quiet),
+    )?;
+    bar.finish_and_clear();
+    let (mut pairs, mut exacts, mut failed) = (Vec::new(), Vec::new(), Vec::new());
+    for s in batch.samples {
+        match s.outcome {
+            Ok((pair, exact_fit, problems)) => {
+                failed.extend(problems.into_iter().map(|p| (s.dir.clone(), p)));
+                pairs.push(pair);
+                if exact {
+                    exacts.push(exact_fit);
+                }
+            }
+            Err(e) => failed.push((s.dir, e)),
         }
-        pairs.push((
-            existing.to_result(Some("profile.csv")),
-            proposed.to_result(Some("profile.csv")),
-        ));
     }
     Ok((pairs, exacts, failed))
 }

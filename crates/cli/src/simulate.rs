@@ -30,7 +30,7 @@ pub struct Args {
     /// work grows like 1/(1 − g) as g → 1.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub g: f64,
-    /// Slab thickness [mm]: finite, > 0; omit for a half-space.
+    /// Slab thickness \[mm\]: finite, > 0; omit for a half-space.
     #[arg(long, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub thickness_mm: Option<f64>,
     /// Number of photons: a count ≥ 1 (1e6 is fine); the expected work must fit --max-interactions.
@@ -43,10 +43,10 @@ pub struct Args {
     /// (Gaussian, 1/e² radius R mm, R in (0, 1000]).
     #[arg(long, default_value = "pencil")]
     pub beam: String,
-    /// Angle of incidence [degrees] in air, in [0, 90) (0 = normal).
+    /// Angle of incidence \[degrees\] in air, in [0, 90) (0 = normal).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub incidence_deg: f64,
-    /// Outer radius of the Rd(r) grid [mm]: in (0, 10⁶].
+    /// Outer radius of the Rd(r) grid \[mm\]: in (0, 10⁶].
     #[arg(long, default_value_t = 10.0, value_parser = crate::numeric::parse_finite)]
     pub r_max_mm: f64,
     /// Number of radial bins (uniform width r_max/bins): a count ≥ 1, within the memory budget

@@ -9,7 +9,7 @@
 //! - **existing** (Jensen et al. 2001): σ′s, σa and k from the profile alone, η given.
 //!
 //! Residuals are logarithmic and weighted by each ring's relative standard error; unknowns are
-//! logarithms (so coefficients stay positive); the Jacobian is analytic ([`problem`] documents the
+//! logarithms (so coefficients stay positive); the Jacobian is analytic (`problem.rs` documents the
 //! equations). The light spot is a disk, not a point: by default the model is convolved with it
 //! ([`spot`]) and rings inside one spot diameter are skipped ([`RingSelection::for_spot`]). Rings
 //! below the bracket's detection limit are excluded and counted ([`profile`]).
@@ -147,11 +147,11 @@ pub struct Estimate {
 pub struct FittedRing {
     /// Index of the ring in the profile.
     pub index: usize,
-    /// Radius [mm].
+    /// Radius \[mm\].
     pub r_mm: f64,
-    /// Measured value [relative].
+    /// Measured value \[relative\].
     pub measured: f64,
-    /// Model × scale at the solution [relative].
+    /// Model × scale at the solution \[relative\].
     pub model: f64,
     /// Standard deviation of ln(measured) used as the weight.
     pub sigma_ln: f64,
@@ -187,9 +187,9 @@ pub struct FitReport {
     pub termination: String,
     /// Residual evaluations.
     pub evaluations: usize,
-    /// Wall time of the start search and the solver [s].
+    /// Wall time of the start search and the solver \[s\].
     pub fit_time_s: f64,
-    /// Wall time of the preparation (ring selection, spot kernel) [s].
+    /// Wall time of the preparation (ring selection, spot kernel) \[s\].
     pub prepare_time_s: f64,
     /// Mean of (measured/k − model)² over the fitted rings [mm⁻⁴] (Choi et al. 2014, Table 2).
     pub mse: f64,

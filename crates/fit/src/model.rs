@@ -23,9 +23,9 @@ use crate::spot::SpotKernel;
 pub enum Spot {
     /// A point of incidence: the model as it stands (the paper's treatment).
     Point,
-    /// A uniform disk of this radius [mm]: the model convolved with it ([`crate::spot`]).
+    /// A uniform disk of this radius \[mm\]: the model convolved with it ([`crate::spot`]).
     Disk {
-        /// Radius [mm].
+        /// Radius \[mm\].
         radius_mm: f64,
     },
     /// A radial spot of any shape (Gaussian, measured) as a mixture of disks

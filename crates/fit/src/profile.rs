@@ -13,7 +13,7 @@ use crate::error::{FitError, Result, check};
 /// One ring of a measured profile.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Ring {
-    /// Ring radius [mm] (mean distance of its pixels from the spot centre).
+    /// Ring radius \[mm\] (mean distance of its pixels from the spot centre).
     pub r_mm: f64,
     /// Mean value of the ring's pixels [relative radiance]; NaN when there is none.
     pub value: f64,
@@ -125,7 +125,7 @@ impl RingSelection {
         relative_error_floor: Self::DEFAULT_ERROR_FLOOR,
     };
 
-    /// Fit the rings from `r_min_mm` to `r_max_mm` (∞: every ring of the profile) [mm] whose value is
+    /// Fit the rings from `r_min_mm` to `r_max_mm` (∞: every ring of the profile) \[mm\] whose value is
     /// at least `detection_factor` × their detection limit, each weighted with a relative standard
     /// error of at least `relative_error_floor` (a ring's weight never exceeds 1/floor² in the log
     /// residual).
@@ -163,7 +163,7 @@ impl RingSelection {
         )
     }
 
-    /// The same with another innermost radius [mm].
+    /// The same with another innermost radius \[mm\].
     ///
     /// # Errors
     /// As [`RingSelection::new`].
@@ -176,7 +176,7 @@ impl RingSelection {
         )
     }
 
-    /// The same with another outermost radius [mm].
+    /// The same with another outermost radius \[mm\].
     ///
     /// # Errors
     /// As [`RingSelection::new`].
@@ -202,12 +202,12 @@ impl RingSelection {
         )
     }
 
-    /// Innermost radius fitted [mm]; rings inside are counted as "inside the spot".
+    /// Innermost radius fitted \[mm\]; rings inside are counted as "inside the spot".
     pub fn r_min_mm(&self) -> f64 {
         self.r_min_mm
     }
 
-    /// Outermost radius fitted [mm] (∞: every ring of the profile).
+    /// Outermost radius fitted \[mm\] (∞: every ring of the profile).
     pub fn r_max_mm(&self) -> f64 {
         self.r_max_mm
     }
@@ -253,9 +253,9 @@ impl RingSelection {
 /// The rings a fit uses, with the counts of those it left out and why.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Selected {
-    /// Radii of the fitted rings [mm].
+    /// Radii of the fitted rings \[mm\].
     pub r_mm: Vec<f64>,
-    /// Their values [relative].
+    /// Their values \[relative\].
     pub value: Vec<f64>,
     /// Standard deviation of ln(value) per ring (relative error, floored).
     pub sigma_ln: Vec<f64>,

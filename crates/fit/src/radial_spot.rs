@@ -2,7 +2,7 @@
 //! opaque white target — as a mixture of uniform disks (issue 16).
 //!
 //! A radial irradiance I(ρ) that is constant on annuli a_{k−1} ≤ ρ < a_k (a_0 = 0) is a sum of
-//! concentric uniform disks: I(ρ) = Σ_k (I_k − I_{k+1}) 1[ρ < a_k] (the "layer-cake"
+//! concentric uniform disks: I(ρ) = Σ_k (I_k − I_{k+1}) 1\[ρ < a_k\] (the "layer-cake"
 //! decomposition; weights are negative where a measured profile rises outward). Convolution is
 //! linear, so the model convolved with the spot is the same mixture of the model convolved with
 //! each disk, which [`crate::spot`] computes exactly; [`crate::SpotKernel::from_disks`] sums their
@@ -133,12 +133,12 @@ impl RadialSpot {
         Self::from_annuli(&edges, &intensity)
     }
 
-    /// The disks: (radius [mm], fraction of the power).
+    /// The disks: (radius \[mm\], fraction of the power).
     pub fn disks(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         (0..self.n).map(|k| (self.radius_mm[k], self.weight[k]))
     }
 
-    /// The outermost radius [mm].
+    /// The outermost radius \[mm\].
     pub fn outer_radius_mm(&self) -> f64 {
         self.radius_mm[self.n.saturating_sub(1)]
     }
@@ -150,7 +150,7 @@ impl RadialSpot {
         (2.0 * m2.max(0.0)).sqrt().max(1e-6)
     }
 
-    /// The radius [mm] inside which `fraction` of the power falls.
+    /// The radius \[mm\] inside which `fraction` of the power falls.
     pub fn radius_enclosing(&self, fraction: f64) -> f64 {
         // Power inside ρ: Σ_k w_k min(1, ρ²/a_k²); increasing in ρ for a non-negative spot.
         let inside = |r: f64| -> f64 {

@@ -202,12 +202,12 @@ impl SpotKernel {
         Ok(k)
     }
 
-    /// Spot radius [mm].
+    /// Spot radius \[mm\].
     pub fn radius_mm(&self) -> f64 {
         self.radius_mm
     }
 
-    /// The radii [mm] at which the model must be evaluated.
+    /// The radii \[mm\] at which the model must be evaluated.
     pub fn nodes(&self) -> &[f64] {
         &self.nodes
     }

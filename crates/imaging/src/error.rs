@@ -167,9 +167,9 @@ pub enum ImagingError {
         shorter: usize,
         /// Index (as given) of the frame with the longer time.
         longer: usize,
-        /// Its time [s].
+        /// Its time \[s\].
         t_shorter: f64,
-        /// Its time [s].
+        /// Its time \[s\].
         t_longer: f64,
         /// Pixel values compared (not clipped at the same end in both frames).
         compared: usize,
@@ -189,7 +189,7 @@ pub enum ImagingError {
     ExposureMismatch {
         /// Index of the frame, by time.
         frame: usize,
-        /// Its nominal time [s].
+        /// Its nominal time \[s\].
         time_s: f64,
         /// Its estimated exposure over the nominal one.
         factor: f64,

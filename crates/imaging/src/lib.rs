@@ -6,7 +6,7 @@
 //! The pipeline, with its entry points:
 //! 1. [`recover_response`] (or [`ResponseCurve::from_log_exposure`] / [`ResponseCurve::linear`] for a
 //!    known curve) — the camera response g(z) = ln exposure per channel, gauge g(128) = 0;
-//! 2. [`merge`] (8-bit frames and a response) or [`merge_linear_u16`] (linear 16-bit frames) — a
+//! 2. [`merge()`] (8-bit frames and a response) or [`merge_linear_u16`] (linear 16-bit frames) — a
 //!    relative radiance map with a mask of pixels clipped in every exposure;
 //! 3. [`find_spot_center`] (or [`SpotCenter::given`]) — the spot centre, sub-pixel;
 //! 4. [`radial_profile`] — per-ring mean, standard error and count, radius in pixels and mm.

@@ -627,7 +627,7 @@ pub fn merge_linear_u16(
 /// camera that does not subtract it): the noise-aware linear-domain estimate of [`merge`]'s
 /// default, E = Σ_j u_j Δt_j (v_j − b)/Σ_j u_j Δt_j² (Robertson et al. 2003; Granados et al.
 /// 2010, with a noise constant in the signal), per channel with its own black level `black[c]`
-/// [DN]. Values below the black level are kept as the negative readings they are (read noise
+/// \[DN\]. Values below the black level are kept as the negative readings they are (read noise
 /// about a faint signal: dropping them, as a logarithm must, would bias faint pixels upward);
 /// u = 1 up to half the range, then fading linearly to 0 at `saturation`; saturated samples
 /// (v ≥ saturation) are dropped. A pixel-channel saturated in every frame is flagged

@@ -51,12 +51,12 @@ impl ProfileOptions {
         })
     }
 
-    /// Ring width [px].
+    /// Ring width \[px\].
     pub fn ring_width_px(&self) -> f64 {
         self.ring_width_px
     }
 
-    /// Outer radius [px] (exclusive).
+    /// Outer radius \[px\] (exclusive).
     pub fn r_max_px(&self) -> f64 {
         self.r_max_px
     }

@@ -151,7 +151,7 @@ pub enum BracketError {
 pub struct ExposureEntry {
     /// The image, resolved against the CSV's folder.
     pub path: PathBuf,
-    /// Shutter time Δt [s].
+    /// Shutter time Δt \[s\].
     pub time_s: f64,
     /// 1-based line in the CSV.
     pub line: u64,
@@ -298,7 +298,7 @@ fn parse_time(text: &str, dialect: &CsvDialect) -> Option<f64> {
     }
 }
 
-/// The EXIF `ExposureTime` [s] of an image file's bytes (JPEG, TIFF, PNG `eXIf`, HEIF, WebP).
+/// The EXIF `ExposureTime` \[s\] of an image file's bytes (JPEG, TIFF, PNG `eXIf`, HEIF, WebP).
 ///
 /// # Errors
 /// [`BracketError::MissingTime`] if the file has no EXIF data or no usable `ExposureTime`;
@@ -345,7 +345,7 @@ pub fn exif_exposure_time(bytes: &[u8], path: &Path) -> Result<f64, BracketError
 pub struct BracketFrame {
     /// The file it came from.
     pub path: PathBuf,
-    /// Shutter time Δt [s].
+    /// Shutter time Δt \[s\].
     pub time_s: f64,
     /// The pixels, at the file's bit depth.
     pub frame: CameraFrame,
@@ -405,7 +405,7 @@ impl Bracket {
         self.frames
     }
 
-    /// Shutter times Δt [s], in frame order.
+    /// Shutter times Δt \[s\], in frame order.
     pub fn times_s(&self) -> Vec<f64> {
         self.frames.iter().map(|f| f.time_s).collect()
     }
@@ -484,7 +484,7 @@ pub fn read_bracket(
     )
 }
 
-/// [`read_bracket`] within a memory budget [bytes] (a command's `--max-memory-mib`) instead of the
+/// [`read_bracket`] within a memory budget \[bytes\] (a command's `--max-memory-mib`) instead of the
 /// environment's: the frames' decoded size, read from their headers, is checked against it before
 /// any frame is decoded.
 ///
@@ -593,7 +593,7 @@ pub fn read_bracket_within(
     Bracket::new(frames)
 }
 
-/// The decoded size [bytes] of the frames `paths`, from their headers (not their pixels): the sum,
+/// The decoded size \[bytes\] of the frames `paths`, from their headers (not their pixels): the sum,
 /// the largest frame and the first frame's shape. Headers that cannot be read count 0 (the decoder
 /// reports them).
 pub fn decoded_size<'a>(paths: impl IntoIterator<Item = &'a Path>) -> (u64, u64, String) {

@@ -6,7 +6,7 @@
 //! [`DEFAULT_MEMORY_BUDGET_MIB`], holds a 13-frame bracket of 100-MP 16-bit RGB frames; raise it with
 //! the environment variable [`MEMORY_BUDGET_ENV`] (MiB), or with a command's `--max-memory-mib`.
 
-/// The default budget [MiB]: 8 GiB, a third of the project's 24-GiB standard machine.
+/// The default budget \[MiB\]: 8 GiB, a third of the project's 24-GiB standard machine.
 pub const DEFAULT_MEMORY_BUDGET_MIB: u64 = 8192;
 
 /// Environment variable that sets the budget in MiB, e.g. `SCATTERFIT_MAX_MEMORY_MIB=32768`.

@@ -157,9 +157,9 @@ pub struct DecodedFrame {
 /// What a camera RAW file's metadata say ([`crate::raw`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RawInfo {
-    /// Black and white levels [DN].
+    /// Black and white levels \[DN\].
     pub levels: crate::raw::RawLevels,
-    /// The exposure time [s], if the file records one.
+    /// The exposure time \[s\], if the file records one.
     pub exposure_time_s: Option<f64>,
 }
 
@@ -183,7 +183,7 @@ pub fn decode_camera_frame(bytes: &[u8], path: &Path) -> Result<DecodedFrame, Im
     decode_camera_frame_within(bytes, path, crate::budget::memory_budget_bytes())
 }
 
-/// [`decode_camera_frame`] with an explicit memory budget [bytes]: the decoded image and the copy
+/// [`decode_camera_frame`] with an explicit memory budget \[bytes\]: the decoded image and the copy
 /// without alpha must fit in it, checked from the header before any pixel is decoded.
 ///
 /// # Errors
@@ -518,7 +518,7 @@ pub fn read_radiance(path: &Path) -> Result<ImageBuf<f32>, ImageFileError> {
     read_radiance_within(path, crate::budget::memory_budget_bytes())
 }
 
-/// [`read_radiance`] within a memory budget [bytes] (a command's `--max-memory-mib`) instead of
+/// [`read_radiance`] within a memory budget \[bytes\] (a command's `--max-memory-mib`) instead of
 /// the environment's.
 ///
 /// # Errors
@@ -528,7 +528,7 @@ pub fn read_radiance_within(path: &Path, budget: u64) -> Result<ImageBuf<f32>, I
     decode_radiance(&bytes, path, budget)
 }
 
-/// [`read_radiance`] on the bytes of a file, within a memory budget [bytes] checked from the header
+/// [`read_radiance`] on the bytes of a file, within a memory budget \[bytes\] checked from the header
 /// before any pixel is decoded; `path` is only used in error messages.
 ///
 /// # Errors

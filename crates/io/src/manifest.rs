@@ -109,12 +109,12 @@ pub struct SpectroSection {
     /// wavelength (a re-placed sample, the calibration): what the uncertainties of η, α′ and,
     /// through them, σ′s and σa are propagated from. Default [`DEFAULT_SPECTRO_REPEATABILITY`].
     pub repeatability: Option<f64>,
-    /// Diameter of the instrument's measured area [mm] (its port, e.g. 4, 8 or 25 mm). Given, the
+    /// Diameter of the instrument's measured area \[mm\] (its port, e.g. 4, 8 or 25 mm). Given, the
     /// reading's edge loss (light that enters inside the lit area and leaves beyond the measured
     /// one) is corrected from the fitted profile (issue 15; `scatterfit_optics::port`); absent, the
     /// reading is taken as loss-free and the result says so.
     pub aperture_mm: Option<f64>,
-    /// Diameter of the illuminated area [mm] when the instrument lights a different area than it
+    /// Diameter of the illuminated area \[mm\] when the instrument lights a different area than it
     /// measures (default: `aperture_mm`). Only with `aperture_mm`.
     pub illuminated_mm: Option<f64>,
 }
@@ -174,9 +174,9 @@ pub enum ExposureCorrection {
 pub enum BlackLevelSetting {
     /// `"auto"` (from a dark frame, the file's metadata, or the frames' far corners) or `"none"`.
     Mode(AutoOrNone),
-    /// The same level [DN] for every channel.
+    /// The same level \[DN\] for every channel.
     One(f64),
-    /// A level [DN] per channel R, G, B.
+    /// A level \[DN\] per channel R, G, B.
     PerChannel([f64; 3]),
 }
 
@@ -198,7 +198,7 @@ pub struct CameraSection {
     pub dark: Option<PathBuf>,
     /// The spot centre [x, y] px.
     pub center_px: Option<[f64; 2]>,
-    /// Diameter of the light spot [mm].
+    /// Diameter of the light spot \[mm\].
     pub spot_diameter_mm: Option<f64>,
     /// The spot's radial shape (default disk).
     pub spot_profile: Option<SpotProfileName>,
@@ -225,9 +225,9 @@ pub struct FitSection {
     /// diffusion | mc: how α′ is obtained from the spectrophotometer's Rd (default: the physics of
     /// `model`: mc for the mc model, else diffusion).
     pub albedo_model: Option<AlbedoModel>,
-    /// Outermost profile radius [px] (default 300, the paper's).
+    /// Outermost profile radius \[px\] (default 300, the paper's).
     pub r_max_px: Option<f64>,
-    /// Innermost fitted radius [mm] (default: the spot diameter).
+    /// Innermost fitted radius \[mm\] (default: the spot diameter).
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed method).
     pub normalise_with_spectro: Option<bool>,

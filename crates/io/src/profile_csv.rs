@@ -67,9 +67,9 @@ pub struct ProfileColumn {
 /// A radial profile: ring radii and per-channel columns.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProfileTable {
-    /// Ring radius [mm].
+    /// Ring radius \[mm\].
     pub r_mm: Vec<f64>,
-    /// Ring radius [px].
+    /// Ring radius \[px\].
     pub r_px: Vec<f64>,
     /// One entry per channel.
     pub channels: Vec<ProfileColumn>,

@@ -29,7 +29,7 @@ pub fn is_raw_path(path: &Path) -> bool {
         .is_some_and(|e| RAW_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
-/// A RAW file's levels, from its metadata [DN].
+/// A RAW file's levels, from its metadata \[DN\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RawLevels {
     /// The black level per channel R, G, B (the mean over the channel's CFA sites).
@@ -45,7 +45,7 @@ pub struct RawFrame {
     pub rgb: ImageBuf<u16>,
     /// Black and white levels.
     pub levels: RawLevels,
-    /// The exposure time from the metadata [s], when there is one.
+    /// The exposure time from the metadata \[s\], when there is one.
     pub exposure_time_s: Option<f64>,
     /// e.g. `Canon EOS R5, RGGB mosaic, 14-bit`.
     pub description: String,
@@ -221,11 +221,11 @@ fn demosaic_bilinear(
 /// What [`write_dng`] puts in the file's metadata.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DngInfo {
-    /// Black level per channel R, G, B [DN].
+    /// Black level per channel R, G, B \[DN\].
     pub black_level: [u16; 3],
-    /// White level [DN].
+    /// White level \[DN\].
     pub white_level: u16,
-    /// Exposure time [s].
+    /// Exposure time \[s\].
     pub exposure_time_s: f64,
 }
 

@@ -17,9 +17,12 @@
 //!   "version": "0.1.0" }
 //! ```
 
+use std::fmt;
 use std::path::{Path, PathBuf};
+use std::str::FromStr;
 
-use serde::{Deserialize, Serialize};
+use scatterfit_optics::{AlbedoModel, Channel, Estimate, Method, ModelName, OpticsError, Rgb};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// What can go wrong reading or writing a result file.
 #[derive(Debug, thiserror::Error)]
@@ -52,6 +55,236 @@ pub enum ResultJsonError {
         /// What was wrong, naming the field, and what to do.
         detail: String,
     },
+    /// The result names a forward model scatterfit does not know (a newer scatterfit's, or another
+    /// program's). Read it with [`read_result_json_assuming`] to take one of ours instead (`render
+    /// --model`).
+    #[error(
+        "{}: `model` = {}: not a forward model scatterfit knows ({})",
+        path.display(),
+        crate::escape::token(found),
+        ModelName::ALL.map(ModelName::name).join(", ")
+    )]
+    UnknownModel {
+        /// The file.
+        path: PathBuf,
+        /// The model it names (trimmed; escape it before showing it: `escape::token`).
+        found: String,
+    },
+}
+
+/// Where a result's η came from (`eta_source`: `"spectro"` or `"given"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EtaSource {
+    /// Measured: SCI − SCE of the spectrophotometer's reading (Schlick at 8°): `spectro`.
+    Spectro,
+    /// Given by the user (manifest `spectro.eta`, `--eta`): `given`.
+    Given,
+}
+
+impl EtaSource {
+    /// Both, in the order of the docs.
+    pub const ALL: [EtaSource; 2] = [EtaSource::Spectro, EtaSource::Given];
+
+    /// The name in `result.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            EtaSource::Spectro => "spectro",
+            EtaSource::Given => "given",
+        }
+    }
+}
+
+impl From<scatterfit_optics::spectro::EtaSource> for EtaSource {
+    fn from(s: scatterfit_optics::spectro::EtaSource) -> Self {
+        match s {
+            scatterfit_optics::spectro::EtaSource::Given => EtaSource::Given,
+            _ => EtaSource::Spectro,
+        }
+    }
+}
+
+/// Where a result's α′ came from (`albedo_model`): the spectrophotometer's Rd inverted by an
+/// [`AlbedoModel`] (`"diffusion"`, `"mc"`), or given by the user (`"given"`, `scatterfit fit
+/// --albedo`). The existing method fits its own α′ and records the albedo model it was run with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum AlbedoSource {
+    /// The reading's Rd inverted by this model's total Rd(α′, η).
+    Model(AlbedoModel),
+    /// Given by the user.
+    Given,
+}
+
+impl AlbedoSource {
+    /// The name in `result.json`: the albedo model's name, or `given`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AlbedoSource::Model(m) => m.name(),
+            AlbedoSource::Given => "given",
+        }
+    }
+}
+
+impl From<AlbedoModel> for AlbedoSource {
+    fn from(m: AlbedoModel) -> Self {
+        AlbedoSource::Model(m)
+    }
+}
+
+/// How the bracket became radiance (`inputs.options.response`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[non_exhaustive]
+pub enum ResponseKind {
+    /// 8-bit frames, the camera response recovered from the bracket (Debevec & Malik 1997).
+    Recovered,
+    /// 8-bit frames, a known response from a CSV (`camera.response`).
+    Given,
+    /// 16-bit frames merged as linear data.
+    Linear,
+    /// An already merged radiance map (`camera.hdr`): no bracket.
+    Merged,
+}
+
+impl ResponseKind {
+    /// Every kind, in the order of the docs.
+    pub const ALL: [ResponseKind; 4] = [
+        ResponseKind::Recovered,
+        ResponseKind::Given,
+        ResponseKind::Linear,
+        ResponseKind::Merged,
+    ];
+
+    /// The name in `result.json` and in `scatterfit merge`'s output.
+    pub fn name(self) -> &'static str {
+        match self {
+            ResponseKind::Recovered => "recovered",
+            ResponseKind::Given => "given",
+            ResponseKind::Linear => "linear",
+            ResponseKind::Merged => "merged",
+        }
+    }
+}
+
+/// One of `all` by its `name`, or an [`OpticsError::UnknownName`] listing the valid names.
+fn parse_name<T: Copy>(
+    all: &[T],
+    name: fn(T) -> &'static str,
+    text: &str,
+    what: &'static str,
+    expected: &'static str,
+) -> Result<T, OpticsError> {
+    all.iter()
+        .copied()
+        .find(|v| name(*v) == text)
+        .ok_or_else(|| OpticsError::UnknownName {
+            what,
+            given: text.to_string(),
+            expected,
+        })
+}
+
+/// `Display` as the name in files.
+macro_rules! display_name {
+    ($($t:ty),*) => {$(
+        impl fmt::Display for $t {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+    )*};
+}
+
+display_name!(EtaSource, AlbedoSource, ResponseKind);
+
+impl FromStr for EtaSource {
+    type Err = OpticsError;
+    fn from_str(s: &str) -> Result<Self, OpticsError> {
+        parse_name(&Self::ALL, Self::name, s, "η source", "spectro, given")
+    }
+}
+
+impl FromStr for AlbedoSource {
+    type Err = OpticsError;
+    fn from_str(s: &str) -> Result<Self, OpticsError> {
+        let all = [
+            AlbedoSource::Model(AlbedoModel::Diffusion),
+            AlbedoSource::Model(AlbedoModel::Mc),
+            AlbedoSource::Given,
+        ];
+        parse_name(&all, Self::name, s, "albedo source", "diffusion, mc, given")
+    }
+}
+
+impl FromStr for ResponseKind {
+    type Err = OpticsError;
+    fn from_str(s: &str) -> Result<Self, OpticsError> {
+        parse_name(
+            &Self::ALL,
+            Self::name,
+            s,
+            "response kind",
+            "recovered, given, linear, merged",
+        )
+    }
+}
+
+impl Serialize for AlbedoSource {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for AlbedoSource {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let text = String::deserialize(d)?;
+        text.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+/// The names of a result read as `render` always read its model: surrounding blanks and ASCII
+/// case ignored (`" Dipole "` is `dipole`); anything else refused naming the valid names.
+mod lenient {
+    use std::str::FromStr;
+
+    use serde::{Deserialize, Deserializer};
+
+    fn normalise(text: &str) -> String {
+        text.trim().to_ascii_lowercase()
+    }
+
+    /// A required name.
+    pub fn name<'de, D, T>(d: D) -> Result<T, D::Error>
+    where
+        D: Deserializer<'de>,
+        T: FromStr,
+        T::Err: std::fmt::Display,
+    {
+        let text = String::deserialize(d)?;
+        normalise(&text).parse().map_err(serde::de::Error::custom)
+    }
+
+    /// An optional name: missing, `null` or `""` (an empty field of an older writer) is `None`.
+    pub fn optional<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+    where
+        D: Deserializer<'de>,
+        T: FromStr,
+        T::Err: std::fmt::Display,
+    {
+        match Option::<String>::deserialize(d)? {
+            None => Ok(None),
+            Some(text) if text.trim().is_empty() => Ok(None),
+            Some(text) => normalise(&text)
+                .parse()
+                .map(Some)
+                .map_err(serde::de::Error::custom),
+        }
+    }
+
+    /// The model name as `parse_result_json` checks it before the typed read.
+    pub fn model(text: &str) -> Option<scatterfit_optics::ModelName> {
+        normalise(text).parse().ok()
+    }
 }
 
 /// How one channel's measurement ended.
@@ -116,7 +349,7 @@ pub struct ChannelResult {
     /// Parameters the data do not constrain (empty when every parameter is measured).
     #[serde(default)]
     pub unconstrained: Vec<String>,
-    /// Wall time of the fit [s].
+    /// Wall time of the fit \[s\].
     #[serde(default)]
     pub fit_time_s: f64,
     /// Levenberg–Marquardt iterations (residual evaluations).
@@ -156,28 +389,42 @@ pub struct ChannelResult {
     pub quality: Option<crate::quality::Quality>,
 }
 
-/// The three channels.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Channels {
-    /// Red.
-    pub r: ChannelResult,
-    /// Green.
-    pub g: ChannelResult,
-    /// Blue.
-    pub b: ChannelResult,
-}
-
-impl Channels {
-    /// The channels in R, G, B order.
-    pub fn as_array(&self) -> [&ChannelResult; 3] {
-        [&self.r, &self.g, &self.b]
+impl ChannelResult {
+    /// σ′s with its uncertainty terms (the fit's and the spectrophotometer's standard errors), as
+    /// the pipeline had it before the file flattened it; `None` without a value.
+    pub fn sigma_s_prime_estimate(&self) -> Option<Estimate> {
+        self.sigma_s_prime.map(|value| Estimate {
+            value,
+            fit: self.sigma_s_prime_stderr,
+            spectro: self.sigma_s_prime_stderr_spectro,
+            g: None,
+        })
     }
 
-    /// Builds from an array in R, G, B order.
-    pub fn from_array([r, g, b]: [ChannelResult; 3]) -> Self {
-        Self { r, g, b }
+    /// σa with its uncertainty terms; `None` without a value.
+    pub fn sigma_a_estimate(&self) -> Option<Estimate> {
+        self.sigma_a.map(|value| Estimate {
+            value,
+            fit: self.sigma_a_stderr,
+            spectro: self.sigma_a_stderr_spectro,
+            g: None,
+        })
+    }
+
+    /// α′ with the spectrophotometer's standard error (the proposed method's α′ is the reading's);
+    /// `None` without a value.
+    pub fn albedo_prime_estimate(&self) -> Option<Estimate> {
+        self.albedo_prime.map(|value| Estimate {
+            value,
+            fit: None,
+            spectro: self.albedo_prime_stderr,
+            g: None,
+        })
     }
 }
+
+/// The three channels, keyed `"r"`, `"g"`, `"b"` in the file.
+pub type Channels = Rgb<ChannelResult>;
 
 /// A file the result was made from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -206,12 +453,60 @@ pub struct Inputs {
     pub profile: Option<String>,
     /// Image scale on the sample [mm per pixel].
     pub mm_per_pixel: Option<f64>,
-    /// Radius of the light spot the model was convolved with [mm].
+    /// Radius of the light spot the model was convolved with \[mm\].
     pub spot_radius_mm: Option<f64>,
     /// Spot centre [x, y] in pixels.
     pub center_px: Option<[f64; 2]>,
-    /// Fit options (method, model, ring limits…) as given.
-    pub options: serde_json::Value,
+    /// The options the result was made with (method, model, ring limits…), as resolved.
+    #[serde(deserialize_with = "lenient_options")]
+    pub options: RunOptions,
+}
+
+/// The options a result was made with (`inputs.options`), as resolved from the manifest and the
+/// command line. Provenance: a key that does not apply is left out of the file.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+// Fields in the file's key order (alphabetical, as the untyped map wrote them).
+pub struct RunOptions {
+    /// How α′ came from the spectrophotometer's Rd.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub albedo_model: Option<AlbedoModel>,
+    /// What the HDR and profile stages found and corrected of a real camera (black level,
+    /// exposure times, flat frame, background), as they serialise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera: Option<serde_json::Value>,
+    /// The bracket's detection limit per channel (R, G, B) [relative radiance]; `null` where
+    /// unknown.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub detection_limit: Option<Vec<Option<f64>>>,
+    /// The fitting method.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub method: Option<Method>,
+    /// The forward model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelName>,
+    /// Whether the profile's scale was fixed by the spectrophotometer.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub normalise_with_spectro: Option<bool>,
+    /// Outermost ring \[px\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub r_max_px: Option<f64>,
+    /// Innermost fitted radius \[mm\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub r_min_mm: Option<f64>,
+    /// How the bracket became radiance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub response: Option<ResponseKind>,
+    /// Radius of the light spot \[mm\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spot_radius_mm: Option<f64>,
+}
+
+/// `inputs.options` of a file: provenance no consumer relies on, so a map of another shape (a
+/// foreign writer's) reads as no options rather than refusing the result.
+fn lenient_options<'de, D: Deserializer<'de>>(d: D) -> Result<RunOptions, D::Error> {
+    let value = serde_json::Value::deserialize(d)?;
+    Ok(serde_json::from_value(value).unwrap_or_default())
 }
 
 /// A whole result file.
@@ -221,9 +516,9 @@ pub struct MeasurementResult {
     pub name: String,
     /// Relative refractive index η used by the fit.
     pub eta: f64,
-    /// Where η came from: `spectro` (SCI − SCE) or `given`.
-    #[serde(default)]
-    pub eta_source: String,
+    /// Where η came from: `spectro` (SCI − SCE) or `given`; `None` in a file without the key.
+    #[serde(default, deserialize_with = "lenient::optional")]
+    pub eta_source: Option<EtaSource>,
     /// Standard error of η from the reading's repeatability (`None` when η was given).
     #[serde(default)]
     pub eta_stderr: Option<f64>,
@@ -231,12 +526,16 @@ pub struct MeasurementResult {
     #[serde(default)]
     pub spectro_repeatability: Option<f64>,
     /// `proposed` or `existing`.
-    pub method: String,
-    /// The forward model of the profile fit, e.g. `dipole`.
-    pub model: String,
-    /// How α′ was obtained from the spectrophotometer's Rd, e.g. `diffusion`.
-    #[serde(default)]
-    pub albedo_model: String,
+    #[serde(deserialize_with = "lenient::name")]
+    pub method: Method,
+    /// The forward model of the profile fit, e.g. `dipole`. A file naming a model scatterfit does
+    /// not know is refused by [`read_result_json`] ([`ResultJsonError::UnknownModel`]) unless read
+    /// with [`read_result_json_assuming`].
+    #[serde(deserialize_with = "lenient::name")]
+    pub model: ModelName,
+    /// How α′ was obtained, e.g. `diffusion`; `None` in a file without the key.
+    #[serde(default, deserialize_with = "lenient::optional")]
+    pub albedo_model: Option<AlbedoSource>,
     /// Per-channel results.
     pub channels: Channels,
     /// Provenance.
@@ -260,9 +559,9 @@ pub struct MeasurementResult {
 /// What the port correction did ([`MeasurementResult::spectro_port`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PortResult {
-    /// Diameter of the measured aperture [mm].
+    /// Diameter of the measured aperture \[mm\].
     pub aperture_mm: f64,
-    /// Diameter of the lit disc [mm].
+    /// Diameter of the lit disc \[mm\].
     pub illuminated_mm: f64,
     /// Rd per channel as the instrument read it.
     pub rd_read: scatterfit_optics::Rgb<f64>,
@@ -277,27 +576,41 @@ pub struct PortResult {
 /// A measured diffuse reflectance spectrum ([`MeasurementResult::rd_spectrum`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RdSpectrum {
-    /// Wavelengths [nm], increasing.
+    /// Wavelengths \[nm\], increasing.
     pub wavelength_nm: Vec<f64>,
     /// The diffuse reflectance (SCE, fraction 0–1) at each wavelength.
     pub rd: Vec<f64>,
 }
 
 impl MeasurementResult {
-    /// σ′s, σa per channel (R, G, B) when every channel has both, else the first channel without.
+    /// (σ′s, σa) per channel when every channel has both, else the first channel (R, G, B order)
+    /// without.
     ///
     /// # Errors
-    /// The channel name (`"r"`, `"g"` or `"b"`) lacking a value.
-    pub fn coefficients(&self) -> Result<[(f64, f64); 3], &'static str> {
-        let names = ["r", "g", "b"];
-        let mut out = [(0.0, 0.0); 3];
-        for (k, c) in self.channels.as_array().iter().enumerate() {
-            match (c.sigma_s_prime, c.sigma_a) {
-                (Some(s), Some(a)) => out[k] = (s, a),
-                _ => return Err(names[k]),
-            }
+    /// The channel lacking a value.
+    pub fn coefficients(&self) -> Result<Rgb<(f64, f64)>, Channel> {
+        self.channels
+            .as_ref()
+            .map_with_channel(|ch, c| match (c.sigma_s_prime, c.sigma_a) {
+                (Some(s), Some(a)) => Ok((s, a)),
+                _ => Err(ch),
+            })
+            .transpose()
+    }
+
+    /// The forward model the parameters were fitted with (what `render` renders them with).
+    pub fn model(&self) -> ModelName {
+        self.model
+    }
+
+    /// η with the spectrophotometer's standard error (`eta_stderr`; none when η was given).
+    pub fn eta_estimate(&self) -> Estimate {
+        Estimate {
+            value: self.eta,
+            fit: None,
+            spectro: self.eta_stderr,
+            g: None,
         }
-        Ok(out)
     }
 }
 
@@ -325,6 +638,19 @@ pub fn write_result_json(path: &Path, result: &MeasurementResult) -> Result<(), 
 pub fn read_result_json(path: &Path) -> Result<MeasurementResult, ResultJsonError> {
     let text = crate::text::read_text_file(path).map_err(text_error)?;
     parse_result_json(&text.text, path)
+}
+
+/// [`read_result_json`], taking `model` as the result's forward model when the file names one
+/// scatterfit does not know (`render --model`); a known model is read as written.
+///
+/// # Errors
+/// As [`read_result_json`], without [`ResultJsonError::UnknownModel`].
+pub fn read_result_json_assuming(
+    path: &Path,
+    model: ModelName,
+) -> Result<MeasurementResult, ResultJsonError> {
+    let text = crate::text::read_text_file(path).map_err(text_error)?;
+    parse_result(&text.text, path, Some(model))
 }
 
 /// [`read_result_json`] on the bytes of a file (UTF-8 with or without BOM, UTF-16 with BOM).
@@ -360,6 +686,14 @@ fn classify_json(e: &serde_json::Error) -> String {
 /// # Errors
 /// As [`read_result_json`].
 pub fn parse_result_json(text: &str, path: &Path) -> Result<MeasurementResult, ResultJsonError> {
+    parse_result(text, path, None)
+}
+
+fn parse_result(
+    text: &str,
+    path: &Path,
+    assume_model: Option<ModelName>,
+) -> Result<MeasurementResult, ResultJsonError> {
     let invalid = |detail: String| ResultJsonError::Invalid {
         path: path.to_path_buf(),
         detail,
@@ -383,19 +717,40 @@ pub fn parse_result_json(text: &str, path: &Path) -> Result<MeasurementResult, R
              shown; {EXPECTED}"
         )));
     }
-    let result: MeasurementResult = serde_json::from_str(text).map_err(|e| {
+    let shape = |e: serde_json::Error| {
         invalid(format!(
             "not a scatterfit result ({}); {EXPECTED}",
             crate::escape::shorten_quotes(&e.to_string())
         ))
-    })?;
+    };
+    // A model we do not know is the caller's to decide (render asks for --model), not a malformed
+    // file: checked before the typed read.
+    let unknown_model = value
+        .get("model")
+        .and_then(serde_json::Value::as_str)
+        .filter(|m| lenient::model(m).is_none());
+    let result: MeasurementResult = match (unknown_model, assume_model) {
+        (None, _) => serde_json::from_str(text).map_err(shape)?,
+        (Some(found), None) => {
+            return Err(ResultJsonError::UnknownModel {
+                path: path.to_path_buf(),
+                found: found.trim().to_string(),
+            });
+        }
+        (Some(_), Some(model)) => {
+            let mut value = value;
+            value["model"] = serde_json::Value::from(model.name());
+            serde_json::from_value(value).map_err(shape)?
+        }
+    };
     if !(result.eta.is_finite() && result.eta >= 1.0) {
         return Err(invalid(format!(
             "`eta` = {} must be a number ≥ 1 (relative refractive index)",
             crate::escape::number(result.eta)
         )));
     }
-    for (name, c) in ["r", "g", "b"].iter().zip(result.channels.as_array()) {
+    for (ch, c) in result.channels.iter_channels() {
+        let name = ch.key();
         let fields = [
             ("sigma_s_prime", c.sigma_s_prime),
             ("sigma_a", c.sigma_a),
@@ -467,12 +822,12 @@ mod tests {
         MeasurementResult {
             name: "pink plastic".into(),
             eta: 1.2886,
-            eta_source: "spectro".into(),
+            eta_source: Some(EtaSource::Spectro),
             eta_stderr: None,
             spectro_repeatability: None,
-            method: "proposed".into(),
-            model: "dipole".into(),
-            albedo_model: "diffusion".into(),
+            method: Method::Proposed,
+            model: ModelName::Dipole,
+            albedo_model: Some(AlbedoSource::Model(AlbedoModel::Diffusion)),
             channels: Channels::from_array([
                 channel(1.979, 0.000792),
                 channel(1.893, 0.0496),
@@ -493,7 +848,7 @@ mod tests {
         write_result_json(&path, &r).unwrap();
         let back = read_result_json(&path).unwrap();
         assert_eq!(back, r);
-        assert_eq!(back.coefficients().unwrap()[1], (1.893, 0.0496));
+        assert_eq!(back.coefficients().unwrap().g, (1.893, 0.0496));
         // Without a spectrum the file has no `rd_spectrum` key (files stay as they were); with one
         // it round-trips.
         assert!(
@@ -510,6 +865,132 @@ mod tests {
         assert_eq!(read_result_json(&path).unwrap(), r);
     }
 
+    /// The meanings are enums in code and today's strings in the file: every name, in every
+    /// place, written as the untyped writer wrote it (options in its alphabetical key order, NaN
+    /// detection limits as null) and read back to the same value.
+    #[test]
+    fn names_are_the_files_strings() {
+        let mut r = result();
+        r.method = Method::Existing;
+        r.model = ModelName::BetterDipole;
+        r.eta_source = Some(EtaSource::Given);
+        r.albedo_model = Some(AlbedoSource::Given);
+        r.inputs.options = RunOptions {
+            method: Some(Method::Existing),
+            model: Some(ModelName::BetterDipole),
+            albedo_model: Some(AlbedoModel::Mc),
+            camera: Some(serde_json::json!({"background": "none"})),
+            normalise_with_spectro: Some(false),
+            r_min_mm: Some(1.0),
+            r_max_px: Some(300.0),
+            spot_radius_mm: Some(0.5),
+            response: Some(ResponseKind::Recovered),
+            detection_limit: Some(vec![Some(0.25), None, Some(1.0)]),
+        };
+        let v = serde_json::to_value(&r).unwrap();
+        assert_eq!(v["method"], "existing");
+        assert_eq!(v["model"], "better-dipole");
+        assert_eq!(v["eta_source"], "given");
+        assert_eq!(v["albedo_model"], "given");
+        let options = serde_json::to_string(&r.inputs.options).unwrap();
+        assert_eq!(
+            options,
+            r#"{"albedo_model":"mc","camera":{"background":"none"},"detection_limit":[0.25,null,1.0],"method":"existing","model":"better-dipole","normalise_with_spectro":false,"r_max_px":300.0,"r_min_mm":1.0,"response":"recovered","spot_radius_mm":0.5}"#
+        );
+        let back = parse_result_json(&v.to_string(), Path::new("r.json")).unwrap();
+        assert_eq!(back, r);
+        for kind in ResponseKind::ALL {
+            assert_eq!(kind.to_string().parse::<ResponseKind>().unwrap(), kind);
+        }
+        for source in [
+            AlbedoSource::Given,
+            AlbedoSource::Model(AlbedoModel::Diffusion),
+            AlbedoSource::Model(AlbedoModel::Mc),
+        ] {
+            assert_eq!(source.to_string().parse::<AlbedoSource>().unwrap(), source);
+        }
+        // The fit command's options: only what applies is written.
+        let fit = RunOptions {
+            method: Some(Method::Proposed),
+            model: Some(ModelName::Dipole),
+            normalise_with_spectro: Some(false),
+            r_min_mm: Some(1.0),
+            ..RunOptions::default()
+        };
+        assert_eq!(
+            serde_json::to_string(&fit).unwrap(),
+            r#"{"method":"proposed","model":"dipole","normalise_with_spectro":false,"r_min_mm":1.0}"#
+        );
+    }
+
+    /// A model scatterfit does not know is a typed error naming it (render turns it into "pass
+    /// --model"), and reads with an assumed model; names are read as render always read the model
+    /// (blanks and case ignored); an older file without `eta_source`/`albedo_model` (or with them
+    /// empty) reads them as unknown.
+    #[test]
+    fn unknown_models_and_lenient_names() {
+        let mut v = serde_json::to_value(result()).unwrap();
+        v["model"] = serde_json::json!(" Photon-Tracer ");
+        let text = v.to_string();
+        match parse_result_json(&text, Path::new("r.json")) {
+            Err(ResultJsonError::UnknownModel { found, .. }) => assert_eq!(found, "Photon-Tracer"),
+            other => panic!("{other:?}"),
+        }
+        let err = parse_result_json(&text, Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("Photon-Tracer") && err.contains("better-dipole"),
+            "{err}"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("result.json");
+        std::fs::write(&path, &text).unwrap();
+        let r = read_result_json_assuming(&path, ModelName::Pbd).unwrap();
+        assert_eq!(r.model(), ModelName::Pbd);
+        assert_eq!(r.channels, result().channels);
+        // A known model is read as written, whatever is assumed.
+        write_result_json(&path, &result()).unwrap();
+        let r = read_result_json_assuming(&path, ModelName::Pbd).unwrap();
+        assert_eq!(r.model(), ModelName::Dipole);
+
+        let mut v = serde_json::to_value(result()).unwrap();
+        v["model"] = serde_json::json!(" Better-Dipole");
+        v["method"] = serde_json::json!("EXISTING ");
+        v["eta_source"] = serde_json::json!("");
+        v.as_object_mut().unwrap().remove("albedo_model");
+        let r = parse_result_json(&v.to_string(), Path::new("r.json")).unwrap();
+        assert_eq!(
+            (r.model, r.method),
+            (ModelName::BetterDipole, Method::Existing)
+        );
+        assert_eq!((r.eta_source, r.albedo_model), (None, None));
+        v["method"] = serde_json::json!("guessed");
+        let err = parse_result_json(&v.to_string(), Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("proposed, existing"), "{err}");
+    }
+
+    /// The file's flat error fields come back as estimates with their terms apart.
+    #[test]
+    fn estimates_from_the_flat_fields() {
+        let mut c = channel(2.0, 0.01);
+        c.sigma_s_prime_stderr_spectro = Some(0.03);
+        let e = c.sigma_s_prime_estimate().unwrap();
+        assert_eq!(
+            (e.value, e.fit, e.spectro, e.g),
+            (2.0, Some(0.01), Some(0.03), None)
+        );
+        let e = c.sigma_a_estimate().unwrap();
+        assert_eq!((e.fit, e.spectro), (Some(0.001), None));
+        c.sigma_a = None;
+        assert_eq!(c.sigma_a_estimate(), None);
+        let mut r = result();
+        r.eta_stderr = Some(0.002);
+        assert_eq!(r.eta_estimate().total(), Some(0.002));
+    }
+
     /// The minimal hand-written file of ARCHITECTURE.md (only the stable names) is accepted.
     #[test]
     fn minimal_hand_written_file_reads() {
@@ -524,7 +1005,7 @@ mod tests {
                    "problem": "out of gamut" } },
           "version": "0.1.0" }"#;
         let r = parse_result_json(text, Path::new("hand.json")).unwrap();
-        assert_eq!(r.coefficients(), Err("b"));
+        assert_eq!(r.coefficients(), Err(Channel::B));
     }
 
     #[test]

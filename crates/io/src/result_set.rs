@@ -31,7 +31,7 @@ pub const SET_FORMAT: &str = "scatterfit-result-files/1";
 pub struct SetEntry {
     /// The file name (in the set's folder).
     pub name: String,
-    /// Its size [bytes].
+    /// Its size \[bytes\].
     pub bytes: u64,
     /// SHA-256 of its bytes, lower-case hex.
     pub sha256: String,

@@ -4,9 +4,9 @@
 
 use std::fmt::Write as _;
 
-use crate::result_json::{ChannelResult, ChannelStatus, MeasurementResult};
+use scatterfit_optics::{Channel, Estimate};
 
-const CHANNELS: [&str; 3] = ["R", "G", "B"];
+use crate::result_json::{ChannelResult, ChannelStatus, MeasurementResult};
 
 fn num(v: Option<f64>, digits: usize) -> String {
     match v {
@@ -33,51 +33,43 @@ pub fn sig4(v: f64) -> String {
     }
 }
 
-/// "value ± stderr", or the reason there is none.
-fn with_error(c: &ChannelResult, v: Option<f64>, e: Option<f64>, name: &str) -> String {
-    value_with_errors(c, v, e, None, name)
+/// "value ± fit" (the fit's standard error only), or the reason there is none.
+fn with_fit_error(c: &ChannelResult, v: Option<Estimate>, name: &str) -> String {
+    value_with_errors(c, v.map(|e| Estimate { spectro: None, ..e }), name)
 }
 
 /// "value ± fit" or, when the spectrophotometer's part is known, "value ± fit ± spectro"; "failed"
-/// or "unconstrained" where there is no measurement.
-pub fn value_with_errors(
-    c: &ChannelResult,
-    v: Option<f64>,
-    fit: Option<f64>,
-    spectro: Option<f64>,
-    name: &str,
-) -> String {
+/// or "unconstrained" where there is no measurement (`name` is the parameter's name in
+/// `unconstrained`).
+pub fn value_with_errors(c: &ChannelResult, v: Option<Estimate>, name: &str) -> String {
     if c.status == ChannelStatus::Failed {
         return "failed".into();
     }
     if c.unconstrained.iter().any(|u| u == name) {
         return "unconstrained".into();
     }
-    match (v, fit, spectro) {
-        (Some(v), Some(e), Some(s)) => format!("{} ± {} ± {}", sig4(v), sig4(e), sig4(s)),
-        (Some(v), Some(e), None) => format!("{} ± {}", sig4(v), sig4(e)),
-        (Some(v), None, _) => sig4(v),
-        _ => "—".into(),
+    match v {
+        Some(Estimate {
+            value,
+            fit: Some(fit),
+            spectro: Some(spectro),
+            ..
+        }) => format!("{} ± {} ± {}", sig4(value), sig4(fit), sig4(spectro)),
+        Some(Estimate {
+            value,
+            fit: Some(fit),
+            ..
+        }) => format!("{} ± {}", sig4(value), sig4(fit)),
+        Some(e) => sig4(e.value),
+        None => "—".into(),
     }
 }
 
 /// σ′s and σa of a channel as "value ± fit ± spectro" ([`value_with_errors`]).
 pub fn sigma_cells(c: &ChannelResult) -> [String; 2] {
     [
-        value_with_errors(
-            c,
-            c.sigma_s_prime,
-            c.sigma_s_prime_stderr,
-            c.sigma_s_prime_stderr_spectro,
-            "sigma_s_prime",
-        ),
-        value_with_errors(
-            c,
-            c.sigma_a,
-            c.sigma_a_stderr,
-            c.sigma_a_stderr_spectro,
-            "sigma_a",
-        ),
+        value_with_errors(c, c.sigma_s_prime_estimate(), "sigma_s_prime"),
+        value_with_errors(c, c.sigma_a_estimate(), "sigma_a"),
     ]
 }
 
@@ -88,7 +80,6 @@ pub fn errors_note(results: &[MeasurementResult]) -> String {
         .iter()
         .filter(|r| {
             r.channels
-                .as_array()
                 .iter()
                 .any(|c| c.sigma_s_prime_stderr_spectro.is_some())
         })
@@ -166,7 +157,8 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
          sigma_s_prime_stderr_spectro,sigma_a_stderr_spectro,albedo_prime_stderr,eta_stderr\n",
     );
     for r in results {
-        for (name, c) in CHANNELS.iter().zip(r.channels.as_array()) {
+        for (ch, c) in r.channels.iter_channels() {
+            let name = ch.name();
             let status = match c.status {
                 ChannelStatus::Ok => "ok",
                 ChannelStatus::Unconstrained => "unconstrained",
@@ -183,8 +175,8 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 num(c.albedo_prime, 6),
                 num(c.rd_total, 6),
                 num(Some(r.eta), 4),
-                csv_text(&r.method),
-                csv_text(&r.model),
+                r.method,
+                r.model,
                 num(Some(c.fit_time_s), 7),
                 c.iterations,
                 num(c.mse, 8),
@@ -218,16 +210,17 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
          |---|---|---|---|---|---|---|---|\n",
     );
     for r in results {
-        for (k, (name, c)) in CHANNELS.iter().zip(r.channels.as_array()).enumerate() {
+        for (ch, c) in r.channels.iter_channels() {
+            let name = ch.name();
             // The name is the user's text: `|`, line breaks and raw HTML must not break the table.
-            let material = if k == 0 {
+            let material = if ch == Channel::R {
                 crate::escape::markdown_cell(&r.name)
             } else {
                 String::new()
             };
-            let eta = match (k, r.eta_stderr) {
-                (1, Some(e)) => format!("{:.4} ± {}", r.eta, sig4(e)),
-                (1, None) => format!("{:.4}", r.eta),
+            let eta = match (ch, r.eta_stderr) {
+                (Channel::G, Some(e)) => format!("{:.4} ± {}", r.eta, sig4(e)),
+                (Channel::G, None) => format!("{:.4}", r.eta),
                 _ => String::new(),
             };
             let time = if c.status == ChannelStatus::Failed && c.iterations == 0 {
@@ -251,18 +244,15 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
     let notes: Vec<String> = results
         .iter()
         .flat_map(|r| {
-            CHANNELS
-                .iter()
-                .zip(r.channels.as_array())
-                .filter_map(move |(n, c)| {
-                    c.problem.as_ref().map(|p| {
-                        format!(
-                            "- {} {n}: {}",
-                            crate::escape::markdown_cell(&r.name),
-                            crate::escape::markdown_cell(p)
-                        )
-                    })
+            r.channels.iter_channels().filter_map(move |(n, c)| {
+                c.problem.as_ref().map(|p| {
+                    format!(
+                        "- {} {n}: {}",
+                        crate::escape::markdown_cell(&r.name),
+                        crate::escape::markdown_cell(p)
+                    )
                 })
+            })
         })
         .collect();
     let errors = errors_note(results);
@@ -291,12 +281,10 @@ pub fn table2_markdown(pairs: &[(MeasurementResult, MeasurementResult)]) -> Stri
          |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for (existing, proposed) in pairs {
-        for (k, name) in CHANNELS.iter().enumerate() {
-            let (e, p) = (
-                existing.channels.as_array()[k],
-                proposed.channels.as_array()[k],
-            );
-            let material = if k == 0 {
+        for ch in Channel::ALL {
+            let name = ch.name();
+            let (e, p) = (&existing.channels[ch], &proposed.channels[ch]);
+            let material = if ch == Channel::R {
                 crate::escape::markdown_cell(&existing.name)
             } else {
                 String::new()
@@ -304,12 +292,12 @@ pub fn table2_markdown(pairs: &[(MeasurementResult, MeasurementResult)]) -> Stri
             let _ = writeln!(
                 t,
                 "| {material} | {name} | {} | {} | {} | {:.0} | {} | {} | {} | {:.0} |",
-                with_error(e, e.sigma_s_prime, e.sigma_s_prime_stderr, "sigma_s_prime"),
-                with_error(e, e.sigma_a, e.sigma_a_stderr, "sigma_a"),
+                with_fit_error(e, e.sigma_s_prime_estimate(), "sigma_s_prime"),
+                with_fit_error(e, e.sigma_a_estimate(), "sigma_a"),
                 e.mse.map_or("—".into(), sig4),
                 e.fit_time_s * 1e6,
-                with_error(p, p.sigma_s_prime, p.sigma_s_prime_stderr, "sigma_s_prime"),
-                with_error(p, p.sigma_a, p.sigma_a_stderr, "sigma_a"),
+                with_fit_error(p, p.sigma_s_prime_estimate(), "sigma_s_prime"),
+                with_fit_error(p, p.sigma_a_estimate(), "sigma_a"),
                 p.mse.map_or("—".into(), sig4),
                 p.fit_time_s * 1e6,
             );
@@ -330,8 +318,9 @@ pub fn table2_csv(pairs: &[(MeasurementResult, MeasurementResult)]) -> String {
         ChannelStatus::Failed => "failed",
     };
     for (e, p) in pairs {
-        for (k, name) in CHANNELS.iter().enumerate() {
-            let (ce, cp) = (e.channels.as_array()[k], p.channels.as_array()[k]);
+        for ch in Channel::ALL {
+            let name = ch.name();
+            let (ce, cp) = (&e.channels[ch], &p.channels[ch]);
             let _ = writeln!(
                 t,
                 "{},{name},{},{},{},{},{},{},{},{},{},{}",

@@ -8,10 +8,69 @@ use rayon::prelude::*;
 use scatterfit_imaging::ImageBuf;
 use scatterfit_optics::spectro::SpectroReading;
 
-use crate::image_files::CameraFrame;
-use crate::manifest::{CameraSection, FitSection, SampleManifest, SpectroSection};
+use crate::image_files::{CameraFrame, ImageFileError};
+use crate::manifest::{CameraSection, FitSection, ManifestError, SampleManifest, SpectroSection};
+use crate::spectro::SpectroCsvError;
 
-/// What goes into a sample folder.
+/// Why a sample folder could not be written. Each names the file (or the setting) and what to do.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SampleFolderError {
+    /// A setting the folder cannot be written with (no frames, times that do not match them, a
+    /// missing or non-positive image scale…).
+    #[error("sample folder `{name}`: {field}: {detail}")]
+    Invalid {
+        /// The sample's name.
+        name: String,
+        /// The setting, as its builder method is named (`bracket`, `mm_per_pixel`, …).
+        field: &'static str,
+        /// What was wrong and what to do.
+        detail: String,
+    },
+    /// The folder could not be created.
+    #[error("cannot create {}: {source}", path.display())]
+    CreateDir {
+        /// The folder.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A file could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The spectrophotometer CSV could not be written.
+    #[error(transparent)]
+    Spectro(#[from] SpectroCsvError),
+    /// A frame could not be encoded or written.
+    #[error(transparent)]
+    Frame(#[from] ImageFileError),
+    /// The manifest could not be written.
+    #[error(transparent)]
+    Manifest(#[from] ManifestError),
+}
+
+/// What goes into a sample folder. Build it with [`SampleFiles::new`] and the setters, then
+/// [`SampleFiles::write`]:
+///
+/// ```no_run
+/// # fn demo(reading: &scatterfit_optics::spectro::SpectroReading,
+/// #         frames: &[scatterfit_imaging::ImageBuf<u8>], times: &[f64])
+/// #         -> Result<(), scatterfit_io::sample_folder::SampleFolderError> {
+/// use scatterfit_io::sample_folder::SampleFiles;
+///
+/// let written = SampleFiles::new("pink plastic", reading)
+///     .bracket(frames, times) // 8-bit RGB frames, shortest exposure first; shutter times [s]
+///     .mm_per_pixel(0.1)
+///     .spot_diameter_mm(1.0)
+///     .provenance("measured on the lab rig, 2026-11-24")
+///     .write(std::path::Path::new("samples/pink-plastic"))?;
+/// # Ok(()) }
+/// ```
 #[derive(Debug, Clone)]
 pub struct SampleFiles<'a> {
     /// The sample's name.
@@ -23,11 +82,11 @@ pub struct SampleFiles<'a> {
     pub lab10: Option<[f64; 3]>,
     /// 8-bit RGB frames, shortest exposure first.
     pub frames: &'a [ImageBuf<u8>],
-    /// Their shutter times [s].
+    /// Their shutter times \[s\].
     pub times_s: &'a [f64],
-    /// Image scale [mm per pixel].
+    /// Image scale \[mm per pixel\].
     pub mm_per_pixel: f64,
-    /// The light spot's diameter [mm].
+    /// The light spot's diameter \[mm\].
     pub spot_diameter_mm: f64,
     /// `truth.json` content, when the sample is synthetic.
     pub truth_json: Option<&'a str>,
@@ -35,6 +94,147 @@ pub struct SampleFiles<'a> {
     pub provenance: &'a str,
     /// The manifest's `[fit]` (default: every key at its default).
     pub fit: FitSection,
+}
+
+impl<'a> SampleFiles<'a> {
+    /// A sample named `name` with its spectrophotometer reading; give the bracket
+    /// ([`SampleFiles::bracket`]) and the image scale ([`SampleFiles::mm_per_pixel`]) before
+    /// writing. The spot diameter defaults to 1 mm (the manifest's default), `[fit]` to its
+    /// defaults, the rest to none.
+    #[must_use]
+    pub fn new(name: &'a str, reading: &'a SpectroReading) -> Self {
+        Self {
+            name,
+            reading,
+            lab10: None,
+            frames: &[],
+            times_s: &[],
+            mm_per_pixel: f64::NAN,
+            spot_diameter_mm: 1.0,
+            truth_json: None,
+            provenance: "",
+            fit: FitSection::default(),
+        }
+    }
+
+    /// The exposure bracket: 8-bit RGB frames, shortest exposure first, and their shutter times
+    /// \[s\].
+    #[must_use]
+    pub fn bracket(self, frames: &'a [ImageBuf<u8>], times_s: &'a [f64]) -> Self {
+        Self {
+            frames,
+            times_s,
+            ..self
+        }
+    }
+
+    /// The image scale on the sample surface \[mm per pixel\].
+    #[must_use]
+    pub fn mm_per_pixel(self, mm_per_pixel: f64) -> Self {
+        Self {
+            mm_per_pixel,
+            ..self
+        }
+    }
+
+    /// The light spot's diameter \[mm\].
+    #[must_use]
+    pub fn spot_diameter_mm(self, spot_diameter_mm: f64) -> Self {
+        Self {
+            spot_diameter_mm,
+            ..self
+        }
+    }
+
+    /// The instrument's L\*a\*b\* (D65, 10°), noted in the manifest.
+    #[must_use]
+    pub fn lab10(self, lab: [f64; 3]) -> Self {
+        Self {
+            lab10: Some(lab),
+            ..self
+        }
+    }
+
+    /// `truth.json`'s content (a synthetic sample's parameters).
+    #[must_use]
+    pub fn truth_json(self, truth: &'a str) -> Self {
+        Self {
+            truth_json: Some(truth),
+            ..self
+        }
+    }
+
+    /// Where the folder came from (a comment on top of the manifest and the spectro CSV).
+    #[must_use]
+    pub fn provenance(self, provenance: &'a str) -> Self {
+        Self { provenance, ..self }
+    }
+
+    /// The manifest's `[fit]` section.
+    #[must_use]
+    pub fn fit(self, fit: FitSection) -> Self {
+        Self { fit, ..self }
+    }
+
+    /// Writes the folder ([`write_sample_folder`]).
+    ///
+    /// # Errors
+    /// As [`write_sample_folder`].
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, SampleFolderError> {
+        write_sample_folder(dir, self)
+    }
+
+    /// Refuses settings the folder cannot be written with, before any file is written.
+    fn check(&self, frames: usize) -> Result<(), SampleFolderError> {
+        let invalid = |field, detail: String| SampleFolderError::Invalid {
+            name: crate::escape::token(self.name),
+            field,
+            detail,
+        };
+        if frames < 2 {
+            return Err(invalid(
+                "bracket",
+                format!("{frames} frame(s): a bracket needs at least two exposures"),
+            ));
+        }
+        if frames != self.times_s.len() {
+            return Err(invalid(
+                "bracket",
+                format!(
+                    "{frames} frames but {} shutter times: give one time per frame",
+                    self.times_s.len()
+                ),
+            ));
+        }
+        if let Some(t) = self.times_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+            return Err(invalid(
+                "bracket",
+                format!(
+                    "shutter time {}: must be a positive number of seconds",
+                    crate::escape::number(*t)
+                ),
+            ));
+        }
+        if !(self.mm_per_pixel.is_finite() && self.mm_per_pixel > 0.0) {
+            return Err(invalid(
+                "mm_per_pixel",
+                format!(
+                    "{}: give the image scale on the sample, a positive number of mm per pixel",
+                    crate::escape::number(self.mm_per_pixel)
+                ),
+            ));
+        }
+        if !(self.spot_diameter_mm.is_finite() && self.spot_diameter_mm > 0.0) {
+            return Err(invalid(
+                "spot_diameter_mm",
+                format!(
+                    "{}: the light spot's diameter must be a positive number of mm",
+                    crate::escape::number(self.spot_diameter_mm)
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// The files a sample folder holds, in the order written.
@@ -77,31 +277,42 @@ fn frame_names(frames: usize, dng: bool) -> Vec<String> {
 /// a folder with a `sample.toml` is complete.
 ///
 /// # Errors
-/// The first I/O or encoding error, naming the file.
-pub fn write_sample_folder(dir: &Path, s: &SampleFiles<'_>) -> Result<Vec<PathBuf>, String> {
+/// [`SampleFolderError::Invalid`] for settings it cannot be written with (checked before any
+/// file is written); otherwise the first file that could not be written, named.
+pub fn write_sample_folder(
+    dir: &Path,
+    s: &SampleFiles<'_>,
+) -> Result<Vec<PathBuf>, SampleFolderError> {
     write_sample_folder_with(dir, s, &CameraFiles::default())
 }
 
 /// [`write_sample_folder`] with a real camera's files ([`CameraFiles`]).
 ///
 /// # Errors
-/// The first I/O or encoding error, naming the file.
+/// As [`write_sample_folder`].
 pub fn write_sample_folder_with(
     dir: &Path,
     s: &SampleFiles<'_>,
     extra: &CameraFiles,
-) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+) -> Result<Vec<PathBuf>, SampleFolderError> {
+    let frame_count = if extra.frames_u16.is_empty() {
+        s.frames.len()
+    } else {
+        extra.frames_u16.len()
+    };
+    s.check(frame_count)?;
+    std::fs::create_dir_all(dir).map_err(|source| SampleFolderError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let mut written = Vec::new();
     let spectro = dir.join("spectro.csv");
-    crate::spectro::write_spectro_csv(&spectro, s.reading, s.provenance)
-        .map_err(|e| e.to_string())?;
+    crate::spectro::write_spectro_csv(&spectro, s.reading, s.provenance)?;
     written.push(spectro);
     let names: Vec<String> = if extra.frames_u16.is_empty() {
         let names = frame_names(s.frames.len(), false);
         s.frames.par_iter().zip(&names).try_for_each(|(f, name)| {
             crate::image_files::write_camera_frame(&dir.join(name), &CameraFrame::U8(f.clone()))
-                .map_err(|e| e.to_string())
         })?;
         names
     } else {
@@ -120,13 +331,11 @@ pub fn write_sample_folder_with(
                         white_level: white,
                         exposure_time_s: t,
                     },
-                )
-                .map_err(|e| e.to_string()),
+                ),
                 None => crate::image_files::write_camera_frame(
                     &dir.join(name),
                     &CameraFrame::U16(f.clone()),
-                )
-                .map_err(|e| e.to_string()),
+                ),
             })?;
         names
     };
@@ -134,7 +343,7 @@ pub fn write_sample_folder_with(
     for (name, frame) in [("flat.png", &extra.flat), ("spot.png", &extra.spot_image)] {
         if let Some(f) = frame {
             let path = dir.join(name);
-            crate::image_files::write_camera_frame(&path, f).map_err(|e| e.to_string())?;
+            crate::image_files::write_camera_frame(&path, f)?;
             written.push(path);
         }
     }
@@ -144,12 +353,21 @@ pub fn write_sample_folder_with(
         .cloned()
         .zip(s.times_s.iter().copied())
         .collect();
-    crate::bracket::write_exposures_csv(&exposures, &entries).map_err(|e| e.to_string())?;
+    crate::bracket::write_exposures_csv(&exposures, &entries).map_err(|source| {
+        SampleFolderError::Write {
+            path: exposures.clone(),
+            source,
+        }
+    })?;
     written.push(exposures);
     if let Some(truth) = s.truth_json {
         let path = dir.join("truth.json");
-        crate::atomic::write_atomic(&path, truth.as_bytes())
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        crate::atomic::write_atomic(&path, truth.as_bytes()).map_err(|source| {
+            SampleFolderError::Write {
+                path: path.clone(),
+                source,
+            }
+        })?;
         written.push(path);
     }
     let manifest = SampleManifest {
@@ -178,7 +396,99 @@ pub fn write_sample_folder_with(
         ));
     }
     let path = dir.join(crate::manifest::MANIFEST_NAME);
-    crate::manifest::write_manifest(&path, &manifest, &comment).map_err(|e| e.to_string())?;
+    crate::manifest::write_manifest(&path, &manifest, &comment)?;
     written.push(path);
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reading() -> SpectroReading {
+        let wl: Vec<f64> = (40..=70).map(|k| 10.0 * f64::from(k)).collect();
+        let sce = vec![0.5; wl.len()];
+        let sci = vec![0.54; wl.len()];
+        SpectroReading::new(wl, sci, sce).unwrap()
+    }
+
+    /// The builder's folder is what a manifest reader reads back (scale, spot, `[fit]`, the
+    /// bracket through exposures.csv), and the files are listed in the order written.
+    #[test]
+    fn builder_writes_a_folder_the_reader_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let reading = reading();
+        let frames = vec![ImageBuf::filled(8, 6, 3, 10u8).unwrap(); 3];
+        let times = [0.01, 0.1, 1.0];
+        let fit = FitSection {
+            model: Some(scatterfit_optics::ModelName::Mc),
+            ..FitSection::default()
+        };
+        let written = SampleFiles::new("a sample", &reading)
+            .bracket(&frames, &times)
+            .mm_per_pixel(0.25)
+            .spot_diameter_mm(0.8)
+            .provenance("test")
+            .fit(fit.clone())
+            .write(dir.path())
+            .unwrap();
+        let names: Vec<String> = written
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, file_names(3, false));
+        let m = crate::manifest::read_manifest(dir.path()).unwrap();
+        assert_eq!(m.name.as_deref(), Some("a sample"));
+        assert_eq!(m.camera.mm_per_pixel, Some(0.25));
+        assert_eq!(m.camera.spot_diameter_mm, Some(0.8));
+        assert_eq!(m.fit.model, fit.model);
+        let listed = crate::bracket::read_exposures_csv(&dir.path().join("exposures.csv")).unwrap();
+        let listed_times: Vec<f64> = listed.iter().map(|e| e.time_s).collect();
+        assert_eq!(listed_times, times);
+    }
+
+    /// Settings the folder cannot be written with are typed errors naming the setting, and
+    /// nothing is written.
+    #[test]
+    fn bad_settings_are_refused_before_writing() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("s");
+        let reading = reading();
+        let frames = vec![ImageBuf::filled(4, 4, 3, 10u8).unwrap(); 2];
+        let field = |r: Result<Vec<PathBuf>, SampleFolderError>| match r {
+            Err(SampleFolderError::Invalid { field, .. }) => field,
+            other => panic!("{other:?}"),
+        };
+        let base = SampleFiles::new("s", &reading).bracket(&frames, &[0.1, 1.0]);
+        assert_eq!(field(base.clone().write(&target)), "mm_per_pixel");
+        assert_eq!(
+            field(
+                base.clone()
+                    .mm_per_pixel(0.1)
+                    .spot_diameter_mm(0.0)
+                    .write(&target)
+            ),
+            "spot_diameter_mm"
+        );
+        assert_eq!(
+            field(
+                base.clone()
+                    .bracket(&frames, &[0.1])
+                    .mm_per_pixel(0.1)
+                    .write(&target)
+            ),
+            "bracket"
+        );
+        assert_eq!(
+            field(
+                SampleFiles::new("s", &reading)
+                    .mm_per_pixel(0.1)
+                    .write(&target)
+            ),
+            "bracket"
+        );
+        let err = base.write(&target).unwrap_err().to_string();
+        assert!(err.contains("mm_per_pixel") && err.contains("`s`"), "{err}");
+        assert!(!target.exists());
+    }
 }

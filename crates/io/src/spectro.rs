@@ -140,7 +140,7 @@ pub enum SpectroCsvError {
         path: PathBuf,
         /// 1-based line number.
         line: u64,
-        /// The wavelength [nm].
+        /// The wavelength \[nm\].
         wavelength: f64,
         /// SCI (fraction).
         sci: f64,

@@ -10,14 +10,14 @@ use crate::error::{Result, check};
 pub enum BeamProfile {
     /// An infinitely thin pencil beam (MCML's source).
     Pencil,
-    /// Uniform irradiance over a disk of this radius [mm].
+    /// Uniform irradiance over a disk of this radius \[mm\].
     Disk {
-        /// Radius [mm].
+        /// Radius \[mm\].
         radius: f64,
     },
-    /// Gaussian irradiance I(ρ) ∝ exp(−2ρ²/w²) with w the 1/e² radius [mm] (the laser convention).
+    /// Gaussian irradiance I(ρ) ∝ exp(−2ρ²/w²) with w the 1/e² radius \[mm\] (the laser convention).
     Gaussian {
-        /// 1/e² intensity radius w [mm].
+        /// 1/e² intensity radius w \[mm\].
         radius: f64,
     },
 }
@@ -78,7 +78,7 @@ impl Beam {
         })
     }
 
-    /// The same beam at polar incidence angle `theta` [radians] in [0, π/2).
+    /// The same beam at polar incidence angle `theta` \[radians\] in [0, π/2).
     ///
     /// # Errors
     /// `InvalidParameter` for an angle outside [0, π/2).
@@ -97,7 +97,7 @@ impl Beam {
     pub fn profile(&self) -> BeamProfile {
         self.profile
     }
-    /// Polar angle of incidence [radians].
+    /// Polar angle of incidence \[radians\].
     pub fn incidence(&self) -> f64 {
         self.incidence
     }

@@ -46,12 +46,12 @@ pub struct CostEstimate {
     pub interactions_per_photon: f64,
     /// Expected steps in all, photons × the above.
     pub interactions: f64,
-    /// Memory the tallies take while running [bytes].
+    /// Memory the tallies take while running \[bytes\].
     pub memory_bytes: u64,
 }
 
 impl CostEstimate {
-    /// The expected run time [s] on `threads` threads at [`REFERENCE_INTERACTIONS_PER_SECOND`].
+    /// The expected run time \[s\] on `threads` threads at [`REFERENCE_INTERACTIONS_PER_SECOND`].
     pub fn seconds(&self, threads: usize) -> f64 {
         self.interactions / (REFERENCE_INTERACTIONS_PER_SECOND * threads.max(1) as f64)
     }
@@ -157,7 +157,7 @@ impl Simulation {
         self.photons
     }
 
-    /// Memory the tallies take while running [bytes]: a wave of [`WAVE_CHUNKS`] chunk tallies plus
+    /// Memory the tallies take while running \[bytes\]: a wave of `WAVE_CHUNKS` chunk tallies plus
     /// the running total, each a sum and a sum of squares per radial and angular bin, and the
     /// result. Independent of the photon count.
     pub fn memory_bytes(&self) -> u64 {
@@ -312,11 +312,11 @@ pub struct SimulationResult {
     pub absorbed: Estimate,
     /// R_sp + Rd + Tt + A, which is 1 up to Russian-roulette noise.
     pub conservation: Estimate,
-    /// The radial grid [mm].
+    /// The radial grid \[mm\].
     pub grid: RadialGrid,
     /// Rd(r) per annulus of `grid` [mm⁻²]: reflected weight / (photons × annulus area).
     pub rd_profile: Vec<Estimate>,
-    /// Exit-angle bin edges θ [radians], empty when the tally is off.
+    /// Exit-angle bin edges θ \[radians\], empty when the tally is off.
     pub angle_edges: Vec<f64>,
     /// Diffuse reflectance per exit-angle bin per steradian of solid angle [sr⁻¹].
     pub rd_angle: Vec<Estimate>,

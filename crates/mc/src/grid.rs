@@ -43,7 +43,7 @@ impl PartialEq for RadialGrid {
 }
 
 impl RadialGrid {
-    /// `bins` annuli of width `dr` [mm] (MCML's grid: `dr`, `nr`).
+    /// `bins` annuli of width `dr` \[mm\] (MCML's grid: `dr`, `nr`).
     ///
     /// # Errors
     /// `InvalidParameter` for dr not finite and > 0, or zero bins.
@@ -76,7 +76,7 @@ impl RadialGrid {
         })
     }
 
-    /// Annuli between the given edges [mm]: the first must be 0, the rest strictly increasing and finite.
+    /// Annuli between the given edges \[mm\]: the first must be 0, the rest strictly increasing and finite.
     /// Edges that are exactly i·dr (as [`RadialGrid::uniform`] makes them) give a uniform grid.
     ///
     /// # Errors
@@ -111,7 +111,7 @@ impl RadialGrid {
         })
     }
 
-    /// `bins` annuli: [0, r_first) then logarithmically spaced up to `r_max` [mm].
+    /// `bins` annuli: [0, r_first) then logarithmically spaced up to `r_max` \[mm\].
     ///
     /// # Errors
     /// `InvalidParameter` unless 0 < r_first < r_max (finite) and bins ≥ 2.
@@ -130,7 +130,7 @@ impl RadialGrid {
         Self::from_edges(edges)
     }
 
-    /// Bin edges [mm], one more than the number of bins.
+    /// Bin edges \[mm\], one more than the number of bins.
     pub fn edges(&self) -> &[f64] {
         &self.edges
     }
@@ -138,11 +138,11 @@ impl RadialGrid {
     pub fn bins(&self) -> usize {
         self.edges.len() - 1
     }
-    /// Area π(r_{i+1}² − r_i²) of annulus `i` [mm²].
+    /// Area π(r_{i+1}² − r_i²) of annulus `i` \[mm²\].
     pub fn area(&self, i: usize) -> f64 {
         std::f64::consts::PI * (self.edges[i + 1].powi(2) - self.edges[i].powi(2))
     }
-    /// Area-weighted mean radius of annulus `i`, ⅔ (r₂³ − r₁³)/(r₂² − r₁²) [mm]: where a profile that is
+    /// Area-weighted mean radius of annulus `i`, ⅔ (r₂³ − r₁³)/(r₂² − r₁²) \[mm\]: where a profile that is
     /// linear across the bin takes the bin's average value.
     pub fn center(&self, i: usize) -> f64 {
         let (a, b) = (self.edges[i], self.edges[i + 1]);

@@ -916,7 +916,7 @@ impl McProfile {
         &self.props
     }
 
-    /// Outer radius of the Monte Carlo data behind the model at this albedo [mm] (interpolated like
+    /// Outer radius of the Monte Carlo data behind the model at this albedo \[mm\] (interpolated like
     /// the model): beyond it Rd(r) is the smoother's extrapolation.
     pub fn r_data_max_mm(&self) -> f64 {
         self.r_data_max

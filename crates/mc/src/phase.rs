@@ -37,7 +37,7 @@ pub(crate) fn azimuth(table: &[[f64; 2]; AZIMUTH_TABLE], bits: u64) -> (f64, f64
 ///
 /// Henyey & Greenstein 1941; the inversion of MCML `SpinTheta` (Wang, Jacques & Zheng 1995,
 /// eq. 3.28; docs/physics.md §4.1), cos θ = [1 + g² − ((1 − g²)/(1 − g + 2gu))²] / (2g), written as one
-/// fraction ([`HgSampler`]) so that it costs one division and stays accurate as g → 0 (where it
+/// fraction (`HgSampler`) so that it costs one division and stays accurate as g → 0 (where it
 /// tends to 2u − 1, the g = 0 case, which is returned exactly).
 #[inline]
 pub fn sample_hg_cos(g: f64, u: f64) -> f64 {

@@ -57,7 +57,7 @@ impl From<Layer> for RawLayer {
 impl Layer {
     /// A layer from its absorption coefficient σa [mm⁻¹], scattering coefficient σs [mm⁻¹],
     /// Henyey–Greenstein asymmetry g ∈ (−1, 1), refractive index n > 0 (absolute: the outside media
-    /// have their own indices) and thickness [mm] (`f64::INFINITY` for a half-space).
+    /// have their own indices) and thickness \[mm\] (`f64::INFINITY` for a half-space).
     ///
     /// # Errors
     /// `InvalidParameter` for negative or non-finite coefficients, σa + σs = 0 (a clear layer is not
@@ -154,7 +154,7 @@ impl Layer {
     pub fn n(&self) -> f64 {
         self.n
     }
-    /// Thickness [mm] (infinite for a half-space).
+    /// Thickness \[mm\] (infinite for a half-space).
     pub fn thickness(&self) -> f64 {
         self.thickness
     }

@@ -27,7 +27,7 @@
 //! integrated column.
 //!
 //! Derivatives in σ′s and σa are analytic: forward-mode duals for the parameter chain and analytic
-//! partials of the source-pair term ([`crate::diffusion`]), finite at σa = 0.
+//! partials of the source-pair term (`crate::diffusion`), finite at σa = 0.
 
 use std::f64::consts::PI;
 

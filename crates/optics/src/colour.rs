@@ -85,9 +85,9 @@ pub struct Lab {
     pub b: f64,
 }
 
-/// First wavelength of the weighting table [nm].
+/// First wavelength of the weighting table \[nm\].
 pub const WEIGHTS_START_NM: f64 = 400.0;
-/// Step of the weighting table [nm].
+/// Step of the weighting table \[nm\].
 pub const WEIGHTS_STEP_NM: f64 = 10.0;
 
 /// D65 tristimulus weighting factors at 400, 410, …, 700 nm for (x̄, ȳ, z̄) of the 2° observer followed

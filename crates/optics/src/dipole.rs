@@ -259,7 +259,7 @@ impl Dipole {
     /// the two sets the count). This is the hot path of the fit (one call per Levenberg–Marquardt
     /// iteration), so it is arranged for speed: blocks of 8 radii, square roots and exponentials in
     /// their own loops, and every per-dipole constant hoisted into a local. It repeats the arithmetic of
-    /// [`Dipole::sample_from_distances`] rather than calling it because the call, even inlined, measured
+    /// `Dipole::sample_from_distances` rather than calling it because the call, even inlined, measured
     /// slower here (3.95 vs 4.85 µs in `scatterfit bench optics`; BENCHMARKS.md);
     /// `blocked_profile_equals_scalar` pins the two together.
     pub fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {

@@ -45,13 +45,13 @@ impl ProfileSample {
 /// normal incidence, for one set of optical properties (built per parameter set, like
 /// [`crate::dipole::Dipole::new`], usually by [`ModelFamily::profile`]).
 pub trait ProfileModel: Send + Sync {
-    /// Rd(r) [mm⁻²] at radius `r_mm` ≥ 0 [mm] from the point of incidence.
+    /// Rd(r) [mm⁻²] at radius `r_mm` ≥ 0 \[mm\] from the point of incidence.
     fn rd(&self, r_mm: f64) -> f64;
     /// Rd and its partial derivatives ∂Rd/∂σ′s, ∂Rd/∂σa at every radius of `radii_mm`, written to
     /// `out` (the shorter of the two sets the count). Derivatives are analytic (never finite
     /// differences).
     fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]);
-    /// Total diffuse reflectance ∫₀^∞ 2πr Rd(r) dr [1] (excluding the specular reflection).
+    /// Total diffuse reflectance ∫₀^∞ 2πr Rd(r) dr \[1\] (excluding the specular reflection).
     fn rd_total(&self) -> f64;
 }
 

@@ -7,7 +7,7 @@
 use crate::error::{OpticsError, Result};
 
 /// The viewing angle of a d/8 (di:8°, de:8°) sphere spectrophotometer such as the Konica Minolta
-/// CM-600d used by Choi, Lee & Chin (2014, §3.1) [degrees].
+/// CM-600d used by Choi, Lee & Chin (2014, §3.1) \[degrees\].
 pub const D8_VIEWING_ANGLE_DEG: f64 = 8.0;
 
 /// Exact unpolarised Fresnel reflectance of a smooth dielectric boundary.

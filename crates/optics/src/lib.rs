@@ -24,11 +24,13 @@
 //! The vocabulary the crates above share: [`Channel`] and [`Rgb`] (a value per linear-sRGB
 //! channel, by name), [`ModelName`], [`AlbedoModel`] and [`Method`] (what a user chooses), and the
 //! forward-model traits [`ProfileModel`] (Rd(r) of one parameter set) and [`ModelFamily`] (a named
-//! model: profiles, its total Rd(α′, η, g) and the α′ inversion).
+//! model: profiles, its total Rd(α′, η, g) and the α′ inversion), and [`Estimate`] (a measured value
+//! with the standard errors of its independent sources: fit, spectrophotometer, g).
 
 pub mod better_dipole;
 pub mod colour;
 pub mod dipole;
+pub mod estimate;
 pub mod family;
 pub mod fresnel;
 pub mod model;
@@ -45,6 +47,7 @@ mod properties;
 mod roots;
 
 pub use error::{OpticsError, Result};
+pub use estimate::Estimate;
 pub use family::{AtG, ModelFamily, ProfileModel, ProfileSample};
 pub use model::DiffusionModel;
 pub use names::{AlbedoModel, Method, ModelName};

@@ -2,7 +2,7 @@
 //! Carlo Method for Subsurface Scattering", EGSR) exactly as pbrt-v4 evaluates it
 //! (`src/pbrt/bssrdf.cpp`: `BeamDiffusionMS` + `BeamDiffusionSS`; docs/physics.md §2.1), in millimetres.
 //!
-//! Parameters and domains: σ′s > 0, σa ≥ 0 [mm⁻¹], 1 ≤ η ≤ [`FRESNEL_MOMENT_MAX_ETA`], Henyey–Greenstein
+//! Parameters and domains: σ′s > 0, σa ≥ 0 [mm⁻¹], 1 ≤ η ≤ [`FRESNEL_MOMENT_MAX_ETA`](crate::fresnel::FRESNEL_MOMENT_MAX_ETA), Henyey–Greenstein
 //! g ∈ (−1, 1), 0 by default (then σs = σ′s; otherwise σs = σ′s/(1 − g)). pbrt tabulates this at
 //! σt = 1 and scales; we evaluate it directly (same numbers: the depth samples scale with 1/σt).
 //!
@@ -22,7 +22,7 @@
 //!     SS += ρ e^{−σt(d + t_c)}/d² · p_HG(cos θo; g) · (1 − F_r(−cos θo)) · cos θo
 //! SS /= 100
 //! ```
-//! with pbrt's Fresnel-moment polynomials C₁, C₂ ([`fresnel_moment1`], [`fresnel_moment2`]), the
+//! with pbrt's Fresnel-moment polynomials C₁, C₂ ([`fresnel_moment1`](crate::fresnel::fresnel_moment1), [`fresnel_moment2`](crate::fresnel::fresnel_moment2)), the
 //! exact dielectric Fresnel reflectance F_r for light leaving the medium, and pbrt-v4's HG
 //! convention p = (1 − g²)/(4π(1 + g² + 2g cos θo)^{3/2}) (cos θo is minus the scattering cosine).
 //! Rd(r) = MS(r) + SS(r) [mm⁻²].
@@ -35,7 +35,7 @@
 //!
 //! Derivatives in σ′s and σa: forward-mode duals through every parameter-dependent quantity (depth
 //! samples included) and analytic partials of each depth's source-pair term
-//! ([`crate::diffusion`]); no finite differences.
+//! (`crate::diffusion`); no finite differences.
 
 use std::f64::consts::PI;
 

@@ -45,7 +45,7 @@ pub struct PortReading {
 
 impl Port {
     /// A port lighting a disc of diameter `illuminated_mm` and measuring over a concentric
-    /// aperture of diameter `aperture_mm` [mm] (the same for an instrument that lights what it
+    /// aperture of diameter `aperture_mm` \[mm\] (the same for an instrument that lights what it
     /// measures).
     ///
     /// # Errors
@@ -69,18 +69,18 @@ impl Port {
         })
     }
 
-    /// Diameter of the lit disc [mm].
+    /// Diameter of the lit disc \[mm\].
     pub fn illuminated_mm(&self) -> f64 {
         2.0 * self.illuminated_radius
     }
 
-    /// Diameter of the measured aperture [mm].
+    /// Diameter of the measured aperture \[mm\].
     pub fn aperture_mm(&self) -> f64 {
         2.0 * self.aperture_radius
     }
 
     /// K(r): the probability that light entering uniformly over the lit disc and leaving the surface
-    /// r [mm] away in a uniformly random direction leaves inside the aperture.
+    /// r \[mm\] away in a uniformly random direction leaves inside the aperture.
     pub fn kernel(&self, r_mm: f64) -> f64 {
         let (a, b) = (self.illuminated_radius, self.aperture_radius);
         disc_intersection_area(a, b, r_mm.abs()) / (std::f64::consts::PI * a * a)

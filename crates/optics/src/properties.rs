@@ -96,12 +96,12 @@ impl OpticalProperties {
         self.sigma_a
     }
 
-    /// Relative refractive index η = n_material / n_air [1].
+    /// Relative refractive index η = n_material / n_air \[1\].
     pub fn eta(&self) -> f64 {
         self.eta
     }
 
-    /// Henyey–Greenstein asymmetry g [1] (0 unless set by [`OpticalProperties::with_g`]).
+    /// Henyey–Greenstein asymmetry g \[1\] (0 unless set by [`OpticalProperties::with_g`]).
     pub fn g(&self) -> f64 {
         self.g
     }
@@ -117,7 +117,7 @@ impl OpticalProperties {
         self.sigma_a + self.sigma_s_prime
     }
 
-    /// Reduced albedo α′ = σ′s / σ′t [1].
+    /// Reduced albedo α′ = σ′s / σ′t \[1\].
     pub fn albedo_prime(&self) -> f64 {
         self.sigma_s_prime / self.sigma_t_prime()
     }

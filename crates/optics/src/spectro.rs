@@ -43,7 +43,7 @@ pub struct SpectroReading {
 }
 
 impl SpectroReading {
-    /// A reading from its wavelengths [nm] and the SCI and SCE reflectances at them (fractions).
+    /// A reading from its wavelengths \[nm\] and the SCI and SCE reflectances at them (fractions).
     ///
     /// # Errors
     /// [`OpticsError::Spectrum`] when the lengths differ, there are fewer than two wavelengths, a
@@ -91,7 +91,7 @@ impl SpectroReading {
         })
     }
 
-    /// Wavelengths [nm], strictly increasing.
+    /// Wavelengths \[nm\], strictly increasing.
     pub fn wavelengths_nm(&self) -> &[f64] {
         &self.wavelengths_nm
     }
@@ -119,7 +119,7 @@ pub struct SpectroOptions {
 /// η at one wavelength.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SpectralPoint {
-    /// Wavelength [nm].
+    /// Wavelength \[nm\].
     pub wavelength_nm: f64,
     /// SCI (fraction).
     pub sci: f64,

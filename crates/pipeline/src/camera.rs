@@ -32,7 +32,7 @@ pub fn corner_pixels(w: usize, h: usize, step: usize) -> Vec<usize> {
 /// A black level estimated from the far corners of a linear bracket.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BlackLevelEstimate {
-    /// Per channel [DN]: the intercept at Δt = 0 of the corners' mean value against exposure time
+    /// Per channel \[DN\]: the intercept at Δt = 0 of the corners' mean value against exposure time
     /// (the part that does not grow with time: the sensor's pedestal).
     pub level: Vec<f64>,
     /// Per channel, the slope [DN/s]: what grows with time in the corners (veiling glare, dark
@@ -240,7 +240,7 @@ pub struct Background {
     pub subtracted: bool,
 }
 
-/// Fits y(r) = b + A e^{−s r}/r^p to rings (r [mm], value, standard error) — a diffusion profile's
+/// Fits y(r) = b + A e^{−s r}/r^p to rings (r \[mm\], value, standard error) — a diffusion profile's
 /// far field over a constant background — by least squares in (b, A) for each s on a log grid in
 /// [0.005, 20] mm⁻¹ and p ∈ {1, 1.5, 2, 3}, keeping the best. Returns (b, σ_b), σ_b scaled by
 /// √χ²_red when that exceeds 1. `None` for fewer than 8 rings.

@@ -16,6 +16,8 @@
 use scatterfit_fit::FitReport;
 use scatterfit_imaging::{CenterOptions, find_spot_center};
 pub use scatterfit_io::quality::{Quality, Reason, ReasonKind, Verdict};
+use scatterfit_io::result_json::ResponseKind;
+use scatterfit_optics::Rgb;
 
 use crate::fit::ChannelOutcome;
 use crate::measure::Measurement;
@@ -162,7 +164,7 @@ pub fn incomplete_rings(w: usize, h: usize, c: [f64; 2], r_fit_px: f64) -> Optio
     })
 }
 
-/// The profile's half width at half maximum [px], on the channel sum (the first ring where the
+/// The profile's half width at half maximum \[px\], on the channel sum (the first ring where the
 /// sum falls below half the maximum of the first rings, linearly interpolated).
 pub fn spot_hwhm_px(m: &Measurement) -> Option<f64> {
     let rings = &m.profile.profile.rings;
@@ -309,7 +311,7 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
                 message: problem.clone(),
             }];
         }
-        ChannelOutcome::Fitted(r) => r,
+        ChannelOutcome::Fitted(f) => &f.report,
     };
     if !r.converged {
         reasons.push(Reason {
@@ -364,14 +366,10 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
 }
 
 /// The verdict on each channel (R, G, B): the fit's checks and the sample's.
-pub fn quality(m: &Measurement) -> [Quality; 3] {
+pub fn quality(m: &Measurement) -> Rgb<Quality> {
     let sample = sample_checks(m);
-    std::array::from_fn(|c| {
-        let mut reasons = m
-            .fits
-            .get(c)
-            .map(|o| fit_reasons(o, m.spectro.eta))
-            .unwrap_or_default();
+    m.fits.as_ref().map(|o| {
+        let mut reasons = fit_reasons(o, m.spectro.eta);
         // A failed channel has no value the sample's findings could qualify.
         if !reasons.iter().any(|r| r.severity == Verdict::Failed) {
             reasons.extend(sample.reasons.iter().cloned());
@@ -406,7 +404,7 @@ pub const PLATEAU_MIN_SAMPLES: usize = 16;
 /// Finds the codes 16-bit frames use ([`CodeRange`]).
 ///
 /// # Errors
-/// [`PipelineError::Input`] for 8-bit frames scaled into 16 bits (every code a multiple of 257,
+/// [`crate::PipelineError::Input`] for 8-bit frames scaled into 16 bits (every code a multiple of 257,
 /// as an image editor converts): their tone curve is not linear, and merging them as linear data
 /// would give wrong radiances.
 pub fn code_range(
@@ -479,14 +477,14 @@ pub struct Registration {
     /// frame); `None` where fewer than [`REGISTRATION_MIN_PIXELS`] pixels are, or the disk touches
     /// the frame's edge.
     pub centroids: Vec<Option<[f64; 2]>>,
-    /// The largest shift between two frames' centroids [px].
+    /// The largest shift between two frames' centroids \[px\].
     pub max_shift_px: f64,
 }
 
 /// Pixels a frame's half-saturated disk needs for its centroid to count.
 pub const REGISTRATION_MIN_PIXELS: usize = 12;
 
-/// A shift between frames beyond this [px] makes every channel suspect: the rings of the merged
+/// A shift between frames beyond this \[px\] makes every channel suspect: the rings of the merged
 /// map then average light from two positions. The demo's frames agree to 0.18 px.
 pub const MAX_FRAME_SHIFT_PX: f64 = 1.5;
 
@@ -576,14 +574,14 @@ pub const MAX_STEP_LINEAR: f64 = 256.0;
 /// +712 % and was called ok).
 pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
     let limit = match m.hdr.response_kind {
-        "recovered" | "given" => MAX_STEP_8BIT,
-        "linear" => MAX_STEP_LINEAR,
+        ResponseKind::Recovered | ResponseKind::Given => MAX_STEP_8BIT,
+        ResponseKind::Linear => MAX_STEP_LINEAR,
         _ => return Vec::new(),
     };
     let mut times: Vec<f64> = m.hdr.frames.iter().map(|f| f.time_s).collect();
     times.sort_by(f64::total_cmp);
     let mut reasons = Vec::new();
-    if m.hdr.response_kind == "recovered" && times.len() < 3 {
+    if m.hdr.response_kind == ResponseKind::Recovered && times.len() < 3 {
         reasons.push(suspect(
             ReasonKind::BracketGap,
             format!(

@@ -2,7 +2,7 @@
 
 use scatterfit_fit::{ChannelInput, FitOptions, FitReport, PreparedFit, ProfileData, Spot, Start};
 use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
-use scatterfit_optics::{AlbedoModel, Channel, Method, ModelFamily, ModelName};
+use scatterfit_optics::{AlbedoModel, Channel, Estimate, Method, ModelFamily, ModelName, Rgb};
 use serde::Serialize;
 
 use crate::error::{PipelineError, Result};
@@ -17,13 +17,13 @@ pub struct FitSettings {
     pub model: ModelName,
     /// How α′ comes from the spectrophotometer's Rd (`scatterfit_mc::albedo_family`).
     pub albedo_model: AlbedoModel,
-    /// Radius of the light spot [mm]; the model is convolved with it. For a radial spot
+    /// Radius of the light spot \[mm\]; the model is convolved with it. For a radial spot
     /// (`spot`), the radius holding 99 % of its power (which sets the default r_min).
     pub spot_radius_mm: f64,
     /// The spot's shape: a uniform disk of `spot_radius_mm`, or a radial profile (a Gaussian, a
     /// measured spot image; issue 16).
     pub spot: SpotShape,
-    /// Innermost fitted radius [mm] (default: the spot's diameter).
+    /// Innermost fitted radius \[mm\] (default: the spot's diameter).
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed only).
     pub normalise_with_spectro: bool,
@@ -68,18 +68,58 @@ impl FitSettings {
         Ok(o)
     }
 
-    /// The innermost fitted radius [mm]: the given one, else the spot's diameter.
+    /// The innermost fitted radius \[mm\]: the given one, else the spot's diameter.
     pub fn r_min_mm(&self) -> f64 {
         self.r_min_mm.unwrap_or(2.0 * self.spot_radius_mm)
     }
 }
 
-/// One channel's outcome: a report, or why there is none.
+/// A fitted channel: the solver's report and the measured values with their uncertainty terms.
+#[derive(Debug, Clone, Serialize)]
+pub struct ChannelFit {
+    /// What the solver did and reached (rings, residuals, correlations, its own standard errors).
+    pub report: FitReport,
+    /// σ′s \[mm⁻¹\]: the fit's value with the fit's standard error and, once propagated
+    /// ([`propagate_spectro`]), the spectrophotometer's.
+    pub sigma_s_prime: Estimate,
+    /// σa \[mm⁻¹\], with the same terms.
+    pub sigma_a: Estimate,
+    /// α′: the spectrophotometer's (proposed method, with its standard error) or the one the
+    /// fitted σ′s and σa give (existing method, no term).
+    pub albedo_prime: Estimate,
+}
+
+impl ChannelFit {
+    /// The report of a channel fitted with `method`, α′'s standard error from the reading
+    /// (`albedo_prime_stderr`, used by the proposed method only); no spectrophotometer term yet.
+    pub fn new(report: FitReport, albedo_prime_stderr: Option<f64>) -> Self {
+        let estimate = |e: scatterfit_fit::Estimate| Estimate {
+            value: e.value,
+            fit: finite(e.stderr),
+            spectro: None,
+            g: None,
+        };
+        Self {
+            sigma_s_prime: estimate(report.sigma_s_prime),
+            sigma_a: estimate(report.sigma_a),
+            albedo_prime: Estimate {
+                value: report.albedo_prime,
+                fit: None,
+                // The existing method's α′ comes from its fitted coefficients, not the reading.
+                spectro: albedo_prime_stderr.filter(|_| report.method == Method::Proposed),
+                g: None,
+            },
+            report,
+        }
+    }
+}
+
+/// One channel's outcome: a fit, or why there is none.
 #[derive(Debug, Clone, Serialize)]
 #[serde(tag = "outcome", rename_all = "snake_case")]
 pub enum ChannelOutcome {
     /// The fit ran.
-    Fitted(Box<FitReport>),
+    Fitted(Box<ChannelFit>),
     /// No fit: the spectrophotometer gave no α′, or too few rings.
     NotFitted {
         /// Why.
@@ -88,77 +128,108 @@ pub enum ChannelOutcome {
 }
 
 impl ChannelOutcome {
-    /// The report, if the fit ran.
-    pub fn report(&self) -> Option<&FitReport> {
+    /// The fit, if it ran.
+    pub fn fit(&self) -> Option<&ChannelFit> {
         match self {
-            ChannelOutcome::Fitted(r) => Some(r),
+            ChannelOutcome::Fitted(f) => Some(f),
             ChannelOutcome::NotFitted { .. } => None,
         }
+    }
+
+    /// The solver's report, if the fit ran.
+    pub fn report(&self) -> Option<&FitReport> {
+        self.fit().map(|f| &f.report)
+    }
+
+    /// σ′s with its uncertainty terms, if the fit ran (see [`ChannelOutcome::is_measurement`]
+    /// for whether the data constrain it).
+    pub fn sigma_s_prime(&self) -> Option<Estimate> {
+        self.fit().map(|f| f.sigma_s_prime)
+    }
+
+    /// σa with its uncertainty terms, if the fit ran.
+    pub fn sigma_a(&self) -> Option<Estimate> {
+        self.fit().map(|f| f.sigma_a)
     }
 
     /// True when the channel gave parameters the data constrain.
     pub fn is_measurement(&self) -> bool {
         self.report().is_some_and(FitReport::is_measurement)
     }
+
+    /// The same outcome with the spectrophotometer's part of σ′s's and σa's uncertainty
+    /// ([`propagate_spectro`]; `None` leaves it unknown).
+    #[must_use]
+    pub fn with_spectro(mut self, errors: Option<SpectroErrors>) -> Self {
+        if let (ChannelOutcome::Fitted(f), Some(e)) = (&mut self, errors) {
+            f.sigma_s_prime.spectro = finite(e.sigma_s_prime);
+            f.sigma_a.spectro = finite(e.sigma_a);
+        }
+        self
+    }
 }
 
-/// Fits the three channels of a profile (one [`ProfileData`] per channel) with the
-/// spectrophotometer's η and α′, in parallel is not worth it (microseconds each).
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+/// Fits the three channels of a profile with the spectrophotometer's η and α′ (one after the
+/// other: microseconds each, not worth threads). The outcomes carry the fit's standard errors;
+/// [`propagate_spectro`] adds the spectrophotometer's.
 pub fn fit_stage(
-    profiles: &[ProfileData],
+    profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
     settings: &FitSettings,
     model: &dyn ModelFamily,
-) -> Vec<ChannelOutcome> {
+) -> Rgb<ChannelOutcome> {
     let opts = match settings.options() {
         Ok(o) => o,
         Err(e) => {
-            return profiles
-                .iter()
-                .map(|_| ChannelOutcome::NotFitted {
-                    problem: e.to_string(),
-                })
-                .collect();
+            return Rgb::from_fn(|_| ChannelOutcome::NotFitted {
+                problem: e.to_string(),
+            });
         }
     };
-    profiles
-        .iter()
-        .enumerate()
-        .map(|(c, data)| {
-            let albedo = spectro.albedo_prime.get(c).copied().flatten();
-            if settings.method == Method::Proposed && albedo.is_none() {
-                return ChannelOutcome::NotFitted {
-                    problem: spectro
-                        .problems
-                        .get(c)
-                        .cloned()
-                        .flatten()
-                        .unwrap_or_else(|| {
-                            format!("channel {}: no reduced albedo", channel_name(c))
-                        }),
-                };
-            }
-            let input = ChannelInput {
-                eta: spectro.eta,
-                albedo_prime: albedo,
-                rd_total: spectro.rd.get(c).copied(),
+    profiles.as_ref().map_with_channel(|c, data| {
+        let albedo = spectro.albedo_prime[c];
+        if settings.method == Method::Proposed && albedo.is_none() {
+            return ChannelOutcome::NotFitted {
+                problem: spectro.problems[c]
+                    .clone()
+                    .unwrap_or_else(|| format!("channel {}: no reduced albedo", c.name())),
             };
-            match scatterfit_fit::fit_channel(data, &input, model, &opts) {
-                Ok(r) => ChannelOutcome::Fitted(Box::new(r)),
-                Err(e) => ChannelOutcome::NotFitted {
-                    problem: format!("channel {}: {e}", channel_name(c)),
-                },
-            }
-        })
-        .collect()
+        }
+        let input = ChannelInput {
+            eta: spectro.eta,
+            albedo_prime: albedo,
+            rd_total: Some(spectro.rd[c]),
+        };
+        match scatterfit_fit::fit_channel(data, &input, model, &opts) {
+            Ok(r) => ChannelOutcome::Fitted(Box::new(ChannelFit::new(
+                r,
+                spectro.uncertainty.albedo_prime_stderr[c],
+            ))),
+            Err(e) => ChannelOutcome::NotFitted {
+                problem: format!("channel {}: {e}", c.name()),
+            },
+        }
+    })
 }
 
-/// "R", "G", "B" for 0, 1, 2 ("?" beyond).
-fn channel_name(c: usize) -> &'static str {
-    Channel::ALL.get(c).map_or("?", |ch| ch.name())
+/// [`fit_stage`], then [`propagate_spectro`] into the outcomes: the channels with every
+/// uncertainty term the measurement knows.
+pub fn fit_and_propagate(
+    profiles: &Rgb<ProfileData>,
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    model: &dyn ModelFamily,
+) -> Rgb<ChannelOutcome> {
+    let fits = fit_stage(profiles, spectro, settings, model);
+    let errors = propagate_spectro(profiles, spectro, settings, model, &fits);
+    fits.zip(errors).map(|(f, e)| f.with_spectro(e))
 }
 
-/// The part of a channel's uncertainty that the spectrophotometer contributes [mm⁻¹].
+/// The part of a channel's uncertainty that the spectrophotometer contributes \[mm⁻¹\].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SpectroErrors {
     /// Standard error of σ′s from η and α′.
@@ -176,21 +247,20 @@ pub struct SpectroErrors {
 /// does not use α′: only its η moves. `None` for a channel that was not fitted, or when a perturbed
 /// α′ cannot be inverted or a refit does not converge (the uncertainty is then unknown, not zero).
 pub fn propagate_spectro(
-    profiles: &[ProfileData],
+    profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
     settings: &FitSettings,
     model: &dyn ModelFamily,
-    fits: &[ChannelOutcome],
-) -> Vec<Option<SpectroErrors>> {
+    fits: &Rgb<ChannelOutcome>,
+) -> Rgb<Option<SpectroErrors>> {
     let Ok(opts) = settings.options() else {
-        return vec![None; fits.len()];
+        return Rgb::default();
     };
     let u = &spectro.uncertainty;
     let proposed = settings.method == Method::Proposed;
-    fits.iter()
-        .zip(profiles)
-        .enumerate()
-        .map(|(c, (outcome, data))| {
+    fits.as_ref()
+        .zip(profiles.as_ref())
+        .map_with_channel(|c, (outcome, data)| {
             let report = outcome.report().filter(|r| r.converged)?;
             if u.repeatability == 0.0 {
                 return Some(SpectroErrors {
@@ -207,11 +277,11 @@ pub fn propagate_spectro(
                 Some(ChannelInput {
                     eta: u.eta_pm[k],
                     albedo_prime: if proposed {
-                        Some(u.albedo_pm.get(c)?[k]?)
+                        Some(u.albedo_pm[c][k]?)
                     } else {
-                        spectro.albedo_prime.get(c).copied().flatten()
+                        spectro.albedo_prime[c]
                     },
-                    rd_total: Some(u.rd_pm.get(c)?[k]),
+                    rd_total: Some(u.rd_pm[c][k]),
                 })
             };
             let values = |r: FitReport| {
@@ -228,24 +298,17 @@ pub fn propagate_spectro(
                 sigma_a: 0.5 * (hi.1 - lo.1).abs(),
             })
         })
-        .collect()
 }
 
-/// A channel's row of `result.json`, with the spectrophotometer's part of its uncertainty when
-/// it was propagated ([`propagate_spectro`]).
+/// Channel `c`'s row of `result.json`: the outcome's estimates flattened into the file's fields
+/// (`sigma_s_prime`, `sigma_s_prime_stderr`, `sigma_s_prime_stderr_spectro`, …), with the
+/// spectrophotometer's Rd (and, for a channel that was not fitted, its α′).
 pub fn channel_result(
     outcome: &ChannelOutcome,
     spectro: &SpectroStage,
-    c: usize,
-    spectro_errors: Option<&SpectroErrors>,
+    c: Channel,
 ) -> ChannelResult {
-    let rd_total = spectro.rd.get(c).copied();
-    let albedo_prime_stderr = spectro
-        .uncertainty
-        .albedo_prime_stderr
-        .get(c)
-        .copied()
-        .flatten();
+    let rd_total = Some(spectro.rd[c]);
     match outcome {
         ChannelOutcome::NotFitted { problem } => ChannelResult {
             status: ChannelStatus::Failed,
@@ -255,8 +318,8 @@ pub fn channel_result(
             sigma_a_stderr: None,
             sigma_s_prime_stderr_spectro: None,
             sigma_a_stderr_spectro: None,
-            albedo_prime_stderr,
-            albedo_prime: spectro.albedo_prime.get(c).copied().flatten(),
+            albedo_prime_stderr: spectro.uncertainty.albedo_prime_stderr[c],
+            albedo_prime: spectro.albedo_prime[c],
             rd_total,
             scale: None,
             correlation: None,
@@ -274,7 +337,8 @@ pub fn channel_result(
             problem: Some(problem.clone()),
             quality: None,
         },
-        ChannelOutcome::Fitted(r) => {
+        ChannelOutcome::Fitted(f) => {
+            let r = &f.report;
             let status = if !r.converged {
                 ChannelStatus::Failed
             } else if r.unconstrained.is_empty() {
@@ -282,7 +346,6 @@ pub fn channel_result(
             } else {
                 ChannelStatus::Unconstrained
             };
-            let finite = |v: f64| v.is_finite().then_some(v);
             let problem = if !r.converged {
                 Some(format!("the fit did not converge: {}", r.termination))
             } else if !r.unconstrained.is_empty() {
@@ -297,17 +360,14 @@ pub fn channel_result(
             };
             ChannelResult {
                 status,
-                sigma_s_prime: finite(r.sigma_s_prime.value),
-                sigma_s_prime_stderr: finite(r.sigma_s_prime.stderr),
-                sigma_a: finite(r.sigma_a.value),
-                sigma_a_stderr: finite(r.sigma_a.stderr),
-                sigma_s_prime_stderr_spectro: spectro_errors.and_then(|e| finite(e.sigma_s_prime)),
-                sigma_a_stderr_spectro: spectro_errors.and_then(|e| finite(e.sigma_a)),
-                // The existing method's α′ comes from its fitted coefficients, not the reading.
-                albedo_prime_stderr: (r.method == Method::Proposed)
-                    .then_some(albedo_prime_stderr)
-                    .flatten(),
-                albedo_prime: finite(r.albedo_prime),
+                sigma_s_prime: finite(f.sigma_s_prime.value),
+                sigma_s_prime_stderr: f.sigma_s_prime.fit,
+                sigma_a: finite(f.sigma_a.value),
+                sigma_a_stderr: f.sigma_a.fit,
+                sigma_s_prime_stderr_spectro: f.sigma_s_prime.spectro,
+                sigma_a_stderr_spectro: f.sigma_a.spectro,
+                albedo_prime_stderr: f.albedo_prime.spectro,
+                albedo_prime: finite(f.albedo_prime.value),
                 rd_total,
                 scale: finite(r.scale.value),
                 // JSON has no NaN: a singular fit has no correlation matrix.

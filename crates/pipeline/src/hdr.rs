@@ -23,6 +23,9 @@ use serde::Serialize;
 use crate::camera::{ExposureEstimate, estimate_black_level, estimate_exposures, flat_divisor};
 use crate::error::{PipelineError, Result};
 
+/// How the bracket became radiance (the name `result.json` records).
+pub use scatterfit_io::result_json::ResponseKind;
+
 /// Exposure corrections estimated from the frames are applied automatically
 /// ([`ExposureCorrection::Auto`]) when some frame's time is off by more than this (1 %): a good
 /// shutter's scatter and the estimate's own (about 0.1 % on the twin) stay below it.
@@ -63,7 +66,7 @@ pub enum BlackLevel {
     Auto,
     /// None (the frames are black-subtracted already).
     None,
-    /// Given per channel [DN] (one value for all channels is repeated).
+    /// Given per channel \[DN\] (one value for all channels is repeated).
     Given(Vec<f64>),
 }
 
@@ -180,7 +183,7 @@ impl HdrInputs {
 pub struct FrameInfo {
     /// The file.
     pub file: PathBuf,
-    /// Shutter time [s].
+    /// Shutter time \[s\].
     pub time_s: f64,
 }
 
@@ -191,8 +194,8 @@ pub struct HdrStage {
     pub hdr: HdrImage,
     /// The response used (8-bit), `None` for a linear 16-bit merge or a given radiance map.
     pub response: Option<ResponseCurve>,
-    /// `recovered`, `given`, `linear` or `merged` (a radiance map from the manifest).
-    pub response_kind: &'static str,
+    /// Recovered, given, linear or merged (a radiance map from the manifest).
+    pub response_kind: ResponseKind,
     /// RMS residual of the response recovery per channel (recovered responses only).
     pub rms: Vec<f64>,
     /// The frames, shortest first.
@@ -203,9 +206,9 @@ pub struct HdrStage {
     pub detection_limit: Vec<f64>,
     /// Frames whose alpha channel was dropped.
     pub dropped_alpha: Vec<PathBuf>,
-    /// Wall time reading [s].
+    /// Wall time reading \[s\].
     pub read_s: f64,
-    /// Wall time recovering and merging [s].
+    /// Wall time recovering and merging \[s\].
     pub merge_s: f64,
     /// What was found and corrected of a real camera (black level, exposure times, flat).
     pub corrections: Corrections,
@@ -226,7 +229,7 @@ pub struct FramesRead {
     pub image: String,
     /// Frames whose alpha channel was dropped.
     pub dropped_alpha: Vec<PathBuf>,
-    /// Wall time reading [s].
+    /// Wall time reading \[s\].
     pub read_s: f64,
 }
 
@@ -414,16 +417,16 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             Ok((cal.response, rms))
         };
         let (mut response, kind, mut rms) = match &inputs.response {
-            Some(path) => (load_response(path)?, "given", Vec::new()),
+            Some(path) => (load_response(path)?, ResponseKind::Given, Vec::new()),
             None => {
                 let (r, rms) = recover(&times)?;
-                (r, "recovered", rms)
+                (r, ResponseKind::Recovered, rms)
             }
         };
         // Exposure times from the frames: ratios of linearised codes in the well-exposed range.
         let mut times_used = times.clone();
         if inputs.exposure_correction != ExposureCorrection::Never {
-            let recovered = kind == "recovered";
+            let recovered = kind == ResponseKind::Recovered;
             let ch = bufs[0].channels();
             let n = bufs[0].data().len();
             for round in 0..if recovered { 4 } else { 1 } {
@@ -652,7 +655,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
         HdrStage {
             hdr,
             response: None,
-            response_kind: "linear",
+            response_kind: ResponseKind::Linear,
             rms: Vec::new(),
             frames,
             image,
@@ -791,7 +794,7 @@ pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
             clipped_count: 0,
         },
         response: None,
-        response_kind: "merged",
+        response_kind: ResponseKind::Merged,
         rms: Vec::new(),
         frames: Vec::new(),
         image: format!("{w}×{h} {}", if ch == 1 { "grey" } else { "RGB" }),

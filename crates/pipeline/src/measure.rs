@@ -1,28 +1,37 @@
 //! `measure_sample`: a sample folder in, the paper's Table 1 row out — spectro → η, α′; bracket →
 //! HDR → profile; the fit per channel.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-use scatterfit_fit::ProfileData;
-use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest, read_manifest};
-use scatterfit_io::result_json::{Channels, FileRef, Inputs, MeasurementResult};
+use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest};
+use scatterfit_io::result_json::{AlbedoSource, FileRef, Inputs, MeasurementResult, RunOptions};
 use scatterfit_mc::{albedo_family, family};
-use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
+use scatterfit_optics::{AlbedoModel, AtG, Estimate, Method, ModelName, Rgb};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::error::{PipelineError, Result};
 use crate::fit::{
-    ChannelOutcome, FitSettings, SpectroErrors, SpotShape, channel_result, fit_stage,
-    propagate_spectro,
+    ChannelOutcome, FitSettings, SpotShape, channel_result, fit_and_propagate, fit_stage,
 };
 use crate::hdr::BlackLevel;
 use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
 use crate::profile::{ProfileSettings, ProfileStage, profile_stage_with};
+use crate::samples::{SampleInputs, sample_inputs};
 use crate::spectro::{SpectroStage, spectro_stage};
 
-/// Options that override the manifest's `[fit]` (from the command line).
+/// Options that override the manifest's `[fit]` (from the command line, or a program). Every
+/// option unset means "as the manifest says"; choose with the setters:
+///
+/// ```
+/// use scatterfit_pipeline::{Method, ModelName, Overrides};
+///
+/// let exact = Overrides::default().model(ModelName::Mc);
+/// let existing = Overrides::default().method(Method::Existing).eta(1.45);
+/// assert_eq!(exact.model, Some(ModelName::Mc));
+/// assert_eq!(existing.eta, Some(1.45));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Overrides {
     /// proposed | existing.
@@ -38,6 +47,62 @@ pub struct Overrides {
     /// Allow the manifest to name files outside the sample folder (the input path policy,
     /// `scatterfit_io::inputs`; `--allow-outside-paths`).
     pub allow_outside_paths: bool,
+}
+
+impl Overrides {
+    /// The fitting method (proposed | existing).
+    #[must_use]
+    pub fn method(self, method: Method) -> Self {
+        Self {
+            method: Some(method),
+            ..self
+        }
+    }
+
+    /// The forward model.
+    #[must_use]
+    pub fn model(self, model: ModelName) -> Self {
+        Self {
+            model: Some(model),
+            ..self
+        }
+    }
+
+    /// How α′ comes from the spectrophotometer (default: the model's own, [`AlbedoModel::default_for`]).
+    #[must_use]
+    pub fn albedo_model(self, albedo_model: AlbedoModel) -> Self {
+        Self {
+            albedo_model: Some(albedo_model),
+            ..self
+        }
+    }
+
+    /// A known η instead of the measured one.
+    #[must_use]
+    pub fn eta(self, eta: f64) -> Self {
+        Self {
+            eta: Some(eta),
+            ..self
+        }
+    }
+
+    /// Fix the profile's scale by the spectrophotometer's Rd (proposed method only).
+    #[must_use]
+    pub fn normalise_with_spectro(self, normalise: bool) -> Self {
+        Self {
+            normalise_with_spectro: Some(normalise),
+            ..self
+        }
+    }
+
+    /// Let the manifest name files outside the sample folder (`scatterfit_io::inputs`).
+    #[must_use]
+    pub fn allow_outside_paths(self, allow: bool) -> Self {
+        Self {
+            allow_outside_paths: allow,
+            ..self
+        }
+    }
 }
 
 /// A stage of [`measure_sample`], for progress reports.
@@ -69,19 +134,18 @@ pub struct Measurement {
     pub hdr: HdrStage,
     /// Spot and rings.
     pub profile: ProfileStage,
-    /// Per channel.
-    pub fits: Vec<ChannelOutcome>,
-    /// Per channel, the spectrophotometer's part of the uncertainty ([`propagate_spectro`]).
-    pub spectro_errors: Vec<Option<SpectroErrors>>,
+    /// Per channel: σ′s, σa and α′ with their uncertainty terms, the solver's report, or why the
+    /// channel was not fitted.
+    pub fits: Rgb<ChannelOutcome>,
     /// The port's edge-loss correction (`spectro.aperture_mm` given; `spectro` is then the
     /// corrected stage and the correction keeps the reading), or `None`: the reading was taken as
     /// loss-free.
     pub port: Option<crate::port::PortCorrection>,
-    /// Wall times per stage [s].
+    /// Wall times per stage \[s\].
     pub timings: Timings,
 }
 
-/// Wall times per stage [s].
+/// Wall times per stage \[s\].
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct Timings {
     /// Spectro stage.
@@ -163,7 +227,8 @@ fn families(settings: &FitSettings) -> Result<(AtG<'static>, AtG<'static>)> {
     Ok((model, albedo))
 }
 
-/// Measures the sample in folder `dir` (its `sample.toml`).
+/// Measures the sample in folder `dir` (its `sample.toml`): [`sample_inputs`], then
+/// [`measure_inputs`].
 ///
 /// # Errors
 /// [`PipelineError`] for bad input (exit 2) or a stage that failed (exit 1, see
@@ -175,7 +240,30 @@ pub fn measure_sample(
     progress: &(dyn Fn(Stage) + Sync),
 ) -> Result<Measurement> {
     let t0 = Instant::now();
-    let manifest = sample_inputs(dir, overrides.allow_outside_paths)?.manifest;
+    let inputs = sample_inputs(dir, overrides.allow_outside_paths)?;
+    measure_from(&inputs, overrides, progress, t0)
+}
+
+/// Measures a sample whose manifest and inputs [`sample_inputs`] already resolved (a caller that
+/// checked its outputs against them first reads the manifest once).
+///
+/// # Errors
+/// As [`measure_sample`].
+pub fn measure_inputs(
+    inputs: &SampleInputs,
+    overrides: &Overrides,
+    progress: &(dyn Fn(Stage) + Sync),
+) -> Result<Measurement> {
+    measure_from(inputs, overrides, progress, Instant::now())
+}
+
+fn measure_from(
+    inputs: &SampleInputs,
+    overrides: &Overrides,
+    progress: &(dyn Fn(Stage) + Sync),
+    t0: Instant,
+) -> Result<Measurement> {
+    let manifest = inputs.manifest.clone();
     let settings = fit_settings(&manifest, overrides)?;
     let (model, albedo) = families(&settings)?;
     let (model, albedo) = (&model, &albedo);
@@ -248,17 +336,9 @@ pub fn measure_sample(
         settings.spot_radius_mm = s.radius_enclosing(0.99);
     }
     let profile_s = t_profile.elapsed().as_secs_f64();
-    let channels = profile.profile.channels();
-    if channels != 3 {
-        return Err(PipelineError::Input(format!(
-            "the radiance map has {channels} channel(s); σ′s and σa per colour need RGB images"
-        )));
-    }
+    let data = profile.rgb_data()?;
     progress(Stage::Fit);
     let t_fit = Instant::now();
-    let data: Vec<ProfileData> = (0..3)
-        .map(|c| profile.channel_data(c))
-        .collect::<Result<_>>()?;
     let port = crate::port::port_of(
         manifest.spectro.aperture_mm,
         manifest.spectro.illuminated_mm,
@@ -270,8 +350,7 @@ pub fn measure_sample(
         }
         None => (spectro, None),
     };
-    let fits = fit_stage(&data, &spectro, &settings, model);
-    let spectro_errors = propagate_spectro(&data, &spectro, &settings, model, &fits);
+    let fits = fit_and_propagate(&data, &spectro, &settings, model);
     let fit_s = t_fit.elapsed().as_secs_f64();
     let timings = Timings {
         spectro_s,
@@ -288,7 +367,6 @@ pub fn measure_sample(
         hdr,
         profile,
         fits,
-        spectro_errors,
         port,
         timings,
     })
@@ -320,7 +398,8 @@ impl Measurement {
     }
 
     /// [`Measurement::refit_with`] without the spectrophotometer's uncertainty (no refits at the
-    /// perturbed readings; `spectro_errors` all `None`): for studies that compare values only —
+    /// perturbed readings; every estimate's `spectro` term `None`): for studies that compare
+    /// values only —
     /// with PBD the propagation would triple the fitting time.
     ///
     /// # Errors
@@ -333,9 +412,7 @@ impl Measurement {
         let (model, albedo) = families(&settings)?;
         let (model, albedo) = (&model, &albedo);
         let t = Instant::now();
-        let data: Vec<ProfileData> = (0..3)
-            .map(|c| self.profile.channel_data(c))
-            .collect::<Result<_>>()?;
+        let data = self.profile.rgb_data()?;
         // The port correction depends on the model: start again from the reading.
         let (spectro, port) = match &self.port {
             Some(p) => {
@@ -350,11 +427,10 @@ impl Measurement {
             }
             None => (self.spectro.with_albedo_model(albedo), None),
         };
-        let fits = fit_stage(&data, &spectro, &settings, model);
-        let spectro_errors = if propagate {
-            propagate_spectro(&data, &spectro, &settings, model, &fits)
+        let fits = if propagate {
+            fit_and_propagate(&data, &spectro, &settings, model)
         } else {
-            vec![None; fits.len()]
+            fit_stage(&data, &spectro, &settings, model)
         };
         let mut timings = self.timings;
         timings.fit_s = t.elapsed().as_secs_f64();
@@ -365,7 +441,6 @@ impl Measurement {
             hdr: self.hdr.clone(),
             profile: self.profile.clone(),
             fits,
-            spectro_errors,
             port,
             timings,
         })
@@ -376,8 +451,13 @@ impl Measurement {
         self.fits.iter().all(ChannelOutcome::is_measurement)
     }
 
-    /// The data checks' verdict per channel (R, G, B; [`crate::checks`]).
-    pub fn quality(&self) -> [crate::checks::Quality; 3] {
+    /// η with the spectrophotometer's standard error (none when η was given).
+    pub fn eta(&self) -> Estimate {
+        self.spectro.eta_estimate()
+    }
+
+    /// The data checks' verdict per channel ([`crate::checks`]).
+    pub fn quality(&self) -> Rgb<crate::checks::Quality> {
         crate::checks::quality(self)
     }
 
@@ -407,26 +487,22 @@ impl Measurement {
                 file_ref(&rel)
             })
             .collect();
-        let mut quality = crate::checks::quality(self).map(Some);
-        let channels = Channels::from_array(std::array::from_fn(|c| {
-            let mut r = channel_result(
-                &self.fits[c],
-                &self.spectro,
-                c,
-                self.spectro_errors.get(c).and_then(Option::as_ref),
-            );
-            r.quality = quality[c].take();
+        let quality = crate::checks::quality(self);
+        let channels = self.fits.as_ref().map_with_channel(|c, outcome| {
+            let mut r = channel_result(outcome, &self.spectro, c);
+            r.quality = Some(quality[c].clone());
             r
-        }));
+        });
+        let s = &self.settings;
         MeasurementResult {
             name: m.display_name(),
             eta: self.spectro.eta,
-            eta_source: self.spectro.eta_source.into(),
+            eta_source: Some(self.spectro.eta_source),
             eta_stderr: self.spectro.uncertainty.eta_stderr,
             spectro_repeatability: Some(self.spectro.uncertainty.repeatability),
-            method: self.settings.method.name().into(),
-            model: self.settings.model.name().into(),
-            albedo_model: self.settings.albedo_model.name().into(),
+            method: s.method,
+            model: s.model,
+            albedo_model: Some(AlbedoSource::Model(s.albedo_model)),
             channels,
             inputs: Inputs {
                 sample_dir: m.dir.to_string_lossy().into_owned(),
@@ -438,21 +514,28 @@ impl Measurement {
                 mm_per_pixel: m.camera.mm_per_pixel,
                 spot_radius_mm: Some(self.settings.spot_radius_mm),
                 center_px: Some(self.profile.center.xy()),
-                options: serde_json::json!({
-                    "method": self.settings.method.name(),
-                    "model": self.settings.model.name(),
-                    "albedo_model": self.settings.albedo_model.name(),
-                    "normalise_with_spectro": self.settings.normalise_with_spectro,
-                    "r_min_mm": self.settings.r_min_mm(),
-                    "r_max_px": m.fit.r_max_px.unwrap_or(300.0),
-                    "spot_radius_mm": self.settings.spot_radius_mm,
-                    "response": self.hdr.response_kind,
-                    "detection_limit": self.profile.detection_limit,
-                    "camera": {
+                options: RunOptions {
+                    method: Some(s.method),
+                    model: Some(s.model),
+                    albedo_model: Some(s.albedo_model),
+                    normalise_with_spectro: Some(s.normalise_with_spectro),
+                    r_min_mm: Some(s.r_min_mm()),
+                    r_max_px: Some(m.fit.r_max_px.unwrap_or(300.0)),
+                    spot_radius_mm: Some(s.spot_radius_mm),
+                    response: Some(self.hdr.response_kind),
+                    // JSON has no NaN: an unknown limit is null.
+                    detection_limit: Some(
+                        self.profile
+                            .detection_limit
+                            .iter()
+                            .map(|v| v.is_finite().then_some(*v))
+                            .collect(),
+                    ),
+                    camera: Some(serde_json::json!({
                         "corrections": self.hdr.corrections,
                         "background": self.profile.background,
-                    },
-                }),
+                    })),
+                },
             },
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()),
@@ -462,7 +545,7 @@ impl Measurement {
                 .map(|p| scatterfit_io::result_json::PortResult {
                     aperture_mm: p.aperture_mm,
                     illuminated_mm: p.illuminated_mm,
-                    rd_read: Rgb::from_array(p.read.rd),
+                    rd_read: p.read.rd,
                     reading_fraction: p.reading_fraction,
                     problems: p.problems.clone(),
                 }),
@@ -492,221 +575,4 @@ pub fn hash_file(path: &Path) -> Option<String> {
             .ok()?;
     let digest = Sha256::digest(&bytes);
     Some(digest.iter().map(|b| format!("{b:02x}")).collect())
-}
-
-/// A sample's manifest and every file a measurement of it reads.
-#[derive(Debug, Clone)]
-pub struct SampleInputs {
-    /// The manifest.
-    pub manifest: SampleManifest,
-    /// Every input file with where it is named (`sample.toml`, `spectro.file`, `camera.images`,
-    /// `exposures.csv line 3`, …), resolved against the sample folder.
-    pub files: Vec<(String, PathBuf)>,
-}
-
-/// Reads the manifest of the sample `dir` (a folder, or a manifest file) and lists every file a
-/// measurement reads — the manifest, the files it names, the frames its exposures CSV lists — each
-/// checked against the input path policy (`scatterfit_io::inputs`: inside the sample folder, links
-/// that leave it counting as outside, unless `allow_outside`). Cheap: no image is decoded. What
-/// `measure_sample` starts with, and what the CLI checks its outputs against before any work.
-///
-/// # Errors
-/// [`PipelineError::InputPath`] for a file outside the folder; the manifest's errors. (An exposures
-/// CSV that cannot be read lists no frame; the measurement reports it.)
-pub fn sample_inputs(dir: &Path, allow_outside: bool) -> Result<SampleInputs> {
-    let manifest_path = if dir.is_dir() {
-        dir.join(scatterfit_io::manifest::MANIFEST_NAME)
-    } else {
-        dir.to_path_buf()
-    };
-    let folder = manifest_path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let policy = scatterfit_io::inputs::InputPolicy::new(folder, allow_outside)?;
-    // The manifest itself: a link that leaves the folder is refused before it is read.
-    policy.check(&manifest_path, "the manifest", &manifest_path)?;
-    let manifest = read_manifest(dir)?;
-    let mut files = vec![("the manifest".to_string(), manifest_path.clone())];
-    let m = &manifest;
-    let named = [
-        ("spectro.file", m.spectro.file.as_ref()),
-        ("camera.exposures", m.camera.exposures.as_ref()),
-        ("camera.hdr", m.camera.hdr.as_ref()),
-        ("camera.response", m.camera.response.as_ref()),
-        ("camera.dark", m.camera.dark.as_ref()),
-    ];
-    for (key, p) in named {
-        if let Some(p) = p {
-            files.push((format!("`{key}`"), m.resolve(p)));
-        }
-    }
-    for p in m.camera.images.iter().flatten() {
-        files.push(("`camera.images`".to_string(), m.resolve(p)));
-    }
-    for (key, path) in &files {
-        policy.check(&manifest_path, key, path)?;
-    }
-    if m.camera.hdr.is_none()
-        && m.camera.images.as_ref().is_none_or(Vec::is_empty)
-        && let Some(csv) = &m.camera.exposures
-    {
-        let csv = m.resolve(csv);
-        // An exposures CSV that cannot be read names no frame that could be read; the bracket
-        // stage reports it in its turn (after the spectrophotometer's errors, as before).
-        let listed = scatterfit_io::bracket::read_exposures_csv(&csv).unwrap_or_default();
-        for e in listed {
-            let key = format!(
-                "the frame on line {} of {}",
-                e.line,
-                csv.file_name().unwrap_or_default().to_string_lossy()
-            );
-            policy.check(&csv, &key, &e.path)?;
-            files.push((key, e.path));
-        }
-    }
-    Ok(SampleInputs { manifest, files })
-}
-
-/// The sample folders found by [`sample_dirs`], and what it did not measure.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct SampleDirs {
-    /// The sample folders, each once, in the order given (a folder of samples expands to its
-    /// sub-folders that hold a `sample.toml`, sorted).
-    pub dirs: Vec<PathBuf>,
-    /// Paths naming a folder already in `dirs` under another spelling (`a`, `./a`, `a/`, a link to
-    /// it): `(path, the one kept)`. Each folder is measured once.
-    pub duplicates: Vec<(PathBuf, PathBuf)>,
-    /// Folders without a `sample.toml` but with a file that looks like a misspelt one
-    /// (`Sample.toml`, `sample.TOML`, `sample.toml.txt`): `(folder, the file)`. Not measured;
-    /// to be reported.
-    pub misspelt: Vec<(PathBuf, PathBuf)>,
-}
-
-/// A file in `dir` whose name looks like a misspelt `sample.toml`.
-pub fn misspelt_manifest(dir: &Path) -> Option<PathBuf> {
-    let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
-        .ok()?
-        .flatten()
-        .filter(|e| {
-            let name = e.file_name().to_string_lossy().to_lowercase();
-            let exact = e.file_name() == scatterfit_io::manifest::MANIFEST_NAME;
-            !exact
-                && (name == "sample.toml"
-                    || name.starts_with("sample.toml")
-                    || (name.starts_with("sample")
-                        && (name.ends_with(".toml") || name.ends_with(".tml"))))
-        })
-        .map(|e| e.path())
-        .collect();
-    found.sort();
-    found.into_iter().next()
-}
-
-/// The sample folders among `paths`: each path that holds a `sample.toml`, or, for a folder that
-/// does not, its immediate sub-folders that do (so `batch samples/` works on a folder of samples).
-pub fn sample_dirs(paths: &[PathBuf]) -> SampleDirs {
-    let manifest = scatterfit_io::manifest::MANIFEST_NAME;
-    let mut candidates: Vec<PathBuf> = Vec::new();
-    let mut misspelt = Vec::new();
-    for p in paths {
-        if p.join(manifest).is_file() || !p.is_dir() {
-            candidates.push(p.clone());
-            continue;
-        }
-        let mut subs: Vec<PathBuf> = std::fs::read_dir(p)
-            .into_iter()
-            .flatten()
-            .flatten()
-            .map(|e| e.path())
-            .filter(|d| d.is_dir())
-            .collect();
-        subs.sort();
-        let mut found = Vec::new();
-        for d in subs {
-            if d.join(manifest).is_file() {
-                found.push(d);
-            } else if let Some(f) = misspelt_manifest(&d) {
-                misspelt.push((d, f));
-            }
-        }
-        if found.is_empty() {
-            // Not a folder of samples: measured as given (and its error reported), unless its
-            // manifest is misspelt.
-            match misspelt_manifest(p) {
-                Some(f) => misspelt.push((p.clone(), f)),
-                None => candidates.push(p.clone()),
-            }
-        } else {
-            candidates.extend(found);
-        }
-    }
-    let mut out = SampleDirs {
-        misspelt,
-        ..SampleDirs::default()
-    };
-    let mut seen: Vec<(PathBuf, PathBuf)> = Vec::new();
-    for c in candidates {
-        let id = std::fs::canonicalize(&c).unwrap_or_else(|_| c.clone());
-        if let Some((_, kept)) = seen.iter().find(|(i, _)| *i == id) {
-            out.duplicates.push((c, kept.clone()));
-        } else {
-            seen.push((id, c.clone()));
-            out.dirs.push(c);
-        }
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// One folder named four ways is one sample; misspelt manifests are reported, not skipped.
-    #[test]
-    fn sample_dirs_measures_each_folder_once_and_reports_misspelt_manifests() {
-        let top = tempfile::tempdir().unwrap();
-        let t = top.path();
-        for (d, m) in [
-            ("a", "sample.toml"),
-            ("b", "Sample.toml"),
-            ("c", "sample.TOML"),
-            ("d", "sample.toml.txt"),
-            ("e", "notes.txt"),
-        ] {
-            std::fs::create_dir(t.join(d)).unwrap();
-            std::fs::write(t.join(d).join(m), b"").unwrap();
-        }
-        let a = t.join("a");
-        let mut given = vec![
-            a.clone(),
-            t.join("./a"),
-            PathBuf::from(format!("{}/", a.display())),
-        ];
-        #[cfg(unix)]
-        {
-            std::os::unix::fs::symlink(&a, t.join("link-to-a")).unwrap();
-            given.push(t.join("link-to-a"));
-        }
-        given.push(t.to_path_buf());
-        let found = sample_dirs(&given);
-        assert_eq!(found.dirs, vec![a.clone()]);
-        // Every other spelling (and the folder of samples, which holds `a` and the link) is a
-        // duplicate of the first.
-        assert!(found.duplicates.len() >= given.len() - 1, "{found:?}");
-        assert!(found.duplicates.iter().all(|(_, kept)| *kept == a));
-        let mut misspelt: Vec<String> = found
-            .misspelt
-            .iter()
-            .map(|(_, f)| f.file_name().unwrap().to_string_lossy().into_owned())
-            .collect();
-        misspelt.sort();
-        assert_eq!(misspelt, ["Sample.toml", "sample.TOML", "sample.toml.txt"]);
-        // A folder given directly whose manifest is misspelt is reported too.
-        let found = sample_dirs(&[t.join("b")]);
-        assert!(
-            found.dirs.is_empty() && found.misspelt.len() == 1,
-            "{found:?}"
-        );
-    }
 }

@@ -29,9 +29,9 @@ const TOLERANCE: f64 = 1e-6;
 /// What the port correction did, per channel.
 #[derive(Debug, Clone, Serialize)]
 pub struct PortCorrection {
-    /// Diameter of the lit disc [mm].
+    /// Diameter of the lit disc \[mm\].
     pub illuminated_mm: f64,
-    /// Diameter of the measured aperture [mm].
+    /// Diameter of the measured aperture \[mm\].
     pub aperture_mm: f64,
     /// The stage as read, before the correction (a refit with another model starts again here).
     #[serde(skip)]
@@ -66,7 +66,7 @@ pub fn port_of(
 /// fit ↔ F per channel (module docs). Returns the corrected stage and what was done; a channel
 /// that cannot be fitted keeps its reading, with the reason.
 pub fn correct_port(
-    data: &[ProfileData],
+    data: &Rgb<ProfileData>,
     read: &SpectroStage,
     settings: &FitSettings,
     model: &dyn ModelFamily,
@@ -79,12 +79,12 @@ pub fn correct_port(
     let mut problems: Rgb<Option<String>> = Rgb::from_fn(|_| None);
     let mut rd = read.rd;
     for ch in Channel::ALL {
-        let c = ch.index();
-        let (Ok(opts), Some(data)) = (&opts, data.get(c)) else {
-            problems[ch] = Some("no fit options or profile".into());
+        let data = &data[ch];
+        let Ok(opts) = &opts else {
+            problems[ch] = Some("no fit options".into());
             continue;
         };
-        let rd_read = read.rd[c];
+        let rd_read = read.rd[ch];
         let mut rd_c = rd_read;
         let mut albedo_prime = match albedo.albedo_from_rd(rd_c, read.eta, 0.0) {
             Ok(a) => a,
@@ -163,7 +163,7 @@ pub fn correct_port(
             }
         }
         if problems[ch].is_none() {
-            rd[c] = rd_c;
+            rd[ch] = rd_c;
         } else {
             fraction[ch] = None;
         }

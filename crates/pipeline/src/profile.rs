@@ -9,6 +9,7 @@ use scatterfit_imaging::{
 };
 use scatterfit_io::manifest::AutoOrNone;
 use scatterfit_io::profile_csv::{ProfileColumn, ProfileTable};
+use scatterfit_optics::{Channel, Rgb};
 
 pub use crate::camera::Background;
 use serde::Serialize;
@@ -47,9 +48,9 @@ pub struct ProfileStage {
 pub struct ProfileSettings {
     /// Image scale on the sample [mm per pixel].
     pub mm_per_pixel: f64,
-    /// Outermost ring [px] (the paper's 300).
+    /// Outermost ring \[px\] (the paper's 300).
     pub r_max_px: f64,
-    /// Ring width [px].
+    /// Ring width \[px\].
     pub ring_width_px: f64,
     /// A given spot centre [x, y] px.
     pub center_px: Option<[f64; 2]>,
@@ -256,12 +257,15 @@ pub fn estimate_background(
 }
 
 impl ProfileStage {
-    /// Channel `c`'s rings as the fit takes them (rings with no pixel at all are dropped).
+    /// Channel `c`'s rings as the fit takes them (rings with no pixel at all are dropped; a grey
+    /// profile has no channel but its one, read as R).
     ///
     /// # Errors
     /// [`PipelineError::Input`] if the ring radii are not increasing (cannot happen for a profile
     /// made here).
-    pub fn channel_data(&self, c: usize) -> Result<ProfileData> {
+    pub fn channel_data(&self, c: Channel) -> Result<ProfileData> {
+        // The image's channels are R, G, B in that order.
+        let c = c.index();
         profile_data((0..self.profile.rings.len()).filter_map(|k| {
             let ring = &self.profile.rings[k];
             let ch = ring.channels.get(c)?;
@@ -270,16 +274,31 @@ impl ProfileStage {
                 ch.mean,
                 ch.std_err,
                 ch.count as u64,
-                self.detection_limit[c],
+                self.detection_limit.get(c).copied().unwrap_or(f64::NAN),
             ))
         }))
+    }
+
+    /// The three channels' rings as the fit takes them.
+    ///
+    /// # Errors
+    /// [`PipelineError::Input`] for a profile that is not RGB (σ′s and σa per colour need RGB
+    /// images), or as [`ProfileStage::channel_data`].
+    pub fn rgb_data(&self) -> Result<Rgb<ProfileData>> {
+        let channels = self.profile.channels();
+        if channels != 3 {
+            return Err(PipelineError::Input(format!(
+                "the radiance map has {channels} channel(s); σ′s and σa per colour need RGB images"
+            )));
+        }
+        Rgb::from_fn(|c| self.channel_data(c)).transpose()
     }
 
     /// The profile as the CSV table (`r_mm,r_px,value_c,stderr_c,count_c,limit_c`).
     pub fn to_table(&self) -> ProfileTable {
         let names: Vec<String> = match self.profile.channels() {
             1 => vec!["y".into()],
-            3 => vec!["r".into(), "g".into(), "b".into()],
+            3 => Channel::ALL.map(|c| c.key().to_string()).to_vec(),
             n => (0..n).map(|c| format!("c{c}")).collect(),
         };
         let rings = &self.profile.rings;
@@ -305,6 +324,14 @@ impl ProfileStage {
                 .collect(),
         }
     }
+}
+
+/// The three channels of a profile CSV (`value_r`, `value_g`, `value_b`, …) as the fit takes them.
+///
+/// # Errors
+/// [`PipelineError::Input`] naming the first channel that is not in the table.
+pub fn rgb_from_table(table: &ProfileTable) -> Result<Rgb<ProfileData>> {
+    Rgb::from_fn(|c| channel_from_table(table, c.key())).transpose()
 }
 
 /// A channel of a profile CSV as the fit takes it.

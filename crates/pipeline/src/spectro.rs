@@ -5,9 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use scatterfit_io::manifest::SampleManifest;
+pub use scatterfit_io::result_json::EtaSource;
 use scatterfit_optics::colour::{Lab, Observer};
 use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
-use scatterfit_optics::{Channel, ModelFamily};
+use scatterfit_optics::{Channel, Estimate, ModelFamily, Rgb};
 use serde::Serialize;
 
 use crate::error::{PipelineError, Result};
@@ -21,14 +22,14 @@ pub struct SpectroStage {
     pub analysis: Option<SpectroAnalysis>,
     /// η used by the fit.
     pub eta: f64,
-    /// `spectro` (SCI − SCE, Schlick at 8°) or `given`.
-    pub eta_source: &'static str,
+    /// Measured (SCI − SCE, Schlick at 8°) or given.
+    pub eta_source: EtaSource,
     /// Rd per channel (linear sRGB).
-    pub rd: [f64; 3],
+    pub rd: Rgb<f64>,
     /// α′ per channel, `None` where Rd cannot be inverted (see `problems`).
-    pub albedo_prime: [Option<f64>; 3],
+    pub albedo_prime: Rgb<Option<f64>>,
     /// Why a channel has no α′.
-    pub problems: [Option<String>; 3],
+    pub problems: Rgb<Option<String>>,
     /// Things the user should know.
     pub warnings: Vec<String>,
     /// The reading's uncertainty and what it does to η and α′.
@@ -49,30 +50,66 @@ pub struct SpectroUncertainty {
     /// η at the specular part × (1 − ε) and × (1 + ε) (η itself when given).
     pub eta_pm: [f64; 2],
     /// Rd per channel × (1 − ε), × (1 + ε).
-    pub rd_pm: [[f64; 2]; 3],
+    pub rd_pm: Rgb<[f64; 2]>,
     /// α′ per channel of the readings × (1 − ε) and × (1 + ε): at (Rd₋, η₋) and (Rd₊, η₊); `None`
     /// where it cannot be inverted.
-    pub albedo_pm: [[Option<f64>; 2]; 3],
+    pub albedo_pm: Rgb<[Option<f64>; 2]>,
     /// Standard error of α′ per channel, |α′(Rd₊, η₊) − α′(Rd₋, η₋)|/2 (first-order propagation
     /// by central differences at ±1 standard deviation).
-    pub albedo_prime_stderr: [Option<f64>; 3],
+    pub albedo_prime_stderr: Rgb<Option<f64>>,
 }
 
 impl SpectroUncertainty {
     /// Nothing to propagate: η, Rd and α′ taken as exact (given by the user, not read).
-    pub fn none(eta: f64, rd: [f64; 3], albedo_prime: [Option<f64>; 3]) -> Self {
+    pub fn none(eta: f64, rd: Rgb<f64>, albedo_prime: Rgb<Option<f64>>) -> Self {
         Self {
             repeatability: 0.0,
             eta_stderr: None,
             eta_pm: [eta; 2],
             rd_pm: rd.map(|r| [r; 2]),
             albedo_pm: albedo_prime.map(|a| [a; 2]),
-            albedo_prime_stderr: [None; 3],
+            albedo_prime_stderr: Rgb::default(),
         }
     }
 }
 
 impl SpectroStage {
+    /// Known values, not a reading: η and, per channel, Rd and α′ given by the user (`scatterfit
+    /// fit`), without uncertainty. A channel without α′ is one the proposed method cannot fit.
+    pub fn given(eta: f64, rd: Rgb<f64>, albedo_prime: Rgb<Option<f64>>) -> SpectroStage {
+        SpectroStage {
+            file: None,
+            analysis: None,
+            eta,
+            eta_source: EtaSource::Given,
+            rd,
+            albedo_prime,
+            problems: Rgb::default(),
+            warnings: Vec::new(),
+            uncertainty: SpectroUncertainty::none(eta, rd, albedo_prime),
+        }
+    }
+
+    /// η with the reading's standard error (none when η was given).
+    pub fn eta_estimate(&self) -> Estimate {
+        Estimate {
+            value: self.eta,
+            fit: None,
+            spectro: self.uncertainty.eta_stderr,
+            g: None,
+        }
+    }
+
+    /// Channel `c`'s α′ with the reading's standard error; `None` where Rd cannot be inverted.
+    pub fn albedo_prime_estimate(&self, c: Channel) -> Option<Estimate> {
+        self.albedo_prime[c].map(|value| Estimate {
+            value,
+            fit: None,
+            spectro: self.uncertainty.albedo_prime_stderr[c],
+            g: None,
+        })
+    }
+
     /// The same reading with α′ from another model's total Rd(α′, η).
     pub fn with_albedo_model(&self, albedo: &dyn ModelFamily) -> SpectroStage {
         self.with_rd(self.rd, albedo)
@@ -81,7 +118,7 @@ impl SpectroStage {
     /// The same reading with Rd replaced per channel (the port correction, `crate::port`): α′ and
     /// the uncertainty's perturbed readings follow from the new Rd (the reading's relative error ε
     /// applies to it unchanged, the correction being a factor).
-    pub fn with_rd(&self, rd: [f64; 3], albedo: &dyn ModelFamily) -> SpectroStage {
+    pub fn with_rd(&self, rd: Rgb<f64>, albedo: &dyn ModelFamily) -> SpectroStage {
         from_rd(
             Reading {
                 file: self.file.clone(),
@@ -102,9 +139,9 @@ impl SpectroStage {
 struct Reading {
     file: Option<PathBuf>,
     analysis: Option<SpectroAnalysis>,
-    rd: [f64; 3],
+    rd: Rgb<f64>,
     eta: f64,
-    eta_source: &'static str,
+    eta_source: EtaSource,
     warnings: Vec<String>,
     repeatability: f64,
     eta_pm: [f64; 2],
@@ -164,14 +201,14 @@ pub fn spectro_stage(
             let (lab, observer) = lab.ok_or_else(|| {
                 PipelineError::Input("without a spectro file, give spectro.lab".into())
             })?;
-            let rd = scatterfit_optics::colour::lab_to_linear_srgb(lab, observer);
+            let rd = Rgb::from_array(scatterfit_optics::colour::lab_to_linear_srgb(lab, observer));
             Ok(from_rd(
                 Reading {
                     file: None,
                     analysis: None,
                     rd,
                     eta,
-                    eta_source: "given",
+                    eta_source: EtaSource::Given,
                     warnings: Vec::new(),
                     repeatability,
                     eta_pm: [eta; 2],
@@ -208,11 +245,9 @@ pub fn from_reading(
             source,
         }
     })?;
-    let rd = std::array::from_fn(|c| analysis.channels[c].rd_total);
-    let source = match analysis.eta_source {
-        scatterfit_optics::spectro::EtaSource::Given => "given",
-        _ => "spectro",
-    };
+    // The analysis keeps its channels in an array, R, G, B.
+    let rd = Rgb::from_fn(|c| analysis.channels[c.index()].rd_total);
+    let source = EtaSource::from(analysis.eta_source);
     let warnings = analysis.warnings.clone();
     let eta = analysis.eta;
     let eta_pm = eta_pm(&analysis, repeatability);
@@ -246,37 +281,29 @@ fn from_rd(reading: Reading, albedo: &dyn ModelFamily) -> SpectroStage {
         repeatability,
         eta_pm,
     } = reading;
-    let mut albedo_prime = [None; 3];
-    let mut problems: [Option<String>; 3] = Default::default();
-    for c in 0..3 {
-        // The paper's eq. (1) (the dipole's total diffuse reflectance, inverted) or the same
-        // inversion with another model's total.
-        match albedo.albedo_from_rd(rd[c], eta, ISOTROPIC) {
-            Ok(a) => albedo_prime[c] = Some(a),
-            Err(e) => {
-                problems[c] = Some(format!(
-                    "channel {}: α′ from Rd = {:.4} by the {} total: {e}",
-                    Channel::ALL[c].name(),
-                    rd[c],
-                    albedo.name()
-                ));
-            }
-        }
-    }
-    let rd_pm: [[f64; 2]; 3] =
-        std::array::from_fn(|c| [rd[c] * (1.0 - repeatability), rd[c] * (1.0 + repeatability)]);
-    let albedo_pm: [[Option<f64>; 2]; 3] = std::array::from_fn(|c| {
-        std::array::from_fn(|k| {
-            albedo
-                .albedo_from_rd(rd_pm[c][k], eta_pm[k], ISOTROPIC)
-                .ok()
+    // The paper's eq. (1) (the dipole's total diffuse reflectance, inverted) or the same
+    // inversion with another model's total.
+    let inverted = rd.map_with_channel(|c, rd| {
+        albedo.albedo_from_rd(rd, eta, ISOTROPIC).map_err(|e| {
+            format!(
+                "channel {}: α′ from Rd = {rd:.4} by the {} total: {e}",
+                c.name(),
+                albedo.name()
+            )
         })
     });
-    let albedo_prime_stderr = std::array::from_fn(|c| match albedo_pm[c] {
+    let albedo_prime = inverted.as_ref().map(|r| r.as_ref().ok().copied());
+    let problems = inverted.map(std::result::Result::err);
+    let rd_pm = rd.map(|r| [r * (1.0 - repeatability), r * (1.0 + repeatability)]);
+    let albedo_pm = rd_pm.map(|rd_pm| {
+        std::array::from_fn(|k| albedo.albedo_from_rd(rd_pm[k], eta_pm[k], ISOTROPIC).ok())
+    });
+    let albedo_prime_stderr = albedo_pm.map(|pm| match pm {
         [Some(a0), Some(a1)] => Some(0.5 * (a1 - a0).abs()),
         _ => None,
     });
-    let eta_stderr = (eta_source != "given").then_some(0.5 * (eta_pm[1] - eta_pm[0]).abs());
+    let eta_stderr =
+        (eta_source != EtaSource::Given).then_some(0.5 * (eta_pm[1] - eta_pm[0]).abs());
     SpectroStage {
         file,
         analysis,

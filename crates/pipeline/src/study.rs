@@ -203,7 +203,6 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
         let result = m.to_result(None);
         for ((ch, t), &albedo) in result
             .channels
-            .as_array()
             .iter()
             .zip(&truth.channels)
             .zip(&sample.albedos)

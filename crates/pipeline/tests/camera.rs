@@ -600,7 +600,10 @@ fn a_raw_bracket_agrees_with_the_8_bit_one() {
         )
         .unwrap();
         if camera == "dng" {
-            assert_eq!(meas.hdr.response_kind, "linear");
+            assert_eq!(
+                meas.hdr.response_kind,
+                scatterfit_pipeline::ResponseKind::Linear
+            );
             let (black, source) = meas.hdr.corrections.black_level.clone().unwrap();
             assert_eq!(source, "metadata");
             assert!(black.iter().all(|b| (b - 512.0).abs() < 1e-9), "{black:?}");
@@ -608,7 +611,9 @@ fn a_raw_bracket_agrees_with_the_8_bit_one() {
         results.push(
             (0..3)
                 .map(|c| {
-                    let r = meas.fits[c].report().unwrap();
+                    let r = meas.fits[scatterfit_optics::Channel::ALL[c]]
+                        .report()
+                        .unwrap();
                     (r.sigma_s_prime.value, r.sigma_a.value)
                 })
                 .collect::<Vec<_>>(),

@@ -58,13 +58,15 @@ fn write(dir: &Path, frames: &[ImageBuf<u8>], times: &[f64], mm_per_pixel: f64) 
 /// Measures the folder; prints σ′s's error per channel and the verdicts.
 fn measure(label: &str, dir: &Path) -> (Measurement, [Quality; 3]) {
     let m = measure_sample(dir, &Overrides::default(), &|_| {}).unwrap();
-    let q = m.quality();
+    let q = m.quality().into_array();
     let truth = by_name(MATERIAL).unwrap().sigma_s_prime;
     let mut line = format!("{label:24}");
     for c in 0..3 {
-        let err = m.fits[c].report().map_or(f64::NAN, |r| {
-            100.0 * (r.sigma_s_prime.value / truth[c] - 1.0)
-        });
+        let err = m.fits[scatterfit_optics::Channel::ALL[c]]
+            .report()
+            .map_or(f64::NAN, |r| {
+                100.0 * (r.sigma_s_prime.value / truth[c] - 1.0)
+            });
         let kinds: Vec<ReasonKind> = q[c].reasons.iter().map(|r| r.kind).collect();
         line += &format!(" | {err:+6.1} % {} {kinds:?}", q[c].verdict);
     }

@@ -17,7 +17,10 @@ fn manifest(model: ModelName, g: Option<f64>) -> SampleManifest {
 fn manifest_g_reaches_the_settings_and_is_checked_against_the_tables() {
     let o = Overrides::default();
     // Default: isotropic, as before issue 15.
-    assert_eq!(fit_settings(&manifest(ModelName::Mc, None), &o).unwrap().g, 0.0);
+    assert_eq!(
+        fit_settings(&manifest(ModelName::Mc, None), &o).unwrap().g,
+        0.0
+    );
     let s = fit_settings(&manifest(ModelName::Mc, Some(0.85)), &o).unwrap();
     assert_eq!((s.g, s.albedo_model), (0.85, AlbedoModel::Mc));
     // The dipole does not depend on g: any g is accepted.

@@ -79,7 +79,10 @@ fn the_two_halves_are_read_and_merge() {
     assert_eq!(read.samples_per_frame(), (W * H * 3) as u64);
     assert_eq!(read.decoded_bytes(), (6 * W * H * 3) as u64);
     let split = merge_frames(read, &inputs).unwrap();
-    assert_eq!(split.response_kind, "recovered");
+    assert_eq!(
+        split.response_kind,
+        scatterfit_pipeline::ResponseKind::Recovered
+    );
     let (_, times) = bracket();
     let frame_times: Vec<f64> = split.frames.iter().map(|f| f.time_s).collect();
     assert_eq!(frame_times, times);

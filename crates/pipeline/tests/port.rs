@@ -98,7 +98,7 @@ fn errors_both(
         assert_eq!(meas.port.is_some(), with_port);
         let result = meas.to_result(None);
         out[k] = std::array::from_fn(|c| {
-            let ch = result.channels.as_array()[c];
+            let ch = &result.channels[scatterfit_optics::Channel::ALL[c]];
             (
                 ch.sigma_s_prime
                     .map_or(f64::NAN, |v| v / m.sigma_s_prime[c] - 1.0),

@@ -65,10 +65,10 @@ fn proposed_method_meets_the_targets_on_twin_samples() {
         let result = meas.to_result(Some("profile.csv"));
         let text = serde_json::to_string(&result).unwrap();
         let back = parse_result_json(&text, std::path::Path::new("result.json")).unwrap();
-        assert_eq!(back.method, "proposed");
+        assert_eq!(back.method, Method::Proposed);
         for c in 0..3 {
             let truth_alpha = m.albedo_prime()[c];
-            let ch = back.channels.as_array()[c];
+            let ch = &back.channels[scatterfit_optics::Channel::ALL[c]];
             if !(0.9..=0.9995).contains(&truth_alpha) {
                 continue;
             }
@@ -78,7 +78,7 @@ fn proposed_method_meets_the_targets_on_twin_samples() {
         }
         // The existing method runs on the same profile without failing outright.
         let existing = meas.refit(Method::Existing).unwrap();
-        assert_eq!(existing.fits.len(), 3);
+        assert!(existing.fits.iter().any(|f| f.fit().is_some()));
     }
     assert!(sp_err.len() >= 9, "{} channels in range", sp_err.len());
     let (msp, msa) = (median(sp_err.clone()), median(sa_err.clone()));

@@ -14,7 +14,7 @@ use scatterfit_fit::{ProfileData, Ring};
 use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
 use scatterfit_optics::spectro::SpectroReading;
-use scatterfit_optics::{AlbedoModel, DiffusionModel, Method, ModelName};
+use scatterfit_optics::{AlbedoModel, Channel, DiffusionModel, Method, ModelName, Rgb};
 use scatterfit_pipeline::fit::{FitSettings, fit_stage, propagate_spectro};
 use scatterfit_pipeline::spectro::{SpectroStage, from_reading};
 
@@ -83,7 +83,7 @@ fn eta_and_albedo_errors_match_repeated_readings() {
         "η: spread {got:.3e} vs propagated {want:.3e}"
     );
     for (c, list) in albedos.iter().enumerate() {
-        let want = u.albedo_prime_stderr[c].unwrap();
+        let want = u.albedo_prime_stderr[Channel::ALL[c]].unwrap();
         let got = sd(list);
         assert!(
             (got / want - 1.0).abs() < tolerance(),
@@ -104,28 +104,26 @@ fn eta_and_albedo_errors_match_repeated_readings() {
 /// A profile of 240 rings (0.05 mm apart from 1 mm out) made from the dipole at the channel's α′
 /// and η (the profile is held fixed: only the reading varies, which is what the propagation is
 /// about), with 1 % ring errors.
-fn profiles(s: &SpectroStage) -> Vec<ProfileData> {
-    (0..3)
-        .map(|c| {
-            let a = s.albedo_prime[c].unwrap();
-            let sp = 1.5;
-            let d = Dipole::new(&OpticalProperties::new(sp, sp * (1.0 / a - 1.0), s.eta).unwrap());
-            let rings = (0..240)
-                .map(|i| {
-                    let r = 1.0 + 0.05 * f64::from(i);
-                    let v = 100.0 * d.rd(r);
-                    Ring {
-                        r_mm: r,
-                        value: v,
-                        stderr: 0.01 * v,
-                        count: 100,
-                        detection_limit: 0.0,
-                    }
-                })
-                .collect();
-            ProfileData::new(rings).unwrap()
-        })
-        .collect()
+fn profiles(s: &SpectroStage) -> Rgb<ProfileData> {
+    Rgb::from_fn(|c| {
+        let a = s.albedo_prime[c].unwrap();
+        let sp = 1.5;
+        let d = Dipole::new(&OpticalProperties::new(sp, sp * (1.0 / a - 1.0), s.eta).unwrap());
+        let rings = (0..240)
+            .map(|i| {
+                let r = 1.0 + 0.05 * f64::from(i);
+                let v = 100.0 * d.rd(r);
+                Ring {
+                    r_mm: r,
+                    value: v,
+                    stderr: 0.01 * v,
+                    count: 100,
+                    detection_limit: 0.0,
+                }
+            })
+            .collect();
+        ProfileData::new(rings).unwrap()
+    })
 }
 
 #[test]
@@ -158,7 +156,7 @@ fn sigma_errors_match_refits_of_repeated_readings() {
         }
     }
     for c in 0..3 {
-        let e = errors[c].unwrap();
+        let e = errors[Channel::ALL[c]].unwrap();
         for (name, want, got) in [
             ("σ′s", e.sigma_s_prime, sd(&sp[c])),
             ("σa", e.sigma_a, sd(&sa[c])),

@@ -12,10 +12,10 @@ use glam::DVec3;
 
 use crate::mesh::{Aabb, Mesh};
 
-/// A ray: origin [mm] and unit direction.
+/// A ray: origin \[mm\] and unit direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ray {
-    /// Origin [mm].
+    /// Origin \[mm\].
     pub origin: DVec3,
     /// Unit direction.
     pub dir: DVec3,
@@ -24,7 +24,7 @@ pub struct Ray {
 /// The nearest intersection of a ray with the mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
-    /// Distance along the ray [mm].
+    /// Distance along the ray \[mm\].
     pub t: f64,
     /// Index of the triangle in the mesh.
     pub triangle: u32,

@@ -1,5 +1,5 @@
 //! The subsurface colour method: Choi, Lee & Chin 2014, §4.1, eqs. (3)–(5), after Groenhuis et al.
-//! 1983 (their ref. [9]) and a colour-rendering model (their ref. [20]).
+//! 1983 (their ref. \[9\]) and a colour-rendering model (their ref. \[20\]).
 //!
 //! Groenhuis' T(d), R(d) and P(g) could not be found outside the seed paper (docs/physics.md §9),
 //! so eqs. (3) and (4) are implemented **as printed** there. They describe a layer of thickness d
@@ -148,7 +148,7 @@ impl Layer {
         }
     }
 
-    /// d₀ = 1/(σa + σ′s P): the depth where the first-order unscattered beam is used up [mm].
+    /// d₀ = 1/(σa + σ′s P): the depth where the first-order unscattered beam is used up \[mm\].
     pub fn d0(&self) -> f64 {
         1.0 / (self.sigma_a + self.sigma_back)
     }

@@ -23,9 +23,9 @@ pub struct Panel {
 pub struct FigureStyle {
     /// Panels per row.
     pub columns: usize,
-    /// Space around and between panels [px].
+    /// Space around and between panels \[px\].
     pub gap: usize,
-    /// Caption text height [px].
+    /// Caption text height \[px\].
     pub text_px: f32,
     /// Background (sRGB 8-bit).
     pub background: [u8; 3],

@@ -144,9 +144,8 @@ pub fn read_measured(
             })
     })
     .transpose()?;
-    let channels = result.channels.as_array();
     let scales = Rgb::from_fn(|c| {
-        channels[c.index()]
+        result.channels[c]
             .scale
             .filter(|k| k.is_finite() && *k > 0.0)
             .ok_or_else(|| {
@@ -191,7 +190,7 @@ pub fn read_measured(
         r_mm: table.r_mm,
         values,
         scales,
-        fit_mse: Rgb::from_fn(|c| channels[c.index()].mse),
+        fit_mse: Rgb::from_fn(|c| result.channels[c].mse),
         mm_per_pixel,
         spot_radius_mm,
     })

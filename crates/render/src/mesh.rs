@@ -7,7 +7,7 @@ use glam::DVec3;
 
 use crate::error::{RenderError, Result};
 
-/// An axis-aligned box [mm].
+/// An axis-aligned box \[mm\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Aabb {
     /// Lower corner.
@@ -59,7 +59,7 @@ impl Aabb {
     }
 }
 
-/// A triangle mesh: positions [mm], unit vertex normals (shading), and triangles as vertex indices.
+/// A triangle mesh: positions \[mm\], unit vertex normals (shading), and triangles as vertex indices.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mesh {
     positions: Vec<DVec3>,
@@ -68,7 +68,7 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    /// A mesh from positions [mm], optional per-vertex normals (computed as area-weighted averages of
+    /// A mesh from positions \[mm\], optional per-vertex normals (computed as area-weighted averages of
     /// the adjacent faces' normals when `None`) and triangles.
     ///
     /// # Errors
@@ -132,7 +132,7 @@ impl Mesh {
         })
     }
 
-    /// Vertex positions [mm].
+    /// Vertex positions \[mm\].
     pub fn positions(&self) -> &[DVec3] {
         &self.positions
     }
@@ -158,12 +158,12 @@ impl Mesh {
         ]
     }
 
-    /// The bounding box [mm].
+    /// The bounding box \[mm\].
     pub fn bounds(&self) -> Aabb {
         self.positions.iter().fold(Aabb::EMPTY, |b, &p| b.grow(p))
     }
 
-    /// Total surface area [mm²].
+    /// Total surface area \[mm²\].
     pub fn area(&self) -> f64 {
         (0..self.triangles.len())
             .map(|t| {
@@ -173,7 +173,7 @@ impl Mesh {
             .sum()
     }
 
-    /// Enclosed volume [mm³] by the divergence theorem (positive for outward winding; meaningful for
+    /// Enclosed volume \[mm³\] by the divergence theorem (positive for outward winding; meaningful for
     /// closed meshes).
     pub fn signed_volume(&self) -> f64 {
         (0..self.triangles.len())
@@ -192,7 +192,7 @@ impl Mesh {
         self
     }
 
-    /// The mesh translated by `offset` [mm].
+    /// The mesh translated by `offset` \[mm\].
     pub fn translated(mut self, offset: DVec3) -> Self {
         for p in &mut self.positions {
             *p += offset;
@@ -210,7 +210,7 @@ impl Mesh {
         self
     }
 
-    /// A UV sphere of `radius` [mm] centred at the origin, with `segments` around and `segments/2`
+    /// A UV sphere of `radius` \[mm\] centred at the origin, with `segments` around and `segments/2`
     /// rings (about `segments²` triangles).
     ///
     /// # Errors
@@ -240,7 +240,7 @@ impl Mesh {
         Ok(revolve(&profile, segments, |_, _, r| r))
     }
 
-    /// A box slab: `width` (x) × `depth` (z) × `thickness` (y) [mm], its top face at y = 0 facing +y,
+    /// A box slab: `width` (x) × `depth` (z) × `thickness` (y) \[mm\], its top face at y = 0 facing +y,
     /// centred on the y axis. Faces have their own vertices (flat normals).
     ///
     /// # Errors

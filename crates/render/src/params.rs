@@ -10,7 +10,9 @@
 
 use std::path::{Path, PathBuf};
 
-use scatterfit_io::result_json::{MeasurementResult, read_result_json};
+use scatterfit_io::result_json::{
+    MeasurementResult, ResultJsonError, read_result_json, read_result_json_assuming,
+};
 use scatterfit_optics::{ModelName, Rgb};
 use scatterfit_synth::materials::{PublishedSet, choi_2014_set, choi_2014_sets};
 
@@ -41,7 +43,7 @@ pub struct ParameterSet {
     /// The forward model the parameters were fitted with (`dipole` for published ones).
     pub model: ModelName,
     /// `proposed`, `existing`, or the result's method.
-    pub method: String,
+    pub method: scatterfit_optics::Method,
     /// Where it came from, for people: the path, or "published: Choi et al. 2014, Table 1".
     pub source: String,
     /// Relative refractive index η.
@@ -66,28 +68,26 @@ impl ParameterSet {
         if !path.exists() {
             return Self::published(spec);
         }
-        let result = read_result_json(path)?;
-        let fitted = match result
-            .model
-            .trim()
-            .to_ascii_lowercase()
-            .parse::<ModelName>()
-        {
-            Ok(m) => m,
-            Err(_) => model.ok_or_else(|| RenderError::UnknownModel {
-                spec: spec.to_owned(),
-                model: scatterfit_io::escape::token(result.model.trim()).to_string(),
-            })?,
+        // A model this version does not know is the caller's to replace (`model`), else refused.
+        let read = match model {
+            Some(m) => read_result_json_assuming(path, m),
+            None => read_result_json(path),
         };
+        let result = match read {
+            Err(ResultJsonError::UnknownModel { found, .. }) => {
+                return Err(RenderError::UnknownModel {
+                    spec: spec.to_owned(),
+                    model: scatterfit_io::escape::token(&found).to_string(),
+                });
+            }
+            r => r?,
+        };
+        let fitted = result.model();
         let coefficients = result.coefficients().map_err(|ch| {
-            let c = match ch {
-                "r" => &result.channels.r,
-                "g" => &result.channels.g,
-                _ => &result.channels.b,
-            };
+            let c = &result.channels[ch];
             RenderError::FailedChannel {
                 spec: spec.to_owned(),
-                channel: ch,
+                channel: ch.key(),
                 status: format!("{:?}", c.status),
                 problem: c.problem.clone(),
             }
@@ -99,10 +99,10 @@ impl ParameterSet {
         Ok(Self {
             model: fitted,
             name: result.name.clone(),
-            method: result.method.clone(),
+            method: result.method,
             source: path.display().to_string(),
             eta: result.eta,
-            coefficients: Rgb::from_array(coefficients),
+            coefficients,
             origin: ParamOrigin::Result {
                 result: Box::new(result),
                 path: path.to_path_buf(),
@@ -127,7 +127,7 @@ impl ParameterSet {
         Ok(Self {
             model: ModelName::Dipole,
             name: m.name.replace('-', " "),
-            method: set.method.name().into(),
+            method: set.method,
             source: format!("published: {}", set.citation()),
             eta: m.eta,
             coefficients: Rgb::from_array(std::array::from_fn(|c| {
@@ -178,7 +178,7 @@ mod tests {
     fn published_sets_by_name() {
         let p = ParameterSet::load("pink-plastic-existing", None).unwrap();
         assert_eq!(p.name, "pink plastic");
-        assert_eq!(p.method, "existing");
+        assert_eq!(p.method, scatterfit_optics::Method::Existing);
         assert_eq!(p.model, ModelName::Dipole);
         // The paper's sentence for Figure 5 (a1)/(a3): G: (1.522, 0.4515); η of Table 1.
         assert_eq!(p.coefficients.g, (1.522, 0.4515));

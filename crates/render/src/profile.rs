@@ -140,7 +140,7 @@ pub struct RdTable {
 const MAX_DQ: f64 = 0.003;
 
 impl RdTable {
-    /// Tabulates `profile` (negative values taken as 0) out to at most `r_limit` [mm] (distances
+    /// Tabulates `profile` (negative values taken as 0) out to at most `r_limit` \[mm\] (distances
     /// beyond never occur).
     pub fn new(profile: &dyn ProfileModel, r_limit: f64) -> Self {
         let rd = |r: f64| nonnegative_rd(profile, r);
@@ -201,12 +201,12 @@ impl RdTable {
         }
     }
 
-    /// The radius where Rd has fallen to half its peak [mm]: the profile's finest length scale.
+    /// The radius where Rd has fallen to half its peak \[mm\]: the profile's finest length scale.
     pub fn half_width(&self) -> f64 {
         self.half_width
     }
 
-    /// The radius beyond which the table is 0 [mm].
+    /// The radius beyond which the table is 0 \[mm\].
     pub fn r_cut(&self) -> f64 {
         self.r_cut
     }

@@ -49,9 +49,9 @@ impl Method {
 /// Options of [`render`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderOptions {
-    /// Image width [pixels].
+    /// Image width \[pixels\].
     pub width: usize,
-    /// Image height [pixels].
+    /// Image height \[pixels\].
     pub height: usize,
     /// Camera samples per pixel: 1 is the pixel centre; a perfect square is stratified (jittered
     /// grid); other counts are uniform random. Box filter. The texture-space method evaluates the
@@ -80,7 +80,7 @@ impl Default for RenderOptions {
     }
 }
 
-/// Where the time went [s].
+/// Where the time went \[s\].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Timings {
     /// Shooting the lights' rays for the irradiance points (dipole method).

@@ -414,7 +414,7 @@ const BYTES_PER_TRIANGLE: u64 = 256;
 /// Memory per light ray of the texture-space method [bytes]: its irradiance point and tree share.
 const BYTES_PER_LIGHT_RAY: u64 = 160;
 
-/// An upper bound of a render's memory [bytes], known before anything is allocated: `panels`
+/// An upper bound of a render's memory \[bytes\], known before anything is allocated: `panels`
 /// images of `width` × `height` pixels, `triangles` triangles and two lights' `light_rays` each
 /// (default: the automatic count's maximum, 2²¹).
 pub fn memory_bytes(
@@ -438,9 +438,9 @@ pub struct MeshSummary {
     pub source: String,
     /// Triangles.
     pub triangles: usize,
-    /// Bounding-box size [mm].
+    /// Bounding-box size \[mm\].
     pub size_mm: [f64; 3],
-    /// Reading the mesh and building the BVH [s].
+    /// Reading the mesh and building the BVH \[s\].
     pub bvh_build_s: f64,
 }
 
@@ -459,19 +459,19 @@ pub struct RenderSummary {
     pub sigma_s_prime: [f64; 3],
     /// σa per channel [mm⁻¹].
     pub sigma_a: [f64; 3],
-    /// Width [px].
+    /// Width \[px\].
     pub width: usize,
-    /// Height [px].
+    /// Height \[px\].
     pub height: usize,
     /// Samples per pixel.
     pub spp: usize,
     /// Seed.
     pub seed: u64,
-    /// Irradiance sampling [s].
+    /// Irradiance sampling \[s\].
     pub irradiance_s: f64,
-    /// Profile tables and hierarchy [s].
+    /// Profile tables and hierarchy \[s\].
     pub tree_s: f64,
-    /// Camera rays and shading [s].
+    /// Camera rays and shading \[s\].
     pub shading_s: f64,
     /// Rays per light (texture-space method).
     pub light_rays: usize,
@@ -541,11 +541,11 @@ pub struct ProfileSummary {
     pub measured: PathBuf,
     /// Image scale [mm/px].
     pub mm_per_pixel: f64,
-    /// Spot radius [mm].
+    /// Spot radius \[mm\].
     pub spot_radius_mm: f64,
-    /// Largest measured ring radius [mm].
+    /// Largest measured ring radius \[mm\].
     pub r_max_mm: f64,
-    /// The slab render [s].
+    /// The slab render \[s\].
     pub render_s: f64,
     /// Per channel.
     pub channels: Vec<ChannelMse>,

@@ -10,14 +10,14 @@ use crate::mesh::Mesh;
 /// How the camera projects.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Projection {
-    /// Pinhole camera with a vertical field of view [degrees].
+    /// Pinhole camera with a vertical field of view \[degrees\].
     Perspective {
-        /// Vertical field of view [degrees], in (0, 180).
+        /// Vertical field of view \[degrees\], in (0, 180).
         fov_y_deg: f64,
     },
     /// Parallel projection showing `height_mm` vertically (pixels are square).
     Orthographic {
-        /// Height of the view [mm].
+        /// Height of the view \[mm\].
         height_mm: f64,
     },
 }
@@ -25,9 +25,9 @@ pub enum Projection {
 /// A camera looking from `eye` at `target`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
-    /// Position [mm].
+    /// Position \[mm\].
     pub eye: DVec3,
-    /// The point at the image centre [mm].
+    /// The point at the image centre \[mm\].
     pub target: DVec3,
     /// Approximate up direction (the image's up is this made orthogonal to the view).
     pub up: DVec3,
@@ -36,7 +36,7 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// A perspective camera looking at the bounding sphere (centre `center`, `radius` [mm]) from
+    /// A perspective camera looking at the bounding sphere (centre `center`, `radius` \[mm\]) from
     /// direction `from` (towards the camera), framed so that the sphere fills `fill` of the image
     /// height.
     pub fn framing(center: DVec3, radius: f64, from: DVec3, fov_y_deg: f64, fill: f64) -> Self {
@@ -50,7 +50,7 @@ impl Camera {
         }
     }
 
-    /// The width of one pixel's footprint [mm] at distance `t` along a camera ray, for an image
+    /// The width of one pixel's footprint \[mm\] at distance `t` along a camera ray, for an image
     /// `height` pixels tall.
     pub fn pixel_footprint(&self, t: f64, height: usize) -> f64 {
         match self.projection {
@@ -102,7 +102,7 @@ pub enum Light {
     },
     /// Isotropic point light: irradiance I·cos θ/d² at distance d.
     Point {
-        /// Position [mm].
+        /// Position \[mm\].
         position: DVec3,
         /// Radiant intensity per channel [irradiance units · mm²].
         intensity: [f64; 3],
@@ -110,11 +110,11 @@ pub enum Light {
     /// A collimated beam of circular cross-section (the measurement rig's light spot): parallel light
     /// from `direction` inside the cylinder of `radius` around the axis through `center`.
     Spot {
-        /// A point on the beam's axis [mm] (where it meets the sample).
+        /// A point on the beam's axis \[mm\] (where it meets the sample).
         center: DVec3,
         /// Unit vector towards the light.
         direction: DVec3,
-        /// Beam radius [mm].
+        /// Beam radius \[mm\].
         radius: f64,
         /// Irradiance across the beam, per channel.
         irradiance: [f64; 3],
@@ -127,7 +127,7 @@ pub enum Light {
 pub struct Incident {
     /// Unit vector towards the light.
     pub l: DVec3,
-    /// Distance to the light [mm] (∞ for parallel light).
+    /// Distance to the light \[mm\] (∞ for parallel light).
     pub dist: f64,
     /// Irradiance on a surface facing the light, per channel.
     pub e: [f64; 3],
@@ -225,7 +225,7 @@ pub struct Scene {
 /// A surface point seen along a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfacePoint {
-    /// Position [mm].
+    /// Position \[mm\].
     pub p: DVec3,
     /// Geometric (face) normal, unit, outward.
     pub ng: DVec3,
@@ -278,7 +278,7 @@ impl Scene {
         &self.bvh
     }
 
-    /// Ray offset used against self-intersection [mm].
+    /// Ray offset used against self-intersection \[mm\].
     pub fn eps(&self) -> f64 {
         self.eps
     }

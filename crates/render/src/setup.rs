@@ -90,7 +90,7 @@ pub enum MeshSource {
 /// A mesh ready to light, with where it came from.
 #[derive(Debug, Clone)]
 pub struct LoadedMesh {
-    /// The mesh [mm].
+    /// The mesh \[mm\].
     pub mesh: Mesh,
     /// For people: the file's path, or "built-in statue".
     pub source: String,
@@ -170,7 +170,7 @@ impl LoadedMesh {
     }
 }
 
-/// `mesh` rotated about the x axis by `angle` [rad] (towards the camera at +z).
+/// `mesh` rotated about the x axis by `angle` \[rad\] (towards the camera at +z).
 ///
 /// # Errors
 /// Never for a valid mesh (a rotation keeps it valid); typed as [`Mesh::new`].
@@ -198,9 +198,9 @@ pub struct StudioScene {
     pub source: String,
     /// Triangles.
     pub triangles: usize,
-    /// Bounding-box size [mm].
+    /// Bounding-box size \[mm\].
     pub size_mm: [f64; 3],
-    /// Wall time from reading the mesh to the built BVH [s] (`started` of [`StudioScene::new`]).
+    /// Wall time from reading the mesh to the built BVH \[s\] (`started` of [`StudioScene::new`]).
     pub build_s: f64,
 }
 

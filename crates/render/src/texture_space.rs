@@ -111,11 +111,11 @@ impl DipoleParams {
     }
 }
 
-/// A sample of the transmitted irradiance: position [mm] and the flux it carries into the surface
+/// A sample of the transmitted irradiance: position \[mm\] and the flux it carries into the surface
 /// per channel (E·ΔA).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IrradiancePoint {
-    /// Position [mm].
+    /// Position \[mm\].
     pub p: DVec3,
     /// Transmitted flux per channel [irradiance units · mm²].
     pub power: [f64; 3],

@@ -27,9 +27,9 @@ use scatterfit_optics::{Channel, Rgb};
 pub struct SpotSetup {
     /// Image scale [mm per pixel].
     pub mm_per_pixel: f64,
-    /// Outer radius of the profile [mm].
+    /// Outer radius of the profile \[mm\].
     pub r_max_mm: f64,
-    /// Radius of the light spot [mm].
+    /// Radius of the light spot \[mm\].
     pub spot_radius_mm: f64,
 }
 
@@ -101,7 +101,7 @@ pub fn spot_scene(setup: &SpotSetup) -> Result<Scene> {
 /// A rendered radial profile in mm⁻² (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderedProfile {
-    /// Ring radius (mean pixel distance) [mm].
+    /// Ring radius (mean pixel distance) \[mm\].
     pub r_mm: Vec<f64>,
     /// Rd_render per channel and ring [mm⁻²].
     pub rd: [Vec<f64>; 3],
@@ -172,7 +172,7 @@ pub fn rd_per_radiance(eta: f64, spot_radius_mm: f64) -> f64 {
 pub struct MeasuredProfile {
     /// The profile's file (for messages).
     pub file: std::path::PathBuf,
-    /// Ring radius [mm].
+    /// Ring radius \[mm\].
     pub r_mm: Vec<f64>,
     /// Measured value per channel and ring (the profile's units: k × mm⁻²).
     pub values: Rgb<Vec<f64>>,
@@ -182,12 +182,12 @@ pub struct MeasuredProfile {
     pub fit_mse: Rgb<Option<f64>>,
     /// Image scale [mm per pixel].
     pub mm_per_pixel: f64,
-    /// Light-spot radius [mm].
+    /// Light-spot radius \[mm\].
     pub spot_radius_mm: f64,
 }
 
 impl MeasuredProfile {
-    /// The largest finite ring radius [mm].
+    /// The largest finite ring radius \[mm\].
     pub fn r_max_mm(&self) -> f64 {
         self.r_mm
             .iter()
@@ -221,7 +221,7 @@ pub struct ProfileValidation {
     /// Rd_render per unit of rendered radiance ([`rd_per_radiance`] of the material's η and the
     /// spot).
     pub rd_per_radiance: f64,
-    /// Wall time of the render and its profile [s].
+    /// Wall time of the render and its profile \[s\].
     pub render_s: f64,
 }
 

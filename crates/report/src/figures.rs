@@ -5,17 +5,22 @@
 use scatterfit_fit::{FitReport, model_profile};
 use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_io::result_table::sig4;
-use scatterfit_optics::OpticalProperties;
+use scatterfit_optics::{Channel, OpticalProperties};
 use scatterfit_pipeline::Measurement;
-use scatterfit_pipeline::fit::ChannelOutcome;
 
 use crate::plot::{Figure, Panel, Series, SeriesStyle};
 
-const NAMES: [&str; 3] = ["R", "G", "B"];
-const COLOURS: [(u8, u8, u8); 3] = [(200, 30, 30), (20, 140, 40), (30, 70, 200)];
+/// A channel's colour in the plots.
+fn colour(c: Channel) -> (u8, u8, u8) {
+    match c {
+        Channel::R => (200, 30, 30),
+        Channel::G => (20, 140, 40),
+        Channel::B => (30, 70, 200),
+    }
+}
 
 /// The measured rings of channel `c`: used ones with error bars, excluded ones apart.
-fn measured_series(m: &Measurement, c: usize, report: Option<&FitReport>) -> Vec<Series> {
+fn measured_series(m: &Measurement, c: Channel, report: Option<&FitReport>) -> Vec<Series> {
     let rings = &m.profile.profile.rings;
     let used: std::collections::HashSet<usize> = report
         .map(|r| r.fitted.iter().map(|f| f.index).collect())
@@ -25,7 +30,10 @@ fn measured_series(m: &Measurement, c: usize, report: Option<&FitReport>) -> Vec
         let Some(r_mm) = m.profile.profile.r_mm(k) else {
             continue;
         };
-        let ch = &ring.channels[c];
+        // The profile's channels are the image's: R, G, B in that order.
+        let Some(ch) = ring.channels.get(c.index()) else {
+            continue;
+        };
         if !(ch.mean.is_finite() && ch.mean > 0.0) {
             continue;
         }
@@ -90,9 +98,9 @@ fn model_series(
 
 /// Figure 4's shape: per channel, the measured profile and the fitted model.
 pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
-    let panels = (0..3)
+    let panels = Channel::ALL
         .map(|c| {
-            let report = m.fits.get(c).and_then(ChannelOutcome::report);
+            let report = m.fits[c].report();
             let mut series = measured_series(m, c, report);
             if let Some(r) = report
                 && let Some(s) = model_series(
@@ -104,7 +112,7 @@ pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
             {
                 series.push(s);
             }
-            let ch = result.channels.as_array()[c];
+            let ch = &result.channels[c];
             let note = match (ch.sigma_s_prime, ch.sigma_a) {
                 (Some(sp), Some(sa)) => format!(
                     "σ′s = {} mm⁻¹, σa = {} mm⁻¹, α′ = {}{}",
@@ -120,13 +128,13 @@ pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
                 _ => ch.problem.clone().unwrap_or_else(|| "not fitted".into()),
             };
             Panel {
-                title: format!("{} channel", NAMES[c]),
-                colour: COLOURS[c],
+                title: format!("{} channel", c.name()),
+                colour: colour(c),
                 series,
                 note: Some(note),
             }
         })
-        .collect();
+        .to_vec();
     Figure {
         title: format!(
             "{} — radial profile and {} fit ({} method, η = {:.4})",
@@ -143,10 +151,10 @@ pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
 /// Figure 6's shape: per channel, the measured profile with the existing and the proposed fits
 /// (both measurements are of the same sample; the profile is the proposed one's).
 pub fn compare_figure(existing: &Measurement, proposed: &Measurement, name: &str) -> Figure {
-    let panels = (0..3)
+    let panels = Channel::ALL
         .map(|c| {
-            let rp = proposed.fits.get(c).and_then(ChannelOutcome::report);
-            let re = existing.fits.get(c).and_then(ChannelOutcome::report);
+            let rp = proposed.fits[c].report();
+            let re = existing.fits[c].report();
             let mut series = measured_series(proposed, c, rp);
             if let Some(r) = re
                 && let Some(s) = model_series(
@@ -166,8 +174,8 @@ pub fn compare_figure(existing: &Measurement, proposed: &Measurement, name: &str
             }
             let mse = |r: Option<&FitReport>| r.map_or("—".into(), |r| sig4(r.mse));
             Panel {
-                title: format!("{} channel", NAMES[c]),
-                colour: COLOURS[c],
+                title: format!("{} channel", c.name()),
+                colour: colour(c),
                 series,
                 note: Some(format!(
                     "MSE existing {}, proposed {} mm⁻⁴",
@@ -176,7 +184,7 @@ pub fn compare_figure(existing: &Measurement, proposed: &Measurement, name: &str
                 )),
             }
         })
-        .collect();
+        .to_vec();
     Figure {
         title: format!("{name} — measured profile, existing and proposed methods"),
         x_label: "r [mm]".into(),

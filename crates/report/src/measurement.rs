@@ -84,10 +84,14 @@ pub fn write_measurement(dir: &Path, m: &Measurement) -> Result<WrittenReport> {
 /// `quality: R ok · G suspect · B ok` (the data checks' verdict per channel), `None` for a result
 /// without verdicts (written before the checks, or by a command that makes none).
 pub fn quality_line(r: &MeasurementResult) -> Option<String> {
-    let cells: Vec<String> = ["R", "G", "B"]
-        .iter()
-        .zip(r.channels.as_array())
-        .filter_map(|(name, c)| c.quality.as_ref().map(|q| format!("{name} {}", q.verdict)))
+    let cells: Vec<String> = r
+        .channels
+        .iter_channels()
+        .filter_map(|(ch, c)| {
+            c.quality
+                .as_ref()
+                .map(|q| format!("{} {}", ch.name(), q.verdict))
+        })
         .collect();
     (!cells.is_empty()).then(|| format!("quality: {}", cells.join(" · ")))
 }
@@ -105,16 +109,17 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         t,
         "{}: η = {eta} ({}), method {}, model {}",
         scatterfit_io::escape::one_line(&r.name),
-        scatterfit_io::escape::one_line(&r.eta_source),
-        scatterfit_io::escape::one_line(&r.method),
-        scatterfit_io::escape::one_line(&r.model)
+        r.eta_source.map_or("", |s| s.name()),
+        r.method,
+        r.model
     );
     let _ = writeln!(
         t,
         "  ch  {:<30} {:<32} {:<8} {:<10} {:>9} {:>6}",
         "σ′s [mm⁻¹]", "σa [mm⁻¹]", "α′", "MSE", "fit [µs]", "rings"
     );
-    for (name, c) in ["R", "G", "B"].iter().zip(r.channels.as_array()) {
+    for (ch, c) in r.channels.iter_channels() {
+        let name = ch.name();
         let [sp, sa] = sigma_cells(c);
         let _ = writeln!(
             t,

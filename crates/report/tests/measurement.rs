@@ -99,7 +99,7 @@ fn a_measured_sample_gets_its_report_files() {
     assert_eq!(back.name, "wood-tile");
     let summary = summary_text(&written.result);
     assert!(summary.starts_with("wood-tile: η = "), "{summary}");
-    for ch in back.channels.as_array() {
+    for ch in back.channels.iter() {
         let sp = ch
             .sigma_s_prime
             .expect("every channel of the wood tile fits");

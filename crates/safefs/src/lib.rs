@@ -5,7 +5,7 @@
 //! elsewhere, block, or exhaust memory. Two halves, used by `scatterfit-io` (every format), the Monte
 //! Carlo cache of `scatterfit-mc` and the profile cache of `scatterfit-synth`:
 //!
-//! - [`write`]: atomic writes through an **exclusively created, unpredictable temporary** in the
+//! - [`mod@write`]: atomic writes through an **exclusively created, unpredictable temporary** in the
 //!   target's folder (`tempfile`), locked while in flight, synced, renamed over a destination that
 //!   must be a regular file or absent (never a symbolic link), the folder synced after. A registry
 //!   of temporaries in flight serves Ctrl-C; temporaries left by a killed run are recognised by

@@ -33,9 +33,9 @@ use crate::SynthError;
 /// The camera of the twin: a linear sensor counted in electrons, then a tone curve and 8 bits.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CameraModel {
-    /// Full-well capacity [electrons]: the linear signal's 1.
+    /// Full-well capacity \[electrons\]: the linear signal's 1.
     pub full_well_e: f64,
-    /// Read noise, one standard deviation [electrons].
+    /// Read noise, one standard deviation \[electrons\].
     pub read_noise_e: f64,
     /// Knee b of the tone curve T(s) = (1 + b)s/(s + b) (see [`CameraModel::tone`]).
     pub tone_knee: f64,
@@ -132,9 +132,9 @@ pub enum SensorOutput {
     /// black)/full well, clipped at `white_level`; no tone curve. Written as 16-bit PNG (values as
     /// they are) or DNG (with the levels in its metadata).
     Linear {
-        /// The sensor's black level per channel [DN] (what a raw file's pixels read in the dark).
+        /// The sensor's black level per channel \[DN\] (what a raw file's pixels read in the dark).
         black_level: [f64; 3],
-        /// The clip level [DN] (16383 for a 14-bit sensor, 65535 for full 16-bit).
+        /// The clip level \[DN\] (16383 for a 14-bit sensor, 65535 for full 16-bit).
         white_level: f64,
     },
 }
@@ -238,15 +238,15 @@ impl CameraModel {
 /// The geometry, exposures and camera of the twin.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RigSpec {
-    /// Image width [px].
+    /// Image width \[px\].
     pub width: usize,
-    /// Image height [px].
+    /// Image height \[px\].
     pub height: usize,
     /// Image scale on the sample [mm per pixel].
     pub mm_per_pixel: f64,
-    /// Radius of the uniform light spot [mm] (the paper: "less than 1 mm in diameter").
+    /// Radius of the uniform light spot \[mm\] (the paper: "less than 1 mm in diameter").
     pub spot_radius_mm: f64,
-    /// Shutter times [s], shortest first.
+    /// Shutter times \[s\], shortest first.
     pub times_s: Vec<f64>,
     /// The camera.
     pub camera: CameraModel,
@@ -424,7 +424,7 @@ impl RigSpec {
         Ok(())
     }
 
-    /// Distance from the image centre to a corner [mm]: how far the profile must reach.
+    /// Distance from the image centre to a corner \[mm\]: how far the profile must reach.
     pub fn corner_mm(&self) -> f64 {
         0.5 * (self.width as f64).hypot(self.height as f64) * self.mm_per_pixel + 1.0
     }
@@ -458,13 +458,13 @@ pub struct ProfileSpec {
     pub eta: f64,
     /// Henyey–Greenstein g.
     pub g: f64,
-    /// Uniform disk beam radius [mm] (the 1/e² radius of a Gaussian beam when `gaussian`).
+    /// Uniform disk beam radius \[mm\] (the 1/e² radius of a Gaussian beam when `gaussian`).
     pub spot_radius_mm: f64,
     /// A Gaussian beam instead of a uniform disk (absent from the JSON when false, so the cache
     /// names of disk profiles are those made before the field existed).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub gaussian: bool,
-    /// Radial bin edges [mm].
+    /// Radial bin edges \[mm\].
     pub edges: Vec<f64>,
     /// Photons.
     pub photons: u64,
@@ -526,7 +526,7 @@ pub struct McProfile {
     format: String,
     /// The spec that made it.
     pub spec: ProfileSpec,
-    /// Area-weighted bin centres [mm].
+    /// Area-weighted bin centres \[mm\].
     pub centers: Vec<f64>,
     /// Rd per bin [mm⁻²].
     pub value: Vec<f64>,
@@ -804,9 +804,9 @@ pub struct Bracket {
     pub frames: Vec<ImageBuf<u8>>,
     /// Linear raw RGB frames of a [`SensorOutput::Linear`] camera, shortest first (else empty).
     pub frames_u16: Vec<ImageBuf<u16>>,
-    /// Their nominal shutter times [s] (what the files say).
+    /// Their nominal shutter times \[s\] (what the files say).
     pub times_s: Vec<f64>,
-    /// The true exposure times [s] (the nominal ones unless [`RigEffects::exposure_error`]).
+    /// The true exposure times \[s\] (the nominal ones unless [`RigEffects::exposure_error`]).
     pub true_times_s: Vec<f64>,
     /// The spot centre used [x, y] px.
     pub center_px: [f64; 2],

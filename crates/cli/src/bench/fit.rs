@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use scatterfit_fit::{ChannelInput, FitOptions, Method, PreparedFit, Spot};
-use scatterfit_optics::DiffusionModel;
+use scatterfit_optics::{Channel, DiffusionModel};
 use scatterfit_pipeline::measure_sample;
 use scatterfit_synth::materials::by_name;
 
@@ -40,12 +40,12 @@ pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
     }
     totals.sort_by(f64::total_cmp);
     let meas = last.context("three runs")?;
-    let data = meas.profile.channel_data(1)?;
+    let data = meas.profile.channel_data(Channel::G)?;
     let rings = data.rings().len();
     let input = ChannelInput {
         eta: meas.spectro.eta,
-        albedo_prime: meas.spectro.albedo_prime[1],
-        rd_total: Some(meas.spectro.rd[1]),
+        albedo_prime: meas.spectro.albedo_prime[Channel::G],
+        rd_total: Some(meas.spectro.rd[Channel::G]),
     };
     let reps = if args.quick { 200 } else { 2_000 };
     let mut figures = Vec::new();

@@ -115,7 +115,7 @@ pub const ETA_RANGE: (f64, f64) = (1.0, 4.0);
 pub const SIGMA_S_RANGE: (f64, f64) = (1e-6, 1e6);
 /// Documented range of σa [mm⁻¹].
 pub const SIGMA_A_RANGE: (f64, f64) = (0.0, 1e6);
-/// Documented range of a reflectance spectrum's wavelengths [nm].
+/// Documented range of a reflectance spectrum's wavelengths \[nm\].
 pub const WAVELENGTH_RANGE: (f64, f64) = (300.0, 1000.0);
 
 /// A target format of `scatterfit export`.
@@ -272,7 +272,7 @@ impl ExportOptions {
 /// at the measured spectrum's wavelengths, extended to [`SPECTRAL_RANGE`] with the end values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SpectralMedium {
-    /// Wavelengths [nm], increasing.
+    /// Wavelengths \[nm\], increasing.
     pub wavelength_nm: Vec<f64>,
     /// Single-scattering albedo σs/σt (g = 0) whose exact-transport Rd is the measured Rd(λ).
     pub albedo: Vec<f64>,
@@ -281,11 +281,11 @@ pub struct SpectralMedium {
     pub sigma_t: Vec<f64>,
 }
 
-/// The wavelengths [nm] at which the spectral medium takes each channel's σ′t (R, G, B): near the
+/// The wavelengths \[nm\] at which the spectral medium takes each channel's σ′t (R, G, B): near the
 /// dominant wavelengths of the sRGB primaries (611, 549, 464 nm, CIE 1931, D65 white).
 pub const CHANNEL_WAVELENGTHS: [f64; 3] = [611.0, 549.0, 464.0];
 
-/// The span [nm] spectral exports cover: renderers sample 360–830 nm, and a piecewise-linear spectrum
+/// The span \[nm\] spectral exports cover: renderers sample 360–830 nm, and a piecewise-linear spectrum
 /// is zero outside its points in pbrt, so the measured spectrum is extended with its end values.
 pub const SPECTRAL_RANGE: (f64, f64) = (360.0, 830.0);
 
@@ -389,17 +389,6 @@ pub struct RendererParameters {
     pub conventions: String,
 }
 
-/// The result's profile model, as a string (the one place that reads the field; it becomes a typed
-/// model name with the vocabulary of issue 14).
-fn result_model(result: &MeasurementResult) -> String {
-    result.model.to_string()
-}
-
-/// The result's albedo model, as a string (see [`result_model`]).
-fn result_albedo_model(result: &MeasurementResult) -> String {
-    result.albedo_model.to_string()
-}
-
 /// Checks that `value` lies in `range` (inclusive) and is finite.
 fn in_range(field: String, value: f64, range: (f64, f64), unit: &str) -> Result<f64, ExportError> {
     if value.is_finite() && value >= range.0 && value <= range.1 {
@@ -477,7 +466,7 @@ impl RendererParameters {
     ) -> Result<(Self, Vec<String>), ExportError> {
         let unit = options.unit;
         let mut warnings = Vec::new();
-        let channels = result.channels.as_array();
+        let channels = result.channels.as_ref().into_array();
         in_range("eta".into(), result.eta, ETA_RANGE, "")?;
         let mut checked = [(0.0, 0.0, None); 3];
         for (k, (name, c)) in CHANNEL_NAMES.iter().zip(channels).enumerate() {
@@ -584,9 +573,13 @@ impl RendererParameters {
             rd_spectrum,
             source: Provenance {
                 method: result.method.to_string(),
-                model: result_model(result),
-                albedo_model: result_albedo_model(result),
-                eta_source: result.eta_source.clone(),
+                model: result.model.to_string(),
+                albedo_model: result
+                    .albedo_model
+                    .map_or_else(String::new, |a| a.to_string()),
+                eta_source: result
+                    .eta_source
+                    .map_or_else(String::new, |e| e.to_string()),
                 measured_with: result.version.clone(),
             },
             conventions: format!(
@@ -1181,7 +1174,7 @@ fn unsafe_char(c: char) -> bool {
 
 /// Free text as one line safe in every format's comments and strings of this module: whitespace
 /// controls (tab, newline, carriage return, form feed, NEL, line and paragraph separators) become a
-/// space, every other [`unsafe_char`] U+FFFD (�).
+/// space, every other `unsafe_char` U+FFFD (�).
 pub fn one_line(text: &str) -> String {
     text.chars()
         .map(|c| match c {
@@ -1310,12 +1303,12 @@ mod fixtures {
         MeasurementResult {
             name: "marble".into(),
             eta: 1.5,
-            eta_source: "given".into(),
+            eta_source: Some(crate::result_json::EtaSource::Given),
             eta_stderr: None,
             spectro_repeatability: None,
-            method: "proposed".into(),
-            model: "dipole".into(),
-            albedo_model: "diffusion".into(),
+            method: scatterfit_optics::Method::Proposed,
+            model: scatterfit_optics::ModelName::Dipole,
+            albedo_model: Some(scatterfit_optics::AlbedoModel::Diffusion.into()),
             channels: Channels::from_array([
                 channel(2.19, 0.0021, 0.8302),
                 channel(2.62, 0.0041, 0.7910),
@@ -1340,6 +1333,8 @@ mod fixtures {
 mod tests {
     use super::fixtures::{SA, SP, marble};
     use super::*;
+    use crate::result_json::AlbedoSource;
+    use scatterfit_optics::{AlbedoModel, ModelName};
 
     #[test]
     fn failed_channel_is_refused_with_its_name_and_problem() {
@@ -1603,22 +1598,15 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(256))]
 
-        /// Any name and any provenance text: every format stays well-formed.
+        /// Any name and any version text: every format stays well-formed.
         #[test]
         fn every_format_is_well_formed_for_any_text(
             name in hostile_text(90),
-            method in hostile_text(12),
-            model in hostile_text(12),
-            albedo_model in hostile_text(12),
-            eta_source in hostile_text(12),
             version in hostile_text(12),
         ) {
+            // Method, model, albedo model and η source are enums: only these two are free text.
             let mut r = marble();
             r.name = name;
-            r.method = method;
-            r.model = model;
-            r.albedo_model = albedo_model;
-            r.eta_source = eta_source;
             r.version = version;
             check_all_formats(&r)?;
         }
@@ -1725,8 +1713,8 @@ mod tests {
         let p = export_with(&r, Format::Pbrt, &options).unwrap();
         assert_eq!(p.warnings.len(), 1, "{:?}", p.warnings);
         assert!(p.text.contains("MODEL WARNING for pbrt's subsurface"));
-        r.model = "mc".into();
-        r.albedo_model = "mc".into();
+        r.model = ModelName::Mc;
+        r.albedo_model = Some(AlbedoSource::Model(AlbedoModel::Mc));
         let e = export_with(&r, Format::Mitsuba, &options).unwrap();
         assert!(e.warnings.is_empty(), "{:?}", e.warnings);
         assert!(!e.text.contains("MODEL WARNING"));
@@ -1741,8 +1729,8 @@ mod tests {
         assert_eq!(p.warnings.len(), 1, "{:?}", p.warnings);
         assert!(p.warnings[0].contains("pbrt's subsurface"));
         // A pbd/diffusion result shares pbrt's subsurface model, not the volumetric one.
-        r.model = "pbd".into();
-        r.albedo_model = "diffusion".into();
+        r.model = ModelName::Pbd;
+        r.albedo_model = Some(AlbedoSource::Model(AlbedoModel::Diffusion));
         let p = export_with(&r, Format::Pbrt, &options).unwrap();
         assert_eq!(p.warnings.len(), 1, "{:?}", p.warnings);
         assert!(p.warnings[0].contains("volpath"));

@@ -1,0 +1,114 @@
+//! [`Estimate`]: a measured value with the standard errors of its independent sources.
+//!
+//! A measured σ′s is uncertain for more than one reason: the profile's noise (the fit's standard
+//! error, from its Jacobian), the spectrophotometer's repeatability (its η and α′, propagated by
+//! refits) and, once the anisotropy g is modelled, the unknown g. Each is kept apart, so a report
+//! can print "value ± fit ± spectro" and a program can weigh them, and [`Estimate::total`] combines
+//! them.
+
+use serde::{Deserialize, Serialize};
+
+/// A value and the standard errors of its independent sources of uncertainty, in the value's unit.
+///
+/// A term is `None` when that source is unknown or does not apply (no spectrophotometer reading,
+/// a refit that did not converge); it is never a stand-in zero. A term of `Some(0.0)` means the
+/// source was evaluated and contributes nothing (a reading declared exact).
+///
+/// ```
+/// use scatterfit_optics::Estimate;
+///
+/// let sigma_s_prime = Estimate::new(1.979).with_fit(0.004).with_spectro(0.003);
+/// assert!((sigma_s_prime.total().unwrap() - 0.005).abs() < 1e-12);
+/// assert_eq!(Estimate::new(1.0).total(), None);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Estimate {
+    /// The value.
+    pub value: f64,
+    /// Standard error from the profile's noise: the fit's (JᵀJ)⁻¹ at the solution, scaled by
+    /// max(1, χ²_red) (`scatterfit_fit::FitReport`).
+    pub fit: Option<f64>,
+    /// Standard error from the spectrophotometer: its η and α′ at the reading's repeatability,
+    /// propagated to the value by refits (`scatterfit_pipeline::fit::propagate_spectro`).
+    pub spectro: Option<f64>,
+    /// Standard error from the unknown anisotropy g of the phase function. Reserved for the
+    /// anisotropy work (the forward models are evaluated at g = 0 and the measurement gives σ′s
+    /// only): always `None` today.
+    pub g: Option<f64>,
+}
+
+impl Estimate {
+    /// A value with no known uncertainty yet.
+    #[must_use]
+    pub fn new(value: f64) -> Self {
+        Self {
+            value,
+            ..Self::default()
+        }
+    }
+
+    /// The same value with the fit's standard error.
+    #[must_use]
+    pub fn with_fit(self, stderr: f64) -> Self {
+        Self {
+            fit: Some(stderr),
+            ..self
+        }
+    }
+
+    /// The same value with the spectrophotometer's standard error.
+    #[must_use]
+    pub fn with_spectro(self, stderr: f64) -> Self {
+        Self {
+            spectro: Some(stderr),
+            ..self
+        }
+    }
+
+    /// The known terms, in the order fit, spectro, g.
+    pub fn terms(&self) -> impl Iterator<Item = f64> {
+        [self.fit, self.spectro, self.g].into_iter().flatten()
+    }
+
+    /// The total standard error: the known terms added in quadrature, √(fit² + spectro² + g²).
+    ///
+    /// Quadrature is right because the sources are independent: the profile's noise is the
+    /// camera's (shot and read noise of the bracket), the spectrophotometer's is a separate
+    /// instrument's reading, and g is a property of the material neither instrument sees. (Within
+    /// the spectrophotometer's term, η and α′ are *not* independent — one reading moves both — which
+    /// is why that term is propagated as one, never as an η part and an α′ part added here.)
+    /// `pipeline/tests/uncertainty.rs` and `cli/tests/measure.rs` check the sum against brute force
+    /// and against the truth. `None` when no term is known: the uncertainty is then unknown, not
+    /// zero.
+    pub fn total(&self) -> Option<f64> {
+        let mut terms = self.terms().peekable();
+        terms.peek()?;
+        Some(terms.map(|t| t * t).sum::<f64>().sqrt())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The total is the quadrature sum of exactly the known terms (3-4-12-13: every term counts,
+    /// none twice).
+    #[test]
+    fn total_adds_known_terms_in_quadrature() {
+        let e = Estimate {
+            value: 7.0,
+            fit: Some(3.0),
+            spectro: Some(4.0),
+            g: Some(12.0),
+        };
+        assert_eq!(e.total(), Some(13.0));
+        assert_eq!(
+            Estimate::new(7.0).with_fit(3.0).with_spectro(4.0).total(),
+            Some(5.0)
+        );
+        assert_eq!(Estimate::new(7.0).with_spectro(0.5).total(), Some(0.5));
+        assert_eq!(Estimate::new(7.0).with_fit(0.0).total(), Some(0.0));
+        assert_eq!(Estimate::new(7.0).total(), None);
+        assert_eq!(e.terms().collect::<Vec<_>>(), [3.0, 4.0, 12.0]);
+    }
+}

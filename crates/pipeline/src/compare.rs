@@ -1,0 +1,97 @@
+//! The proposed and the existing method on the same data (Choi et al. 2014, Table 2 and Figure 6):
+//! each sample measured once with the proposed method, then refitted with the existing one from
+//! the same merge and profile ([`Measurement::refit`]); optionally also fitted beyond the paper,
+//! with the Monte Carlo forward model and α′ from the Monte Carlo total (exact transport).
+
+use std::path::Path;
+
+use scatterfit_optics::{AlbedoModel, Method, ModelName};
+
+use crate::batch::{BatchError, BatchEvent, BatchOutcome, BatchRequest, for_each_sample};
+use crate::error::Result;
+use crate::fit::FitSettings;
+use crate::measure::{Measurement, Overrides, measure_inputs};
+use crate::samples::SampleInputs;
+
+/// One sample fitted both ways (and, when asked, exactly).
+#[derive(Debug)]
+pub struct Compared {
+    /// The proposed method (α′ from the spectrophotometer, σ′s fitted): the measurement.
+    pub proposed: Measurement,
+    /// The existing method (σ′s and σa fitted) on the same profile.
+    pub existing: Measurement,
+    /// When asked: the proposed method with the Monte Carlo model and α′ from the Monte Carlo
+    /// total, or why that fit could not run.
+    pub exact: Option<Result<Measurement>>,
+}
+
+/// Fits `proposed` (a measurement) the existing way and, with `exact`, the exact way.
+///
+/// # Errors
+/// [`crate::PipelineError`] when the existing method's refit cannot run (its model cannot be
+/// loaded).
+pub fn compare_measurement(proposed: Measurement, exact: bool) -> Result<Compared> {
+    let existing = proposed.refit(Method::Existing)?;
+    let exact = exact.then(|| {
+        proposed.refit_with(FitSettings {
+            model: ModelName::Mc,
+            albedo_model: AlbedoModel::Mc,
+            ..proposed.settings
+        })
+    });
+    Ok(Compared {
+        proposed,
+        existing,
+        exact,
+    })
+}
+
+/// Measures one resolved sample with the proposed method (whatever `overrides.method` says) and
+/// compares ([`compare_measurement`]).
+///
+/// # Errors
+/// As [`crate::measure_inputs`] and [`compare_measurement`].
+pub fn compare_sample(
+    inputs: &SampleInputs,
+    overrides: &Overrides,
+    exact: bool,
+) -> Result<Compared> {
+    let overrides = overrides.method(Method::Proposed);
+    compare_measurement(measure_inputs(inputs, &overrides, &|_| {})?, exact)
+}
+
+/// Compares every sample of `request` ([`compare_batch_with`] keeping each comparison).
+///
+/// # Errors
+/// [`BatchError`] only when the worker threads cannot start.
+pub fn compare_batch(
+    request: BatchRequest,
+    exact: bool,
+    on_event: &(dyn Fn(BatchEvent<'_>) + Sync),
+) -> std::result::Result<BatchOutcome<Result<Compared>>, BatchError> {
+    compare_batch_with(request, exact, &|_, c| c, on_event)
+}
+
+/// Measures every sample of `request` with the proposed method and compares it
+/// ([`compare_sample`]), in parallel as [`crate::batch::measure_batch_with`] does; `work` runs on
+/// each comparison as soon as it is done (write its files there) and returns the sample's outcome.
+///
+/// # Errors
+/// [`BatchError`] only when the worker threads cannot start.
+pub fn compare_batch_with<T: Send>(
+    request: BatchRequest,
+    exact: bool,
+    work: &(dyn Fn(&Path, Result<Compared>) -> T + Sync),
+    on_event: &(dyn Fn(BatchEvent<'_>) + Sync),
+) -> std::result::Result<BatchOutcome<T>, BatchError> {
+    for_each_sample(
+        request,
+        &|sample| {
+            let compared = sample
+                .inputs
+                .and_then(|inputs| compare_sample(&inputs, &sample.overrides, exact));
+            work(&sample.dir, compared)
+        },
+        on_event,
+    )
+}

@@ -1,0 +1,130 @@
+//! Fitting a profile a user already has (`scatterfit fit`): the three channels of a profile table
+//! with η and, for the proposed method, α′ given rather than read — no spectrophotometer, so no
+//! spectrophotometer part in the uncertainties.
+
+use scatterfit_fit::ProfileData;
+use scatterfit_io::result_json::{AlbedoSource, Inputs, MeasurementResult, RunOptions};
+use scatterfit_optics::{AlbedoModel, Method, ModelName, Rgb};
+
+use crate::error::Result;
+use crate::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage};
+use crate::spectro::SpectroStage;
+
+/// What to fit a given profile with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileFitRequest {
+    /// The result's name (e.g. the profile file's stem).
+    pub name: String,
+    /// The profile file, as recorded in the result's `inputs.profile`.
+    pub profile_file: Option<String>,
+    /// The relative refractive index η.
+    pub eta: f64,
+    /// α′ per channel (the proposed method needs it).
+    pub albedo_prime: Option<Rgb<f64>>,
+    /// The spectrophotometer's Rd per channel (for normalising with it); default: the model's
+    /// total Rd of the given α′.
+    pub rd: Option<Rgb<f64>>,
+    /// proposed | existing.
+    pub method: Method,
+    /// The forward model.
+    pub model: ModelName,
+    /// The light spot's diameter \[mm\]; the model is convolved with it.
+    pub spot_diameter_mm: f64,
+    /// The innermost fitted radius \[mm\] (default: the spot's diameter).
+    pub r_min_mm: Option<f64>,
+    /// Fix the profile's scale by Rd (proposed method).
+    pub normalise_with_spectro: bool,
+}
+
+/// A given profile, fitted.
+#[derive(Debug, Clone)]
+pub struct ProfileFit {
+    /// What was asked.
+    pub request: ProfileFitRequest,
+    /// The fit settings used.
+    pub settings: FitSettings,
+    /// The given η, α′ and Rd, as the fit took them.
+    pub spectro: SpectroStage,
+    /// Per channel: σ′s, σa with the fit's standard errors, the report, or why not fitted.
+    pub fits: Rgb<ChannelOutcome>,
+}
+
+/// Fits the three channels of `profile` as `request` says.
+///
+/// # Errors
+/// [`crate::PipelineError::Input`] when the model cannot be loaded. Channels that cannot be fitted
+/// are [`ChannelOutcome::NotFitted`].
+pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> Result<ProfileFit> {
+    let model = scatterfit_mc::family(request.model)?;
+    let albedo = request.albedo_prime.map_or(Rgb::default(), |a| a.map(Some));
+    let rd = request.rd.unwrap_or_else(|| {
+        albedo.map(|a| {
+            a.map_or(f64::NAN, |a| {
+                model.rd_total(a, request.eta, 0.0).unwrap_or(f64::NAN)
+            })
+        })
+    });
+    let spectro = SpectroStage::given(request.eta, rd, albedo);
+    let settings = FitSettings {
+        method: request.method,
+        model: request.model,
+        albedo_model: AlbedoModel::Diffusion,
+        spot_radius_mm: 0.5 * request.spot_diameter_mm,
+        spot: crate::fit::SpotShape::Disk,
+        r_min_mm: request.r_min_mm,
+        normalise_with_spectro: request.normalise_with_spectro,
+        g: 0.0,
+    };
+    let fits = fit_stage(profile, &spectro, &settings, model);
+    Ok(ProfileFit {
+        request: request.clone(),
+        settings,
+        spectro,
+        fits,
+    })
+}
+
+impl ProfileFit {
+    /// True when every channel gave constrained parameters.
+    pub fn complete(&self) -> bool {
+        self.fits.iter().all(ChannelOutcome::is_measurement)
+    }
+
+    /// The result in `result.json`'s shape: η and α′ `given`, no input hashes.
+    pub fn to_result(&self) -> MeasurementResult {
+        let s = &self.settings;
+        MeasurementResult {
+            name: self.request.name.clone(),
+            eta: self.request.eta,
+            eta_source: Some(crate::spectro::EtaSource::Given),
+            eta_stderr: None,
+            spectro_repeatability: None,
+            method: s.method,
+            model: s.model,
+            albedo_model: Some(AlbedoSource::Given),
+            channels: self.fits.as_ref().map_with_channel(|c, outcome| {
+                // The fit's own checks (no image here: the residuals and the ranges).
+                let mut r = channel_result(outcome, &self.spectro, c);
+                r.quality = Some(crate::checks::Quality::from_reasons(
+                    crate::checks::fit_reasons(outcome, self.request.eta),
+                ));
+                r
+            }),
+            inputs: Inputs {
+                profile: self.request.profile_file.clone(),
+                spot_radius_mm: Some(s.spot_radius_mm),
+                options: RunOptions {
+                    method: Some(s.method),
+                    model: Some(s.model),
+                    normalise_with_spectro: Some(s.normalise_with_spectro),
+                    r_min_mm: Some(s.r_min_mm()),
+                    ..RunOptions::default()
+                },
+                ..Inputs::default()
+            },
+            version: env!("CARGO_PKG_VERSION").into(),
+            rd_spectrum: None,
+            spectro_port: None,
+        }
+    }
+}
