@@ -519,6 +519,7 @@ impl Measurement {
                     model: Some(s.model),
                     albedo_model: Some(s.albedo_model),
                     normalise_with_spectro: Some(s.normalise_with_spectro),
+                    g: Some(s.g),
                     r_min_mm: Some(s.r_min_mm()),
                     r_max_px: Some(m.fit.r_max_px.unwrap_or(300.0)),
                     spot_radius_mm: Some(s.spot_radius_mm),
