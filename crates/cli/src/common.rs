@@ -4,7 +4,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_pipeline::Overrides;
 
@@ -257,103 +257,15 @@ impl CacheArgs {
 
 pub use scatterfit_io::inputs::{identity, same_file};
 
-/// The files `measure` (and `batch`, `compare`'s and `demo`'s measurements) write into a sample's
-/// output folder; the set manifest last.
-pub const RESULT_FILES: [&str; 7] = [
-    "profile.csv",
-    "result.json",
-    "result.csv",
-    "result.md",
-    "fit.svg",
-    "fit.png",
-    scatterfit_io::result_set::SET_FILE,
-];
-
-/// Refuses, before any work, to let `command` write any of `outputs` over one of the sample's
-/// `inputs` (compared by [`same_file`]): a spectro file called `result.csv`, a frame called
-/// `fit.png` would be destroyed by the run that reads them.
-///
-/// # Errors
-/// Names the output, the input and where the input is named, and what to do.
-pub fn refuse_outputs_that_are_inputs(
-    command: &str,
-    outputs: &[PathBuf],
-    inputs: &[(String, PathBuf)],
-) -> anyhow::Result<()> {
-    for out in outputs {
-        if let Some((key, input)) = inputs.iter().find(|(_, i)| same_file(i, out)) {
-            bail!(
-                "{} would be written by `{command}`, but it is an input of the sample ({key}: \
-                 {}); inputs are never overwritten and nothing was written — rename the input (and \
-                 where it is named) or write the results elsewhere with -o DIR",
-                out.display(),
-                input.display()
-            );
-        }
-    }
-    Ok(())
-}
-
-/// `measure A -o B`: refuses, unless `force`, to write into a folder `out` that is not the sample's
-/// own (`sample_dir`) when it is another sample's folder (it holds a `sample.toml`) or holds result
-/// files that are not this sample's (their `result-files.json` names another sample, or there is
-/// none to tell). This sample's earlier results there are replaced.
-///
-/// # Errors
-/// Says what is there and how to proceed.
-pub fn refuse_foreign_results(sample_dir: &Path, out: &Path, force: bool) -> anyhow::Result<()> {
-    if force || !out.is_dir() || same_file(out, sample_dir) {
-        return Ok(());
-    }
-    let manifest = out.join(scatterfit_io::manifest::MANIFEST_NAME);
-    if std::fs::symlink_metadata(&manifest).is_ok() {
-        bail!(
-            "-o {}: this is the folder of another sample (it holds {}); its result files would be \
-             replaced by this sample's and nothing was written — choose another folder, or pass \
-             --force if you mean it",
-            out.display(),
-            scatterfit_io::manifest::MANIFEST_NAME
-        );
-    }
-    let present: Vec<&str> = RESULT_FILES
-        .iter()
-        .copied()
-        .filter(|f| std::fs::symlink_metadata(out.join(f)).is_ok())
-        .collect();
-    if present.is_empty() {
-        return Ok(());
-    }
-    let what = match scatterfit_io::result_set::read(out) {
-        Ok(Some(set)) if same_file(Path::new(&set.sample_dir), sample_dir) => return Ok(()),
-        Ok(Some(set)) => format!(
-            "the results of the sample {} (measured from {}, run {})",
-            scatterfit_io::escape::token(&set.sample),
-            scatterfit_io::escape::one_line(&set.sample_dir),
-            scatterfit_io::escape::token(&set.run_id)
-        ),
-        Ok(None) => format!(
-            "result files that cannot be tied to this sample (no {}: written by another sample, an \
-             older scatterfit or an interrupted run)",
-            scatterfit_io::result_set::SET_FILE
-        ),
-        Err(e) => format!("result files with an unreadable set manifest ({e})"),
-    };
-    bail!(
-        "-o {} holds {what}: {}; nothing was written — pass --force to replace them, or choose \
-         another folder",
-        out.display(),
-        present.join(", ")
-    )
-}
-
-/// Samples that were not measured, with the reason: `(folder, why)`.
-pub type Failures = Vec<(PathBuf, String)>;
+pub use scatterfit_pipeline::outputs::{
+    Failures, Format, RESULT_FILES, check_destination, check_output_dir, check_output_file,
+    check_output_folder, refuse_foreign_results, refuse_outputs_that_are_inputs, refuse_overwrite,
+};
 
 /// The sample folders of a command over many samples (`batch`, `compare`), found and checked before
-/// any work: each folder once (other spellings of it — `a`, `./a`, `a/`, a link — noted on stderr
-/// unless `quiet`), folders whose manifest is misspelt returned as failures to report, and every
-/// sample's `per_sample` outputs (in its own folder) and the command's `shared` outputs checked
-/// against every sample's inputs (refused, exit 2, when one would overwrite an input).
+/// any work ([`scatterfit_pipeline::outputs::check_samples`]): each folder once (other spellings of
+/// it — `a`, `./a`, `a/`, a link — noted on stderr unless `quiet`), folders whose manifest is
+/// misspelt returned as failures to report.
 ///
 /// # Errors
 /// An output that is an input, or a link at an output's name.
@@ -365,7 +277,13 @@ pub fn samples_for(
     allow_outside: bool,
     quiet: bool,
 ) -> anyhow::Result<(Vec<PathBuf>, Failures)> {
-    let found = scatterfit_pipeline::sample_dirs(dirs);
+    let found = scatterfit_pipeline::outputs::check_samples(
+        command,
+        dirs,
+        per_sample,
+        shared,
+        allow_outside,
+    )?;
     if !quiet {
         for (path, kept) in &found.duplicates {
             crate::output::errln!(
@@ -375,185 +293,7 @@ pub fn samples_for(
             );
         }
     }
-    let misspelt: Vec<(PathBuf, String)> = found
-        .misspelt
-        .iter()
-        .map(|(dir, file)| {
-            (
-                dir.clone(),
-                format!(
-                    "no sample.toml, but {} — rename it to exactly sample.toml (names are \
-                     case-sensitive); not measured",
-                    scatterfit_io::escape::token(
-                        &file.file_name().unwrap_or_default().to_string_lossy()
-                    )
-                ),
-            )
-        })
-        .collect();
-    for o in shared {
-        check_destination(o, "-o")?;
-    }
-    for dir in &found.dirs {
-        // A sample whose manifest cannot be read fails later with its own error, like any other.
-        let Ok(inputs) = scatterfit_pipeline::sample_inputs(dir, allow_outside) else {
-            continue;
-        };
-        let mut outputs: Vec<PathBuf> = per_sample.iter().map(|f| dir.join(f)).collect();
-        for o in &outputs {
-            check_destination(o, "-o")?;
-        }
-        outputs.extend(shared.iter().cloned());
-        refuse_outputs_that_are_inputs(command, &outputs, &inputs.files)
-            .with_context(|| format!("sample {}", dir.display()))?;
-    }
-    Ok((found.dirs, misspelt))
-}
-
-/// Refuses to write `output` over any of `inputs`.
-pub fn refuse_overwrite(output: &Path, what: &str, inputs: &[&Path]) -> anyhow::Result<()> {
-    if let Some(input) = inputs.iter().find(|i| same_file(i, output)) {
-        bail!(
-            "{what} {} is also an input ({}); inputs are never overwritten — choose another output file",
-            output.display(),
-            input.display()
-        );
-    }
-    Ok(())
-}
-
-/// What an output file must be: its extensions and, for messages, what is written into it.
-#[derive(Debug, Clone, Copy)]
-pub struct Format {
-    /// Accepted extensions, lower case without the dot; the first is suggested.
-    pub extensions: &'static [&'static str],
-    /// What the command writes, e.g. "the profile is CSV".
-    pub what: &'static str,
-}
-
-/// Checks an output file before any work is done, so that a mistake costs milliseconds, not a
-/// computation: the extension matches what is written, the path is not one of the `inputs`, not a
-/// folder, not an existing file unless `force`, and its folder exists and is writable (a probe file
-/// is created and removed there).
-///
-/// # Errors
-/// The first problem, naming `flag` and the path and saying what to do.
-pub fn check_output_file(
-    path: &Path,
-    flag: &str,
-    format: Format,
-    inputs: &[&Path],
-    force: bool,
-) -> anyhow::Result<()> {
-    refuse_overwrite(path, flag, inputs)?;
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    if !format.extensions.iter().any(|e| ext.as_deref() == Some(*e)) {
-        let list: Vec<String> = format.extensions.iter().map(|e| format!(".{e}")).collect();
-        bail!(
-            "{flag} {}: {}; name the file {} (e.g. `{}`)",
-            path.display(),
-            format.what,
-            list.join(" or "),
-            path.with_extension(format.extensions[0]).display()
-        );
-    }
-    if path.is_dir() {
-        bail!("{flag} {}: is a folder; name a file", path.display());
-    }
-    check_destination(path, flag)?;
-    if path.exists() && !force {
-        bail!(
-            "{flag} {}: the file exists; nothing was done — pass --force to replace it, or choose \
-             another name",
-            path.display()
-        );
-    }
-    check_output_folder(path, flag)
-}
-
-/// Refuses an output path that is a symbolic link (even a dangling one) or exists and is not a
-/// regular file: writes never go through a link (`scatterfit_io::atomic`), and saying so before the
-/// work saves it.
-///
-/// # Errors
-/// Names `flag`, the path and what it is.
-pub fn check_destination(path: &Path, flag: &str) -> anyhow::Result<()> {
-    scatterfit_io::atomic::check_destination(path)
-        .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
-}
-
-/// Checks that the folder of the output file `path` exists and is writable (a probe file is
-/// created and removed there).
-///
-/// # Errors
-/// The problem, naming `flag` and the path.
-pub fn check_output_folder(path: &Path, flag: &str) -> anyhow::Result<()> {
-    let folder = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if folder.exists() && !folder.is_dir() {
-        bail!(
-            "{flag} {}: {} is not a folder; choose another output file",
-            path.display(),
-            folder.display()
-        );
-    }
-    if !folder.is_dir() {
-        bail!(
-            "{flag} {}: the folder {} does not exist; create it first",
-            path.display(),
-            folder.display()
-        );
-    }
-    scatterfit_io::atomic::check_can_write_in(folder).map_err(|e| {
-        anyhow::anyhow!(
-            "{flag} {}: cannot write in {} ({e}); choose a writable folder",
-            path.display(),
-            folder.display()
-        )
-    })
-}
-
-/// Checks an output folder before any work: an existing one must be a writable folder; a new one
-/// is created later, so the nearest folder above it that exists must be writable.
-///
-/// # Errors
-/// The problem, naming `flag` and the folder.
-pub fn check_output_dir(dir: &Path, flag: &str) -> anyhow::Result<()> {
-    let mut probe = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
-    };
-    loop {
-        if probe.exists() {
-            break;
-        }
-        match probe.parent() {
-            Some(p) if !p.as_os_str().is_empty() => probe = p,
-            _ => {
-                probe = Path::new(".");
-                break;
-            }
-        }
-    }
-    if !probe.is_dir() {
-        bail!(
-            "{flag} {}: {} is not a folder; choose another output folder",
-            dir.display(),
-            probe.display()
-        );
-    }
-    scatterfit_io::atomic::check_can_write_in(probe).map_err(|e| {
-        anyhow::anyhow!(
-            "{flag} {}: cannot write in {} ({e}); choose a writable folder",
-            dir.display(),
-            probe.display()
-        )
-    })
+    Ok((found.dirs, found.misspelt))
 }
 
 /// True when no channel of a result has a data-check verdict other than `ok` (results without

@@ -8,7 +8,6 @@
 //! folder holding anything else unless `--force`. Monte Carlo profiles are cached (the second run
 //! takes seconds).
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -16,9 +15,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_io::result_table::{table1_csv, table1_markdown, table2_csv, table2_markdown};
-use scatterfit_synth::Truth;
 use scatterfit_synth::materials::CHOI_2014;
-use serde::Serialize;
 
 use crate::common::CacheArgs;
 use crate::output::{errln, out, outln};
@@ -62,42 +59,6 @@ pub struct Args {
 }
 
 const MARKER: &str = ".scatterfit-demo";
-
-/// One channel of the accuracy table.
-#[derive(Debug, Serialize)]
-struct ChannelRow {
-    channel: &'static str,
-    sigma_s_prime_true: f64,
-    sigma_a_true: f64,
-    albedo_prime_true: f64,
-    proposed_sigma_s_prime: Option<f64>,
-    proposed_sigma_a: Option<f64>,
-    proposed_albedo_prime: Option<f64>,
-    existing_sigma_s_prime: Option<f64>,
-    existing_sigma_a: Option<f64>,
-    proposed_sigma_s_prime_error: Option<f64>,
-    proposed_sigma_a_error: Option<f64>,
-    existing_sigma_s_prime_error: Option<f64>,
-    existing_sigma_a_error: Option<f64>,
-    /// Beyond the paper: the Monte Carlo forward model, α′ from the Monte Carlo total.
-    exact_sigma_s_prime: Option<f64>,
-    exact_sigma_a: Option<f64>,
-    exact_sigma_s_prime_error: Option<f64>,
-    exact_sigma_a_error: Option<f64>,
-}
-
-/// One material of the accuracy table.
-#[derive(Debug, Serialize)]
-struct MaterialRow {
-    name: String,
-    eta_true: f64,
-    eta_found: f64,
-    channels: Vec<ChannelRow>,
-}
-
-fn rel(found: Option<f64>, truth: f64) -> Option<f64> {
-    found.map(|f| f / truth - 1.0)
-}
 
 fn check_folder(dir: &Path, force: bool) -> anyhow::Result<()> {
     if !dir.exists() || force || dir.join(MARKER).exists() {
@@ -164,10 +125,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         true,
     )?;
     let measure_s = t1.elapsed().as_secs_f64();
-    let rows = accuracy_rows(&pairs, &exacts, &truths);
+    let rows = scatterfit_pipeline::accuracy::accuracy_rows(&pairs, &exacts, &truths);
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
     let out = &args.output_dir;
-    let accuracy = accuracy_markdown(&rows);
+    let accuracy = scatterfit_report::accuracy_markdown(&rows);
     for (name, text) in [
         ("summary.csv", table1_csv(&proposed)),
         ("summary.md", table1_markdown(&proposed)),
@@ -229,131 +190,4 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn accuracy_rows(
-    pairs: &[(MeasurementResult, MeasurementResult)],
-    exacts: &[Option<MeasurementResult>],
-    truths: &[Truth],
-) -> Vec<MaterialRow> {
-    let names = ["R", "G", "B"];
-    pairs
-        .iter()
-        .enumerate()
-        .filter_map(|(i, (e, p))| {
-            let t = truths.iter().find(|t| t.name == p.name)?;
-            let x = exacts.get(i).and_then(Option::as_ref);
-            Some(MaterialRow {
-                name: p.name.clone(),
-                eta_true: t.eta,
-                eta_found: p.eta,
-                channels: (0..3)
-                    .map(|c| {
-                        let (tc, pc, ec) = (
-                            &t.channels[c],
-                            p.channels.as_ref().into_array()[c],
-                            e.channels.as_ref().into_array()[c],
-                        );
-                        ChannelRow {
-                            channel: names[c],
-                            sigma_s_prime_true: tc.sigma_s_prime,
-                            sigma_a_true: tc.sigma_a,
-                            albedo_prime_true: tc.albedo_prime,
-                            proposed_sigma_s_prime: pc.sigma_s_prime,
-                            proposed_sigma_a: pc.sigma_a,
-                            proposed_albedo_prime: pc.albedo_prime,
-                            existing_sigma_s_prime: ec.sigma_s_prime,
-                            existing_sigma_a: ec.sigma_a,
-                            proposed_sigma_s_prime_error: rel(pc.sigma_s_prime, tc.sigma_s_prime),
-                            proposed_sigma_a_error: rel(pc.sigma_a, tc.sigma_a),
-                            existing_sigma_s_prime_error: rel(ec.sigma_s_prime, tc.sigma_s_prime),
-                            existing_sigma_a_error: rel(ec.sigma_a, tc.sigma_a),
-                            exact_sigma_s_prime: x
-                                .and_then(|x| x.channels.as_ref().into_array()[c].sigma_s_prime),
-                            exact_sigma_a: x
-                                .and_then(|x| x.channels.as_ref().into_array()[c].sigma_a),
-                            exact_sigma_s_prime_error: x.and_then(|x| {
-                                rel(
-                                    x.channels.as_ref().into_array()[c].sigma_s_prime,
-                                    tc.sigma_s_prime,
-                                )
-                            }),
-                            exact_sigma_a_error: x.and_then(|x| {
-                                rel(x.channels.as_ref().into_array()[c].sigma_a, tc.sigma_a)
-                            }),
-                        }
-                    })
-                    .collect(),
-            })
-        })
-        .collect()
-}
-
-fn pct(v: Option<f64>) -> String {
-    v.map_or("—".into(), |v| format!("{:+.1} %", 100.0 * v))
-}
-
-fn accuracy_markdown(rows: &[MaterialRow]) -> String {
-    let mut t = String::from(
-        "| Material | η true → found | Ch | σ′s true | σ′s proposed (error) | σa true | σa proposed (error) | σ′s existing (error) | σa existing (error) | σ′s exact MC (error) | σa exact MC (error) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|\n",
-    );
-    let f = |v: Option<f64>| v.map_or("—".into(), scatterfit_io::result_table::sig4);
-    for r in rows {
-        for (k, c) in r.channels.iter().enumerate() {
-            let (name, eta) = if k == 0 {
-                (
-                    r.name.as_str(),
-                    format!("{:.4} → {:.4}", r.eta_true, r.eta_found),
-                )
-            } else {
-                ("", String::new())
-            };
-            let _ = writeln!(
-                t,
-                "| {name} | {eta} | {} | {} | {} ({}) | {} | {} ({}) | {} ({}) | {} ({}) | {} ({}) | {} ({}) |",
-                c.channel,
-                c.sigma_s_prime_true,
-                f(c.proposed_sigma_s_prime),
-                pct(c.proposed_sigma_s_prime_error),
-                c.sigma_a_true,
-                f(c.proposed_sigma_a),
-                pct(c.proposed_sigma_a_error),
-                f(c.existing_sigma_s_prime),
-                pct(c.existing_sigma_s_prime_error),
-                f(c.existing_sigma_a),
-                pct(c.existing_sigma_a_error),
-                f(c.exact_sigma_s_prime),
-                pct(c.exact_sigma_s_prime_error),
-                f(c.exact_sigma_a),
-                pct(c.exact_sigma_a_error),
-            );
-        }
-    }
-    let median = |get: &dyn Fn(&ChannelRow) -> Option<f64>| -> String {
-        let mut v: Vec<f64> = rows
-            .iter()
-            .flat_map(|r| r.channels.iter())
-            .filter_map(get)
-            .map(f64::abs)
-            .collect();
-        if v.is_empty() {
-            return "—".into();
-        }
-        v.sort_by(f64::total_cmp);
-        format!("{:.1} %", 100.0 * v[v.len() / 2])
-    };
-    let _ = writeln!(
-        t,
-        "\nMedian |error| over the 21 channels — the paper's proposed method (dipole): σ′s {}, σa {}; \
-         the existing method (dipole): σ′s {}, σa {}; beyond the paper (Monte Carlo model and α′): \
-         σ′s {}, σa {}.",
-        median(&|c| c.proposed_sigma_s_prime_error),
-        median(&|c| c.proposed_sigma_a_error),
-        median(&|c| c.existing_sigma_s_prime_error),
-        median(&|c| c.existing_sigma_a_error),
-        median(&|c| c.exact_sigma_s_prime_error),
-        median(&|c| c.exact_sigma_a_error),
-    );
-    t
 }

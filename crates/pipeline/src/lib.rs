@@ -39,6 +39,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod accuracy;
 pub mod batch;
 pub mod camera;
 pub mod checks;
@@ -47,6 +48,7 @@ mod error;
 pub mod fit;
 pub mod hdr;
 pub mod measure;
+pub mod outputs;
 pub mod port;
 pub mod profile;
 pub mod profile_fit;

@@ -36,12 +36,14 @@
 
 #![forbid(unsafe_code)]
 
+pub mod accuracy;
 pub mod error;
 pub mod figures;
 pub mod measurement;
 pub mod plot;
 pub mod study;
 
+pub use accuracy::accuracy_markdown;
 pub use error::{ReportError, Result};
 pub use figures::{compare_figure, fit_figure};
 pub use measurement::{WrittenReport, quality_line, summary_text, write_measurement};
