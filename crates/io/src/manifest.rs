@@ -28,6 +28,8 @@
 //! # black_level = "auto"        # linear frames: auto (far corners) | none | DN | [r, g, b] DN
 //! # background = "auto"        # veiling glare: auto (fitted beyond the profile) | none
 //! # exposure_correction = "auto" # shutter times from the frames: auto | always | never
+//! # saturation = 4095           # 16-bit/RAW frames: the code where the camera clips (default: the
+//! #                             # plateau found in the frames, the RAW white level, or 65535)
 //!
 //! [fit]                         # every key optional, defaults shown
 //! method = "proposed"           # proposed | existing
@@ -212,6 +214,10 @@ pub struct CameraSection {
     pub background: Option<AutoOrNone>,
     /// Shutter times estimated from the frames (default auto).
     pub exposure_correction: Option<ExposureCorrection>,
+    /// The code at which a 16-bit or RAW camera clips, in 2…65535 (e.g. 4095 for 12-bit data in
+    /// 16-bit files whose clipped pixels do not all read 4095): overrides the plateau found in the
+    /// frames and the RAW white level. Not for 8-bit frames (they clip at 255).
+    pub saturation: Option<u16>,
 }
 
 /// `[fit]`.
@@ -518,12 +524,23 @@ pub fn parse_manifest(
         _ => {}
     }
     if m.camera.hdr.is_some()
-        && (m.camera.black_level.is_some() || m.camera.exposure_correction.is_some())
+        && (m.camera.black_level.is_some()
+            || m.camera.exposure_correction.is_some()
+            || m.camera.saturation.is_some())
     {
         return Err(invalid(
             "camera.hdr",
-            "is a merged radiance map: `black_level` and `exposure_correction` apply to a bracket"
+            "is a merged radiance map: `black_level`, `exposure_correction` and `saturation` apply \
+             to a bracket"
                 .into(),
+        ));
+    }
+    if let Some(s) = m.camera.saturation
+        && s < 2
+    {
+        return Err(invalid(
+            "camera.saturation",
+            format!("= {s}: the code where the camera clips must lie in 2…65535"),
         ));
     }
     if let Some([x, y]) = m.camera.center_px
@@ -783,6 +800,9 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
             }
         ));
     }
+    if let Some(s) = m.camera.saturation {
+        t.push_str(&format!("saturation = {s}\n"));
+    }
     t.push_str("\n[fit]                         # every key optional\n");
     t.push_str(&format!(
         "method = \"{}\"           # proposed | existing\n",
@@ -866,6 +886,7 @@ r_max_px = 300
         m.spectro.aperture_mm = Some(8.0);
         m.spectro.illuminated_mm = Some(14.0);
         m.camera.center_px = Some([101.5, 99.25]);
+        m.camera.saturation = Some(4095);
         m.fit = FitSection {
             method: Some(Method::Existing),
             model: Some(ModelName::Mc),

@@ -550,7 +550,9 @@ pub struct MeasurementResult {
     /// The spectrophotometer's diffuse reflectance spectrum (its SCE reading), which the channels'
     /// `rd_total` were integrated from: what spectral renderers need to reproduce the colour
     /// (`scatterfit export` writes it into pbrt's reflectance). Absent when the colour came from
-    /// L*a*b* or the result predates the field; never written when absent.
+    /// L*a*b* or the result predates the field; never written when absent. With a port
+    /// correction (`spectro_port`) the spectrum is corrected like the channels (the pipeline's
+    /// `port::correct_spectrum`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rd_spectrum: Option<RdSpectrum>,
     /// The spectrophotometer port's edge-loss correction (issue 15; `spectro.aperture_mm` in the

@@ -120,6 +120,9 @@ pub struct HdrInputs {
     pub samples: Option<usize>,
     /// 16-bit saturation value.
     pub saturation: u16,
+    /// True when `saturation` was stated (`camera.saturation`): it then overrides the clipping
+    /// plateau found in the frames and a RAW file's white level; 8-bit frames are refused with it.
+    pub saturation_given: bool,
     /// What to store for pixel-channels clipped in every exposure.
     pub clipped_fill: ClippedFill,
     /// 8-bit sample weighting.
@@ -147,6 +150,7 @@ impl HdrInputs {
             lambda: 10.0,
             samples: None,
             saturation: u16::MAX,
+            saturation_given: false,
             clipped_fill: ClippedFill::Nan,
             weighting: Weighting::NoiseOptimal,
             memory_budget: None,
@@ -386,6 +390,13 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
     };
     let mut corrections = Corrections::default();
     let depth = bracket.frames()[0].frame.bit_depth();
+    if depth == 8 && inputs.saturation_given {
+        return Err(PipelineError::Input(format!(
+            "camera.saturation = {} applies to 16-bit and RAW frames; these frames are 8-bit (they \
+             clip at code 255 and their response is recovered): remove the key",
+            inputs.saturation
+        )));
+    }
     let mut stage = if depth == 8 {
         let bufs: Vec<ImageBuf<u8>> = bracket
             .into_frames()
@@ -541,14 +552,28 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             })
             .collect();
         let saturation = match raw {
-            Some(r) => (r.levels.white.min(f64::from(u16::MAX)) as u16).max(2),
-            None => inputs.saturation,
+            Some(r) if !inputs.saturation_given => {
+                (r.levels.white.min(f64::from(u16::MAX)) as u16).max(2)
+            }
+            _ => inputs.saturation,
         };
-        // The codes the frames use (8- or 12-bit data in 16-bit files; crate::checks).
+        // The codes the frames use (8- or 12-bit data in 16-bit files; crate::checks); a stated
+        // saturation is used as stated.
         let code_range = raw
             .is_none()
             .then(|| crate::checks::code_range(&bufs, saturation))
-            .transpose()?;
+            .transpose()?
+            .map(|c| {
+                if inputs.saturation_given {
+                    crate::checks::CodeRange {
+                        saturation,
+                        plateau_found: false,
+                        ..c
+                    }
+                } else {
+                    c
+                }
+            });
         let saturation = code_range.as_ref().map_or(saturation, |c| c.saturation);
         scatterfit_imaging::check_bracket_order(&bufs, &times, saturation)
             .map_err(imaging(&order_context()))?;

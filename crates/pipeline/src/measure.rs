@@ -296,6 +296,10 @@ fn measure_from(
             // A real camera (issue 16): black level, shutter times, flat frame.
             inputs.flat = manifest.camera.flat.as_ref().map(|p| manifest.resolve(p));
             inputs.exposure_correction = manifest.camera.exposure_correction.unwrap_or_default();
+            if let Some(s) = manifest.camera.saturation {
+                inputs.saturation = s;
+                inputs.saturation_given = true;
+            }
             inputs.black_level = match manifest.camera.black_level {
                 None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
                 Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
@@ -539,7 +543,13 @@ impl Measurement {
                 },
             },
             version: env!("CARGO_PKG_VERSION").into(),
-            rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()),
+            // The spectrum as the port let the instrument read it, corrected like the channels.
+            rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()).map(|s| {
+                self.port
+                    .as_ref()
+                    .and_then(|p| crate::port::correct_spectrum(&s, &p.reading_fraction))
+                    .unwrap_or(s)
+            }),
             spectro_port: self
                 .port
                 .as_ref()

@@ -179,3 +179,77 @@ pub fn correct_port(
     };
     (corrected, correction)
 }
+
+/// The measured reflectance spectrum corrected for the port's edge loss: Rd(λ) / F(λ), with F
+/// interpolated linearly in wavelength between the channels' reading fractions at the wavelengths
+/// where the exports take each channel (R 611, G 549, B 464 nm,
+/// `scatterfit_io::export::CHANNEL_WAVELENGTHS`) and held beyond them. An approximation: F depends
+/// on the transport at each wavelength, which the fit knows at the three channels only; F follows
+/// the mean free path, which varies slowly across a channel's band for the materials measured.
+/// `None` when a channel has no F (the spectrum is then left as read, as is that channel's Rd).
+pub fn correct_spectrum(
+    spectrum: &scatterfit_io::result_json::RdSpectrum,
+    reading_fraction: &Rgb<Option<f64>>,
+) -> Option<scatterfit_io::result_json::RdSpectrum> {
+    let f = reading_fraction.transpose()?;
+    // (wavelength, F) in increasing wavelength: B, G, R.
+    let wl = scatterfit_io::export::CHANNEL_WAVELENGTHS;
+    let nodes = [(wl[2], f.b), (wl[1], f.g), (wl[0], f.r)];
+    let f_at = |lambda: f64| {
+        if lambda <= nodes[0].0 {
+            return nodes[0].1;
+        }
+        for w in nodes.windows(2) {
+            let ((l0, f0), (l1, f1)) = (w[0], w[1]);
+            if lambda <= l1 {
+                return f0 + (f1 - f0) * (lambda - l0) / (l1 - l0);
+            }
+        }
+        nodes[2].1
+    };
+    Some(scatterfit_io::result_json::RdSpectrum {
+        wavelength_nm: spectrum.wavelength_nm.clone(),
+        rd: spectrum
+            .wavelength_nm
+            .iter()
+            .zip(&spectrum.rd)
+            .map(|(&l, &rd)| rd / f_at(l))
+            .collect(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rd(λ)/F(λ) with F linear between (464, F_B), (549, F_G), (611, F_R) and held beyond: values
+    /// worked by hand; no spectrum without every channel's F.
+    #[test]
+    fn the_spectrum_is_divided_by_the_interpolated_fraction() {
+        let spectrum = scatterfit_io::result_json::RdSpectrum {
+            wavelength_nm: vec![400.0, 464.0, 500.0, 549.0, 611.0, 700.0],
+            rd: vec![0.5; 6],
+        };
+        let f = Rgb {
+            r: Some(0.8),
+            g: Some(0.9),
+            b: Some(0.95),
+        };
+        let got = correct_spectrum(&spectrum, &f).unwrap();
+        // At 500 nm: F = 0.95 − 0.05 · 36/85 = 0.928823…
+        let want = [
+            0.5 / 0.95,
+            0.5 / 0.95,
+            0.5 / 0.928_823_529_4,
+            0.5 / 0.9,
+            0.5 / 0.8,
+            0.5 / 0.8,
+        ];
+        for (g, w) in got.rd.iter().zip(want) {
+            assert!((g - w).abs() < 1e-9, "{g} vs {w}");
+        }
+        assert_eq!(got.wavelength_nm, spectrum.wavelength_nm);
+        let missing = Rgb { g: None, ..f };
+        assert!(correct_spectrum(&spectrum, &missing).is_none());
+    }
+}

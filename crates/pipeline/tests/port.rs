@@ -106,6 +106,32 @@ fn errors_both(
             )
         });
         if let Some(p) = &meas.port {
+            // The reflectance spectrum is corrected with the channels: R's F beyond 611 nm (held
+            // there), never below the reading (F ≤ 1).
+            let read = &meas
+                .spectro
+                .analysis
+                .as_ref()
+                .expect("a spectral reading")
+                .spectral;
+            let corrected = result.rd_spectrum.as_ref().expect("the SCE spectrum");
+            let mut beyond_red = 0;
+            for (point, (&l, &rd)) in read
+                .iter()
+                .zip(corrected.wavelength_nm.iter().zip(&corrected.rd))
+            {
+                assert!(
+                    rd >= point.sce * (1.0 - 1e-12),
+                    "{l} nm: {rd} < {}",
+                    point.sce
+                );
+                if l >= 611.0 {
+                    beyond_red += 1;
+                    let f = p.reading_fraction.r.expect("R corrected");
+                    assert!((point.sce / rd - f).abs() < 1e-9, "{l} nm: F {f}");
+                }
+            }
+            assert!(beyond_red >= 5, "{beyond_red} wavelengths beyond 611 nm");
             eprintln!(
                 "{name}: port {illuminated_mm}/{aperture_mm} mm, reading fraction {:?}, rounds {:?}",
                 p.reading_fraction, p.rounds
