@@ -36,6 +36,7 @@
 //! model = "dipole"              # dipole | better-dipole | pbd | mc
 //! # albedo_model = "diffusion"  # diffusion | mc (default: mc for the mc model, else diffusion)
 //! r_max_px = 300                # the paper's cut-off
+//! # g = 0.85                    # Henyey–Greenstein g of the material, known or assumed (default 0)
 //! ```
 //!
 //! Paths are relative to the manifest's folder. Unknown keys are refused (a misspelt key would
@@ -236,6 +237,14 @@ pub struct FitSection {
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed method).
     pub normalise_with_spectro: Option<bool>,
+    /// The material's Henyey–Greenstein asymmetry g, known or assumed (issue 15): the forward model
+    /// and the α′ inversion are evaluated at it (σs = σ′s/(1 − g)). Default 0 — isotropic
+    /// scattering, what the paper and every model before issue 15 assume; the diffusion dipoles do
+    /// not depend on g, photon beam diffusion and the `mc` tables do (the tables hold g = 0 and
+    /// 0.8–0.9; another g with `mc` is refused with the tables' coverage). Real translucent
+    /// materials have g ≈ 0.7–0.95: assuming 0 for them biases σa high (BENCHMARKS.md, "The `mc`
+    /// model over g").
+    pub g: Option<f64>,
 }
 
 /// A parsed, checked `sample.toml`. Paths are as written (relative to [`SampleManifest::dir`]).
@@ -558,6 +567,18 @@ pub fn parse_manifest(
             format!("= {}: must be ≥ 0 mm", num(r)),
         ));
     }
+    if let Some(g) = m.fit.g
+        && !(g.is_finite() && g > -1.0 && g < 1.0)
+    {
+        return Err(invalid(
+            "fit.g",
+            format!(
+                "= {}: the Henyey–Greenstein g must lie in (−1, 1) (0: isotropic; real translucent \
+                 materials 0.7–0.95)",
+                num(g)
+            ),
+        ));
+    }
     if m.fit.normalise_with_spectro == Some(true) && m.fit.method == Some(Method::Existing) {
         return Err(invalid(
             "fit.normalise_with_spectro",
@@ -804,6 +825,9 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     if let Some(b) = m.fit.normalise_with_spectro {
         t.push_str(&format!("normalise_with_spectro = {b}\n"));
     }
+    if let Some(g) = m.fit.g {
+        t.push_str(&format!("g = {g}\n"));
+    }
     t
 }
 
@@ -870,6 +894,7 @@ r_max_px = 300
             r_max_px: Some(250.0),
             r_min_mm: Some(1.5),
             normalise_with_spectro: Some(false),
+            g: Some(0.85),
         };
         // None of these is what an absent key means.
         assert_ne!(m.fit.model.unwrap(), ModelName::default());
@@ -901,7 +926,7 @@ r_max_px = 300
     /// Each mistake names the key and says what to do.
     #[test]
     fn mistakes_name_the_key() {
-        let cases: [(&str, &str); 8] = [
+        let cases: [(&str, &str); 10] = [
             (
                 &GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = -1"),
                 "camera.mm_per_pixel",
@@ -930,6 +955,14 @@ r_max_px = 300
             (
                 &GOOD.replace("r_max_px = 300", "r_max_px = 0"),
                 "fit.r_max_px",
+            ),
+            (
+                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng = 1.0"),
+                "fit.g",
+            ),
+            (
+                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng = \"fit\""),
+                "g",
             ),
         ];
         for (text, key) in cases {

@@ -479,6 +479,10 @@ pub struct RunOptions {
     /// unknown.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub detection_limit: Option<Vec<Option<f64>>>,
+    /// The Henyey–Greenstein g the model and the α′ inversion were evaluated at (`[fit] g`; 0:
+    /// isotropic scattering assumed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub g: Option<f64>,
     /// The fitting method.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub method: Option<Method>,
@@ -888,6 +892,7 @@ mod tests {
             spot_radius_mm: Some(0.5),
             response: Some(ResponseKind::Recovered),
             detection_limit: Some(vec![Some(0.25), None, Some(1.0)]),
+            g: Some(0.85),
         };
         let v = serde_json::to_value(&r).unwrap();
         assert_eq!(v["method"], "existing");
@@ -897,7 +902,7 @@ mod tests {
         let options = serde_json::to_string(&r.inputs.options).unwrap();
         assert_eq!(
             options,
-            r#"{"albedo_model":"mc","camera":{"background":"none"},"detection_limit":[0.25,null,1.0],"method":"existing","model":"better-dipole","normalise_with_spectro":false,"r_max_px":300.0,"r_min_mm":1.0,"response":"recovered","spot_radius_mm":0.5}"#
+            r#"{"albedo_model":"mc","camera":{"background":"none"},"detection_limit":[0.25,null,1.0],"g":0.85,"method":"existing","model":"better-dipole","normalise_with_spectro":false,"r_max_px":300.0,"r_min_mm":1.0,"response":"recovered","spot_radius_mm":0.5}"#
         );
         let back = parse_result_json(&v.to_string(), Path::new("r.json")).unwrap();
         assert_eq!(back, r);

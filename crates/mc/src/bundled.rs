@@ -10,6 +10,7 @@
 //! [`McTableSpec::new`]: crate::model::McTableSpec::new
 
 use crate::error::{McError, Result};
+use crate::grid_g::McGridSet;
 use crate::model::{McTable, McTableSet};
 
 /// The η of the shipped tables.
@@ -37,6 +38,144 @@ const BUNDLED_JSON: [&str; 17] = [
     // Added so that red aluminum (Choi et al. 2014, η = 2.4102) lies inside the set.
     include_str!("../tables/mc-white-eta2.50.json"),
 ];
+
+/// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
+/// compact JSON). g = 0.8 at η 1.0–2.4 (0.2 apart) and g = 0.9 at η 1.0–1.7 (0.1 apart) and 1.8–2.4
+/// (0.2 apart); Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
+/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 0.9 MB in all (the g = 0 set: 0.75 MB).
+pub const BUNDLED_G: [(f64, f64, &str); 20] = [
+    (
+        1.0,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.00-g0.80.json"),
+    ),
+    (
+        1.2,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.20-g0.80.json"),
+    ),
+    (
+        1.4,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.40-g0.80.json"),
+    ),
+    (
+        1.6,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.60-g0.80.json"),
+    ),
+    (
+        1.8,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.80-g0.80.json"),
+    ),
+    (
+        2.0,
+        0.8,
+        include_str!("../tables-g/mc-white-eta2.00-g0.80.json"),
+    ),
+    (
+        2.2,
+        0.8,
+        include_str!("../tables-g/mc-white-eta2.20-g0.80.json"),
+    ),
+    (
+        2.4,
+        0.8,
+        include_str!("../tables-g/mc-white-eta2.40-g0.80.json"),
+    ),
+    (
+        1.0,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.00-g0.90.json"),
+    ),
+    (
+        1.1,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.10-g0.90.json"),
+    ),
+    (
+        1.2,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.20-g0.90.json"),
+    ),
+    (
+        1.3,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.30-g0.90.json"),
+    ),
+    (
+        1.4,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.40-g0.90.json"),
+    ),
+    (
+        1.5,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.50-g0.90.json"),
+    ),
+    (
+        1.6,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.60-g0.90.json"),
+    ),
+    (
+        1.7,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.70-g0.90.json"),
+    ),
+    (
+        1.8,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.80-g0.90.json"),
+    ),
+    (
+        2.0,
+        0.9,
+        include_str!("../tables-g/mc-white-eta2.00-g0.90.json"),
+    ),
+    (
+        2.2,
+        0.9,
+        include_str!("../tables-g/mc-white-eta2.20-g0.90.json"),
+    ),
+    (
+        2.4,
+        0.9,
+        include_str!("../tables-g/mc-white-eta2.40-g0.90.json"),
+    ),
+];
+
+/// The largest g step the shipped grid interpolates across: 0.1 (between g = 0.8 and 0.9; measured,
+/// BENCHMARKS.md "The `mc` model over g"). The gap from g = 0 to 0.8 is refused.
+pub const BUNDLED_MAX_G_STEP: f64 = 0.1 + 1e-9;
+
+impl McGridSet {
+    /// The shipped grid: the g = 0 set ([`McTableSet::bundled`]) and the anisotropic tables
+    /// ([`BUNDLED_G`]), interpolated in g between nodes at most [`BUNDLED_MAX_G_STEP`] apart.
+    ///
+    /// # Errors
+    /// `Format` if an embedded table does not parse (a build defect).
+    pub fn bundled() -> Result<Self> {
+        let mut sets = vec![McTableSet::bundled()?];
+        let mut gs: Vec<f64> = BUNDLED_G.iter().map(|&(_, g, _)| g).collect();
+        gs.dedup();
+        for g in gs {
+            let tables = BUNDLED_G
+                .iter()
+                .filter(|&&(_, tg, _)| tg == g)
+                .map(|&(eta, g, json)| {
+                    McTable::from_json(json).map_err(|message| McError::Format {
+                        path: format!("<bundled mc table η = {eta}, g = {g}>").into(),
+                        message,
+                    })
+                })
+                .collect::<Result<Vec<_>>>()?;
+            sets.push(McTableSet::new(tables)?);
+        }
+        Self::new(sets, BUNDLED_MAX_G_STEP)
+    }
+}
 
 impl McTableSet {
     /// The shipped tables (g = 0, η from 1.0 to 2.5; module docs), parsed from the copies compiled
@@ -71,5 +210,23 @@ mod tests {
         assert_eq!(etas, BUNDLED_ETAS);
         assert_eq!(set.g(), 0.0);
         assert_eq!(set.eta_range(), (1.0, 2.5));
+    }
+
+    /// Every embedded anisotropic table parses, sits at its (η, g) (the file name's), and the
+    /// grid has the nodes g = 0, 0.8, 0.9 with the η ranges of the README.
+    #[test]
+    fn bundled_grid_parses() {
+        let grid = McGridSet::bundled().unwrap();
+        assert_eq!(grid.g_nodes(), vec![0.0, 0.8, 0.9]);
+        for (set, n) in grid.nodes()[1..].iter().zip([8, 12]) {
+            assert_eq!(set.tables().len(), n);
+            assert_eq!(set.eta_range(), (1.0, 2.4));
+        }
+        for &(eta, g, json) in &BUNDLED_G {
+            let t = McTable::from_json(json).unwrap();
+            // (The η = 1.7 table was built at 1.0 + 7 × 0.1 = 1.7000000000000002.)
+            assert!((t.spec().eta - eta).abs() < 1e-12 && t.spec().g == g);
+        }
+        assert_eq!(grid.nodes()[0], McTableSet::bundled().unwrap());
     }
 }

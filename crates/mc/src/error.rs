@@ -24,6 +24,19 @@ pub enum McError {
         /// What to do instead.
         hint: &'static str,
     },
+    /// A Henyey–Greenstein g that the (η, g) grid of tables neither holds nor interpolates
+    /// ([`crate::McGridSet`]).
+    #[error(
+        "g = {given} is not covered by the Monte Carlo tables: they hold {tabulated}; use one of \
+         those g, or build tables at this g with `cargo run --release -p scatterfit-mc --example \
+         build_g_tables -- --out DIR --g {given}` (crates/mc/tables-g/README.md)"
+    )]
+    AnisotropyNotTabulated {
+        /// The g asked for.
+        given: f64,
+        /// What the grid covers, in words.
+        tabulated: String,
+    },
     /// A query falls outside what a profile table covers.
     #[error("{name} = {value} is outside the table's range [{min}, {max}]")]
     OutOfTable {

@@ -1,11 +1,13 @@
 //! The Monte Carlo tables as a forward model ([`scatterfit_optics::ModelFamily`] for
-//! [`McTableSet`]), and the one place where a model's name becomes a model: [`family`] and
-//! [`albedo_family`].
+//! [`McTableSet`] and for the (η, g) grid [`McGridSet`]), and the one place where a model's name
+//! becomes a model: [`family`] and [`albedo_family`].
 //!
-//! The tables are made for one Henyey–Greenstein g (the shipped set for g = 0); they are in the
-//! single-scattering albedo a = σs/σt, so α′ = a(1 − g)/(1 − ag) and a = α′/(1 − g + gα′) (both the
-//! identity at g = 0). Optical properties with another g are refused
-//! ([`OpticsError::AnisotropyMismatch`]), never silently used with the tables' g.
+//! A [`McTableSet`] is made for one Henyey–Greenstein g; its tables are in the single-scattering
+//! albedo a = σs/σt, so α′ = a(1 − g)/(1 − ag) and a = α′/(1 − g + gα′) (both the identity at
+//! g = 0). Optical properties with another g are refused ([`OpticsError::AnisotropyMismatch`]),
+//! never silently used with the tables' g. The `mc` family is the shipped grid ([`bundled_grid`]:
+//! g = 0, and 0.8–0.9 interpolated), which honours each parameter set's own g and refuses a g it does
+//! not cover ([`OpticsError::AnisotropyNotTabulated`]).
 
 use std::sync::OnceLock;
 
@@ -15,12 +17,16 @@ use scatterfit_optics::{
 };
 
 use crate::error::{McError, Result};
+use crate::grid_g::McGridSet;
 use crate::model::{McProfile, McTableSet};
 
 /// An [`McError`] from a table lookup as the optics vocabulary's error (a lookup only fails with
-/// `OutOfTable` or `InvalidParameter`).
+/// `OutOfTable`, `AnisotropyNotTabulated` or `InvalidParameter`).
 fn lookup_error(e: McError) -> OpticsError {
     match e {
+        McError::AnisotropyNotTabulated { given, tabulated } => {
+            OpticsError::AnisotropyNotTabulated { given, tabulated }
+        }
         McError::OutOfTable {
             name,
             value,
@@ -108,6 +114,57 @@ impl ModelFamily for McTableSet {
     }
 }
 
+impl ModelFamily for McGridSet {
+    fn name(&self) -> ModelName {
+        ModelName::Mc
+    }
+
+    /// The grid's model at `props.g()` ([`McGridSet::profile`]).
+    fn profile(
+        &self,
+        props: &OpticalProperties,
+    ) -> std::result::Result<Box<dyn ProfileModel>, OpticsError> {
+        Ok(Box::new(
+            McGridSet::profile(self, props).map_err(lookup_error)?,
+        ))
+    }
+
+    /// [`McGridSet::profile`] without boxing it.
+    fn eval(&self, props: &OpticalProperties, radii_mm: &[f64], out: &mut [ProfileSample]) {
+        match McGridSet::profile(self, props) {
+            Ok(m) => m.profile_with_derivatives_into(radii_mm, out),
+            Err(_) => out.fill(ProfileSample::NAN),
+        }
+    }
+
+    /// [`McGridSet::rd_total`].
+    fn rd_total(
+        &self,
+        albedo_prime: f64,
+        eta: f64,
+        g: f64,
+    ) -> std::result::Result<f64, OpticsError> {
+        McGridSet::rd_total(self, albedo_prime, eta, g).map_err(lookup_error)
+    }
+
+    /// [`McGridSet::albedo_from_rd`].
+    fn albedo_from_rd(&self, rd: f64, eta: f64, g: f64) -> std::result::Result<f64, OpticsError> {
+        McGridSet::albedo_from_rd(self, rd, eta, g).map_err(lookup_error)
+    }
+}
+
+/// The shipped (η, g) grid ([`McGridSet::bundled`]: g = 0, η 1.0–2.5; g 0.8–0.9, η 1.0–2.4),
+/// parsed once per process.
+///
+/// # Errors
+/// [`McError::BundledTables`] if the tables do not parse (a build defect).
+pub fn bundled_grid() -> Result<&'static McGridSet> {
+    static GRID: OnceLock<std::result::Result<McGridSet, String>> = OnceLock::new();
+    GRID.get_or_init(|| McGridSet::bundled().map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|message| McError::BundledTables(message.clone()))
+}
+
 /// The tables shipped with scatterfit ([`McTableSet::bundled`]), parsed once per process.
 ///
 /// # Errors
@@ -121,7 +178,8 @@ pub fn bundled_tables() -> Result<&'static McTableSet> {
 
 /// The forward model called `name`: the classical dipole (Jensen et al. 2001), the better dipole
 /// (d'Eon 2012), photon beam diffusion (Habel et al. 2013) or the Monte Carlo tables shipped with
-/// scatterfit ([`bundled_tables`]: g = 0, η 1.0–2.5). The one place a name becomes a model.
+/// scatterfit over (η, g) ([`bundled_grid`]: g = 0 at η 1.0–2.5, exactly the g = 0 tables'
+/// numbers; g 0.8–0.9 at η 1.0–2.4; other g refused). The one place a name becomes a model.
 ///
 /// # Errors
 /// [`McError::BundledTables`] when the Monte Carlo tables cannot be loaded.
@@ -133,7 +191,7 @@ pub fn family(name: ModelName) -> Result<&'static dyn ModelFamily> {
         ModelName::Dipole => &DIPOLE,
         ModelName::BetterDipole => &BETTER_DIPOLE,
         ModelName::Pbd => &PBD,
-        ModelName::Mc => bundled_tables()?,
+        ModelName::Mc => bundled_grid()?,
     })
 }
 

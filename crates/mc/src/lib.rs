@@ -1,5 +1,5 @@
 //! Monte Carlo photon transport with MCML's physics, the profile tables built from it (the `mc`
-//! forward model: [`McTable`], [`McTableSet`], [`McProfile`]), and the one place where a model's
+//! forward model: [`McTable`], [`McTableSet`], [`McProfile`], over g [`McGridSet`]), and the one place where a model's
 //! name becomes a model ([`family()`], [`albedo_family()`]).
 //!
 //! The engine follows Wang, Jacques & Zheng 1995 (MCML; the algorithm is summarised in
@@ -37,6 +37,7 @@ mod error;
 pub mod family;
 mod fresnel;
 mod grid;
+pub mod grid_g;
 pub mod model;
 mod phase;
 pub mod port;
@@ -51,9 +52,10 @@ pub use engine::{
     ROULETTE_THRESHOLD, Simulation, SimulationResult,
 };
 pub use error::{McError, Result};
-pub use family::{albedo_family, bundled_tables, family};
+pub use family::{albedo_family, bundled_grid, bundled_tables, family};
 pub use fresnel::{FresnelSample, fresnel_mcml};
 pub use grid::RadialGrid;
+pub use grid_g::{McGridProfile, McGridSet};
 pub use model::{McProfile, McTable, McTableSet, McTableSpec};
 pub use phase::{hg_cdf_cos, hg_pdf_cos, sample_hg_cos};
 pub use sample::{Layer, Sample};

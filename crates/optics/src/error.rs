@@ -84,6 +84,19 @@ pub enum OpticsError {
         /// The tables' g.
         tables: f64,
     },
+    /// A Henyey–Greenstein g that the Monte Carlo tables' (η, g) grid neither holds nor
+    /// interpolates (`scatterfit_mc::McGridSet`).
+    #[error(
+        "g = {given} is not covered by the Monte Carlo tables: they hold {tabulated}; use one of \
+         those g, or build tables at this g with `cargo run --release -p scatterfit-mc --example \
+         build_g_tables -- --out DIR --g {given}` (crates/mc/tables-g/README.md)"
+    )]
+    AnisotropyNotTabulated {
+        /// The g asked for.
+        given: f64,
+        /// What the grid covers, in words.
+        tabulated: String,
+    },
     /// A spectrum that does not cover the range a colour computation needs.
     #[error("spectrum: {0}")]
     Spectrum(String),

@@ -32,8 +32,8 @@ pub struct Estimate {
     /// propagated to the value by refits (`scatterfit_pipeline::fit::propagate_spectro`).
     pub spectro: Option<f64>,
     /// Standard error from the unknown anisotropy g of the phase function. Reserved for the
-    /// anisotropy work (the forward models are evaluated at g = 0 and the measurement gives σ′s
-    /// only): always `None` today.
+    /// anisotropy work (the forward models are evaluated at one g, the manifest's `[fit] g`,
+    /// default 0; a range of g is not propagated yet): always `None` today.
     pub g: Option<f64>,
 }
 

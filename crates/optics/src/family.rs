@@ -66,7 +66,8 @@ pub trait ModelFamily: Send + Sync {
     /// # Errors
     /// Where the model does not cover the parameters: `InvalidParameter` (η > 2.5 for the improved
     /// diffusion models), `OutOfTable` (α′ or η outside the Monte Carlo tables),
-    /// `AnisotropyMismatch` (a g the tables were not made for).
+    /// `AnisotropyMismatch` (a g the tables were not made for), `AnisotropyNotTabulated` (a g the
+    /// Monte Carlo grid neither holds nor interpolates).
     fn profile(&self, props: &OpticalProperties) -> Result<Box<dyn ProfileModel>>;
 
     /// Rd and ∂Rd/∂σ′s, ∂Rd/∂σa for `props` at every radius of `radii_mm`, into `out`; NaN
@@ -94,4 +95,96 @@ pub trait ModelFamily: Send + Sync {
     /// `RdOutOfRange`/`RdOutOfModelRange`/`OutOfTable` for an Rd the model cannot produce,
     /// `InvalidParameter` for η or g outside its range.
     fn albedo_from_rd(&self, rd: f64, eta: f64, g: f64) -> Result<f64>;
+}
+
+/// A family evaluated at one Henyey–Greenstein g: every parameter set it is given is taken at `g`
+/// ([`OpticalProperties::with_g`]), and its totals and their inverse at `g` whatever g they are asked
+/// for. How a known or assumed g (the manifest's `[fit] g`) reaches a fit that builds its parameter
+/// sets from (σ′s, σa, η) alone. The diffusion dipoles ignore g; photon beam diffusion and the Monte
+/// Carlo tables use it.
+#[derive(Clone, Copy)]
+pub struct AtG<'a> {
+    family: &'a dyn ModelFamily,
+    g: f64,
+}
+
+impl<'a> AtG<'a> {
+    /// `family` at asymmetry `g`.
+    ///
+    /// # Errors
+    /// [`crate::OpticsError::InvalidParameter`] for g outside (−1, 1) or not finite.
+    pub fn new(family: &'a dyn ModelFamily, g: f64) -> Result<Self> {
+        crate::error::check_g(g)?;
+        Ok(Self { family, g })
+    }
+
+    /// The g every evaluation uses.
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+}
+
+impl ModelFamily for AtG<'_> {
+    fn name(&self) -> ModelName {
+        self.family.name()
+    }
+
+    fn profile(&self, props: &OpticalProperties) -> Result<Box<dyn ProfileModel>> {
+        self.family.profile(&props.with_g(self.g)?)
+    }
+
+    fn eval(&self, props: &OpticalProperties, radii_mm: &[f64], out: &mut [ProfileSample]) {
+        match props.with_g(self.g) {
+            Ok(p) => self.family.eval(&p, radii_mm, out),
+            Err(_) => out.fill(ProfileSample::NAN),
+        }
+    }
+
+    fn rd_total(&self, albedo_prime: f64, eta: f64, _g: f64) -> Result<f64> {
+        self.family.rd_total(albedo_prime, eta, self.g)
+    }
+
+    fn albedo_from_rd(&self, rd: f64, eta: f64, _g: f64) -> Result<f64> {
+        self.family.albedo_from_rd(rd, eta, self.g)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::DiffusionModel;
+
+    /// `AtG` gives every parameter set its g: photon beam diffusion (which uses g) at g = 0.6
+    /// through the wrapper equals the model given g = 0.6 directly, and differs from g = 0; totals
+    /// and the inversion are taken at the wrapper's g whatever g they are asked for; a bad g is
+    /// refused.
+    #[test]
+    fn at_g_gives_its_g_to_every_evaluation() {
+        let pbd = DiffusionModel::Pbd;
+        let at = AtG::new(&pbd, 0.6).unwrap();
+        assert_eq!(at.name(), ModelName::Pbd);
+        assert_eq!(at.g(), 0.6);
+        let p = OpticalProperties::new(1.2, 0.05, 1.4).unwrap();
+        let radii = [0.3, 1.0, 3.0];
+        let (mut a, mut b, mut c) = (
+            [ProfileSample::ZERO; 3],
+            [ProfileSample::ZERO; 3],
+            [ProfileSample::ZERO; 3],
+        );
+        at.eval(&p, &radii, &mut a);
+        pbd.eval(&p.with_g(0.6).unwrap(), &radii, &mut b);
+        pbd.eval(&p, &radii, &mut c);
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        let direct = pbd.profile(&p.with_g(0.6).unwrap()).unwrap();
+        assert_eq!(at.profile(&p).unwrap().rd(1.0), direct.rd(1.0));
+        let rd = pbd.rd_total(0.9, 1.4, 0.6).unwrap();
+        assert_eq!(at.rd_total(0.9, 1.4, 0.0).unwrap(), rd);
+        assert_eq!(
+            at.albedo_from_rd(rd, 1.4, 0.0).unwrap(),
+            pbd.albedo_from_rd(rd, 1.4, 0.6).unwrap()
+        );
+        assert!(AtG::new(&pbd, 1.0).is_err());
+        assert!(AtG::new(&pbd, f64::NAN).is_err());
+    }
 }

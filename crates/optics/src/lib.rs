@@ -48,7 +48,7 @@ mod roots;
 
 pub use error::{OpticsError, Result};
 pub use estimate::Estimate;
-pub use family::{ModelFamily, ProfileModel, ProfileSample};
+pub use family::{AtG, ModelFamily, ProfileModel, ProfileSample};
 pub use model::DiffusionModel;
 pub use names::{AlbedoModel, Method, ModelName};
 pub use properties::OpticalProperties;

@@ -27,6 +27,9 @@ pub struct FitSettings {
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed only).
     pub normalise_with_spectro: bool,
+    /// The Henyey–Greenstein g the model and the α′ inversion are evaluated at (the manifest's
+    /// `[fit] g`, default 0; `scatterfit_optics::AtG`).
+    pub g: f64,
 }
 
 /// The light spot's shape in [`FitSettings`].

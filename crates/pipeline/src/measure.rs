@@ -7,7 +7,7 @@ use std::time::Instant;
 use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest};
 use scatterfit_io::result_json::{AlbedoSource, FileRef, Inputs, MeasurementResult, RunOptions};
 use scatterfit_mc::{albedo_family, family};
-use scatterfit_optics::{AlbedoModel, Estimate, Method, ModelName, Rgb};
+use scatterfit_optics::{AlbedoModel, AtG, Estimate, Method, ModelName, Rgb};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
@@ -195,7 +195,7 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         }
         _ => (SpotShape::Disk, 0.5 * diameter),
     };
-    Ok(FitSettings {
+    let settings = FitSettings {
         method,
         model,
         albedo_model,
@@ -203,7 +203,28 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         spot_radius_mm,
         r_min_mm: manifest.fit.r_min_mm,
         normalise_with_spectro: normalise,
-    })
+        g: manifest.fit.g.unwrap_or(0.0),
+    };
+    families(&settings)?;
+    Ok(settings)
+}
+
+/// The profile model and the albedo model of `settings`, both at its g (issue 15).
+///
+/// # Errors
+/// [`PipelineError::Input`] for a g the Monte Carlo tables do not cover when either model is `mc`.
+fn families(settings: &FitSettings) -> Result<(AtG<'static>, AtG<'static>)> {
+    let at = |f| AtG::new(f, settings.g).map_err(|e| PipelineError::Input(format!("fit.g: {e}")));
+    let (model, albedo) = (
+        at(family(settings.model)?)?,
+        at(albedo_family(settings.albedo_model, settings.model)?)?,
+    );
+    if settings.model == ModelName::Mc || settings.albedo_model == AlbedoModel::Mc {
+        scatterfit_mc::bundled_grid()?
+            .albedo_prime_range(settings.g)
+            .map_err(|e| PipelineError::Input(format!("fit.g: {e}")))?;
+    }
+    Ok((model, albedo))
 }
 
 /// Measures the sample in folder `dir` (its `sample.toml`): [`sample_inputs`], then
@@ -244,9 +265,9 @@ fn measure_from(
 ) -> Result<Measurement> {
     let manifest = inputs.manifest.clone();
     let settings = fit_settings(&manifest, overrides)?;
-    let model = family(settings.model)?;
+    let (model, albedo) = families(&settings)?;
+    let (model, albedo) = (&model, &albedo);
     progress(Stage::Spectro);
-    let albedo = albedo_family(settings.albedo_model, settings.model)?;
     let spectro = spectro_stage(&manifest, overrides.eta, albedo)?;
     let spectro_s = t0.elapsed().as_secs_f64();
     let hdr = match &manifest.camera.hdr {
@@ -392,8 +413,8 @@ impl Measurement {
     }
 
     fn refit_inner(&self, settings: FitSettings, propagate: bool) -> Result<Measurement> {
-        let model = family(settings.model)?;
-        let albedo = albedo_family(settings.albedo_model, settings.model)?;
+        let (model, albedo) = families(&settings)?;
+        let (model, albedo) = (&model, &albedo);
         let t = Instant::now();
         let data = self.profile.rgb_data()?;
         // The port correction depends on the model: start again from the reading.
@@ -502,6 +523,7 @@ impl Measurement {
                     model: Some(s.model),
                     albedo_model: Some(s.albedo_model),
                     normalise_with_spectro: Some(s.normalise_with_spectro),
+                    g: Some(s.g),
                     r_min_mm: Some(s.r_min_mm()),
                     r_max_px: Some(m.fit.r_max_px.unwrap_or(300.0)),
                     spot_radius_mm: Some(s.spot_radius_mm),

@@ -73,6 +73,7 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
         spot: crate::fit::SpotShape::Disk,
         r_min_mm: request.r_min_mm,
         normalise_with_spectro: request.normalise_with_spectro,
+        g: 0.0,
     };
     let fits = fit_stage(profile, &spectro, &settings, model);
     Ok(ProfileFit {

@@ -136,6 +136,7 @@ fn sigma_errors_match_refits_of_repeated_readings() {
         spot: scatterfit_pipeline::fit::SpotShape::Disk,
         r_min_mm: Some(1.0),
         normalise_with_spectro: false,
+        g: 0.0,
     };
     let nominal = stage(1.0, EPS);
     let data = profiles(&nominal);

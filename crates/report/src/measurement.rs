@@ -130,7 +130,8 @@ pub fn quality_line(r: &MeasurementResult) -> Option<String> {
     (!cells.is_empty()).then(|| format!("quality: {}", cells.join(" · ")))
 }
 
-/// A human summary of one result, as `scatterfit measure` prints it: η and, per channel,
+/// A human summary of one result, as `scatterfit measure` prints it: η (and the g assumed, when the
+/// result records it) and, per channel,
 /// σ′s ± error, σa ± error, α′, MSE, fit time and rings used, the data checks' findings and
 /// their verdict per channel ([`quality_line`]).
 pub fn summary_text(r: &MeasurementResult) -> String {
@@ -139,9 +140,15 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         Some(e) => format!("{:.4} ± {}", r.eta, sig4(e)),
         None => format!("{:.4}", r.eta),
     };
+    // The Henyey–Greenstein g the models were evaluated at (issue 15), when the result records it.
+    let g = r
+        .inputs
+        .options
+        .g
+        .map_or(String::new(), |g| format!(", g = {g} assumed"));
     let _ = writeln!(
         t,
-        "{}: η = {eta} ({}), method {}, model {}",
+        "{}: η = {eta} ({}), method {}, model {}{g}",
         scatterfit_io::escape::one_line(&r.name),
         r.eta_source.map_or("", |s| s.name()),
         r.method,

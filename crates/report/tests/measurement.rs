@@ -100,6 +100,9 @@ fn a_measured_sample_gets_its_report_files() {
     assert_eq!(back.name, "wood-tile");
     let summary = summary_text(&written.result);
     assert!(summary.starts_with("wood-tile: η = "), "{summary}");
+    // The g the models assumed (issue 15): the manifest has none, so 0, and both say so.
+    assert_eq!(back.inputs.options.g, Some(0.0));
+    assert!(summary.contains(", g = 0 assumed"), "{summary}");
     for ch in back.channels.iter() {
         let sp = ch
             .sigma_s_prime

@@ -1,0 +1,403 @@
+//! The `mc` forward model over (η, g): one [`McTableSet`] per Henyey–Greenstein g (each
+//! interpolating in η, [`crate::model`]), and an interpolation in g between neighbouring sets.
+//!
+//! **Reduced units.** Tables of different g are in their own single-scattering albedo a = σs/σt
+//! and σt = σa + σ′s/(1 − g); [`McProfile::new`] maps (σ′s, σa) onto each (similarity, pbrt's
+//! `TabulatedBSSRDF::Sr`, docs/physics.md §2.3). At fixed (σ′s, σa) every node therefore answers at
+//! the same σ′t = σa + σ′s and α′ = σ′s/σ′t, so interpolating ln Rd(r) in g at fixed r is
+//! interpolating ln R′(ρ′; α′) = ln(Rd/σ′t²) in g at fixed reduced radius ρ′ = σ′t r and reduced
+//! albedo α′ — the comparison in which Rd changes least with g (the similarity relation σ′s =
+//! σs(1 − g) holds in the far field; Wyman, Patterson & Wilson 1989).
+//!
+//! **Interpolation in g.** Linear in g on ln Rd(r) (the profile) and on Rd (the total), between the
+//! two bracketing nodes, and only where they are at most [`McGridSet::max_step`] apart; a g within
+//! [`G_NODE_TOLERANCE`] of a node is that node's set, unchanged (so g = 0 gives exactly the g = 0
+//! tables' numbers). Measured (BENCHMARKS.md, "The `mc` model over g"; `examples/g_model_check.rs`):
+//! at g = 0.85 (η 1.4) the interpolant is within 0.2–0.4 % of a 10⁵-photon table built there over
+//! 1–10 mean free paths at α′ ≥ 0.9 (that table's own noise), totals within 7·10⁻⁴, and adding-
+//! doubling's totals are linear in g between 0.8 and 0.9 to 1.4·10⁻⁵. Across the gap from g = 0 to
+//! 0.8 the same interpolation is 1–6 % off MCML at g = 0.5 over 0.5–10 mean free paths (totals
+//! +0.8 … +2.6·10⁻³), ten times the tables' noise, so the shipped grid refuses g in (0, 0.8) and
+//! above 0.9 with [`McError::AnisotropyNotTabulated`] rather than interpolate or extrapolate.
+//!
+//! Derivatives: Rd = Rd_lo^(1−t) Rd_hi^t, so ∂Rd/∂θ = Rd [(1 − t) ∂Rd_lo/∂θ / Rd_lo + t ∂Rd_hi/∂θ /
+//! Rd_hi] for θ = σ′s, σa (t depends on g only) — the derivatives of the interpolant, exactly.
+
+use scatterfit_optics::{OpticalProperties, ProfileModel, ProfileSample};
+
+use crate::error::{McError, Result, check};
+use crate::model::{McProfile, McTableSet};
+
+/// How close a g must be to a node to be that node (a g typed as 0.8 parses to the node exactly;
+/// this absorbs arithmetic on it).
+pub const G_NODE_TOLERANCE: f64 = 1e-9;
+
+/// Single-scattering albedo a with reduced albedo α′ at asymmetry g: a = α′/(1 − g + gα′).
+pub fn albedo_from_reduced(albedo_prime: f64, g: f64) -> f64 {
+    albedo_prime / (1.0 - g + g * albedo_prime)
+}
+
+/// Reduced albedo α′ with single-scattering albedo a at asymmetry g: α′ = a(1 − g)/(1 − ag).
+pub fn reduced_from_albedo(a: f64, g: f64) -> f64 {
+    a * (1.0 - g) / (1.0 - a * g)
+}
+
+/// Where a g falls on the grid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Place {
+    /// At node `k`.
+    Node(usize),
+    /// Between nodes `k` and `k + 1`, fraction `t` of the way.
+    Between(usize, f64),
+}
+
+/// `mc` tables over (η, g): one [`McTableSet`] per g node (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct McGridSet {
+    nodes: Vec<McTableSet>,
+    max_step: f64,
+}
+
+impl McGridSet {
+    /// A grid from one set per g (sorted here by g), interpolating in g only between neighbouring
+    /// nodes at most `max_step` apart (0: only the nodes themselves).
+    ///
+    /// # Errors
+    /// `InvalidParameter` for no sets, two sets at one g, or a negative or non-finite `max_step`.
+    pub fn new(mut nodes: Vec<McTableSet>, max_step: f64) -> Result<Self> {
+        check(
+            !nodes.is_empty(),
+            "sets",
+            0.0,
+            "need at least one table set",
+        )?;
+        check(
+            max_step.is_finite() && max_step >= 0.0,
+            "max_step",
+            max_step,
+            "the largest g step to interpolate across must be finite and ≥ 0",
+        )?;
+        nodes.sort_by(|a, b| a.g().total_cmp(&b.g()));
+        for w in nodes.windows(2) {
+            check(
+                w[1].g() - w[0].g() > G_NODE_TOLERANCE,
+                "g",
+                w[1].g(),
+                "two table sets at one g",
+            )?;
+        }
+        Ok(Self { nodes, max_step })
+    }
+
+    /// The sets, by increasing g.
+    pub fn nodes(&self) -> &[McTableSet] {
+        &self.nodes
+    }
+
+    /// The g of the nodes.
+    pub fn g_nodes(&self) -> Vec<f64> {
+        self.nodes.iter().map(McTableSet::g).collect()
+    }
+
+    /// The largest distance in g between two nodes that is interpolated across.
+    pub fn max_step(&self) -> f64 {
+        self.max_step
+    }
+
+    /// The g values and η ranges the grid covers, in words (for error messages), e.g.
+    /// "g = 0 (η 1–2.5); g 0.8–0.9 interpolated (η 1–2.4)".
+    pub fn coverage(&self) -> String {
+        let mut parts = Vec::new();
+        let mut k = 0;
+        while k < self.nodes.len() {
+            // A run of nodes each within max_step of the next is one interval.
+            let mut end = k;
+            while end + 1 < self.nodes.len()
+                && self.nodes[end + 1].g() - self.nodes[end].g() <= self.max_step
+            {
+                end += 1;
+            }
+            let lo = self.nodes[k..=end]
+                .iter()
+                .map(|s| s.eta_range().0)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let hi = self.nodes[k..=end]
+                .iter()
+                .map(|s| s.eta_range().1)
+                .fold(f64::INFINITY, f64::min);
+            if end == k {
+                parts.push(format!("g = {} (η {lo}–{hi})", self.nodes[k].g()));
+            } else {
+                let nodes: Vec<String> = self.nodes[k..=end]
+                    .iter()
+                    .map(|s| s.g().to_string())
+                    .collect();
+                parts.push(format!(
+                    "g {}–{} (tables at {}, linear in g between; η {lo}–{hi})",
+                    self.nodes[k].g(),
+                    self.nodes[end].g(),
+                    nodes.join(", ")
+                ));
+            }
+            k = end + 1;
+        }
+        parts.join("; ")
+    }
+
+    fn not_tabulated(&self, g: f64) -> McError {
+        McError::AnisotropyNotTabulated {
+            given: g,
+            tabulated: self.coverage(),
+        }
+    }
+
+    fn place(&self, g: f64) -> Result<Place> {
+        if !g.is_finite() {
+            return Err(self.not_tabulated(g));
+        }
+        let gs = self.g_nodes();
+        if let Some(k) = gs.iter().position(|&n| (g - n).abs() <= G_NODE_TOLERANCE) {
+            return Ok(Place::Node(k));
+        }
+        let k = gs.partition_point(|&n| n < g);
+        if k == 0 || k == gs.len() || gs[k] - gs[k - 1] > self.max_step {
+            return Err(self.not_tabulated(g));
+        }
+        Ok(Place::Between(k - 1, (g - gs[k - 1]) / (gs[k] - gs[k - 1])))
+    }
+
+    /// The node sets and weights for g: one (set, 1) at a node, two between.
+    fn weights(&self, g: f64) -> Result<Vec<(&McTableSet, f64)>> {
+        Ok(match self.place(g)? {
+            Place::Node(k) => vec![(&self.nodes[k], 1.0)],
+            Place::Between(k, t) => vec![(&self.nodes[k], 1.0 - t), (&self.nodes[k + 1], t)],
+        })
+    }
+
+    /// The model for `props` at its own g ([`OpticalProperties::g`]).
+    ///
+    /// # Errors
+    /// `AnisotropyNotTabulated` for a g the grid does not cover; `OutOfTable` for η or α′ outside a
+    /// node's tables.
+    pub fn profile(&self, props: &OpticalProperties) -> Result<McGridProfile> {
+        Ok(match self.place(props.g())? {
+            Place::Node(k) => McGridProfile::Node(McProfile::new(&self.nodes[k], props)?),
+            Place::Between(k, t) => {
+                let lo = McProfile::new(&self.nodes[k], props)?;
+                let hi = McProfile::new(&self.nodes[k + 1], props)?;
+                let rd_total = (1.0 - t) * lo.rd_total() + t * hi.rd_total();
+                McGridProfile::Between {
+                    lo,
+                    hi,
+                    t,
+                    rd_total,
+                }
+            }
+        })
+    }
+
+    /// Total diffuse reflectance (excluding R_sp) at reduced albedo α′, η and g: each node's total
+    /// at its single-scattering albedo a = α′/(1 − g + gα′) ([`McTableSet::rd_total`]), linear in g
+    /// between two nodes.
+    ///
+    /// # Errors
+    /// As [`McGridSet::profile`].
+    pub fn rd_total(&self, albedo_prime: f64, eta: f64, g: f64) -> Result<f64> {
+        let mut sum = 0.0;
+        for (set, w) in self.weights(g)? {
+            sum += w * set.rd_total(albedo_from_reduced(albedo_prime, set.g()), eta)?;
+        }
+        Ok(sum)
+    }
+
+    /// The α′ range a g is tabulated over (the intersection of the bracketing nodes').
+    ///
+    /// # Errors
+    /// `AnisotropyNotTabulated` for a g the grid does not cover.
+    pub fn albedo_prime_range(&self, g: f64) -> Result<(f64, f64)> {
+        let mut range = (f64::NEG_INFINITY, f64::INFINITY);
+        for (set, _) in self.weights(g)? {
+            let a = set.tables()[0].albedos();
+            range.0 = range.0.max(reduced_from_albedo(a[0], set.g()));
+            range.1 = range.1.min(reduced_from_albedo(a[a.len() - 1], set.g()));
+        }
+        Ok(range)
+    }
+
+    /// The reduced albedo α′ whose total ([`McGridSet::rd_total`]) at η and g is `rd`. At a node,
+    /// that set's inversion ([`McTableSet::albedo_from_rd_total`]) mapped to α′; between nodes,
+    /// bisection in √(1 − α′) on the interpolated total (increasing in α′: each node's is, and the
+    /// weights do not depend on α′) to 1e-14.
+    ///
+    /// # Errors
+    /// `OutOfTable` (`rd_total`) for an Rd outside the totals at the ends of the α′ range, else as
+    /// [`McGridSet::rd_total`].
+    pub fn albedo_from_rd(&self, rd: f64, eta: f64, g: f64) -> Result<f64> {
+        if let Place::Node(k) = self.place(g)? {
+            let set = &self.nodes[k];
+            let a = set.albedo_from_rd_total(rd, eta)?;
+            return Ok(reduced_from_albedo(a, set.g()));
+        }
+        let (lo, hi) = self.albedo_prime_range(g)?;
+        let (r_lo, r_hi) = (self.rd_total(lo, eta, g)?, self.rd_total(hi, eta, g)?);
+        if !(rd >= r_lo && rd <= r_hi) {
+            return Err(McError::OutOfTable {
+                name: "rd_total",
+                value: rd,
+                min: r_lo,
+                max: r_hi,
+            });
+        }
+        let (mut u_lo, mut u_hi) = ((1.0 - hi).sqrt(), (1.0 - lo).sqrt());
+        for _ in 0..200 {
+            let u = 0.5 * (u_lo + u_hi);
+            if u <= u_lo || u >= u_hi || u_hi - u_lo < 1e-14 {
+                break;
+            }
+            if self.rd_total(1.0 - u * u, eta, g)? >= rd {
+                u_lo = u;
+            } else {
+                u_hi = u;
+            }
+        }
+        let u = 0.5 * (u_lo + u_hi);
+        Ok((1.0 - u * u).clamp(lo, hi))
+    }
+}
+
+/// The grid's model for one parameter set: a node's [`McProfile`], or two interpolated in g.
+#[derive(Debug, Clone, PartialEq)]
+pub enum McGridProfile {
+    /// At a node of the grid.
+    Node(McProfile),
+    /// Between two nodes: Rd = Rd_lo^(1−t) Rd_hi^t, total (1 − t) Rd_lo + t Rd_hi.
+    Between {
+        /// The lower node's model.
+        lo: McProfile,
+        /// The upper node's model.
+        hi: McProfile,
+        /// Fraction of the way from the lower to the upper node's g.
+        t: f64,
+        /// The interpolated total.
+        rd_total: f64,
+    },
+}
+
+impl McGridProfile {
+    /// Rd(r) with its derivatives in σ′s and σa (of the interpolant; module docs).
+    #[inline]
+    pub fn rd_with_derivatives(&self, r_mm: f64) -> ProfileSample {
+        match self {
+            Self::Node(m) => m.rd_with_derivatives(r_mm),
+            Self::Between { lo, hi, t, .. } => {
+                let (a, b) = (lo.rd_with_derivatives(r_mm), hi.rd_with_derivatives(r_mm));
+                if !(a.rd > 0.0 && b.rd > 0.0) {
+                    return ProfileSample::ZERO;
+                }
+                let rd = (a.rd.ln() * (1.0 - t) + b.rd.ln() * t).exp();
+                let mix = |da: f64, db: f64| rd * ((1.0 - t) * da / a.rd + t * db / b.rd);
+                ProfileSample {
+                    rd,
+                    d_sigma_s_prime: mix(a.d_sigma_s_prime, b.d_sigma_s_prime),
+                    d_sigma_a: mix(a.d_sigma_a, b.d_sigma_a),
+                }
+            }
+        }
+    }
+}
+
+impl ProfileModel for McGridProfile {
+    fn rd(&self, r_mm: f64) -> f64 {
+        match self {
+            Self::Node(m) => m.rd(r_mm),
+            Self::Between { lo, hi, t, .. } => {
+                (lo.rd(r_mm).ln() * (1.0 - t) + hi.rd(r_mm).ln() * t).exp()
+            }
+        }
+    }
+
+    fn profile_with_derivatives_into(&self, radii_mm: &[f64], out: &mut [ProfileSample]) {
+        for (r, o) in radii_mm.iter().zip(out.iter_mut()) {
+            *o = self.rd_with_derivatives(*r);
+        }
+    }
+
+    fn rd_total(&self) -> f64 {
+        match self {
+            Self::Node(m) => m.rd_total(),
+            Self::Between { rd_total, .. } => *rd_total,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Between g nodes the derivatives are those of the interpolant: they agree with central
+    /// differences of the model itself (g = 0.85, between the shipped 0.8 and 0.9 sets, at η between
+    /// tables); at a node the model is that node's `McProfile`, unchanged.
+    #[test]
+    fn derivatives_between_g_nodes_match_finite_differences() {
+        let grid = McGridSet::bundled().unwrap();
+        for (sp, sa, eta, g) in [(1.0, 0.05, 1.45, 0.85), (2.0, 0.4, 1.33, 0.82)] {
+            let model = |sp: f64, sa: f64| {
+                let p = OpticalProperties::new(sp, sa, eta)
+                    .unwrap()
+                    .with_g(g)
+                    .unwrap();
+                grid.profile(&p).unwrap()
+            };
+            let m = model(sp, sa);
+            assert!(matches!(m, McGridProfile::Between { .. }));
+            for r in [0.02, 0.3, 1.0, 4.0, 12.0] {
+                let got = m.rd_with_derivatives(r);
+                let (h_sp, h_sa) = (1e-6 * sp, 1e-6 * sa);
+                let fd_sp =
+                    (model(sp + h_sp, sa).rd(r) - model(sp - h_sp, sa).rd(r)) / (2.0 * h_sp);
+                let fd_sa =
+                    (model(sp, sa + h_sa).rd(r) - model(sp, sa - h_sa).rd(r)) / (2.0 * h_sa);
+                let tol = |fd: f64| 1e-5 * fd.abs() + 1e-7 * got.rd;
+                assert!(
+                    (got.d_sigma_s_prime - fd_sp).abs() <= tol(fd_sp),
+                    "∂/∂σ′s r = {r}: {} vs {fd_sp}",
+                    got.d_sigma_s_prime
+                );
+                assert!(
+                    (got.d_sigma_a - fd_sa).abs() <= tol(fd_sa),
+                    "∂/∂σa r = {r}: {} vs {fd_sa}",
+                    got.d_sigma_a
+                );
+                assert!((got.rd / m.rd(r) - 1.0).abs() < 1e-14);
+            }
+        }
+        let p = OpticalProperties::new(1.0, 0.05, 1.45)
+            .unwrap()
+            .with_g(0.8)
+            .unwrap();
+        let node = McProfile::new(&grid.nodes()[1], &p).unwrap();
+        assert_eq!(grid.profile(&p).unwrap(), McGridProfile::Node(node));
+    }
+
+    /// The weights: a node within the tolerance is that node; between nodes at most `max_step`
+    /// apart, the fraction of the way; elsewhere `AnisotropyNotTabulated` with the coverage.
+    #[test]
+    fn places_on_the_grid() {
+        let grid = McGridSet::bundled().unwrap();
+        assert_eq!(grid.place(0.8 + 1e-12).unwrap(), Place::Node(1));
+        match grid.place(0.825).unwrap() {
+            Place::Between(1, t) => assert!((t - 0.25).abs() < 1e-12),
+            p => panic!("{p:?}"),
+        }
+        for g in [0.3, 0.95, f64::NAN] {
+            assert!(matches!(
+                grid.place(g),
+                Err(McError::AnisotropyNotTabulated { .. })
+            ));
+        }
+        assert_eq!(
+            grid.coverage(),
+            "g = 0 (η 1–2.5); g 0.8–0.9 (tables at 0.8, 0.9, linear in g between; η 1–2.4)"
+        );
+    }
+}
