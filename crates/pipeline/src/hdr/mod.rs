@@ -26,6 +26,10 @@ use crate::error::{PipelineError, Result};
 /// How the bracket became radiance (the name `result.json` records).
 pub use scatterfit_io::result_json::ResponseKind;
 
+mod merge;
+
+use merge::*;
+
 /// Exposure corrections estimated from the frames are applied automatically
 /// ([`ExposureCorrection::Auto`]) when some frame's time is off by more than this (1 %): a good
 /// shutter's scatter and the estimate's own (about 0.1 % on the twin) stay below it.
@@ -404,10 +408,6 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
     } = read;
     let times = bracket.times_s();
     let t1 = Instant::now();
-    let imaging = |context: &str| {
-        let context = context.to_string();
-        move |source| PipelineError::Imaging { context, source }
-    };
     let order_context = || {
         let names: Vec<String> = frames
             .iter()
@@ -441,7 +441,14 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
             inputs.saturation
         )));
     }
-    let mut stage = if depth == 8 {
+    let cx = MergeContext {
+        times: &times,
+        dark,
+        flat: flat.as_ref(),
+        inputs,
+        order: &order_context,
+    };
+    let merged = if depth == 8 {
         let bufs: Vec<ImageBuf<u8>> = bracket
             .into_frames()
             .into_iter()
@@ -450,144 +457,8 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                 CameraFrame::U16(_) => None,
             })
             .collect();
-        scatterfit_imaging::check_bracket_order(&bufs, &times, u8::MAX)
-            .map_err(imaging(&order_context()))?;
-        corrections.registration = Some(crate::checks::registration(
-            bufs.len(),
-            bufs[0].width(),
-            bufs[0].height(),
-            bufs[0].channels(),
-            &|j, i| f64::from(bufs[j].data()[i]) / 255.0,
-        ));
-        let samples = inputs
-            .samples
-            .unwrap_or_else(|| default_response_samples(bufs.len()));
-        let recover = |t: &[f64]| -> Result<(ResponseCurve, Vec<f64>)> {
-            let opts = CalibrateOptions::new(samples, inputs.lambda)
-                .map_err(imaging("the response recovery's options"))?;
-            let cal = scatterfit_imaging::recover_response(&bufs, t, &opts).map_err(
-                imaging("recovering the camera response (or give a known one: --response for merge, camera.response in sample.toml for measure)"),
-            )?;
-            let rms = cal.solutions.iter().map(|s| s.rms_residual).collect();
-            Ok((cal.response, rms))
-        };
-        let (mut response, kind, mut rms) = match &inputs.response {
-            Some(path) => (load_response(path)?, ResponseKind::Given, Vec::new()),
-            None => {
-                let (r, rms) = recover(&times)?;
-                (r, ResponseKind::Recovered, rms)
-            }
-        };
-        // Exposure times from the frames: ratios of linearised codes in the well-exposed range.
-        let mut times_used = times.clone();
-        if inputs.exposure_correction != ExposureCorrection::Never {
-            let recovered = kind == ResponseKind::Recovered;
-            let ch = bufs[0].channels();
-            let n = bufs[0].data().len();
-            for round in 0..if recovered { 4 } else { 1 } {
-                let lin: Vec<Vec<f64>> = response
-                    .tables()
-                    .iter()
-                    .map(|g| g.iter().map(|v| v.exp()).collect())
-                    .collect();
-                let est = estimate_exposures(
-                    &times_used,
-                    n,
-                    &|j, i| {
-                        let z = bufs[j].data()[i];
-                        (DETECTION_CODE..=230)
-                            .contains(&z)
-                            .then(|| lin[if lin.len() == 1 { 0 } else { i % ch }][usize::from(z)])
-                    },
-                    recovered,
-                );
-                let apply = inputs.exposure_correction == ExposureCorrection::Always
-                    || (round == 0 && est.max_correction > EXPOSURE_AUTO_THRESHOLD)
-                    || (round > 0 && corrections.exposure_applied);
-                if round == 0 {
-                    check_exposure(&est, &times)?;
-                    corrections.exposure = Some(est.clone());
-                }
-                if !apply {
-                    break;
-                }
-                corrections.exposure_applied = true;
-                for (t, f) in times_used.iter_mut().zip(&est.factor) {
-                    *t *= f;
-                }
-                if recovered {
-                    (response, rms) = recover(&times_used)?;
-                }
-                if est.max_correction < 2e-4 {
-                    break;
-                }
-            }
-            if corrections.exposure_applied
-                && let Some(e) = corrections.exposure.as_mut()
-            {
-                // Report the total correction against the nominal times.
-                e.factor = times_used.iter().zip(&times).map(|(u, t)| u / t).collect();
-                e.max_correction = e.factor.iter().map(|f| (f - 1.0).abs()).fold(0.0, f64::max);
-            }
-        }
-        let dark = dark.and_then(|d| match d {
-            CameraFrame::U8(b) => Some(b),
-            CameraFrame::U16(_) => None,
-        });
-        let opts = MergeOptions {
-            clipped_fill: inputs.clipped_fill,
-            weighting: inputs.weighting,
-        };
-        let mut hdr =
-            scatterfit_imaging::merge(&bufs, &times_used, &response, dark.as_ref(), &opts)
-                .map_err(imaging("merging the bracket"))?;
-        if let Some((path, CameraFrame::U8(f))) = &flat {
-            let tables = response.tables();
-            let ch = f.channels();
-            let lin: Vec<f32> = f
-                .data()
-                .iter()
-                .enumerate()
-                .map(|(i, &z)| {
-                    let g = &tables[if tables.len() == 1 { 0 } else { i % ch }];
-                    if z == 0 {
-                        0.0
-                    } else {
-                        g[usize::from(z)].exp() as f32
-                    }
-                })
-                .collect();
-            corrections.flat = Some(divide_flat(&mut hdr, path, f.width(), f.height(), ch, lin)?);
-        }
-        let t_max = times_used.iter().copied().fold(0.0f64, f64::max);
-        let detection_limit = (0..hdr.radiance.channels())
-            .map(|c| {
-                let g = &response.tables()[if response.channels() == 1 { 0 } else { c }];
-                g[usize::from(DETECTION_CODE)].exp() / t_max
-            })
-            .collect();
-        HdrStage {
-            hdr,
-            response: Some(response),
-            response_kind: kind,
-            rms,
-            frames,
-            image,
-            detection_limit,
-            dropped_alpha,
-            read_s,
-            merge_s: 0.0,
-            corrections: Corrections::default(),
-            thumbnails,
-        }
+        merge_8bit(bufs, cx, &mut corrections)?
     } else {
-        if let Some(path) = &inputs.response {
-            return Err(PipelineError::Input(format!(
-                "{}: a response curve applies to 8-bit frames; these frames are 16-bit and are \
-                 merged as linear data — drop --response (or camera.response in the manifest)",
-                path.display()
-            )));
-        }
         let bufs: Vec<ImageBuf<u16>> = bracket
             .into_frames()
             .into_iter()
@@ -596,146 +467,21 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
                 CameraFrame::U8(_) => None,
             })
             .collect();
-        let saturation = match raw {
-            Some(r) if !inputs.saturation_given => {
-                (r.levels.white.min(f64::from(u16::MAX)) as u16).max(2)
-            }
-            _ => inputs.saturation,
-        };
-        // The codes the frames use (8- or 12-bit data in 16-bit files; crate::checks); a stated
-        // saturation is used as stated.
-        let code_range = raw
-            .is_none()
-            .then(|| crate::checks::code_range(&bufs, saturation))
-            .transpose()?
-            .map(|c| {
-                if inputs.saturation_given {
-                    crate::checks::CodeRange {
-                        saturation,
-                        plateau_found: false,
-                        ..c
-                    }
-                } else {
-                    c
-                }
-            });
-        let saturation = code_range.as_ref().map_or(saturation, |c| c.saturation);
-        scatterfit_imaging::check_bracket_order(&bufs, &times, saturation)
-            .map_err(imaging(&order_context()))?;
-        corrections.registration = Some(crate::checks::registration(
-            bufs.len(),
-            bufs[0].width(),
-            bufs[0].height(),
-            bufs[0].channels(),
-            &|j, i| f64::from(bufs[j].data()[i]) / f64::from(saturation),
-        ));
-        let dark = dark.and_then(|d| match d {
-            CameraFrame::U16(b) => Some(b),
-            CameraFrame::U8(_) => None,
-        });
-        let ch = bufs[0].channels();
-        // The black level: a dark frame is subtracted pixel by pixel (as before); otherwise a level
-        // per channel from the settings, the RAW metadata or the far corners.
-        let black: Option<(Vec<f64>, &'static str)> = if dark.is_some() {
-            None
-        } else {
-            match &inputs.black_level {
-                BlackLevel::None => None,
-                BlackLevel::Given(v) => Some((
-                    (0..ch)
-                        .map(|c| v[if v.len() == 1 { 0 } else { c.min(v.len() - 1) }])
-                        .collect(),
-                    "given",
-                )),
-                BlackLevel::Auto => match raw {
-                    Some(r) => Some((r.levels.black[..ch.min(3)].to_vec(), "metadata")),
-                    None => {
-                        let refs: Vec<&ImageBuf<u16>> = bufs.iter().collect();
-                        let est = estimate_black_level(&refs, &times, saturation);
-                        est.level
-                            .iter()
-                            .any(|l| *l >= 1.0)
-                            .then_some((est.level, "far corners"))
-                    }
-                },
-            }
-        };
-        let black_of = |c: usize| black.as_ref().map_or(0.0, |(b, _)| b[c]);
-        // Exposure times from the frames: ratios of the linear values in the well-exposed range.
-        let mut times_used = times.clone();
-        if inputs.exposure_correction != ExposureCorrection::Never {
-            let n = bufs[0].data().len();
-            let sat = f64::from(saturation);
-            let est = estimate_exposures(
-                &times,
-                n,
-                &|j, i| {
-                    let b = black_of(i % ch);
-                    let v = f64::from(bufs[j].data()[i]);
-                    let d = dark.as_ref().map_or(b, |d| f64::from(d.data()[i]));
-                    (v >= d + 0.02 * (sat - d) && v <= d + 0.8 * (sat - d)).then_some(v - d)
-                },
-                false,
-            );
-            check_exposure(&est, &times)?;
-            let apply = inputs.exposure_correction == ExposureCorrection::Always
-                || est.max_correction > EXPOSURE_AUTO_THRESHOLD;
-            if apply {
-                for (t, f) in times_used.iter_mut().zip(&est.factor) {
-                    *t *= f;
-                }
-            }
-            corrections.exposure = Some(est);
-            corrections.exposure_applied = apply;
-        }
-        let mut hdr = match &black {
-            Some((b, _)) => scatterfit_imaging::merge_linear_black(
-                &bufs,
-                &times_used,
-                b,
-                saturation,
-                inputs.clipped_fill,
-            )
-            .map_err(imaging("merging the linear bracket less its black level"))?,
-            None => {
-                let opts = LinearMergeOptions::new(saturation, inputs.clipped_fill)
-                    .map_err(imaging("the 16-bit merge's options"))?;
-                scatterfit_imaging::merge_linear_u16(&bufs, &times_used, dark.as_ref(), &opts)
-                    .map_err(imaging("merging the 16-bit bracket"))?
-            }
-        };
-        if let Some((path, CameraFrame::U16(f))) = &flat {
-            let lin: Vec<f32> = f
-                .data()
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| {
-                    let d = dark
-                        .as_ref()
-                        .map_or(black_of(i % ch), |d| f64::from(d.data()[i]));
-                    (f64::from(v) - d) as f32
-                })
-                .collect();
-            corrections.flat = Some(divide_flat(&mut hdr, path, f.width(), f.height(), ch, lin)?);
-        }
-        corrections.black_level = black;
-        corrections.codes = code_range;
-        let t_max = times_used.iter().copied().fold(0.0f64, f64::max);
-        let detection_limit = vec![DETECTION_DN_16BIT / t_max; hdr.radiance.channels()];
-        HdrStage {
-            hdr,
-            response: None,
-            response_kind: ResponseKind::Linear,
-            rms: Vec::new(),
-            frames,
-            image,
-            detection_limit,
-            dropped_alpha,
-            read_s,
-            merge_s: 0.0,
-            corrections: Corrections::default(),
-            thumbnails,
-        }
+        merge_linear(bufs, raw, cx, &mut corrections)?
+    };
+    let mut stage = HdrStage {
+        hdr: merged.hdr,
+        response: merged.response,
+        response_kind: merged.kind,
+        rms: merged.rms,
+        frames,
+        image,
+        detection_limit: merged.detection_limit,
+        dropped_alpha,
+        read_s,
+        merge_s: 0.0,
+        corrections: Corrections::default(),
+        thumbnails,
     };
     if let Some((path, f)) = &flat
         && corrections.flat.is_none()
@@ -750,45 +496,6 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
     stage.corrections = corrections;
     stage.merge_s = t1.elapsed().as_secs_f64();
     Ok(stage)
-}
-
-/// Divides the radiance by a flat frame's smoothed, median-normalised linear values
-/// ([`flat_divisor`]); returns the file and the divisor's range.
-fn divide_flat(
-    hdr: &mut HdrImage,
-    path: &Path,
-    w: usize,
-    h: usize,
-    ch: usize,
-    linear: Vec<f32>,
-) -> Result<(PathBuf, f64, f64)> {
-    let bad = || {
-        PipelineError::Input(format!(
-            "{}: the flat frame has no light (a frame of a uniform white target, exposed to \
-             mid-range, is needed)",
-            path.display()
-        ))
-    };
-    let buf = ImageBuf::new(w, h, ch, linear).map_err(|_| bad())?;
-    let div = flat_divisor(&buf).ok_or_else(bad)?;
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    let floor = 1e-3f32;
-    let data: Vec<f32> = hdr
-        .radiance
-        .data()
-        .iter()
-        .zip(div.data())
-        .map(|(&v, &d)| {
-            lo = lo.min(f64::from(d));
-            hi = hi.max(f64::from(d));
-            v / d.max(floor)
-        })
-        .collect();
-    if lo.is_nan() || lo <= 0.0 {
-        return Err(bad());
-    }
-    hdr.radiance = ImageBuf::new(w, h, ch, data).map_err(|_| bad())?;
-    Ok((path.to_path_buf(), lo, hi))
 }
 
 /// The fit's spot kernel from `camera.spot_image` ([`crate::camera::spot_from_image`]): the image
