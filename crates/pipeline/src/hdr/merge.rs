@@ -134,22 +134,15 @@ pub(super) fn merge_8bit(
     let mut hdr = scatterfit_imaging::merge(&bufs, &times_used, &response, dark.as_ref(), &opts)
         .map_err(imaging("merging the bracket"))?;
     if let Some((path, CameraFrame::U8(f))) = cx.flat {
-        let tables = response.tables();
-        let ch = f.channels();
-        let lin: Vec<f32> = f
-            .data()
-            .iter()
-            .enumerate()
-            .map(|(i, &z)| {
-                let g = &tables[if tables.len() == 1 { 0 } else { i % ch }];
-                if z == 0 {
-                    0.0
-                } else {
-                    g[usize::from(z)].exp() as f32
-                }
-            })
-            .collect();
-        corrections.flat = Some(divide_flat(&mut hdr, path, f.width(), f.height(), ch, lin)?);
+        let lin = linearise_u8(f, &response);
+        corrections.flat = Some(divide_flat(
+            &mut hdr,
+            path,
+            f.width(),
+            f.height(),
+            f.channels(),
+            lin,
+        )?);
     }
     let t_max = times_used.iter().copied().fold(0.0f64, f64::max);
     let detection_limit = (0..hdr.radiance.channels())

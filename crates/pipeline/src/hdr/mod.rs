@@ -383,6 +383,27 @@ pub fn read_frames(
     })
 }
 
+/// An 8-bit frame's codes as relative exposure through the camera response: exp g(Z) per sample
+/// (one table for every channel, or one per channel), code 0 as no light. A flat frame and a spot
+/// image taken with the bracket's camera are linearised this way.
+fn linearise_u8(frame: &ImageBuf<u8>, response: &ResponseCurve) -> Vec<f32> {
+    let tables = response.tables();
+    let ch = frame.channels();
+    frame
+        .data()
+        .iter()
+        .enumerate()
+        .map(|(i, &z)| {
+            let g = &tables[if tables.len() == 1 { 0 } else { i % ch }];
+            if z == 0 {
+                0.0
+            } else {
+                g[usize::from(z)].exp() as f32
+            }
+        })
+        .collect()
+}
+
 /// Merges a bracket read by [`read_frames`]: 8-bit frames through the given response
 /// (`inputs.response`) or one recovered from the frames (`inputs.samples`, `inputs.lambda`),
 /// 16-bit and RAW frames as linear data (`inputs.saturation`, or the RAW file's white level) less
@@ -520,22 +541,7 @@ pub fn spot_kernel_from_image(
         .map_err(|e| bad(e.to_string()))?
         .frame;
     let linear: Vec<f32> = match (&frame, &stage.response) {
-        (CameraFrame::U8(f), Some(r)) => {
-            let tables = r.tables();
-            let ch = f.channels();
-            f.data()
-                .iter()
-                .enumerate()
-                .map(|(i, &z)| {
-                    let g = &tables[if tables.len() == 1 { 0 } else { i % ch }];
-                    if z == 0 {
-                        0.0
-                    } else {
-                        g[usize::from(z)].exp() as f32
-                    }
-                })
-                .collect()
-        }
+        (CameraFrame::U8(f), Some(r)) => linearise_u8(f, r),
         (CameraFrame::U8(f), None) => f.data().iter().map(|&z| f32::from(z)).collect(),
         (CameraFrame::U16(f), _) => {
             let ch = f.channels();
