@@ -4,8 +4,13 @@
 //! --albedo-model mc` and the manifest's `[fit] g = 0.8`, and refitted from the same frames and
 //! reading assuming g = 0 (`Measurement::refit_with`). Relative errors against the truth.
 //!
+//! Also printed (stderr), per channel: the twin's Monte Carlo total reflectance (its
+//! spectrophotometer reading) ± its standard error against the `mc` model's total at the truth,
+//! and the σa error that the reading's noise alone makes through the α′ inversion — what separates
+//! the twin's noise from the method's error at α′ → 1.
+//!
 //! ```text
-//! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G]
+//! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G] [paper]
 //! ```
 
 use scatterfit_io::manifest::FitSection;
@@ -22,7 +27,13 @@ fn main() {
         .nth(1)
         .map_or(0.8, |a| a.parse().expect("G"));
     let dir = tempfile::tempdir().unwrap();
-    let mut rig = RigSpec::quick();
+    // `paper` as the second argument: the paper's rig (ten times the photons, 1 MP frames).
+    let paper = std::env::args().nth(2).is_some_and(|a| a == "paper");
+    let mut rig = if paper {
+        RigSpec::paper()
+    } else {
+        RigSpec::quick()
+    };
     rig.g = g;
     println!("| material | ch | α′ | σ′s: g = 0 assumed | g = {g} | σa: g = 0 assumed | g = {g} |");
     println!("|---|---|---|---|---|---|---|");
@@ -41,6 +52,21 @@ fn main() {
         )
         .unwrap();
         eprintln!("{name}: synthesised in {:.0} s", t.elapsed().as_secs_f64());
+        let grid = scatterfit_mc::bundled_grid().unwrap();
+        for (c, ct) in s.truth.channels.iter().enumerate() {
+            let model = grid.rd_total(ct.albedo_prime, m.eta, g).unwrap();
+            let back = grid.albedo_from_rd(ct.rd_total, m.eta, g).unwrap();
+            eprintln!(
+                "  {c}: α′ {:.5}, twin Rd {:.5} ± {:.5}, model Rd {:.5} (z {:+.1}), α′ from twin Rd {:.5} → σa {:+.2} %",
+                ct.albedo_prime,
+                ct.rd_total,
+                ct.rd_total_stderr,
+                model,
+                (ct.rd_total - model) / ct.rd_total_stderr,
+                back,
+                100.0 * ((1.0 / back - 1.0) / (1.0 / ct.albedo_prime - 1.0) - 1.0)
+            );
+        }
         let folder = dir.path().join(m.name);
         write_sample_folder(
             &folder,

@@ -238,9 +238,16 @@ impl RigSpec {
 /// α^n (α = σs/σt, the single-scattering albedo) falls below MCML's roulette threshold 10⁻⁴; the
 /// return time to the surface has a tail P(T > n) ∝ n^{−1/2}, so the expected steps grow like
 /// √n_max with n_max = ln 10⁻⁴ / ln α. Deterministic: the count depends on the optics only.
+///
+/// The count is that of the similar isotropic medium (σs = σ′s, g = 0) whatever [`RigSpec::g`]:
+/// a twin at g ≠ 0 gets the photons, and so the profile's and the total's Monte Carlo noise, of
+/// the same material at g = 0, and costs about 1/(1 − g) times the steps (a Henyey–Greenstein
+/// walk needs 1/(1 − g) scattering events per transport mean free path; docs/physics.md §2.3).
+/// Budgeting the steps at g instead left a g = 0.8 quick twin's total reflectance 2.2× noisier in
+/// variance at α′ = 0.993 (σa ±2–6 % from the reading alone, BENCHMARKS.md "The `mc` model over
+/// g"), which is the twin's error and not the method's.
 pub fn photons_for(sigma_s_prime: f64, sigma_a: f64, rig: &RigSpec) -> u64 {
-    let sigma_s = sigma_s_prime / (1.0 - rig.g);
-    let alpha = sigma_s / (sigma_s + sigma_a);
+    let alpha = sigma_s_prime / (sigma_s_prime + sigma_a);
     let n_max = if alpha < 1.0 {
         (1e-4f64).ln() / alpha.ln()
     } else {
