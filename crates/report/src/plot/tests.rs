@@ -3,7 +3,7 @@
 use std::ops::Range;
 
 use super::axis::{Axis, MAX_DECADES, figure_axes};
-use super::layout::TITLE_HEIGHT;
+use super::layout::{LegendBox, TITLE_HEIGHT, legend_corner};
 use super::series::clip_polyline;
 use super::*;
 
@@ -487,4 +487,46 @@ fn realistic_fit_figures() {
     for c in [RED, GREEN, BLUE] {
         assert!(count(c) > 500, "colour {c:?} on {} pixels", count(c));
     }
+}
+
+/// The legend goes to the corner the data leave free: a rising curve (a camera response) moves it
+/// to the upper left, a falling profile keeps it upper right, a curve rising at both ends sends it
+/// down, and a segment crossing a corner with no point inside it still counts.
+#[test]
+fn the_legend_avoids_the_data() {
+    use plotters::prelude::SeriesLabelPosition as P;
+    let corner = |points: Vec<(f64, f64)>| {
+        let fig = Figure {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            panels: vec![Panel {
+                title: "p".into(),
+                colour: RED,
+                series: vec![series("a curve", points, SeriesStyle::Line)],
+                note: None,
+            }],
+            log_y: false,
+            log_x: false,
+        };
+        let (x, y) = figure_axes(&fig);
+        let legend = LegendBox {
+            width: 0.3,
+            height: 0.15,
+        };
+        format!("{:?}", legend_corner(&fig, &fig.panels[0], &x, &y, legend))
+    };
+    let curve = |f: fn(f64) -> f64| (0..=100).map(|i| (f64::from(i), f(f64::from(i)))).collect();
+    assert_eq!(corner(curve(|x| x)), format!("{:?}", P::UpperLeft));
+    assert_eq!(corner(curve(|x| 100.0 - x)), format!("{:?}", P::UpperRight));
+    assert_eq!(
+        corner(curve(|x| (x - 50.0).powi(2) / 25.0)),
+        format!("{:?}", P::LowerRight)
+    );
+    // Two points only: the segment from the lower left to the upper right crosses the upper right
+    // corner's box between them.
+    assert_eq!(
+        corner(vec![(0.0, 0.0), (50.0, 10.0), (100.0, 100.0)]),
+        format!("{:?}", P::UpperLeft)
+    );
 }
