@@ -40,14 +40,19 @@ const BUNDLED_JSON: [&str; 17] = [
 ];
 
 /// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
-/// compact JSON). g = 0.8 at η 1.0–2.4 (0.2 apart) and g = 0.9 at η 1.0–1.7 (0.1 apart) and 1.8–2.4
+/// compact JSON). g = 0.8 at η 1.0, 1.1 and 1.2–2.4 (0.2 apart) and g = 0.9 at η 1.0–1.7 (0.1 apart) and 1.8–2.4
 /// (0.2 apart); Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
-/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 0.9 MB in all (the g = 0 set: 0.75 MB).
-pub const BUNDLED_G: [(f64, f64, &str); 20] = [
+/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 0.95 MB in all (the g = 0 set: 0.75 MB).
+pub const BUNDLED_G: [(f64, f64, &str); 21] = [
     (
         1.0,
         0.8,
         include_str!("../tables-g/mc-white-eta1.00-g0.80.json"),
+    ),
+    (
+        1.1,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.10-g0.80.json"),
     ),
     (
         1.2,
@@ -218,7 +223,7 @@ mod tests {
     fn bundled_grid_parses() {
         let grid = McGridSet::bundled().unwrap();
         assert_eq!(grid.g_nodes(), vec![0.0, 0.8, 0.9]);
-        for (set, n) in grid.nodes()[1..].iter().zip([8, 12]) {
+        for (set, n) in grid.nodes()[1..].iter().zip([9, 12]) {
             assert_eq!(set.tables().len(), n);
             assert_eq!(set.eta_range(), (1.0, 2.4));
         }
