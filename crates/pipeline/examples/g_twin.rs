@@ -10,7 +10,7 @@
 //! the twin's noise from the method's error at α′ → 1.
 //!
 //! ```text
-//! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G] [paper]
+//! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G] [paper|quick] [MATERIAL,…]
 //! ```
 
 use scatterfit_io::manifest::FitSection;
@@ -29,6 +29,7 @@ fn main() {
     let dir = tempfile::tempdir().unwrap();
     // `paper` as the second argument: the paper's rig (ten times the photons, 1 MP frames).
     let paper = std::env::args().nth(2).is_some_and(|a| a == "paper");
+    // (the seeds are 7, 8, … in the order the materials are given)
     let mut rig = if paper {
         RigSpec::paper()
     } else {
@@ -37,7 +38,12 @@ fn main() {
     rig.g = g;
     println!("| material | ch | α′ | σ′s: g = 0 assumed | g = {g} | σa: g = 0 assumed | g = {g} |");
     println!("|---|---|---|---|---|---|---|");
-    for (k, name) in ["wood-tile", "sulfur", "skin2"].iter().enumerate() {
+    // Materials as the third argument, comma-separated (default: wood-tile, sulfur, skin2).
+    let names: Vec<String> = std::env::args().nth(3).map_or_else(
+        || vec!["wood-tile".into(), "sulfur".into(), "skin2".into()],
+        |a| a.split(',').map(str::to_string).collect(),
+    );
+    for (k, name) in names.iter().enumerate() {
         let m = by_name(name).unwrap();
         let t = std::time::Instant::now();
         let s = synthesize(
