@@ -84,8 +84,8 @@ pub struct Args {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -118,7 +118,7 @@ fn hdr_inputs(args: &Args, budget: u64) -> HdrInputs {
 /// Reads the bracket (with a progress bar unless `quiet`), notes dropped alpha channels, checks the
 /// merge's memory against the budget and merges, through the pipeline's HDR stage.
 fn read_and_merge(args: &Args, quiet: bool) -> anyhow::Result<HdrStage> {
-    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    let budget = args.memory.budget();
     let mut inputs = hdr_inputs(args, budget);
     let bar = crate::common::bar(
         args.images.len() as u64,

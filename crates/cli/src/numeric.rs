@@ -15,6 +15,28 @@ pub const MAX_INTERACTIONS_HELP: &str = "Work budget: the most photon interactio
      σs, σa, g, η and the thickness; a count (default 1e12: about 7 h on 2 cores at 2e7 \
      interactions/s per thread). Raise it to allow longer runs";
 
+/// The memory budget of a command that sizes its work from its flags and inputs
+/// (`--max-memory-mib`: `merge`, `profile`, `render`, `simulate`, `table`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct MemoryArgs {
+    #[arg(long, value_parser = parse_mib, help = MAX_MEMORY_HELP)]
+    pub max_memory_mib: Option<u64>,
+}
+
+impl MemoryArgs {
+    /// The budget \[bytes\] ([`memory_budget`]).
+    pub fn budget(&self) -> u64 {
+        memory_budget(self.max_memory_mib)
+    }
+}
+
+/// The Monte Carlo work budget (`--max-interactions`: `simulate`, `table`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct WorkArgs {
+    #[arg(long, default_value = "1e12", value_parser = parse_count, help = MAX_INTERACTIONS_HELP)]
+    pub max_interactions: u64,
+}
+
 /// Refuses a flag's value unless `ok`, with the flag, the value and `rule` (the valid range, its
 /// unit and why), e.g. `--ring-width-px 0: must be > 0 px …`.
 ///

@@ -49,8 +49,8 @@ pub struct Args {
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -108,7 +108,7 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
     crate::numeric::check_memory(
         &format!("a profile of {rings} rings × 3 channels"),
         (rings as u64 + 1).saturating_mul(3 * BYTES_PER_RING_CHANNEL),
-        crate::numeric::memory_budget(args.max_memory_mib),
+        args.memory.budget(),
     )
 }
 
@@ -140,7 +140,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &[args.radiance.as_path()],
         args.force,
     )?;
-    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    let budget = args.memory.budget();
     let image = read_radiance_within(&args.radiance, budget)?;
     let limits = args.detection_limit.map_or_else(Vec::new, |l| l.to_vec());
     let settings = ProfileSettings {

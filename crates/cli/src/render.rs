@@ -188,8 +188,8 @@ pub struct Args {
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -239,7 +239,7 @@ fn check_numbers(args: &Args, panels: usize) -> anyhow::Result<()> {
     crate::numeric::check_memory(
         &format!("rendering {panels} panel(s) of {w}×{h} px"),
         scatterfit_render::request::memory_bytes(w, h, panels, args.triangles, args.light_rays),
-        crate::numeric::memory_budget(args.max_memory_mib),
+        args.memory.budget(),
     )
 }
 

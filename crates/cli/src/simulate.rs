@@ -58,11 +58,10 @@ pub struct Args {
     /// Accept η < 1 (a material optically thinner than air).
     #[arg(long)]
     pub allow_eta_below_one: bool,
-    #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
-          help = crate::numeric::MAX_INTERACTIONS_HELP)]
-    pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub work: crate::numeric::WorkArgs,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Write the result to FILE: `.csv` the profile (r_inner_mm, r_outer_mm, r_mm, rd_per_mm2,
     /// rd_stderr_per_mm2), `.json` the whole result as --json prints it. Checked before the run; an
     /// existing file only with --force.
@@ -174,7 +173,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
     if args.bins == 0 {
         bail!("--bins 0: the radial grid needs at least one bin");
     }
-    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    let budget = args.memory.budget();
     crate::numeric::check_memory(
         &format!(
             "tallying {} radial and {} angular bins",
@@ -209,7 +208,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
     let sim = Simulation::new(sample, beam, grid, args.photons, args.seed)?
         .with_angle_bins(args.angle_bins);
     let cost = sim.cost_estimate();
-    if cost.interactions > args.max_interactions as f64 {
+    if cost.interactions > args.work.max_interactions as f64 {
         bail!(
             "this run is expected to take about {:.1e} interactions ({:.3e} per photon × {} \
              photons; σs = σ′s/(1 − g) = {:.4e} mm⁻¹, σa = {} mm⁻¹{}), about {} on {} threads, \
@@ -224,7 +223,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
                 .map_or_else(|| ", half-space".to_owned(), |t| format!(", {t} mm thick")),
             crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
             rayon::current_num_threads(),
-            args.max_interactions as f64,
+            args.work.max_interactions as f64,
             if args.thickness_mm.is_some() {
                 ", a thinner slab"
             } else {

@@ -47,11 +47,10 @@ pub struct Args {
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
-          help = crate::numeric::MAX_INTERACTIONS_HELP)]
-    pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub work: crate::numeric::WorkArgs,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the table summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -103,9 +102,9 @@ fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
     crate::numeric::check_memory(
         "the table",
         cost.memory_bytes + table_bytes,
-        crate::numeric::memory_budget(args.max_memory_mib),
+        args.memory.budget(),
     )?;
-    if cost.interactions > args.max_interactions as f64 {
+    if cost.interactions > args.work.max_interactions as f64 {
         bail!(
             "building this table is expected to take about {:.1e} interactions ({} photons, \
              {:.3e} per photon on average; η and g lengthen the walks), about {} on {} threads, \
@@ -116,7 +115,7 @@ fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
             cost.interactions_per_photon,
             crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
             rayon::current_num_threads(),
-            args.max_interactions as f64,
+            args.work.max_interactions as f64,
         );
     }
     Ok(spec)

@@ -166,7 +166,6 @@ impl TableSummary {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::{Beam, Layer, RadialGrid, Sample, Simulation};
 
     /// The profile CSV has one row per annulus, its edges those of the grid, and Rd(r) read back
