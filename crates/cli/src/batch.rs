@@ -8,10 +8,9 @@ use std::process::ExitCode;
 use std::sync::Mutex;
 
 use scatterfit_io::result_json::MeasurementResult;
-use scatterfit_io::result_table::{table1_csv, table1_markdown};
 
 use crate::common::{FitArgs, SamplesArgs};
-use crate::output::{errln, out, outln};
+use crate::output::{out, outln};
 
 /// Arguments of `scatterfit batch`.
 #[derive(Debug, clap::Args)]
@@ -43,14 +42,11 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let shared: Vec<PathBuf> = [
-        "summary.csv",
-        "summary.md",
-        scatterfit_report::html::INDEX_PAGE,
-    ]
-    .iter()
-    .map(|f| args.output_dir.join(f))
-    .collect();
+    let shared: Vec<PathBuf> = scatterfit_report::tables::TABLE1_FILES
+        .iter()
+        .chain([&scatterfit_report::html::INDEX_PAGE])
+        .map(|f| args.output_dir.join(f))
+        .collect();
     let (dirs, misspelt) = crate::common::samples_for(
         "batch",
         &args.samples.dirs,
@@ -63,7 +59,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let outcomes = crate::runner::measure_many(
         &dirs,
         &overrides,
-        args.samples.jobs.unwrap_or(0),
+        args.samples.jobs.count(),
         args.quiet || args.json,
         &|dir, r| {
             if let Ok(m) = r
@@ -93,8 +89,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                         .filter_map(|c| c.problem.clone())
                         .collect();
                     failed.push((o.dir.clone(), why.join("; ")));
-                } else if !crate::common::trusted(&r) {
-                    failed.push((o.dir.clone(), crate::common::suspect_text(&r)));
+                } else if !scatterfit_report::trusted(&r) {
+                    failed.push((o.dir.clone(), scatterfit_report::suspect_text(&r)));
                 }
                 results.push(r);
                 result_dirs.push(o.dir.clone());
@@ -107,15 +103,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     std::fs::create_dir_all(&args.output_dir)?;
-    for (name, text) in [
-        ("summary.csv", table1_csv(&results)),
-        ("summary.md", table1_markdown(&results)),
-    ] {
-        let p = args.output_dir.join(name);
-        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
-            .map_err(|e| anyhow::anyhow!("writing {}: {e}", p.display()))?;
-    }
-    let index = crate::common::write_index(
+    scatterfit_report::write_table1(&args.output_dir, &results)?;
+    let index = scatterfit_report::html::write_results_index(
         &args.output_dir,
         "scatterfit batch",
         "One row per sample: its verdict (the data checks per channel), η, σ′s and σa per channel; \
@@ -123,7 +112,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &results,
         &result_dirs,
         &not_measured,
-        &["summary.csv", "summary.md"],
+        &scatterfit_report::tables::TABLE1_FILES,
     )?;
     if args.json {
         crate::output::print_json(&results)?;
@@ -140,15 +129,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
         outln!("index: {}", index.display())?;
     }
-    if !failed.is_empty() {
-        errln!(
-            "\n{} sample(s) failed, are incomplete or suspect:",
-            failed.len()
-        );
-        for (dir, why) in &failed {
-            errln!("  {}: {why}", dir.display());
-        }
-        return Ok(ExitCode::from(1));
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(crate::common::list_failures(
+        "failed, are incomplete or suspect",
+        &failed,
+    ))
 }

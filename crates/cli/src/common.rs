@@ -70,6 +70,9 @@ pub fn bar(len: u64, template: &str, quiet: bool) -> indicatif::ProgressBar {
     bar
 }
 
+/// The progress bar of a Monte Carlo run (`simulate`, `table`).
+pub const PHOTONS_BAR: &str = "{bar:40} {human_pos}/{human_len} photons  {per_sec}  ETA {eta}";
+
 /// Refuses to write into `dir` when any of `files` already exists there, unless `force`; a link or a
 /// non-file at one of their names always.
 ///
@@ -100,21 +103,7 @@ pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
         .or_else(scatterfit_mc::cache::default_cache_dir)
 }
 
-/// `1/600` for short times that are whole fractions, else 4 significant digits.
-pub fn shutter(t: f64) -> String {
-    if t < 0.5 && t > 0.0 {
-        let inv = 1.0 / t;
-        if (inv - inv.round()).abs() < 1e-6 * inv {
-            return format!("1/{}", inv.round());
-        }
-    }
-    if (1e-3..1e4).contains(&t) {
-        let decimals = (3 - t.log10().floor() as i32).max(0) as usize;
-        format!("{t:.decimals$}")
-    } else {
-        format!("{t:.3e}")
-    }
-}
+pub use scatterfit_pipeline::radiance::shutter;
 
 /// The fitting method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -235,9 +224,41 @@ pub struct SamplesArgs {
     /// Sample folders (each with a sample.toml), or folders holding sample folders.
     #[arg(required = true)]
     pub dirs: Vec<PathBuf>,
-    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
-          help = crate::runner::JOBS_HELP)]
+    #[command(flatten)]
+    pub jobs: JobsArgs,
+}
+
+/// How many samples are measured at once (`batch`, `compare`, `demo`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct JobsArgs {
+    #[arg(short = 'j', long, value_name = "N", value_parser = parse_jobs, help = JOBS_HELP)]
     pub jobs: Option<usize>,
+}
+
+impl JobsArgs {
+    /// The count asked for; 0 for the default (one per core, fewer when the memory budget says so).
+    pub fn count(&self) -> usize {
+        self.jobs.unwrap_or(0)
+    }
+}
+
+/// Samples measured at once [1, 256] (`-j`): the help text shared by `batch`, `compare`, `demo`.
+pub const JOBS_HELP: &str = "Samples measured at the same time: a count, 1 to 256 (default: one \
+     per core). Fewer are run at once when that many would not fit the memory budget \
+     ($SCATTERFIT_MAX_MEMORY_MIB, default 8192 MiB; each sample holds its decoded bracket and \
+     radiance map); a note on stderr says so";
+
+/// Parses `-j`: a count in 1..=256.
+///
+/// # Errors
+/// A message for clap.
+pub fn parse_jobs(text: &str) -> Result<usize, String> {
+    match crate::numeric::parse_size(text)? {
+        n @ 1..=256 => Ok(n),
+        n => Err(format!(
+            "{n} samples at once: give 1 to 256 (each holds a whole bracket in memory)"
+        )),
+    }
 }
 
 /// The Monte Carlo profile cache of the rig twin (`synth`, `demo`).
@@ -296,78 +317,15 @@ pub fn samples_for(
     Ok((found.dirs, found.misspelt))
 }
 
-/// True when no channel of a result has a data-check verdict other than `ok` (results without
-/// verdicts count as trusted: the checks did not run).
-pub fn trusted(r: &scatterfit_io::result_json::MeasurementResult) -> bool {
-    r.channels.iter().all(|c| {
-        c.quality
-            .as_ref()
-            .is_none_or(|q| q.verdict == scatterfit_io::quality::Verdict::Ok)
-    })
-}
-
-/// The suspect channels of a result and why, one line (`G suspect: …; B suspect: …`).
-pub fn suspect_text(r: &scatterfit_io::result_json::MeasurementResult) -> String {
-    r.channels
-        .iter_channels()
-        .filter_map(|(ch, c)| {
-            let q = c.quality.as_ref()?;
-            (q.verdict != scatterfit_io::quality::Verdict::Ok).then(|| {
-                format!(
-                    "{} {}: {}",
-                    ch.name(),
-                    q.verdict,
-                    scatterfit_io::escape::one_line(&q.summary())
-                )
-            })
-        })
-        .collect::<Vec<_>>()
-        .join("; ")
-}
-
-/// Writes `index.html` into `dir`: one row per result (its folder from `dirs`, linked to its
-/// report.html when there is one, and to its compare.svg when there is one), the samples of
-/// `failures` with their message, and links to `files` (names in `dir`). Returns its path.
-///
-/// # Errors
-/// When the page cannot be written.
-pub fn write_index(
-    dir: &Path,
-    title: &str,
-    intro: &str,
-    results: &[scatterfit_io::result_json::MeasurementResult],
-    dirs: &[PathBuf],
-    failures: &[(PathBuf, String)],
-    files: &[&str],
-) -> anyhow::Result<PathBuf> {
-    use scatterfit_report::html::{IndexEntry, IndexPage, SAMPLE_PAGE, link_from};
-    let samples = results
-        .iter()
-        .zip(dirs)
-        .map(|(result, d)| {
-            let page = d.join(SAMPLE_PAGE);
-            let compare = d.join("compare.svg");
-            IndexEntry {
-                result,
-                folder: d.display().to_string(),
-                page: page.exists().then(|| link_from(dir, &page)),
-                links: if compare.exists() {
-                    vec![("Figure 6".into(), link_from(dir, &compare))]
-                } else {
-                    Vec::new()
-                },
-            }
-        })
-        .collect();
-    let page = IndexPage {
-        title: title.into(),
-        intro: intro.into(),
-        samples,
-        failures: failures
-            .iter()
-            .map(|(d, why)| (d.display().to_string(), why.clone()))
-            .collect(),
-        files: files.iter().map(|f| (*f).to_string()).collect(),
-    };
-    Ok(scatterfit_report::html::write_index(dir, &page)?)
+/// Lists the samples of `failed` with why on stderr under `{n} sample(s) {what}:` and returns exit
+/// code 1; exit 0 when there are none.
+pub fn list_failures(what: &str, failed: &[(PathBuf, String)]) -> std::process::ExitCode {
+    if failed.is_empty() {
+        return std::process::ExitCode::SUCCESS;
+    }
+    crate::output::errln!("\n{} sample(s) {what}:", failed.len());
+    for (dir, why) in failed {
+        crate::output::errln!("  {}: {why}", dir.display());
+    }
+    std::process::ExitCode::from(1)
 }

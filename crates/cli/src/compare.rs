@@ -7,10 +7,10 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use scatterfit_io::result_table::{table2_csv, table2_markdown};
+use scatterfit_io::result_table::table2_markdown;
 
 use crate::common::{FitArgs, SamplesArgs};
-use crate::output::{errln, out, outln};
+use crate::output::{out, outln};
 
 /// Arguments of `scatterfit compare`.
 #[derive(Debug, clap::Args)]
@@ -41,14 +41,11 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let overrides = args.fit.overrides()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    let shared: Vec<PathBuf> = [
-        "compare.csv",
-        "compare.md",
-        scatterfit_report::html::INDEX_PAGE,
-    ]
-    .iter()
-    .map(|f| args.output_dir.join(f))
-    .collect();
+    let shared: Vec<PathBuf> = scatterfit_report::tables::TABLE2_FILES
+        .iter()
+        .chain([&scatterfit_report::html::INDEX_PAGE])
+        .map(|f| args.output_dir.join(f))
+        .collect();
     let (dirs, misspelt) = crate::common::samples_for(
         "compare",
         &args.samples.dirs,
@@ -65,23 +62,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } = crate::runner::compare_dirs(
         &dirs,
         &overrides,
-        args.samples.jobs.unwrap_or(0),
+        args.samples.jobs.count(),
         args.quiet || args.json,
         false,
         false,
     )?;
     failed.extend(misspelt);
     std::fs::create_dir_all(&args.output_dir)?;
-    for (name, text) in [
-        ("compare.csv", table2_csv(&pairs)),
-        ("compare.md", table2_markdown(&pairs)),
-    ] {
-        let p = args.output_dir.join(name);
-        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
-            .map_err(|e| anyhow::anyhow!("writing {}: {e}", p.display()))?;
-    }
+    scatterfit_report::write_table2(&args.output_dir, &pairs)?;
     let proposed: Vec<_> = pairs.iter().map(|(_, p)| p.clone()).collect();
-    let index = crate::common::write_index(
+    let index = scatterfit_report::html::write_results_index(
         &args.output_dir,
         "scatterfit compare",
         "One row per sample, the proposed method's values (α′ from the spectrophotometer, σ′s \
@@ -89,7 +79,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &proposed,
         &pair_dirs,
         &failed,
-        &["compare.csv", "compare.md"],
+        &scatterfit_report::tables::TABLE2_FILES,
     )?;
     if args.json {
         crate::output::print_json(&pairs)?;
@@ -102,12 +92,5 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
         outln!("index: {}", index.display())?;
     }
-    if !failed.is_empty() {
-        errln!("\n{} sample(s) failed:", failed.len());
-        for (dir, why) in &failed {
-            errln!("  {}: {why}", dir.display());
-        }
-        return Ok(ExitCode::from(1));
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(crate::common::list_failures("failed", &failed))
 }

@@ -15,7 +15,6 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use scatterfit_io::result_json::MeasurementResult;
-use scatterfit_io::result_table::{table1_csv, table1_markdown, table2_csv, table2_markdown};
 use scatterfit_synth::materials::CHOI_2014;
 
 use crate::common::CacheArgs;
@@ -39,9 +38,8 @@ pub struct Args {
     /// Seed of the rig twin, 0 to 2⁶⁴ − 1.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    #[arg(short = 'j', long, value_name = "N", value_parser = crate::runner::parse_jobs,
-          help = crate::runner::JOBS_HELP)]
-    pub jobs: Option<usize>,
+    #[command(flatten)]
+    pub jobs: crate::common::JobsArgs,
     /// Small fast samples (256 × 256 px at 0.1 mm/px, a tenth of the photons): a quick look, not the
     /// accuracy of the full rig.
     #[arg(long)]
@@ -125,7 +123,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } = crate::runner::compare_dirs(
         &dirs,
         &scatterfit_pipeline::Overrides::default(),
-        args.jobs.unwrap_or(0),
+        args.jobs.count(),
         quiet,
         true,
         true,
@@ -135,22 +133,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
     let out = &args.output_dir;
     let accuracy = scatterfit_report::accuracy_markdown(&rows);
-    for (name, text) in [
-        ("summary.csv", table1_csv(&proposed)),
-        ("summary.md", table1_markdown(&proposed)),
-        ("compare.csv", table2_csv(&pairs)),
-        ("compare.md", table2_markdown(&pairs)),
-        ("accuracy.md", accuracy.clone()),
-        (
-            "demo-summary.json",
-            serde_json::to_string_pretty(&rows).context("serialising the summary")? + "\n",
-        ),
-    ] {
-        let p = out.join(name);
-        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
-            .with_context(|| format!("writing {}", p.display()))?;
+    scatterfit_report::write_table1(out, &proposed)?;
+    scatterfit_report::write_table2(out, &pairs)?;
+    let json = serde_json::to_string_pretty(&rows).context("serialising the summary")? + "\n";
+    for (name, text) in [("accuracy.md", &accuracy), ("demo-summary.json", &json)] {
+        scatterfit_report::tables::write_text(&out.join(name), text)?;
     }
-    let index = crate::common::write_index(
+    let index = scatterfit_report::html::write_results_index(
         out,
         "scatterfit demo: the seven materials of Choi, Lee & Chin (2014)",
         "Monte Carlo rig-twin samples of the paper's seven materials, measured with the proposed \
@@ -192,12 +181,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         // The data checks' verdict on the proposed method's channels (RELIABILITY.md).
         let suspect: Vec<String> = proposed
             .iter()
-            .filter(|r| !crate::common::trusted(r))
+            .filter(|r| !scatterfit_report::trusted(r))
             .map(|r| {
                 format!(
                     "{}: {}",
                     scatterfit_io::escape::one_line(&r.name),
-                    crate::common::suspect_text(r)
+                    scatterfit_report::suspect_text(r)
                 )
             })
             .collect();
@@ -209,12 +198,5 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         // Last: the page a person opens (every sample's verdict and numbers, a link to each report).
         outln!("index: {}", index.display())?;
     }
-    if !failed.is_empty() {
-        errln!("\n{} sample(s) failed:", failed.len());
-        for (dir, why) in &failed {
-            errln!("  {}: {why}", dir.display());
-        }
-        return Ok(ExitCode::from(1));
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(crate::common::list_failures("failed", &failed))
 }

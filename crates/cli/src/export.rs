@@ -2,6 +2,7 @@
 //! Mitsuba 3, Blender (bpy script) or renderer-neutral JSON.
 //!
 //! The formats and their conventions are `scatterfit_io::export`'s (ARCHITECTURE.md, "io: exports");
+//! the exact-transport figures from the Monte Carlo tables are `scatterfit_pipeline::export`'s;
 //! this file parses the arguments, checks the output path, writes atomically or prints to stdout.
 //! A result with a failed channel exports nothing (exit 1, the channel named); unconstrained channels
 //! are exported with a warning on stderr.
@@ -11,10 +12,8 @@ use std::process::ExitCode;
 
 use crate::output::errln;
 use anyhow::{Context, bail};
-use scatterfit_io::export::{
-    ExportError, ExportOptions, Format, MitsubaVariant, SceneUnit, export_with,
-};
-use scatterfit_io::result_json::{MeasurementResult, read_result_json};
+use scatterfit_io::export::{ExportError, Format, MitsubaVariant, SceneUnit, export_with};
+use scatterfit_io::result_json::read_result_json;
 
 /// Arguments of `scatterfit export`.
 #[derive(Debug, clap::Args)]
@@ -110,15 +109,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     // The error's message already includes its cause; flatten it so `{:#}` does not repeat it.
     let result = read_result_json(&args.result).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let options = ExportOptions {
-        unit,
-        exact_rd: exact_transport_rd(&result),
-        spectral_albedo: spectral_albedo(&result),
-        mitsuba_variant: match args.mitsuba_variant {
-            VariantArg::Rgb => MitsubaVariant::Rgb,
-            VariantArg::Spectral => MitsubaVariant::Spectral,
-        },
+    let variant = match args.mitsuba_variant {
+        VariantArg::Rgb => MitsubaVariant::Rgb,
+        VariantArg::Spectral => MitsubaVariant::Spectral,
     };
+    let options = scatterfit_pipeline::export::export_options(&result, unit, variant);
     let exported = match export_with(&result, format, &options) {
         Ok(e) => e,
         Err(err @ ExportError::FailedChannel { .. }) => {
@@ -153,54 +148,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => crate::output::write_stdout_bytes(exported.text.as_bytes())?,
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Exact transport's total diffuse reflectance Rd_exact(α′, η) of each channel's exported medium (a
-/// half-space with the result's σ′s, σa, g = 0 and η), from the Monte Carlo tables shipped with
-/// scatterfit: what Mitsuba's and pbrt's volumetric path tracers render, which the export's header
-/// compares with the measured Rd. `None` when the tables do not cover the result (η outside 1.0–2.5)
-/// or a channel has no coefficients (the export then refuses it anyway).
-fn exact_transport_rd(result: &MeasurementResult) -> Option<[f64; 3]> {
-    let mc = scatterfit_mc::family(scatterfit_optics::ModelName::Mc).ok()?;
-    let rd = result.coefficients().ok()?.map(|(sp, sa)| {
-        let rd = mc.rd_total(sp / (sp + sa), result.eta, 0.0).ok()?;
-        (rd.is_finite() && (0.0..=1.0).contains(&rd)).then_some(rd)
-    });
-    Some(rd.transpose()?.into_array())
-}
-
-/// The single-scattering albedo whose exact-transport total Rd is the measured Rd(λ), at each
-/// wavelength of the result's spectrum (the Monte Carlo tables' inversion): the spectral medium's
-/// albedo. Rd(λ) beyond what the tables reach at this η (a nearly black band, Rd below the lowest
-/// tabulated albedo's; or above the highest's) takes that end albedo: the light it misplaces is at
-/// most the lowest albedo's Rd (a few 10⁻³ at most). `None` without a spectrum or where the tables do
-/// not cover η (1.0–2.5).
-fn spectral_albedo(result: &MeasurementResult) -> Option<Vec<f64>> {
-    let spec = result.rd_spectrum.as_ref()?;
-    let mc = scatterfit_mc::family(scatterfit_optics::ModelName::Mc).ok()?;
-    let eta = result.eta;
-    let reach = |grid: &[f64]| {
-        grid.iter().copied().find_map(|a| {
-            mc.rd_total(a, eta, 0.0)
-                .ok()
-                .filter(|rd| rd.is_finite())
-                .map(|rd| (a, rd))
-        })
-    };
-    let (a_lo, rd_lo) = reach(&[1e-3, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5])?;
-    let (a_hi, rd_hi) = reach(&[0.9999, 0.9995, 0.999, 0.995, 0.99])?;
-    spec.rd
-        .iter()
-        .map(|&rd| {
-            if rd <= rd_lo {
-                Some(a_lo)
-            } else if rd >= rd_hi {
-                Some(a_hi)
-            } else {
-                mc.albedo_from_rd(rd, eta, 0.0).ok()
-            }
-        })
-        .collect()
 }
 
 /// Refuses an output whose extension does not match the format, an existing file without `--force`,

@@ -6,7 +6,6 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use scatterfit_pipeline::{Stage, measure_sample};
-use serde::Serialize;
 
 use crate::common::{FitArgs, bar};
 use crate::output::{errln, out, outln};
@@ -33,11 +32,6 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
-}
-
-#[derive(Serialize)]
-struct Timing {
-    timings: scatterfit_pipeline::Timings,
 }
 
 /// Runs `scatterfit measure`.
@@ -108,10 +102,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .join(", ")
         )?;
     }
-    let _ = Timing { timings: m.timings };
     // Exit 1 for a channel without constrained parameters, or one the data checks call suspect
     // (the files are written first: the lab looks at fit.png and result.json's `quality`).
-    Ok(if crate::common::trusted(&result) && m.complete() {
+    Ok(if scatterfit_report::trusted(&result) && m.complete() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

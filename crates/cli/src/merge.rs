@@ -3,19 +3,20 @@
 //! The pipeline's HDR stage (`scatterfit_pipeline::hdr`) reads the frames (in parallel), recovers
 //! the camera response (or takes a known one) and merges; this command checks its flags and
 //! outputs first, shows the reading's progress, checks the merge's memory, saves the radiance map
-//! (EXR or HDR) and the response (CSV), and prints a summary. 8-bit frames use a response curve;
+//! (EXR or HDR) and the response (CSV), and prints the summary
+//! (`scatterfit_pipeline::radiance::MergeSummary`). 8-bit frames use a response curve;
 //! 16-bit frames are merged as linear data (raw or linear TIFF).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use crate::output::{errln, outln};
+use crate::output::{errln, out};
 use anyhow::{Context, bail};
 use scatterfit_imaging::{ClippedFill, Weighting};
 use scatterfit_io::image_files::write_radiance;
 use scatterfit_io::response_csv::{ResponseTable, write_response_csv};
-use scatterfit_pipeline::hdr::{self, FrameInfo, HdrInputs, HdrStage};
-use serde::Serialize;
+use scatterfit_pipeline::hdr::{self, HdrInputs, HdrStage};
+use scatterfit_pipeline::radiance::MergeSummary;
 
 /// What to store for a pixel-channel clipped in every exposure (it is always counted and reported).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -83,46 +84,11 @@ pub struct Args {
     /// Replace existing output files.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
-}
-
-/// The summary `scatterfit merge` prints.
-#[derive(Debug, Serialize)]
-pub struct Summary {
-    /// The frames, shortest exposure first.
-    pub frames: Vec<FrameInfo>,
-    /// Image size and kind, e.g. `6000×4000 RGB 8-bit`.
-    pub image: String,
-    /// Width \[px\].
-    pub width: usize,
-    /// Height \[px\].
-    pub height: usize,
-    /// `recovered`, `given` (file) or `linear` (16-bit).
-    pub response: String,
-    /// RMS residual of the response fit per channel (recovered responses only).
-    pub response_rms_residual: Vec<f64>,
-    /// Smallest positive finite radiance (relative units).
-    pub radiance_min: f64,
-    /// Largest finite radiance.
-    pub radiance_max: f64,
-    /// Dynamic range radiance_max / radiance_min, in stops (log2).
-    pub dynamic_range_stops: f64,
-    /// Pixel-channels clipped in every exposure (flagged, stored per --clipped-fill).
-    pub clipped_everywhere_samples: usize,
-    /// Pixels with at least one channel clipped in every exposure.
-    pub clipped_everywhere_pixels: usize,
-    /// The radiance map written.
-    pub output: PathBuf,
-    /// The response CSV written (none for a linear 16-bit merge).
-    pub response_out: Option<PathBuf>,
-    /// Wall time for reading the frames \[s\].
-    pub read_s: f64,
-    /// Wall time for response recovery and merge \[s\].
-    pub merge_s: f64,
 }
 
 fn default_response_out(output: &Path) -> PathBuf {
@@ -152,7 +118,7 @@ fn hdr_inputs(args: &Args, budget: u64) -> HdrInputs {
 /// Reads the bracket (with a progress bar unless `quiet`), notes dropped alpha channels, checks the
 /// merge's memory against the budget and merges, through the pipeline's HDR stage.
 fn read_and_merge(args: &Args, quiet: bool) -> anyhow::Result<HdrStage> {
-    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    let budget = args.memory.budget();
     let mut inputs = hdr_inputs(args, budget);
     let bar = crate::common::bar(
         args.images.len() as u64,
@@ -266,36 +232,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
     }
 
-    let HdrStage {
-        hdr,
-        response,
-        response_kind,
-        rms,
-        read_s,
-        merge_s,
-        frames,
-        image,
-        ..
-    } = read_and_merge(&args, args.json)?;
-    let (width, height) = (hdr.radiance.width(), hdr.radiance.height());
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    for (&v, &m) in hdr.radiance.data().iter().zip(hdr.clipped.data()) {
-        let v = f64::from(v);
-        if m == 0 && v.is_finite() && v > 0.0 {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-    }
-    let ch = hdr.clipped.channels();
-    let clipped_pixels = hdr
-        .clipped
-        .data()
-        .chunks_exact(ch)
-        .filter(|p| p.iter().any(|&m| m != 0))
-        .count();
+    let stage = read_and_merge(&args, args.json)?;
     // The radiance map first: if it cannot be written, no response CSV is left without it.
-    write_radiance(&args.output, &hdr.radiance).context("saving the radiance map")?;
-    let response_written = match &response {
+    write_radiance(&args.output, &stage.hdr.radiance).context("saving the radiance map")?;
+    let response_written = match &stage.response {
         Some(curve) if writes_response => {
             let table = ResponseTable {
                 g: curve.tables().iter().map(|t| t.to_vec()).collect(),
@@ -306,88 +246,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         _ => None,
     };
 
-    let summary = Summary {
-        frames,
-        image,
-        width,
-        height,
-        response: response_kind.to_string(),
-        response_rms_residual: rms,
-        radiance_min: if lo.is_finite() { lo } else { f64::NAN },
-        radiance_max: if hi > 0.0 { hi } else { f64::NAN },
-        dynamic_range_stops: if lo.is_finite() && hi > 0.0 {
-            (hi / lo).log2()
-        } else {
-            f64::NAN
-        },
-        clipped_everywhere_samples: hdr.clipped_count,
-        clipped_everywhere_pixels: clipped_pixels,
-        output: args.output.clone(),
-        response_out: response_written,
-        read_s,
-        merge_s,
-    };
+    let summary = MergeSummary::new(&stage, args.output.clone(), response_written);
     if args.json {
         crate::output::print_json(&summary)?;
     } else {
-        print_summary(&summary)?;
+        out!("{}", summary.text())?;
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn print_summary(s: &Summary) -> anyhow::Result<()> {
-    let t_min = s.frames.first().map_or(f64::NAN, |f| f.time_s);
-    let t_max = s.frames.last().map_or(f64::NAN, |f| f.time_s);
-    outln!(
-        "frames        {} × {} ({:.3} s read)",
-        s.frames.len(),
-        s.image,
-        s.read_s
-    )?;
-    outln!(
-        "times         {} s … {} s",
-        crate::common::shutter(t_min),
-        crate::common::shutter(t_max)
-    )?;
-    for f in &s.frames {
-        outln!(
-            "  {:>10} s  {}",
-            crate::common::shutter(f.time_s),
-            f.file.display()
-        )?;
-    }
-    let rms = if s.response_rms_residual.is_empty() {
-        String::new()
-    } else {
-        let v: Vec<String> = s
-            .response_rms_residual
-            .iter()
-            .map(|r| format!("{r:.3}"))
-            .collect();
-        format!(" (weighted RMS residual {})", v.join(", "))
-    };
-    outln!("response      {}{rms}", s.response)?;
-    outln!("merge         {:.3} s", s.merge_s)?;
-    outln!(
-        "radiance      {:.4e} … {:.4e} (relative), dynamic range {:.1} stops ({:.1} decades)",
-        s.radiance_min,
-        s.radiance_max,
-        s.dynamic_range_stops,
-        s.dynamic_range_stops * std::f64::consts::LOG10_2
-    )?;
-    outln!(
-        "clipped       {} pixels ({} pixel-channels) clipped in every exposure{}",
-        s.clipped_everywhere_pixels,
-        s.clipped_everywhere_samples,
-        if s.clipped_everywhere_samples > 0 {
-            " — flagged, not estimated"
-        } else {
-            ""
-        }
-    )?;
-    outln!("wrote         {}", s.output.display())?;
-    if let Some(r) = &s.response_out {
-        outln!("wrote         {}", r.display())?;
-    }
-    Ok(())
 }

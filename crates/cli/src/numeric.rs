@@ -15,6 +15,28 @@ pub const MAX_INTERACTIONS_HELP: &str = "Work budget: the most photon interactio
      σs, σa, g, η and the thickness; a count (default 1e12: about 7 h on 2 cores at 2e7 \
      interactions/s per thread). Raise it to allow longer runs";
 
+/// The memory budget of a command that sizes its work from its flags and inputs
+/// (`--max-memory-mib`: `merge`, `profile`, `render`, `simulate`, `table`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct MemoryArgs {
+    #[arg(long, value_parser = parse_mib, help = MAX_MEMORY_HELP)]
+    pub max_memory_mib: Option<u64>,
+}
+
+impl MemoryArgs {
+    /// The budget \[bytes\] ([`memory_budget`]).
+    pub fn budget(&self) -> u64 {
+        memory_budget(self.max_memory_mib)
+    }
+}
+
+/// The Monte Carlo work budget (`--max-interactions`: `simulate`, `table`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct WorkArgs {
+    #[arg(long, default_value = "1e12", value_parser = parse_count, help = MAX_INTERACTIONS_HELP)]
+    pub max_interactions: u64,
+}
+
 /// Refuses a flag's value unless `ok`, with the flag, the value and `rule` (the valid range, its
 /// unit and why), e.g. `--ring-width-px 0: must be > 0 px …`.
 ///
@@ -132,22 +154,7 @@ pub fn check_memory(what: &str, needed: u64, budget: u64) -> anyhow::Result<()> 
     Ok(())
 }
 
-/// A duration for messages: `45 s`, `12 min`, `3.5 h`, `40 days`, `3e4 years`.
-pub fn describe_seconds(s: f64) -> String {
-    if !s.is_finite() {
-        "forever".into()
-    } else if s < 120.0 {
-        format!("{s:.0} s")
-    } else if s < 7200.0 {
-        format!("{:.0} min", s / 60.0)
-    } else if s < 3.0 * 86_400.0 {
-        format!("{:.1} h", s / 3600.0)
-    } else if s < 1000.0 * 86_400.0 {
-        format!("{:.0} days", s / 86_400.0)
-    } else {
-        format!("{:.1e} years", s / (365.25 * 86_400.0))
-    }
-}
+pub use scatterfit_io::budget::describe_seconds;
 
 #[cfg(test)]
 mod tests {
@@ -174,13 +181,5 @@ mod tests {
         assert_eq!(show(0.5), "0.5");
         let err = ensure(false, "--ring-width-px", 1e-300, "rule").unwrap_err();
         assert_eq!(err.to_string(), "--ring-width-px 1e-300: rule");
-    }
-
-    #[test]
-    fn durations_read_well() {
-        assert_eq!(describe_seconds(45.0), "45 s");
-        assert_eq!(describe_seconds(720.0), "12 min");
-        assert_eq!(describe_seconds(12_600.0), "3.5 h");
-        assert_eq!(describe_seconds(f64::INFINITY), "forever");
     }
 }

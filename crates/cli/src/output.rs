@@ -12,7 +12,7 @@
 //! Both pass their text through one helper, `scatterfit_io::escape::terminal`: sample names, file
 //! names and messages quoting a file may hold escape sequences (ESC, an 8-bit CSI), carriage
 //! returns or bidirectional overrides that a terminal would act on; they are shown as `\u{1b}`
-//! instead (newlines and tabs are kept). JSON on stdout ([`print_json`]) has its C1 and
+//! instead (newlines and tabs are kept). JSON on stdout ([`print_json`], `scatterfit_io::escape::json`) has its C1 and
 //! bidirectional controls written as `\u009b` escapes, which JSON readers decode to the same
 //! string.
 
@@ -87,28 +87,6 @@ pub fn write_stderr(args: fmt::Arguments<'_>) {
         .write_all(scatterfit_io::escape::terminal(&text).as_bytes());
 }
 
-/// JSON text with the characters a terminal acts on that JSON leaves raw (C1 controls, DEL,
-/// bidirectional controls; C0 is already escaped by serde_json) written as `\uXXXX` escapes: the
-/// same JSON value, safe to print.
-pub fn json_terminal_safe(json: &str) -> std::borrow::Cow<'_, str> {
-    let bad = |c: char| {
-        matches!(c, '\u{7f}'..='\u{9f}' | '\u{61c}' | '\u{200e}' | '\u{200f}'
-            | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
-    };
-    if !json.chars().any(bad) {
-        return std::borrow::Cow::Borrowed(json);
-    }
-    let mut out = String::with_capacity(json.len() + 16);
-    for c in json.chars() {
-        if bad(c) {
-            out.push_str(&format!("\\u{:04x}", u32::from(c)));
-        } else {
-            out.push(c);
-        }
-    }
-    std::borrow::Cow::Owned(out)
-}
-
 /// `print!` that returns `anyhow::Result<()>` instead of panicking: use as `out!(…)?`.
 macro_rules! out {
     ($($arg:tt)*) => {
@@ -149,24 +127,5 @@ pub fn write_json_file<T: Serialize>(path: &Path, value: &T) -> anyhow::Result<(
 /// Prints `value` as pretty JSON on stdout.
 pub fn print_json<T: Serialize>(value: &T) -> anyhow::Result<()> {
     let text = serde_json::to_string_pretty(value).context("serialising the result as JSON")?;
-    outln!("{}", json_terminal_safe(&text))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// JSON made safe for a terminal is still the same JSON value.
-    #[test]
-    fn json_keeps_its_value() {
-        let name = "a\u{9b}2J\u{202e}b\u{1b}[31m\u{7f}";
-        let text = serde_json::to_string(&serde_json::json!({ "name": name })).unwrap();
-        let safe = json_terminal_safe(&text);
-        assert!(
-            !safe.contains(['\u{9b}', '\u{202e}', '\u{1b}', '\u{7f}']),
-            "{safe}"
-        );
-        let back: serde_json::Value = serde_json::from_str(&safe).unwrap();
-        assert_eq!(back["name"], name);
-    }
+    outln!("{}", scatterfit_io::escape::json(&text))
 }

@@ -8,12 +8,11 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use crate::output::outln;
+use crate::output::out;
 use anyhow::Context;
 use scatterfit_io::image_files::read_radiance_within;
 use scatterfit_io::profile_csv::write_profile_csv;
-use scatterfit_pipeline::profile::{CenterSource, ProfileSettings, profile_stage};
-use serde::Serialize;
+use scatterfit_pipeline::profile::{ProfileSettings, ProfileSummary, profile_stage};
 
 /// Arguments of `scatterfit profile`. Every number is checked before the radiance map is read
 /// (exit 2 with the range); the rings' memory (r_max / ring width of them) is checked against the
@@ -50,8 +49,8 @@ pub struct Args {
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -109,7 +108,7 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
     crate::numeric::check_memory(
         &format!("a profile of {rings} rings × 3 channels"),
         (rings as u64 + 1).saturating_mul(3 * BYTES_PER_RING_CHANNEL),
-        crate::numeric::memory_budget(args.max_memory_mib),
+        args.memory.budget(),
     )
 }
 
@@ -128,29 +127,6 @@ fn parse_center(text: &str) -> Result<[f64; 2], String> {
     }
 }
 
-/// The summary `scatterfit profile` prints.
-#[derive(Debug, Serialize)]
-pub struct Summary {
-    /// The radiance map read.
-    pub radiance: PathBuf,
-    /// Spot centre `[x, y]` \[px\].
-    pub center_px: [f64; 2],
-    /// `found` or `given`.
-    pub center_source: String,
-    /// Pixels in the spot region (found centres only).
-    pub spot_pixels: usize,
-    /// Rings written.
-    pub rings: usize,
-    /// Rings with no valid pixel in some channel.
-    pub empty_rings: usize,
-    /// Image scale [mm/px].
-    pub mm_per_pixel: f64,
-    /// Outermost ring radius \[mm\].
-    pub r_max_mm: f64,
-    /// The CSV written.
-    pub output: PathBuf,
-}
-
 /// Runs `scatterfit profile`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     check_args(&args)?;
@@ -164,65 +140,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &[args.radiance.as_path()],
         args.force,
     )?;
-    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    let budget = args.memory.budget();
     let image = read_radiance_within(&args.radiance, budget)?;
     let limits = args.detection_limit.map_or_else(Vec::new, |l| l.to_vec());
-    let stage = profile_stage(
-        &image,
-        None,
-        &limits,
-        &ProfileSettings {
-            mm_per_pixel: args.mm_per_pixel,
-            r_max_px: args.r_max_px,
-            ring_width_px: args.ring_width_px,
-            center_px: args.center,
-        },
-    )
-    .with_context(|| format!("{}", args.radiance.display()))?;
-    let table = stage.to_table();
-    write_profile_csv(&args.output, &table)?;
-    let profile = &stage.profile;
-    let summary = Summary {
-        radiance: args.radiance.clone(),
-        center_px: stage.center.xy(),
-        center_source: match stage.center_source {
-            CenterSource::Found => "found",
-            CenterSource::Given => "given",
-        }
-        .into(),
-        spot_pixels: stage.center.spot_pixels(),
-        rings: profile.rings.len(),
-        empty_rings: profile
-            .rings
-            .iter()
-            .filter(|r| r.channels.iter().any(|c| c.count == 0))
-            .count(),
+    let settings = ProfileSettings {
         mm_per_pixel: args.mm_per_pixel,
-        r_max_mm: table.r_mm.last().copied().unwrap_or(f64::NAN),
-        output: args.output.clone(),
+        r_max_px: args.r_max_px,
+        ring_width_px: args.ring_width_px,
+        center_px: args.center,
     };
+    let stage = profile_stage(&image, None, &limits, &settings)
+        .with_context(|| format!("{}", args.radiance.display()))?;
+    write_profile_csv(&args.output, &stage.to_table())?;
+    let summary = ProfileSummary::new(&stage, &settings, args.radiance, args.output);
     if args.json {
         crate::output::print_json(&summary)?;
     } else {
-        outln!(
-            "centre   ({:.3}, {:.3}) px, {}{}",
-            summary.center_px[0],
-            summary.center_px[1],
-            summary.center_source,
-            if stage.center_source == CenterSource::Found {
-                format!(" ({} spot pixels)", summary.spot_pixels)
-            } else {
-                String::new()
-            }
-        )?;
-        outln!(
-            "rings    {} × {} px, out to {:.3} mm ({} with an empty channel)",
-            summary.rings,
-            args.ring_width_px,
-            summary.r_max_mm,
-            summary.empty_rings
-        )?;
-        outln!("wrote    {}", summary.output.display())?;
+        out!("{}", summary.text())?;
     }
     Ok(ExitCode::SUCCESS)
 }

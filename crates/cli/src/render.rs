@@ -8,7 +8,6 @@
 //! method) and the existing method's values quoted with Figure 5 (`pink-plastic-existing`,
 //! `blue-coating-existing`, `brown-leather-existing`, with Table 1's η).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -189,8 +188,8 @@ pub struct Args {
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -240,7 +239,7 @@ fn check_numbers(args: &Args, panels: usize) -> anyhow::Result<()> {
     crate::numeric::check_memory(
         &format!("rendering {panels} panel(s) of {w}×{h} px"),
         scatterfit_render::request::memory_bytes(w, h, panels, args.triangles, args.light_rays),
-        crate::numeric::memory_budget(args.max_memory_mib),
+        args.memory.budget(),
     )
 }
 
@@ -331,12 +330,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         specs.len() * methods.list().len()
     };
     check_numbers(&args, panels)?;
-    if !(args.mesh_scale.is_finite() && args.mesh_scale > 0.0) {
-        bail!(
-            "--mesh-scale {} must be a positive number (mm per file unit)",
-            crate::numeric::show(args.mesh_scale)
-        );
-    }
     if !(1000..=10_000_000).contains(&args.triangles) {
         bail!("--triangles {} must lie in 1000–1e7", args.triangles);
     }
@@ -507,13 +500,9 @@ fn print_summary(args: &Args, s: &Summary) -> anyhow::Result<()> {
 }
 
 fn progress_bar(args: &Args, len: u64) -> indicatif::ProgressBar {
-    if args.quiet || !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(len);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} rows  {msg}  ETA {eta}")
-            .expect("valid template"),
-    );
-    bar
+    crate::common::bar(
+        len,
+        "{bar:40} {pos}/{len} rows  {msg}  ETA {eta}",
+        args.quiet,
+    )
 }

@@ -10,6 +10,7 @@ use indicatif::ProgressBar;
 use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_pipeline::batch::{BatchEvent, BatchRequest, measure_batch_with};
 use scatterfit_pipeline::compare::compare_batch_with;
+use scatterfit_pipeline::outputs::Failures;
 use scatterfit_pipeline::{Measurement, Overrides};
 
 /// One sample's outcome.
@@ -18,25 +19,6 @@ pub struct Outcome {
     pub dir: PathBuf,
     /// The measurement, or why there is none.
     pub result: anyhow::Result<Measurement>,
-}
-
-/// Samples measured at once [1, 256] (`-j`): the help text shared by `batch`, `compare`, `demo`.
-pub const JOBS_HELP: &str = "Samples measured at the same time: a count, 1 to 256 (default: one \
-     per core). Fewer are run at once when that many would not fit the memory budget \
-     ($SCATTERFIT_MAX_MEMORY_MIB, default 8192 MiB; each sample holds its decoded bracket and \
-     radiance map); a note on stderr says so";
-
-/// Parses `-j`: a count in 1..=256.
-///
-/// # Errors
-/// A message for clap.
-pub fn parse_jobs(text: &str) -> Result<usize, String> {
-    match crate::numeric::parse_size(text)? {
-        n @ 1..=256 => Ok(n),
-        n => Err(format!(
-            "{n} samples at once: give 1 to 256 (each holds a whole bracket in memory)"
-        )),
-    }
 }
 
 /// The progress bar's view of a batch: the plan (a note on stderr when the memory budget runs
@@ -108,9 +90,6 @@ pub fn measure_many(
         .collect())
 }
 
-/// Samples that failed, with why.
-pub type Failures = Vec<(PathBuf, String)>;
-
 /// One sample compared: (existing, proposed).
 pub type Pair = (MeasurementResult, MeasurementResult);
 
@@ -156,24 +135,7 @@ pub fn compare_dirs(
                 let e = anyhow::Error::from(e).context(format!("measuring {}", dir.display()));
                 crate::common::error_text(&e)
             })?;
-            let mut problems = Vec::new();
-            if write_results
-                && let Err(e) =
-                    scatterfit_report::write_measurement_with(dir, &c.proposed, Some(&c.existing))
-            {
-                let e = anyhow::Error::from(e);
-                problems.push(format!("writing the results: {e:#}"));
-            }
-            let name = c.proposed.manifest.display_name();
-            let fig = scatterfit_report::compare_figure(&c.existing, &c.proposed, &name);
-            if let Err(e) = scatterfit_report::write_figure(
-                &fig,
-                Some(&dir.join("compare.svg")),
-                Some(&dir.join("compare.png")),
-            ) {
-                let e = anyhow::Error::from(e);
-                problems.push(format!("writing the plot: {e:#}"));
-            }
+            let problems = scatterfit_report::write_comparison(dir, &c, write_results);
             let exact = c
                 .exact
                 .and_then(Result::ok)

@@ -1,14 +1,12 @@
 //! `scatterfit simulate`: Monte Carlo photon transport (MCML physics) in a slab or half-space.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use crate::output::{errln, outln};
+use crate::output::{errln, out, outln};
 use anyhow::{Context, bail};
-use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationResult};
-use serde::Serialize;
+use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationReport};
 
 /// Arguments of `scatterfit simulate`. Every number is checked before any work (exit 2 when out of
 /// range); the run's memory and expected work are checked against `--max-memory-mib` and
@@ -60,11 +58,10 @@ pub struct Args {
     /// Accept η < 1 (a material optically thinner than air).
     #[arg(long)]
     pub allow_eta_below_one: bool,
-    #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
-          help = crate::numeric::MAX_INTERACTIONS_HELP)]
-    pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub work: crate::numeric::WorkArgs,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Write the result to FILE: `.csv` the profile (r_inner_mm, r_outer_mm, r_mm, rd_per_mm2,
     /// rd_stderr_per_mm2), `.json` the whole result as --json prints it. Checked before the run; an
     /// existing file only with --force.
@@ -79,22 +76,6 @@ pub struct Args {
     /// No progress bar and no cost estimate on stderr.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// `simulate --json` output: the simulation result plus its inputs and timing.
-#[derive(Debug, Serialize)]
-struct Report<'a> {
-    sigma_s_prime: f64,
-    sigma_a: f64,
-    eta: f64,
-    g: f64,
-    thickness_mm: Option<f64>,
-    beam: &'a str,
-    incidence_deg: f64,
-    elapsed_s: f64,
-    photons_per_s: f64,
-    threads: usize,
-    result: &'a SimulationResult,
 }
 
 /// Parses `pencil`, `disk:R`, `gauss:R` (R in mm).
@@ -192,7 +173,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
     if args.bins == 0 {
         bail!("--bins 0: the radial grid needs at least one bin");
     }
-    let budget = crate::numeric::memory_budget(args.max_memory_mib);
+    let budget = args.memory.budget();
     crate::numeric::check_memory(
         &format!(
             "tallying {} radial and {} angular bins",
@@ -227,7 +208,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
     let sim = Simulation::new(sample, beam, grid, args.photons, args.seed)?
         .with_angle_bins(args.angle_bins);
     let cost = sim.cost_estimate();
-    if cost.interactions > args.max_interactions as f64 {
+    if cost.interactions > args.work.max_interactions as f64 {
         bail!(
             "this run is expected to take about {:.1e} interactions ({:.3e} per photon × {} \
              photons; σs = σ′s/(1 − g) = {:.4e} mm⁻¹, σa = {} mm⁻¹{}), about {} on {} threads, \
@@ -242,7 +223,7 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
                 .map_or_else(|| ", half-space".to_owned(), |t| format!(", {t} mm thick")),
             crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
             rayon::current_num_threads(),
-            args.max_interactions as f64,
+            args.work.max_interactions as f64,
             if args.thickness_mm.is_some() {
                 ", a thinner slab"
             } else {
@@ -268,7 +249,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.force,
         )?;
     }
-    let show = !args.quiet && std::io::stderr().is_terminal();
     let cost = sim.cost_estimate();
     let expected_s = cost.seconds(rayon::current_num_threads());
     if !args.quiet && expected_s > 10.0 {
@@ -280,30 +260,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             rayon::current_num_threads()
         );
     }
-    let bar = if show {
-        let bar = indicatif::ProgressBar::new(args.photons);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {human_pos}/{human_len} photons  {per_sec}  ETA {eta}",
-            )
-            .expect("static template"),
-        );
-        Some(bar)
-    } else {
-        None
-    };
+    let bar = crate::common::bar(args.photons, crate::common::PHOTONS_BAR, args.quiet);
     let start = Instant::now();
-    let result = sim.run_with_progress(&|done| {
-        if let Some(b) = &bar {
-            b.set_position(done);
-        }
-    });
+    let result = sim.run_with_progress(&|done| bar.set_position(done));
     let elapsed = start.elapsed().as_secs_f64();
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    bar.finish_and_clear();
     let rate = args.photons as f64 / elapsed.max(1e-9);
-    let report = Report {
+    let report = SimulationReport {
         sigma_s_prime: args.sigma_s_prime,
         sigma_a: args.sigma_a,
         eta: args.eta,
@@ -323,18 +286,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if is_json {
             crate::output::write_json_file(path, &report)?;
         } else {
-            let mut csv = String::from("r_inner_mm,r_outer_mm,r_mm,rd_per_mm2,rd_stderr_per_mm2\n");
-            let g = &result.grid;
-            for (i, e) in result.rd_profile.iter().enumerate() {
-                csv.push_str(&format!(
-                    "{},{},{},{:e},{:e}\n",
-                    g.edges()[i],
-                    g.edges()[i + 1],
-                    g.center(i),
-                    e.value,
-                    e.stderr
-                ));
-            }
+            let csv = result.profile_csv();
             scatterfit_io::atomic::write_atomic(path, csv.as_bytes())
                 .with_context(|| format!("writing {}", path.display()))?;
         }
@@ -342,22 +294,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&report)?;
     } else {
-        let e = |x: scatterfit_mc::Estimate| format!("{:.6} ± {:.6}", x.value, x.stderr);
-        outln!("photons            {}", result.photons)?;
-        outln!(
-            "interactions       {} ({:.1} per photon)",
-            result.interactions,
-            result.interactions as f64 / result.photons as f64
-        )?;
-        outln!("specular R_sp      {:.6}", result.specular)?;
-        outln!("diffuse Rd         {}", e(result.rd_total))?;
-        outln!("transmitted Tt     {}", e(result.transmittance))?;
-        outln!("absorbed A         {}", e(result.absorbed))?;
-        outln!("sum (should be 1)  {}", e(result.conservation))?;
-        outln!(
-            "speed              {rate:.3e} photons/s on {} threads ({elapsed:.2} s)",
-            rayon::current_num_threads()
-        )?;
+        out!("{}", report.text())?;
         if let Some(p) = &args.output {
             outln!("wrote              {}", p.display())?;
         }

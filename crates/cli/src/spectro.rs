@@ -1,13 +1,14 @@
-//! `scatterfit spectro`: the spectrophotometer stage on one reading.
+//! `scatterfit spectro`: the spectrophotometer stage on one reading (`scatterfit_optics::spectro`),
+//! reported by `scatterfit_report::spectro`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use crate::output::outln;
+use crate::output::out;
 use anyhow::{Context, bail};
 use scatterfit_optics::colour::{Lab, Observer};
-use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
-use serde::Serialize;
+use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, analyse};
+use scatterfit_report::{SpectroReport, spectro_text};
 
 /// Arguments of `scatterfit spectro`.
 #[derive(Debug, clap::Args)]
@@ -37,22 +38,6 @@ pub struct Args {
     pub force: bool,
 }
 
-/// The JSON document `scatterfit spectro` writes.
-#[derive(Debug, Serialize)]
-pub struct SpectroReport<'a> {
-    /// The input file.
-    pub file: String,
-    /// The options that shaped the result.
-    pub lab: Option<Lab>,
-    /// Observer of `lab`.
-    pub lab_observer: Option<u32>,
-    /// The analysis.
-    #[serde(flatten)]
-    pub analysis: &'a SpectroAnalysis,
-    /// scatterfit's version.
-    pub version: &'static str,
-}
-
 /// Runs `scatterfit spectro`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let options = options_from(&args)?;
@@ -77,7 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&report(&args, &analysis))?;
     } else {
-        print_summary(&args.file, &reading, &analysis)?;
+        out!("{}", spectro_text(&args.file, &reading, &analysis))?;
     }
     Ok(if analysis.complete() {
         ExitCode::SUCCESS
@@ -118,96 +103,13 @@ fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
 }
 
 fn report<'a>(args: &Args, analysis: &'a SpectroAnalysis) -> SpectroReport<'a> {
-    SpectroReport {
-        file: args.file.display().to_string(),
-        lab: analysis_lab(args),
-        lab_observer: args.lab.as_ref().map(|_| args.observer),
-        analysis,
-        version: env!("CARGO_PKG_VERSION"),
-    }
-}
-
-fn analysis_lab(args: &Args) -> Option<Lab> {
-    args.lab.as_ref().map(|v| Lab {
-        l: v[0],
-        a: v[1],
-        b: v[2],
-    })
-}
-
-fn print_summary(file: &Path, reading: &SpectroReading, a: &SpectroAnalysis) -> anyhow::Result<()> {
-    let wl = reading.wavelengths_nm();
-    outln!(
-        "{}: {} wavelengths, {}–{} nm",
-        file.display(),
-        wl.len(),
-        wl.first().copied().unwrap_or(0.0),
-        wl.last().copied().unwrap_or(0.0)
-    )?;
-    match a.eta_source {
-        scatterfit_optics::spectro::EtaSource::Given => outln!("η = {:.4} (given)", a.eta)?,
-        scatterfit_optics::spectro::EtaSource::SchlickSciMinusSce => outln!(
-            "η = {:.4}  (Schlick at 8° from SCI − SCE = {:.5}, luminance-weighted; exact Fresnel: {})",
-            a.eta,
-            a.specular_mean,
-            a.eta_exact_fresnel
-                .map_or("—".into(), |e| format!("{e:.4}"))
-        )?,
-    }
-    let ch = |c: usize| {
-        a.channels[c]
-            .eta_channel
-            .map_or("—".into(), |e| format!("{e:.4}"))
-    };
-    outln!(
-        "η per channel: R {}  G {}  B {}  (dispersion {})",
-        ch(0),
-        ch(1),
-        ch(2),
-        if a.dispersion_significant {
-            "significant"
-        } else {
-            "not significant"
-        }
-    )?;
-    outln!(
-        "SCE colour: L*a*b* D65/2° {:.3} {:.3} {:.3}   D65/10° {:.3} {:.3} {:.3}",
-        a.lab_2deg.l,
-        a.lab_2deg.a,
-        a.lab_2deg.b,
-        a.lab_10deg.l,
-        a.lab_10deg.a,
-        a.lab_10deg.b
-    )?;
-    outln!(
-        "            XYZ 2° {:.4} {:.4} {:.4}   10° {:.4} {:.4} {:.4}",
-        a.xyz_2deg.x,
-        a.xyz_2deg.y,
-        a.xyz_2deg.z,
-        a.xyz_10deg.x,
-        a.xyz_10deg.y,
-        a.xyz_10deg.z
-    )?;
-    let source = match a.colour_source {
-        scatterfit_optics::spectro::ColourSource::SceSpectrum => "SCE spectrum",
-        scatterfit_optics::spectro::ColourSource::Lab2 => "given L*a*b* (2°)",
-        scatterfit_optics::spectro::ColourSource::Lab10 => "given L*a*b* (10°, Bradford to 2°)",
-    };
-    outln!(
-        "\nchannel  Rd (linear sRGB, from {source})   α′ (dipole, η = {:.4})",
-        a.eta
-    )?;
-    for (name, c) in ["R", "G", "B"].iter().zip(&a.channels) {
-        let albedo = c.albedo_prime.map_or("—".to_owned(), |v| format!("{v:.6}"));
-        outln!("{name:<8} {:<38.6} {albedo}", c.rd_total)?;
-    }
-    for c in &a.channels {
-        if let Some(p) = &c.problem {
-            outln!("problem: {p}")?;
-        }
-    }
-    for w in &a.warnings {
-        outln!("warning: {w}")?;
-    }
-    Ok(())
+    let lab = args.lab.as_ref().map(|v| {
+        let lab = Lab {
+            l: v[0],
+            a: v[1],
+            b: v[2],
+        };
+        (lab, args.observer)
+    });
+    SpectroReport::new(&args.file, lab, analysis)
 }

@@ -3,15 +3,12 @@
 //! the tables shipped with scatterfit for g = 0 are such tables, with the default photons) — and can
 //! write it to a file.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use crate::output::{errln, outln};
+use crate::output::{errln, out};
 use anyhow::{Context, bail};
-use scatterfit_mc::McTableSpec;
-use scatterfit_mc::cache::CacheStatus;
-use serde::Serialize;
+use scatterfit_mc::{McTableSpec, TableSummary};
 
 /// Arguments of `scatterfit table`. Every number is checked before any work (exit 2 when out of
 /// range); the build's expected work and memory are checked against `--max-interactions` and
@@ -50,11 +47,10 @@ pub struct Args {
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
-    #[arg(long, default_value = "1e12", value_parser = crate::numeric::parse_count,
-          help = crate::numeric::MAX_INTERACTIONS_HELP)]
-    pub max_interactions: u64,
-    #[arg(long, value_parser = crate::numeric::parse_mib, help = crate::numeric::MAX_MEMORY_HELP)]
-    pub max_memory_mib: Option<u64>,
+    #[command(flatten)]
+    pub work: crate::numeric::WorkArgs,
+    #[command(flatten)]
+    pub memory: crate::numeric::MemoryArgs,
     /// Print the table summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -106,9 +102,9 @@ fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
     crate::numeric::check_memory(
         "the table",
         cost.memory_bytes + table_bytes,
-        crate::numeric::memory_budget(args.max_memory_mib),
+        args.memory.budget(),
     )?;
-    if cost.interactions > args.max_interactions as f64 {
+    if cost.interactions > args.work.max_interactions as f64 {
         bail!(
             "building this table is expected to take about {:.1e} interactions ({} photons, \
              {:.3e} per photon on average; η and g lengthen the walks), about {} on {} threads, \
@@ -119,28 +115,10 @@ fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
             cost.interactions_per_photon,
             crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
             rayon::current_num_threads(),
-            args.max_interactions as f64,
+            args.work.max_interactions as f64,
         );
     }
     Ok(spec)
-}
-
-#[derive(Debug, Serialize)]
-struct Summary {
-    /// The cache file.
-    path: PathBuf,
-    status: &'static str,
-    /// The file written with -o.
-    output: Option<PathBuf>,
-    eta: f64,
-    g: f64,
-    /// The albedo nodes (single-scattering albedo a; α′ for g = 0).
-    albedos: Vec<f64>,
-    rd_total: Vec<f64>,
-    rd_total_stderr: Vec<f64>,
-    radial_bins: usize,
-    /// Photons per stratum: paths cut at 64 and 1024 interactions, and full length.
-    photons: Vec<u64>,
 }
 
 /// Runs `scatterfit table`.
@@ -177,43 +155,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             rayon::current_num_threads()
         );
     }
-    let bar = (!args.quiet && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(0);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {human_pos}/{human_len} photons  {per_sec}  ETA {eta}",
-            )
-            .expect("static template"),
-        );
-        bar
-    });
+    let bar = crate::common::bar(0, crate::common::PHOTONS_BAR, args.quiet);
     let (table, status, path) =
         scatterfit_mc::McTable::load_or_build(&spec, &dir, &|done, total| {
-            if let Some(b) = &bar {
-                b.set_length(total);
-                b.set_position(done);
-            }
+            bar.set_length(total);
+            bar.set_position(done);
         })
         .with_context(|| format!("building the table in {}", dir.display()))?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    let (tot, se) = table.totals();
-    let summary = Summary {
-        path,
-        status: match status {
-            CacheStatus::Loaded => "loaded from cache",
-            _ => "built and cached",
-        },
-        output: args.output.clone(),
-        eta: spec.eta,
-        g: spec.g,
-        albedos: table.albedos().to_vec(),
-        rd_total: tot.to_vec(),
-        rd_total_stderr: se.to_vec(),
-        radial_bins: spec.radial_bins,
-        photons: spec.photons.clone(),
-    };
+    bar.finish_and_clear();
+    let summary = TableSummary::new(&table, &spec, status, path, args.output.clone());
     if let Some(out) = &args.output {
         let json = serde_json::to_vec(&table.clone().compact())
             .context("the table does not serialise (a defect)")?;
@@ -223,26 +173,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.json {
         crate::output::print_json(&summary)?;
     } else {
-        outln!("table   {} ({})", summary.path.display(), summary.status)?;
-        if let Some(out) = &summary.output {
-            outln!("wrote   {}", out.display())?;
-        }
-        outln!(
-            "eta {}  g {}  {} radial bins  photons {}",
-            spec.eta,
-            spec.g,
-            summary.radial_bins,
-            spec.photons
-                .iter()
-                .map(u64::to_string)
-                .collect::<Vec<_>>()
-                .join(" + ")
-        )?;
-        let head = if spec.g == 0.0 { "albedo'" } else { "albedo" };
-        outln!("{head:>10} {:>12} {:>10}", "Rd total", "s.e.")?;
-        for ((a, r), s) in table.albedos().iter().zip(tot).zip(se) {
-            outln!("{a:>10.6} {r:>12.6} {s:>10.6}")?;
-        }
+        out!("{}", summary.text())?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -5,53 +5,20 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::sync::OnceLock;
 use std::time::{Duration, Instant, SystemTime};
 
-struct Run {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
+mod common;
 
-fn scatterfit(cwd: &Path, args: &[&str]) -> Run {
-    let out: Output = Command::new(env!("CARGO_BIN_EXE_scatterfit"))
-        .args(args)
-        .current_dir(cwd)
-        .env("SCATTERFIT_CACHE", cache())
-        .output()
-        .unwrap();
-    Run {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
-
-fn cache() -> &'static Path {
-    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
-    DIR.get_or_init(|| tempfile::tempdir().unwrap()).path()
-}
+use common::{run_cached as scatterfit, synth_quick};
 
 /// One quick twin sample, made once; tests work on copies.
 fn pristine() -> &'static Path {
     static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
     DIR.get_or_init(|| {
-        let d = tempfile::tempdir().unwrap();
-        let out = scatterfit(
-            d.path(),
-            &[
-                "synth",
-                "--material",
-                "wood-tile",
-                "--quick",
-                "-o",
-                "s",
-                "--quiet",
-            ],
-        );
-        assert_eq!(out.code, 0, "{}", out.stderr);
+        let d = common::temp_dir();
+        synth_quick(d.path(), "wood-tile", "s");
         d
     })
     .path()

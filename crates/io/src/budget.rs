@@ -41,6 +41,23 @@ pub fn describe_bytes(bytes: u64) -> String {
     }
 }
 
+/// A duration for messages: `45 s`, `12 min`, `3.5 h`, `40 days`, `3e4 years`.
+pub fn describe_seconds(s: f64) -> String {
+    if !s.is_finite() {
+        "forever".into()
+    } else if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else if s < 3.0 * 86_400.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else if s < 1000.0 * 86_400.0 {
+        format!("{:.0} days", s / 86_400.0)
+    } else {
+        format!("{:.1e} years", s / (365.25 * 86_400.0))
+    }
+}
+
 /// How to raise the budget, for messages.
 pub fn how_to_raise() -> String {
     format!(
@@ -58,5 +75,13 @@ mod tests {
         assert_eq!(describe_bytes(512), "512 bytes");
         assert_eq!(describe_bytes(3 << 29), "1.5 GiB");
         assert_eq!(describe_bytes(144 << 20), "144 MiB");
+    }
+
+    #[test]
+    fn durations_read_well() {
+        assert_eq!(describe_seconds(45.0), "45 s");
+        assert_eq!(describe_seconds(720.0), "12 min");
+        assert_eq!(describe_seconds(12_600.0), "3.5 h");
+        assert_eq!(describe_seconds(f64::INFINITY), "forever");
     }
 }

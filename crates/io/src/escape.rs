@@ -5,7 +5,7 @@
 //!
 //! | where | what is escaped | how |
 //! |---|---|---|
-//! | a terminal ([`terminal`]: everything the CLI prints) | C0 controls but newline and tab (ESC starts every terminal escape sequence; CR rewrites a line), DEL, C1 controls (U+0080–U+009F: U+009B is an 8-bit CSI), the bidirectional overrides and isolates (U+202A–U+202E, U+2066–U+2069, U+200E, U+200F, U+061C: they reorder what is shown) | `\u{1b}` |
+//! | a terminal ([`terminal`]: everything the CLI prints; [`json`]: JSON it prints, as `\u009b` escapes) | C0 controls but newline and tab (ESC starts every terminal escape sequence; CR rewrites a line), DEL, C1 controls (U+0080–U+009F: U+009B is an 8-bit CSI), the bidirectional overrides and isolates (U+202A–U+202E, U+2066–U+2069, U+200E, U+200F, U+061C: they reorder what is shown) | `\u{1b}` |
 //! | one value in a line ([`one_line`]: a sample name, a file name) | the above, and newline and tab | `\u{a}` |
 //! | quoted content of a file ([`token`]) | as [`one_line`], shortened to [`MAX_TOKEN_CHARS`] characters | `…` |
 //! | a Markdown table cell ([`markdown_cell`]) | `\|`, `\`, `<`, `>`, `&` (raw HTML), line breaks, controls | `\|`, `&lt;` |
@@ -40,6 +40,26 @@ pub fn terminal(text: &str) -> Cow<'_, str> {
     for c in text.chars() {
         if is_terminal_control(c) {
             out.push_str(&escaped(c));
+        } else {
+            out.push(c);
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// JSON text with the characters a terminal acts on that JSON leaves raw (C1 controls, DEL,
+/// bidirectional controls; C0 is already escaped by serde_json) written as `\uXXXX` escapes: the
+/// same JSON value, safe to print.
+pub fn json(json: &str) -> Cow<'_, str> {
+    // DEL, C1 and the bidirectional controls: the terminal controls that are not C0.
+    let bad = |c: char| (is_terminal_control(c) && !c.is_ascii_control()) || c == '\u{7f}';
+    if !json.chars().any(bad) {
+        return Cow::Borrowed(json);
+    }
+    let mut out = String::with_capacity(json.len() + 16);
+    for c in json.chars() {
+        if bad(c) {
+            let _ = write!(out, "\\u{:04x}", u32::from(c));
         } else {
             out.push(c);
         }
@@ -258,6 +278,20 @@ pub fn tokens<'a>(items: impl IntoIterator<Item = &'a str>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// JSON made safe for a terminal is still the same JSON value.
+    #[test]
+    fn json_keeps_its_value() {
+        let name = "a\u{9b}2J\u{202e}b\u{1b}[31m\u{7f}";
+        let text = serde_json::to_string(&serde_json::json!({ "name": name })).unwrap();
+        let safe = json(&text);
+        assert!(
+            !safe.contains(['\u{9b}', '\u{202e}', '\u{1b}', '\u{7f}']),
+            "{safe}"
+        );
+        let back: serde_json::Value = serde_json::from_str(&safe).unwrap();
+        assert_eq!(back["name"], name);
+    }
 
     /// Hostile names of our own (not only the issue's): an ANSI colour and title-setting sequence,
     /// an 8-bit CSI, a carriage return that would overwrite "failed" with "ok", a right-to-left

@@ -2,6 +2,8 @@
 //! "pixels at the same distance from the focus point … averaged"), with each ring's detection
 //! limit, as the fit takes them.
 
+use std::path::PathBuf;
+
 use scatterfit_fit::{ProfileData, Ring};
 use scatterfit_imaging::{
     CLIPPED_HIGH, CenterOptions, ImageBuf, ProfileOptions, RadialProfile, SpotCenter,
@@ -323,6 +325,83 @@ impl ProfileStage {
                 })
                 .collect(),
         }
+    }
+}
+
+/// What the profile stage gave, as `scatterfit profile` prints it (`--json` serialises it as is).
+#[derive(Debug, Clone, Serialize)]
+pub struct ProfileSummary {
+    /// The radiance map read.
+    pub radiance: PathBuf,
+    /// Spot centre `[x, y]` \[px\].
+    pub center_px: [f64; 2],
+    /// `found` or `given`.
+    pub center_source: CenterSource,
+    /// Pixels in the spot region (found centres only).
+    pub spot_pixels: usize,
+    /// Rings written.
+    pub rings: usize,
+    /// Rings with no valid pixel in some channel.
+    pub empty_rings: usize,
+    /// Image scale [mm/px].
+    pub mm_per_pixel: f64,
+    /// Outermost ring radius \[mm\].
+    pub r_max_mm: f64,
+    /// The CSV written.
+    pub output: PathBuf,
+    /// Ring width \[px\] (in the text, not the JSON).
+    #[serde(skip)]
+    pub ring_width_px: f64,
+}
+
+impl ProfileSummary {
+    /// The summary of `stage`, made with `settings` from the radiance map `radiance` and written to
+    /// `output`.
+    pub fn new(
+        stage: &ProfileStage,
+        settings: &ProfileSettings,
+        radiance: PathBuf,
+        output: PathBuf,
+    ) -> Self {
+        let profile = &stage.profile;
+        Self {
+            radiance,
+            center_px: stage.center.xy(),
+            center_source: stage.center_source,
+            spot_pixels: stage.center.spot_pixels(),
+            rings: profile.rings.len(),
+            empty_rings: profile
+                .rings
+                .iter()
+                .filter(|r| r.channels.iter().any(|c| c.count == 0))
+                .count(),
+            mm_per_pixel: settings.mm_per_pixel,
+            r_max_mm: (0..profile.rings.len())
+                .filter_map(|k| profile.r_mm(k))
+                .next_back()
+                .unwrap_or(f64::NAN),
+            output,
+            ring_width_px: settings.ring_width_px,
+        }
+    }
+
+    /// The summary as `scatterfit profile` prints it: the centre, the rings, the file written.
+    pub fn text(&self) -> String {
+        let source = match self.center_source {
+            CenterSource::Found => format!("found ({} spot pixels)", self.spot_pixels),
+            CenterSource::Given => "given".into(),
+        };
+        format!(
+            "centre   ({:.3}, {:.3}) px, {source}\nrings    {} × {} px, out to {:.3} mm ({} with an \
+             empty channel)\nwrote    {}\n",
+            self.center_px[0],
+            self.center_px[1],
+            self.rings,
+            self.ring_width_px,
+            self.r_max_mm,
+            self.empty_rings,
+            self.output.display()
+        )
     }
 }
 

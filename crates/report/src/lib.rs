@@ -12,7 +12,8 @@
 //!   shape of the paper's Figure 4; [`compare_figure`]: measured, existing and proposed method, its
 //!   Figure 6), drawn by [`write_figure`] as SVG and/or PNG;
 //! - **the printed summary** ([`summary_text`]): η and per channel σ′s, σa with their
-//!   uncertainties, α′, MSE.
+//!   uncertainties, α′, MSE; and the spectrophotometer stage's alone ([`spectro_text`],
+//!   [`SpectroReport`]).
 //!
 //! Figures are data ([`Figure`] → [`Panel`]s → [`Series`]), so a program can plot its own
 //! profiles the same way. Rendering needs no system fonts: plotters runs without font-kit and the
@@ -45,12 +46,17 @@ pub mod figures;
 pub mod html;
 pub mod measurement;
 pub mod plot;
+pub mod spectro;
 pub mod study;
+pub mod tables;
 
 pub use accuracy::accuracy_markdown;
 pub use error::{ReportError, Result};
 pub use figures::{compare_figure, fit_figure};
 pub use measurement::{
-    WrittenReport, quality_line, summary_text, write_measurement, write_measurement_with,
+    WrittenReport, quality_line, summary_text, suspect_text, trusted, write_comparison,
+    write_measurement, write_measurement_with,
 };
 pub use plot::{Figure, Panel, Series, SeriesStyle, render_png, render_svg, write_figure};
+pub use spectro::{SpectroReport, spectro_text};
+pub use tables::{write_table1, write_table2};

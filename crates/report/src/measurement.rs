@@ -5,11 +5,12 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use scatterfit_io::quality::Verdict;
 use scatterfit_io::result_json::{MeasurementResult, write_result_json};
 use scatterfit_io::result_table::{
     errors_note, port_note, sig4, sigma_cells, table1_csv, table1_markdown,
 };
-use scatterfit_pipeline::Measurement;
+use scatterfit_pipeline::{Compared, Measurement};
 
 use crate::error::{ReportError, Result};
 
@@ -128,6 +129,65 @@ pub fn quality_line(r: &MeasurementResult) -> Option<String> {
         })
         .collect();
     (!cells.is_empty()).then(|| format!("quality: {}", cells.join(" · ")))
+}
+
+/// Writes one sample's comparison into its folder `dir`: the plot shaped like the paper's Figure 6
+/// (`compare.svg`, `compare.png`) and, with `write_results`, the proposed measurement's result files
+/// as [`write_measurement_with`] writes them (its report.html with Figure 6). Returns what could not
+/// be written, one message each (`writing the results: …`, `writing the plot: …`, with their
+/// causes): a sample whose files failed is still compared.
+pub fn write_comparison(dir: &Path, c: &Compared, write_results: bool) -> Vec<String> {
+    let mut problems = Vec::new();
+    if write_results && let Err(e) = write_measurement_with(dir, &c.proposed, Some(&c.existing)) {
+        problems.push(format!("writing the results: {}", chain_text(&e)));
+    }
+    let name = c.proposed.manifest.display_name();
+    let fig = crate::compare_figure(&c.existing, &c.proposed, &name);
+    let (svg, png) = (dir.join("compare.svg"), dir.join("compare.png"));
+    if let Err(e) = crate::write_figure(&fig, Some(&svg), Some(&png)) {
+        problems.push(format!("writing the plot: {}", chain_text(&e)));
+    }
+    problems
+}
+
+/// An error and its causes joined by ": ".
+fn chain_text(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
+}
+
+/// True when no channel of `r` has a data-check verdict other than `ok` (results without verdicts
+/// count as trusted: the checks did not run).
+pub fn trusted(r: &MeasurementResult) -> bool {
+    r.channels
+        .iter()
+        .all(|c| c.quality.as_ref().is_none_or(|q| q.verdict == Verdict::Ok))
+}
+
+/// The suspect channels of `r` and why, one line (`G suspect: …; B suspect: …`); empty when
+/// [`trusted`].
+pub fn suspect_text(r: &MeasurementResult) -> String {
+    r.channels
+        .iter_channels()
+        .filter_map(|(ch, c)| {
+            let q = c.quality.as_ref()?;
+            (q.verdict != Verdict::Ok).then(|| {
+                format!(
+                    "{} {}: {}",
+                    ch.name(),
+                    q.verdict,
+                    scatterfit_io::escape::one_line(&q.summary())
+                )
+            })
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// A human summary of one result, as `scatterfit measure` prints it: η (and the g assumed, when the

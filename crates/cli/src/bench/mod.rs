@@ -1,18 +1,14 @@
 //! `scatterfit bench`: measures the hot paths on this machine and prints the figures that
-//! BENCHMARKS.md records. Each area has its module here (`optics`, `mc`, `imaging`, `fit`,
-//! `render`, as `scatterfit bench --help` lists them), which calls the library crates and the
-//! shared cli modules, never a command's file.
+//! BENCHMARKS.md records. The areas are the `scatterfit-bench` crate's (`optics`, `mc`, `imaging`,
+//! `fit`, `render`); `fit` first writes a rig-twin sample folder through the shared `twin` module,
+//! as `synth` does.
 
 mod fit;
-mod imaging;
-mod mc;
-mod optics;
-mod render;
 
 use std::process::ExitCode;
 
 use crate::output::outln;
-use serde::Serialize;
+pub use scatterfit_bench::Figure;
 
 /// Which part of the pipeline to measure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -45,37 +41,24 @@ pub struct Args {
     pub json: bool,
 }
 
-/// One measured figure.
-#[derive(Debug, Clone, Serialize)]
-pub struct Figure {
-    /// What was measured, e.g. "dipole Rd(r) + derivatives, 300 radii".
-    pub name: String,
-    /// The measured value.
-    pub value: f64,
-    /// Its unit, e.g. "µs", "photons/s", "s".
-    pub unit: String,
-    /// Context: problem size, threads, the target from the issue.
-    pub note: String,
-}
-
 /// Runs `scatterfit bench`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut figures = Vec::new();
     let all = args.area == Area::All;
     if all || args.area == Area::Optics {
-        figures.extend(optics::figures(&args)?);
+        figures.extend(scatterfit_bench::optics::figures(args.quick)?);
     }
     if all || args.area == Area::Mc {
-        figures.extend(mc::figures(&args)?);
+        figures.extend(scatterfit_bench::mc::figures(args.quick)?);
     }
     if all || args.area == Area::Imaging {
-        figures.extend(imaging::figures(&args)?);
+        figures.extend(scatterfit_bench::imaging::figures(args.quick)?);
     }
     if all || args.area == Area::Fit {
         figures.extend(fit::figures(&args)?);
     }
     if all || args.area == Area::Render {
-        figures.extend(render::figures(&args)?);
+        figures.extend(scatterfit_bench::render::figures(args.quick)?);
     }
     if args.json {
         crate::output::print_json(&figures)?;

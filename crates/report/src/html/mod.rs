@@ -108,6 +108,53 @@ pub fn write_index(dir: &Path, page: &IndexPage<'_>) -> Result<PathBuf> {
     Ok(path)
 }
 
+/// Writes `index.html` into `dir` for a command over many samples: one row per result (its folder
+/// from `folders`, linked to its report.html when there is one, and to its compare.svg, Figure 6,
+/// when there is one), the samples of `failures` with their message, and links to `files` (names
+/// in `dir`). Returns its path.
+///
+/// # Errors
+/// [`ReportError::Write`] naming the page.
+pub fn write_results_index(
+    dir: &Path,
+    title: &str,
+    intro: &str,
+    results: &[MeasurementResult],
+    folders: &[PathBuf],
+    failures: &[(PathBuf, String)],
+    files: &[&str],
+) -> Result<PathBuf> {
+    let samples = results
+        .iter()
+        .zip(folders)
+        .map(|(result, d)| {
+            let page = d.join(SAMPLE_PAGE);
+            let compare = d.join("compare.svg");
+            IndexEntry {
+                result,
+                folder: d.display().to_string(),
+                page: page.exists().then(|| link_from(dir, &page)),
+                links: if compare.exists() {
+                    vec![("Figure 6".into(), link_from(dir, &compare))]
+                } else {
+                    Vec::new()
+                },
+            }
+        })
+        .collect();
+    let page = IndexPage {
+        title: title.into(),
+        intro: intro.into(),
+        samples,
+        failures: failures
+            .iter()
+            .map(|(d, why)| (d.display().to_string(), why.clone()))
+            .collect(),
+        files: files.iter().map(|f| (*f).to_string()).collect(),
+    };
+    write_index(dir, &page)
+}
+
 /// The path of `target` as a link from a page in `page_dir`: relative when both resolve on this
 /// machine (so that the folder can be moved whole), else `target` as given; `/`-separated, not yet
 /// percent-encoded (the pages do that).

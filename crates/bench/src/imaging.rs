@@ -1,16 +1,16 @@
-//! `scatterfit bench imaging`: the HDR merge (through the pipeline's HDR stage, as `scatterfit merge`
-//! runs it), the radial profile and the spot centre on a synthetic 24-MP bracket.
+//! The imaging figures (`scatterfit bench imaging`): the HDR merge (through the pipeline's HDR
+//! stage, as `scatterfit merge` runs it), the radial profile and the spot centre on a synthetic
+//! 24-MP bracket.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::Context;
 use rayon::prelude::*;
 use scatterfit_imaging::ImageBuf;
 use scatterfit_io::image_files::CameraFrame;
 use scatterfit_pipeline::hdr::{HdrInputs, read_and_merge};
 
-use super::{Args, Figure};
+use crate::{BenchError, Figure, Result};
 
 /// A synthetic spot bracket: a radially decaying radiance (a light spot on a translucent sample)
 /// through a gamma-2.2 camera with a 1 % shot-like noise, 13 shutter times 1/600 s … 3 s.
@@ -51,15 +51,11 @@ fn synthetic_bracket(width: usize, height: usize) -> (Vec<ImageBuf<u8>>, Vec<f64
 }
 
 /// Writes a bracket as fast-compressed PNGs plus `exposures.csv` into `dir`.
-fn write_bracket_png(
-    dir: &Path,
-    frames: Vec<ImageBuf<u8>>,
-    times: &[f64],
-) -> anyhow::Result<PathBuf> {
+fn write_bracket_png(dir: &Path, frames: Vec<ImageBuf<u8>>, times: &[f64]) -> Result<PathBuf> {
     frames
         .into_par_iter()
         .enumerate()
-        .try_for_each(|(j, f)| -> anyhow::Result<()> {
+        .try_for_each(|(j, f)| -> Result<()> {
             let path = dir.join(format!("frame_{j:02}.png"));
             Ok(scatterfit_io::image_files::write_camera_frame(
                 &path,
@@ -76,30 +72,29 @@ fn write_bracket_jpeg(
     frames: &[ImageBuf<u8>],
     times: &[f64],
     quality: u8,
-) -> anyhow::Result<PathBuf> {
+) -> Result<PathBuf> {
     frames
         .par_iter()
         .enumerate()
-        .try_for_each(|(j, f)| -> anyhow::Result<()> {
+        .try_for_each(|(j, f)| -> Result<()> {
             let path = dir.join(format!("frame_{j:02}.jpg"));
             Ok(scatterfit_io::image_files::write_jpeg(&path, f, quality)?)
         })?;
     write_exposures_csv(dir, "jpg", "exposures_jpeg.csv", times)
 }
 
-fn write_exposures_csv(
-    dir: &Path,
-    ext: &str,
-    name: &str,
-    times: &[f64],
-) -> anyhow::Result<PathBuf> {
+fn write_exposures_csv(dir: &Path, ext: &str, name: &str, times: &[f64]) -> Result<PathBuf> {
     let mut csv = String::from("file,time_s\n");
     for (j, t) in times.iter().enumerate() {
         csv.push_str(&format!("frame_{j:02}.{ext},{t}\n"));
     }
     let csv_path = dir.join(name);
-    scatterfit_io::atomic::write_atomic(&csv_path, csv.as_bytes())
-        .with_context(|| format!("writing {}", csv_path.display()))?;
+    scatterfit_io::atomic::write_atomic(&csv_path, csv.as_bytes()).map_err(|source| {
+        BenchError::Io {
+            what: format!("writing {}", csv_path.display()),
+            source,
+        }
+    })?;
     Ok(csv_path)
 }
 
@@ -108,20 +103,22 @@ fn write_exposures_csv(
 /// quality-90 JPEGs) and the radial
 /// profile of the 24-MP radiance map. Set `SCATTERFIT_BENCH_BRACKET_DIR` to keep the bracket there
 /// (for timing `scatterfit merge` itself, e.g. under `/usr/bin/time -v`).
-pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
-    let (width, height) = if args.quick {
-        (1200, 800)
-    } else {
-        (6000, 4000)
-    };
+pub fn figures(quick: bool) -> Result<Vec<Figure>> {
+    let (width, height) = if quick { (1200, 800) } else { (6000, 4000) };
     let mp = (width * height) as f64 / 1e6;
     let threads = rayon::current_num_threads();
     let (frames, times) = synthetic_bracket(width, height);
     let keep = std::env::var_os("SCATTERFIT_BENCH_BRACKET_DIR").map(PathBuf::from);
-    let temp = tempfile::tempdir().context("creating a temporary folder for the bracket")?;
+    let temp = tempfile::tempdir().map_err(|source| BenchError::Io {
+        what: "creating a temporary folder for the bracket".into(),
+        source,
+    })?;
     let dir = match &keep {
         Some(d) => {
-            std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+            std::fs::create_dir_all(d).map_err(|source| BenchError::Io {
+                what: format!("creating {}", d.display()),
+                source,
+            })?;
             d.clone()
         }
         None => temp.path().to_path_buf(),

@@ -1,20 +1,16 @@
-//! `scatterfit bench render`: the validation renderer, stage by stage.
+//! The renderer figures (`scatterfit bench render`): the validation renderer, stage by stage.
 
 use std::time::Instant;
 
 use rayon::prelude::*;
 use scatterfit_render::{Material, Method, RenderOptions, Shape, render, studio, studio_lights};
 
-use super::{Args, Figure};
+use crate::{Figure, Result};
 
 /// The case — the statue at about 100 000 triangles, 512 × 512, both methods, pink plastic
 /// (Table 1) under the studio lights — with the time of each stage.
-pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
-    let (size, triangles) = if args.quick {
-        (128, 20_000)
-    } else {
-        (512, 100_000)
-    };
+pub fn figures(quick: bool) -> Result<Vec<Figure>> {
+    let (size, triangles) = if quick { (128, 20_000) } else { (512, 100_000) };
     let threads = rayon::current_num_threads();
     let m = &scatterfit_synth::materials::CHOI_2014[0];
     let material = Material::dipole(

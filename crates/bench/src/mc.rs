@@ -1,13 +1,13 @@
-//! `scatterfit bench mc`: Monte Carlo photon transport, photons per second.
+//! The Monte Carlo figures (`scatterfit bench mc`): Monte Carlo photon transport, photons per second.
 
 use std::time::Instant;
 
 use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation};
 
-use super::{Args, Figure};
+use crate::{Figure, Result};
 
 /// The two speed cases: (name, sample, photons at full size).
-fn speed_cases(quick: bool) -> anyhow::Result<Vec<(&'static str, Sample, u64, &'static str)>> {
+fn speed_cases(quick: bool) -> Result<Vec<(&'static str, Sample, u64, &'static str)>> {
     let k = if quick { 10 } else { 1 };
     Ok(vec![
         (
@@ -27,10 +27,10 @@ fn speed_cases(quick: bool) -> anyhow::Result<Vec<(&'static str, Sample, u64, &'
 
 /// Photons/s of both speed cases on one thread and on all threads (grid 0.1 mm × 200, as MCML's
 /// 0.01 cm × 200).
-pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
+pub fn figures(quick: bool) -> Result<Vec<Figure>> {
     let mut figures = Vec::new();
     let all = rayon::current_num_threads();
-    for (name, sample, photons, note) in speed_cases(args.quick)? {
+    for (name, sample, photons, note) in speed_cases(quick)? {
         for threads in [1, all] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

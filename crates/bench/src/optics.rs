@@ -1,4 +1,4 @@
-//! `scatterfit bench optics`: the optics core on one thread.
+//! The optics figures (`scatterfit bench optics`): the optics core on one thread.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -6,12 +6,12 @@ use std::time::Instant;
 use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::{Dipole, ProfileSample, albedo_from_rd};
 
-use super::{Args, Figure};
+use crate::{Figure, Result};
 
 /// The dipole profile with derivatives (300 radii) and the α′ inversion, timed over many
 /// repetitions.
-pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
-    let reps = if args.quick { 2_000 } else { 50_000 };
+pub fn figures(quick: bool) -> Result<Vec<Figure>> {
+    let reps = if quick { 2_000 } else { 50_000 };
     let radii: Vec<f64> = (1..=300).map(|i| 0.1 * i as f64).collect();
     let props = OpticalProperties::new(1.979, 0.0496, 1.2886)?;
     let mut out = vec![
