@@ -144,6 +144,31 @@ impl McGridSet {
         parts.join("; ")
     }
 
+    /// The g the grid answers, as closed intervals by increasing g: a run of nodes each within
+    /// [`McGridSet::max_step`] of the next is one interval, a lone node a point (`lo == hi`).
+    /// Within each interval every g is a node or interpolated between two; outside all of them
+    /// [`McGridSet::profile`] refuses with `AnisotropyNotTabulated` (never extrapolates).
+    pub fn covered(&self) -> Vec<(f64, f64)> {
+        let mut out = Vec::new();
+        let mut k = 0;
+        while k < self.nodes.len() {
+            let mut end = k;
+            while end + 1 < self.nodes.len()
+                && self.nodes[end + 1].g() - self.nodes[end].g() <= self.max_step
+            {
+                end += 1;
+            }
+            out.push((self.nodes[k].g(), self.nodes[end].g()));
+            k = end + 1;
+        }
+        out
+    }
+
+    /// True when the grid answers at `g` (a node, or between two nodes at most `max_step` apart).
+    pub fn covers(&self, g: f64) -> bool {
+        self.place(g).is_ok()
+    }
+
     fn not_tabulated(&self, g: f64) -> McError {
         McError::AnisotropyNotTabulated {
             given: g,
@@ -395,6 +420,8 @@ mod tests {
                 Err(McError::AnisotropyNotTabulated { .. })
             ));
         }
+        assert_eq!(grid.covered(), [(0.0, 0.0), (0.8, 0.9)]);
+        assert!(grid.covers(0.0) && grid.covers(0.85) && !grid.covers(0.5));
         assert_eq!(
             grid.coverage(),
             "g = 0 (η 1–2.5); g 0.8–0.9 (tables at 0.8, 0.9, linear in g between; η 1–2.4)"

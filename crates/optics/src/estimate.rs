@@ -31,9 +31,14 @@ pub struct Estimate {
     /// Standard error from the spectrophotometer: its η and α′ at the reading's repeatability,
     /// propagated to the value by refits (`scatterfit_pipeline::fit::propagate_spectro`).
     pub spectro: Option<f64>,
-    /// Standard error from the unknown anisotropy g of the phase function. Reserved for the
-    /// anisotropy work (the forward models are evaluated at one g, the manifest's `[fit] g`,
-    /// default 0; a range of g is not propagated yet): always `None` today.
+    /// The part from the anisotropy g of the phase function, when g is not known exactly (issue
+    /// 15): how far the estimate of the g-aware exact model (the `mc` tables over g, for the
+    /// profile and the α′ inversion) moves over the stated range of g — the largest deviation from
+    /// the estimate at the values' g, or half the spread when the values are the middle of the
+    /// range (`scatterfit_pipeline::anisotropy`). A bound-like half-width rather than a standard
+    /// deviation: a g anywhere in the range gives an estimate within it. `Some(0.0)` when g was
+    /// given (known); `None` when it could not be evaluated (the tables do not reach the data)
+    /// or was not asked for.
     pub g: Option<f64>,
 }
 
@@ -52,6 +57,15 @@ impl Estimate {
     pub fn with_fit(self, stderr: f64) -> Self {
         Self {
             fit: Some(stderr),
+            ..self
+        }
+    }
+
+    /// The same value with the anisotropy's term ([`Estimate::g`]).
+    #[must_use]
+    pub fn with_g(self, term: f64) -> Self {
+        Self {
+            g: Some(term),
             ..self
         }
     }
