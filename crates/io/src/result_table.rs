@@ -105,7 +105,8 @@ pub fn errors_note(results: &[MeasurementResult]) -> String {
     }
     t.push_str(
         "± … g: the anisotropy's part — how far the estimate moves over the range of the \
-         Henyey–Greenstein g, from the g-aware `mc` model (0 where g was given; issue 15).\n",
+         Henyey–Greenstein g, from the g-aware `mc` model (0 where g was given; issue 15); a bound, \
+         not a standard error: add it to the quadrature sum of the others for the total.\n",
     );
     let descriptions: Vec<String> = with_g
         .iter()

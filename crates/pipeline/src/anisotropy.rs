@@ -21,9 +21,10 @@
 //!   diffusion dipole keeps its value, and its term is the largest deviation from the `mc`
 //!   estimate at the g its fit used).
 //!
-//! This is a bound-like term, not a standard deviation: a g anywhere in the range gives an
-//! estimate within it (the estimates change monotonically with g at fixed data, BENCHMARKS.md),
-//! and it is added in quadrature like the others ([`scatterfit_optics::Estimate::total`]). The
+//! This is a bound, not a standard deviation: a g anywhere in the range gives an estimate within
+//! it (where the estimates change monotonically with g, as they do on the twins, BENCHMARKS.md
+//! "The g term: coverage"), so the total adds it linearly to the quadrature sum of the fit's and
+//! the spectrophotometer's standard errors ([`scatterfit_optics::Estimate::total`]). The
 //! diffusion dipoles do not depend on g; their g term is the sensitivity of the g-aware estimate,
 //! which is what their user needs to know. Parts of the range the tables do not cover are not
 //! evaluated (never extrapolated) and are named in the result ([`GPlan::not_covered`]).

@@ -128,8 +128,8 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
         "</tbody></table></div><p class=\"muted\">± terms are one standard error: fit, from the \
          fit's Jacobian at the solution; spectro, the spectrophotometer's part (its η and α′ at the \
          reading's repeatability, propagated through refits); g, the anisotropy's part (how far \
-         the estimate moves over the range of g; 0 where g was given). Add them in \
-         quadrature for the total.</p><h3>The fits</h3><div class=\"scroll\"><table><thead><tr><th>channel</th>\
+         the estimate moves over the range of g; 0 where g was given). The total is fit and spectro \
+         in quadrature plus g (a bound, not a standard error).</p><h3>The fits</h3><div class=\"scroll\"><table><thead><tr><th>channel</th>\
          <th>MSE [mm⁻⁴]</th><th>rms ln residual</th><th>χ²/dof</th><th>rings used</th>\
          <th>inside the spot</th><th>below detection</th><th>invalid</th><th>solver</th>\
          <th>fit time [µs]</th></tr></thead><tbody>\n",

@@ -37,7 +37,8 @@ impl Valued {
             .join(" ")
     }
 
-    /// The total standard error: the known terms (fit, spectro, g) in quadrature.
+    /// The total uncertainty: fit and spectro in quadrature plus the g term
+    /// (`scatterfit_optics::Estimate::total`).
     pub fn total_error(&self) -> Option<f64> {
         scatterfit_optics::Estimate {
             value: 0.0,
