@@ -108,15 +108,7 @@ impl McGridSet {
     /// "g = 0 (η 1–2.5); g 0.8–0.9 interpolated (η 1–2.4)".
     pub fn coverage(&self) -> String {
         let mut parts = Vec::new();
-        let mut k = 0;
-        while k < self.nodes.len() {
-            // A run of nodes each within max_step of the next is one interval.
-            let mut end = k;
-            while end + 1 < self.nodes.len()
-                && self.nodes[end + 1].g() - self.nodes[end].g() <= self.max_step
-            {
-                end += 1;
-            }
+        for (k, end) in self.runs() {
             let lo = self.nodes[k..=end]
                 .iter()
                 .map(|s| s.eta_range().0)
@@ -139,7 +131,6 @@ impl McGridSet {
                     nodes.join(", ")
                 ));
             }
-            k = end + 1;
         }
         parts.join("; ")
     }
@@ -149,6 +140,15 @@ impl McGridSet {
     /// Within each interval every g is a node or interpolated between two; outside all of them
     /// [`McGridSet::profile`] refuses with `AnisotropyNotTabulated` (never extrapolates).
     pub fn covered(&self) -> Vec<(f64, f64)> {
+        self.runs()
+            .into_iter()
+            .map(|(k, end)| (self.nodes[k].g(), self.nodes[end].g()))
+            .collect()
+    }
+
+    /// The runs of nodes each within `max_step` of the next, as (first, last) node indices: each
+    /// run is one interval of g the grid answers.
+    fn runs(&self) -> Vec<(usize, usize)> {
         let mut out = Vec::new();
         let mut k = 0;
         while k < self.nodes.len() {
@@ -158,7 +158,7 @@ impl McGridSet {
             {
                 end += 1;
             }
-            out.push((self.nodes[k].g(), self.nodes[end].g()));
+            out.push((k, end));
             k = end + 1;
         }
         out

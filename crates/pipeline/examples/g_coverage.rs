@@ -15,10 +15,10 @@
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::ChannelResult;
-use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, ModelName};
 use scatterfit_pipeline::anisotropy::GPrior;
 use scatterfit_pipeline::fit::FitSettings;
+use scatterfit_pipeline::study::write_twin_folder;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
@@ -124,27 +124,13 @@ fn main() {
             )
             .unwrap();
             let folder = dir.path().join(format!("{}-g{g}", m.name));
-            write_sample_folder(
-                &folder,
-                &SampleFiles {
-                    name: m.name,
-                    reading: &s.reading,
-                    lab10: None,
-                    frames: &s.bracket.frames,
-                    times_s: &s.bracket.times_s,
-                    mm_per_pixel: rig.mm_per_pixel,
-                    spot_diameter_mm: 2.0 * rig.spot_radius_mm,
-                    truth_json: None,
-                    provenance: "g_coverage example",
-                    // The user chose the exact model but does not know g: no g, no range.
-                    fit: FitSection {
-                        model: Some(ModelName::Mc),
-                        albedo_model: Some(AlbedoModel::Mc),
-                        ..Default::default()
-                    },
-                },
-            )
-            .unwrap();
+            // The user chose the exact model but does not know g: no g, no range.
+            let fit = FitSection {
+                model: Some(ModelName::Mc),
+                albedo_model: Some(AlbedoModel::Mc),
+                ..Default::default()
+            };
+            write_twin_folder(&folder, &s, fit, "g_coverage example").unwrap();
             let t_synth = t.elapsed().as_secs_f64();
             let t = std::time::Instant::now();
             let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();

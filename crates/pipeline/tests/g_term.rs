@@ -13,8 +13,8 @@
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::GSource;
-use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, ModelName};
+use scatterfit_pipeline::study::write_twin_folder;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
@@ -37,26 +37,12 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
     )
     .unwrap();
     let folder = dir.path().join(m.name);
-    write_sample_folder(
-        &folder,
-        &SampleFiles {
-            name: m.name,
-            reading: &s.reading,
-            lab10: None,
-            frames: &s.bracket.frames,
-            times_s: &s.bracket.times_s,
-            mm_per_pixel: rig.mm_per_pixel,
-            spot_diameter_mm: 2.0 * rig.spot_radius_mm,
-            truth_json: None,
-            provenance: "g_term test",
-            fit: FitSection {
-                model: Some(ModelName::Mc),
-                albedo_model: Some(AlbedoModel::Mc),
-                ..Default::default()
-            },
-        },
-    )
-    .unwrap();
+    let fit = FitSection {
+        model: Some(ModelName::Mc),
+        albedo_model: Some(AlbedoModel::Mc),
+        ..Default::default()
+    };
+    write_twin_folder(&folder, &s, fit, "g_term test").unwrap();
     let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
     let r = measured.to_result(None);
     let g = r.g_uncertainty.as_ref().unwrap();
