@@ -414,17 +414,17 @@ mod tests {
             Place::Between(1, t) => assert!((t - 0.25).abs() < 1e-12),
             p => panic!("{p:?}"),
         }
-        for g in [0.3, 0.95, f64::NAN] {
+        for g in [0.3, 0.96, f64::NAN] {
             assert!(matches!(
                 grid.place(g),
                 Err(McError::AnisotropyNotTabulated { .. })
             ));
         }
-        assert_eq!(grid.covered(), [(0.0, 0.0), (0.8, 0.9)]);
-        assert!(grid.covers(0.0) && grid.covers(0.85) && !grid.covers(0.5));
+        assert_eq!(grid.covered(), [(0.0, 0.0), (0.8, 0.95)]);
+        assert!(grid.covers(0.0) && grid.covers(0.85) && grid.covers(0.93) && !grid.covers(0.5));
         assert_eq!(
             grid.coverage(),
-            "g = 0 (η 1–2.5); g 0.8–0.9 (tables at 0.8, 0.9, linear in g between; η 1–2.4)"
+            "g = 0 (η 1–2.5); g 0.8–0.95 (tables at 0.8, 0.9, 0.95, linear in g between; η 1–1.8)"
         );
     }
 }

@@ -252,7 +252,7 @@ pub struct FitSection {
     /// and the α′ inversion are evaluated at it (σs = σ′s/(1 − g)). Default 0 — isotropic
     /// scattering, what the paper and every model before issue 15 assume; the diffusion dipoles do
     /// not depend on g, photon beam diffusion and the `mc` tables do (the tables hold g = 0 and
-    /// 0.8–0.9; another g with `mc` is refused with the tables' coverage). Real translucent
+    /// 0.8–0.95; another g with `mc` is refused with the tables' coverage). Real translucent
     /// materials have g ≈ 0.7–0.95: assuming 0 for them biases σa high (BENCHMARKS.md, "The `mc`
     /// model over g").
     pub g: Option<f64>,

@@ -416,7 +416,7 @@ pub struct GUncertainty {
 
 impl GUncertainty {
     /// One line for people: "g = 0.85 given (no g term)", or "g not stated, so taken as unknown in
-    /// 0–0.95: values at g = 0; ± g from the g-aware `mc` model at g = 0, 0.8, 0.9 (not evaluated,
+    /// 0–0.95: values at g = 0; ± g from the g-aware `mc` model at g = 0, 0.8, 0.9, 0.95 (not evaluated,
     /// no tables: …)".
     pub fn describe(&self) -> String {
         let list = |v: &[f64]| {
