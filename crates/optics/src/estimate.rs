@@ -100,9 +100,10 @@ impl Estimate {
     /// carries the statistical error of its own fit. The interval that covers the truth is the
     /// range of the estimates widened by that error — a linear sum (the worst case of a bounded
     /// systematic and a random error; a quadrature sum lets the bar fall short of the end of the
-    /// range it claims to cover). Measured on rig twins over g ∈ {0, 0.5, 0.8, 0.9}: the linear
-    /// sum covers 61–100 % of the values per g, the quadrature sum 36–100 % (BENCHMARKS.md, "The g
-    /// term: coverage"). `None` when no term is known: the uncertainty is then unknown, not zero.
+    /// range it claims to cover). Measured on rig twins over g ∈ {0, 0.5, 0.8, 0.9, 0.95}: the
+    /// linear sum covers 89 % of 180 values (81–100 % per g), the quadrature sum 81 % (BENCHMARKS.md,
+    /// "The g term: coverage when g is not known"). `None` when no term is known: the uncertainty is
+    /// then unknown, not zero.
     pub fn total(&self) -> Option<f64> {
         if self.fit.is_none() && self.spectro.is_none() && self.g.is_none() {
             return None;

@@ -23,7 +23,7 @@
 //!
 //! This is a bound, not a standard deviation: a g anywhere in the range gives an estimate within
 //! it (where the estimates change monotonically with g, as they do on the twins, BENCHMARKS.md
-//! "The g term: coverage"), so the total adds it linearly to the quadrature sum of the fit's and
+//! "The g term: coverage when g is not known"), so the total adds it linearly to the quadrature sum of the fit's and
 //! the spectrophotometer's standard errors ([`scatterfit_optics::Estimate::total`]). The
 //! diffusion dipoles do not depend on g; their g term is the sensitivity of the g-aware estimate,
 //! which is what their user needs to know. Parts of the range the tables do not cover are not
