@@ -214,6 +214,7 @@ impl FitArgs {
             eta: self.eta,
             normalise_with_spectro: self.normalise_with_spectro.then_some(true),
             allow_outside_paths: self.allow_outside_paths,
+            ..Overrides::default()
         })
     }
 }

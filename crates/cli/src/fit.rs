@@ -46,6 +46,18 @@ pub struct Args {
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd.
     #[arg(long)]
     pub normalise_with_spectro: bool,
+    /// The material's Henyey–Greenstein g, known or assumed, in (−1, 1): the model is evaluated at
+    /// it (as the manifest's `[fit] g`). Alone, g is known and its error term is 0.
+    #[arg(long, value_name = "G", value_parser = crate::numeric::parse_finite)]
+    pub g: Option<f64>,
+    /// The range LO,HI (0 ≤ LO ≤ HI ≤ 0.95) the material's g lies in (as `[fit] g_range`),
+    /// propagated into σ′s, σa and α′ as a separate "± g" term from the g-aware `mc` model; with
+    /// --g the values are at that g, without it the middle of the estimates over the range.
+    /// Neither --g nor --g-range: the values at g = 0 and the term over 0–0.95 (g not stated is g
+    /// not known). With --albedo and no --rd, α′ is held fixed over the range (the term is then the
+    /// profile's part only); give --rd to have α′ follow g.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_g_range)]
+    pub g_range: Option<[f64; 2]>,
     /// Also write the result (result.json's shape) to this file (`.json`; checked before the fit;
     /// an existing file only with --force).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
@@ -56,6 +68,19 @@ pub struct Args {
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Parses `--g-range LO,HI`: two finite numbers (the range's rule is checked with the other
+/// options).
+pub fn parse_g_range(text: &str) -> Result<[f64; 2], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
+    match (parts.len(), values.as_slice()) {
+        (2, &[lo, hi]) if lo.is_finite() && hi.is_finite() => Ok([lo, hi]),
+        _ => Err(format!(
+            "`{text}` is not a range LO,HI of g (e.g. 0.7,0.95)"
+        )),
+    }
 }
 
 /// Runs `scatterfit fit`.
@@ -133,6 +158,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         spot_diameter_mm: args.spot_diameter_mm,
         r_min_mm: args.r_min_mm,
         normalise_with_spectro: args.normalise_with_spectro,
+        g_prior: scatterfit_pipeline::anisotropy::GPrior {
+            g: args.g,
+            range: args.g_range,
+        },
     };
     let fitted = fit_profile(&data, &request)?;
     let result = fitted.to_result();

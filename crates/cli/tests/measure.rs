@@ -95,6 +95,38 @@ fn synth_then_measure() {
     let f: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     let refit = f["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
     assert!((refit / got - 1.0).abs() < 1e-6, "{refit} vs {got}");
+    // Issue 15: no g stated, so the default range's term; `--g` makes it 0 and leaves the value;
+    // a range that excludes the given g is bad usage.
+    assert_eq!(f["g_uncertainty"]["source"], "default_range");
+    assert!(
+        f["channels"]["r"]["sigma_s_prime_stderr_g"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    let fit_g = |extra: &[&str]| {
+        let mut args = vec!["fit", "wood/profile.csv", "--eta", &eta, "--albedo"];
+        let albedo = a.join(",");
+        args.push(&albedo);
+        args.extend_from_slice(extra);
+        args.push("--json");
+        run_cached(dir.path(), &args)
+    };
+    let out = fit_g(&["--g", "0"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let k: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(k["g_uncertainty"]["source"], "given");
+    assert_eq!(
+        k["channels"]["r"]["sigma_s_prime_stderr_g"].as_f64(),
+        Some(0.0)
+    );
+    assert_eq!(
+        k["channels"]["r"]["sigma_s_prime"],
+        f["channels"]["r"]["sigma_s_prime"]
+    );
+    let out = fit_g(&["--g", "0.5", "--g-range", "0.8,0.9"]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(out.stderr.contains("g range"), "{}", out.stderr);
     // The proposed method without α′ is bad usage.
     let out = run_cached(dir.path(), &["fit", "wood/profile.csv", "--eta", &eta]);
     assert_eq!(out.code, 2);

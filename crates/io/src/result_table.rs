@@ -35,12 +35,20 @@ pub fn sig4(v: f64) -> String {
 
 /// "value ± fit" (the fit's standard error only), or the reason there is none.
 fn with_fit_error(c: &ChannelResult, v: Option<Estimate>, name: &str) -> String {
-    value_with_errors(c, v.map(|e| Estimate { spectro: None, ..e }), name)
+    value_with_errors(
+        c,
+        v.map(|e| Estimate {
+            spectro: None,
+            g: None,
+            ..e
+        }),
+        name,
+    )
 }
 
-/// "value ± fit" or, when the spectrophotometer's part is known, "value ± fit ± spectro"; "failed"
-/// or "unconstrained" where there is no measurement (`name` is the parameter's name in
-/// `unconstrained`).
+/// "value ± fit" or, when the spectrophotometer's part is known, "value ± fit ± spectro", then
+/// " ± g" when the anisotropy's part is known (issue 15); "failed" or "unconstrained" where there is
+/// no measurement (`name` is the parameter's name in `unconstrained`).
 pub fn value_with_errors(c: &ChannelResult, v: Option<Estimate>, name: &str) -> String {
     if c.status == ChannelStatus::Failed {
         return "failed".into();
@@ -48,19 +56,30 @@ pub fn value_with_errors(c: &ChannelResult, v: Option<Estimate>, name: &str) -> 
     if c.unconstrained.iter().any(|u| u == name) {
         return "unconstrained".into();
     }
+    let g = |e: &Estimate| e.g.map_or(String::new(), |g| format!(" ± {} g", sig4(g)));
     match v {
-        Some(Estimate {
-            value,
-            fit: Some(fit),
-            spectro: Some(spectro),
-            ..
-        }) => format!("{} ± {} ± {}", sig4(value), sig4(fit), sig4(spectro)),
-        Some(Estimate {
-            value,
-            fit: Some(fit),
-            ..
-        }) => format!("{} ± {}", sig4(value), sig4(fit)),
-        Some(e) => sig4(e.value),
+        Some(
+            e @ Estimate {
+                value,
+                fit: Some(fit),
+                spectro: Some(spectro),
+                ..
+            },
+        ) => format!(
+            "{} ± {} ± {}{}",
+            sig4(value),
+            sig4(fit),
+            sig4(spectro),
+            g(&e)
+        ),
+        Some(
+            e @ Estimate {
+                value,
+                fit: Some(fit),
+                ..
+            },
+        ) => format!("{} ± {}{}", sig4(value), sig4(fit), g(&e)),
+        Some(e) => format!("{}{}", sig4(e.value), g(&e)),
         None => "—".into(),
     }
 }
@@ -73,9 +92,44 @@ pub fn sigma_cells(c: &ChannelResult) -> [String; 2] {
     ]
 }
 
-/// The line under a table that says what its ± mean (empty when no result carries the
-/// spectrophotometer's part).
+/// The lines under a table that say what its ± mean (empty when no result carries the
+/// spectrophotometer's part or the g term), with how g entered each result (issue 15).
 pub fn errors_note(results: &[MeasurementResult]) -> String {
+    let mut t = spectro_errors_note(results);
+    let with_g: Vec<&MeasurementResult> = results
+        .iter()
+        .filter(|r| r.g_uncertainty.is_some())
+        .collect();
+    if with_g.is_empty() {
+        return t;
+    }
+    t.push_str(
+        "± … g: the anisotropy's part — how far the estimate moves over the range of the \
+         Henyey–Greenstein g, from the g-aware `mc` model (0 where g was given; issue 15); a bound, \
+         not a standard error: add it to the quadrature sum of the others for the total.\n",
+    );
+    let descriptions: Vec<String> = with_g
+        .iter()
+        .filter_map(|r| r.g_uncertainty.as_ref().map(|g| g.describe()))
+        .collect();
+    if descriptions.iter().all(|d| *d == descriptions[0]) {
+        t.push_str(&format!("{}.\n", upper_first(&descriptions[0])));
+    } else {
+        for (r, d) in with_g.iter().zip(&descriptions) {
+            t.push_str(&format!("g ({}): {d}.\n", crate::escape::one_line(&r.name)));
+        }
+    }
+    t
+}
+
+fn upper_first(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
+}
+
+/// The line on the fit and spectrophotometer terms.
+fn spectro_errors_note(results: &[MeasurementResult]) -> String {
     let eps: Vec<f64> = results
         .iter()
         .filter(|r| {
@@ -154,7 +208,8 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
         "material,channel,status,sigma_s_prime_mm-1,sigma_s_prime_stderr,sigma_a_mm-1,sigma_a_stderr,\
          albedo_prime,rd_total,eta,method,model,fit_time_s,iterations,mse_mm-4,rms_log_residual,\
          chi2_reduced,rings_used,rings_inside_spot,rings_below_detection,problem,\
-         sigma_s_prime_stderr_spectro,sigma_a_stderr_spectro,albedo_prime_stderr,eta_stderr\n",
+         sigma_s_prime_stderr_spectro,sigma_a_stderr_spectro,albedo_prime_stderr,eta_stderr,\
+         sigma_s_prime_stderr_g,sigma_a_stderr_g,albedo_prime_stderr_g\n",
     );
     for r in results {
         for (ch, c) in r.channels.iter_channels() {
@@ -166,7 +221,7 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
             };
             let _ = writeln!(
                 t,
-                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 csv_text(&r.name),
                 num(c.sigma_s_prime, 6),
                 num(c.sigma_s_prime_stderr, 6),
@@ -190,6 +245,9 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 num(c.sigma_a_stderr_spectro, 8),
                 num(c.albedo_prime_stderr, 6),
                 num(r.eta_stderr, 6),
+                num(c.sigma_s_prime_stderr_g, 6),
+                num(c.sigma_a_stderr_g, 8),
+                num(c.albedo_prime_stderr_g, 6),
             );
         }
     }
@@ -236,7 +294,10 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
                     (Some(a), Some(e)) => format!("{a:.5} ± {}", sig4(e)),
                     (Some(a), None) => format!("{a:.5}"),
                     _ => "—".into(),
-                },
+                } + &c
+                    .albedo_prime_stderr_g
+                    .filter(|_| c.albedo_prime.is_some())
+                    .map_or(String::new(), |g| format!(" ± {} g", sig4(g))),
                 c.mse.map_or("—".into(), sig4),
             );
         }
@@ -384,7 +445,7 @@ mod tests {
             let mut rows = csv::Reader::from_reader(csv.as_bytes());
             for row in rows.records() {
                 let row = row.unwrap();
-                assert_eq!(row.len(), 25, "{csv}");
+                assert_eq!(row.len(), 28, "{csv}");
                 assert!(!row[0].starts_with(['=', '+', '-', '@']), "{csv}");
             }
             let md = table1_markdown(std::slice::from_ref(&r));

@@ -40,10 +40,11 @@ const BUNDLED_JSON: [&str; 17] = [
 ];
 
 /// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
-/// compact JSON). g = 0.8 at η 1.0, 1.1 and 1.2–2.4 (0.2 apart) and g = 0.9 at η 1.0–1.7 (0.1 apart) and 1.8–2.4
-/// (0.2 apart); Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
-/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 0.95 MB in all (the g = 0 set: 0.75 MB).
-pub const BUNDLED_G: [(f64, f64, &str); 21] = [
+/// compact JSON). g = 0.8 at η 1.0, 1.1, 1.2–2.4 (0.2 apart), g = 0.9 at η 1.0–1.7 (0.1 apart) and
+/// 1.8–2.4 (0.2 apart), g = 0.95 at η 1.0, 1.4, 1.8 (0.4 apart: a first coarse set, issue 15);
+/// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
+/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 0.9 MB in all (the g = 0 set: 0.75 MB).
+pub const BUNDLED_G: [(f64, f64, &str); 24] = [
     (
         1.0,
         0.8,
@@ -149,10 +150,25 @@ pub const BUNDLED_G: [(f64, f64, &str); 21] = [
         0.9,
         include_str!("../tables-g/mc-white-eta2.40-g0.90.json"),
     ),
+    (
+        1.0,
+        0.95,
+        include_str!("../tables-g/mc-white-eta1.00-g0.95.json"),
+    ),
+    (
+        1.4,
+        0.95,
+        include_str!("../tables-g/mc-white-eta1.40-g0.95.json"),
+    ),
+    (
+        1.8,
+        0.95,
+        include_str!("../tables-g/mc-white-eta1.80-g0.95.json"),
+    ),
 ];
 
-/// The largest g step the shipped grid interpolates across: 0.1 (between g = 0.8 and 0.9; measured,
-/// BENCHMARKS.md "The `mc` model over g"). The gap from g = 0 to 0.8 is refused.
+/// The largest g step the shipped grid interpolates across: 0.1 (between g = 0.8 and 0.9, and 0.9
+/// and 0.95; measured, BENCHMARKS.md "The `mc` model over g"). The gap from g = 0 to 0.8 is refused.
 pub const BUNDLED_MAX_G_STEP: f64 = 0.1 + 1e-9;
 
 impl McGridSet {
@@ -218,14 +234,15 @@ mod tests {
     }
 
     /// Every embedded anisotropic table parses, sits at its (η, g) (the file name's), and the
-    /// grid has the nodes g = 0, 0.8, 0.9 with the η ranges of the README.
+    /// grid has the nodes g = 0, 0.8, 0.9, 0.95 with the η ranges of the README.
     #[test]
     fn bundled_grid_parses() {
         let grid = McGridSet::bundled().unwrap();
-        assert_eq!(grid.g_nodes(), vec![0.0, 0.8, 0.9]);
-        for (set, n) in grid.nodes()[1..].iter().zip([9, 12]) {
+        assert_eq!(grid.g_nodes(), vec![0.0, 0.8, 0.9, 0.95]);
+        for (set, n, top) in [(1, 9, 2.4), (2, 12, 2.4), (3, 3, 1.8)] {
+            let set = &grid.nodes()[set];
             assert_eq!(set.tables().len(), n);
-            assert_eq!(set.eta_range(), (1.0, 2.4));
+            assert_eq!(set.eta_range(), (1.0, top));
         }
         for &(eta, g, json) in &BUNDLED_G {
             let t = McTable::from_json(json).unwrap();

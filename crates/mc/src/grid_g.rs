@@ -108,15 +108,7 @@ impl McGridSet {
     /// "g = 0 (η 1–2.5); g 0.8–0.9 interpolated (η 1–2.4)".
     pub fn coverage(&self) -> String {
         let mut parts = Vec::new();
-        let mut k = 0;
-        while k < self.nodes.len() {
-            // A run of nodes each within max_step of the next is one interval.
-            let mut end = k;
-            while end + 1 < self.nodes.len()
-                && self.nodes[end + 1].g() - self.nodes[end].g() <= self.max_step
-            {
-                end += 1;
-            }
+        for (k, end) in self.runs() {
             let lo = self.nodes[k..=end]
                 .iter()
                 .map(|s| s.eta_range().0)
@@ -139,9 +131,42 @@ impl McGridSet {
                     nodes.join(", ")
                 ));
             }
-            k = end + 1;
         }
         parts.join("; ")
+    }
+
+    /// The g the grid answers, as closed intervals by increasing g: a run of nodes each within
+    /// [`McGridSet::max_step`] of the next is one interval, a lone node a point (`lo == hi`).
+    /// Within each interval every g is a node or interpolated between two; outside all of them
+    /// [`McGridSet::profile`] refuses with `AnisotropyNotTabulated` (never extrapolates).
+    pub fn covered(&self) -> Vec<(f64, f64)> {
+        self.runs()
+            .into_iter()
+            .map(|(k, end)| (self.nodes[k].g(), self.nodes[end].g()))
+            .collect()
+    }
+
+    /// The runs of nodes each within `max_step` of the next, as (first, last) node indices: each
+    /// run is one interval of g the grid answers.
+    fn runs(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        let mut k = 0;
+        while k < self.nodes.len() {
+            let mut end = k;
+            while end + 1 < self.nodes.len()
+                && self.nodes[end + 1].g() - self.nodes[end].g() <= self.max_step
+            {
+                end += 1;
+            }
+            out.push((k, end));
+            k = end + 1;
+        }
+        out
+    }
+
+    /// True when the grid answers at `g` (a node, or between two nodes at most `max_step` apart).
+    pub fn covers(&self, g: f64) -> bool {
+        self.place(g).is_ok()
     }
 
     fn not_tabulated(&self, g: f64) -> McError {
@@ -389,15 +414,17 @@ mod tests {
             Place::Between(1, t) => assert!((t - 0.25).abs() < 1e-12),
             p => panic!("{p:?}"),
         }
-        for g in [0.3, 0.95, f64::NAN] {
+        for g in [0.3, 0.96, f64::NAN] {
             assert!(matches!(
                 grid.place(g),
                 Err(McError::AnisotropyNotTabulated { .. })
             ));
         }
+        assert_eq!(grid.covered(), [(0.0, 0.0), (0.8, 0.95)]);
+        assert!(grid.covers(0.0) && grid.covers(0.85) && grid.covers(0.93) && !grid.covers(0.5));
         assert_eq!(
             grid.coverage(),
-            "g = 0 (η 1–2.5); g 0.8–0.9 (tables at 0.8, 0.9, linear in g between; η 1–2.4)"
+            "g = 0 (η 1–2.5); g 0.8–0.95 (tables at 0.8, 0.9, 0.95, linear in g between; η 1–1.8)"
         );
     }
 }

@@ -5,6 +5,7 @@ use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, Method, ModelFamily, ModelName, Rgb};
 use serde::Serialize;
 
+use crate::anisotropy::{AlbedoAtG, GPlan, GPrior, GTerm, propagate_g};
 use crate::error::{PipelineError, Result};
 use crate::spectro::SpectroStage;
 
@@ -27,9 +28,13 @@ pub struct FitSettings {
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed only).
     pub normalise_with_spectro: bool,
-    /// The Henyey–Greenstein g the model and the α′ inversion are evaluated at (the manifest's
-    /// `[fit] g`, default 0; `scatterfit_optics::AtG`).
+    /// The Henyey–Greenstein g the model and the α′ inversion are evaluated at: the manifest's
+    /// `[fit] g`; for a `[fit] g_range` without a g the covered g nearest the range's middle
+    /// ([`GPlan::nominal_g`]); else 0 (`scatterfit_optics::AtG`).
     pub g: f64,
+    /// What is known about g (`[fit] g`, `[fit] g_range`): decides the g uncertainty term
+    /// ([`crate::anisotropy`]).
+    pub g_prior: GPrior,
 }
 
 /// The light spot's shape in [`FitSettings`].
@@ -85,8 +90,11 @@ pub struct ChannelFit {
     /// σa \[mm⁻¹\], with the same terms.
     pub sigma_a: Estimate,
     /// α′: the spectrophotometer's (proposed method, with its standard error) or the one the
-    /// fitted σ′s and σa give (existing method, no term).
+    /// fitted σ′s and σa give (existing method, no spectro term); both with the g term.
     pub albedo_prime: Estimate,
+    /// What the user should know about the g term (g where it could not be evaluated, or why
+    /// there is none).
+    pub g_note: Option<String>,
 }
 
 impl ChannelFit {
@@ -109,6 +117,7 @@ impl ChannelFit {
                 spectro: albedo_prime_stderr.filter(|_| report.method == Method::Proposed),
                 g: None,
             },
+            g_note: None,
             report,
         }
     }
@@ -169,6 +178,39 @@ impl ChannelOutcome {
     }
 }
 
+impl ChannelOutcome {
+    /// The same outcome with the g term ([`crate::anisotropy`]): `None` (known g) sets every term
+    /// to 0; a term sets σ′s's, σa's and α′'s, and for a range without a g with the `mc` model
+    /// replaces the values by the middle of the estimates over the range; an error leaves the
+    /// terms unknown and says why.
+    #[must_use]
+    pub fn with_g(mut self, term: Option<std::result::Result<GTerm, String>>) -> Self {
+        let ChannelOutcome::Fitted(f) = &mut self else {
+            return self;
+        };
+        match term {
+            None => {
+                f.sigma_s_prime.g = Some(0.0);
+                f.sigma_a.g = Some(0.0);
+                f.albedo_prime.g = Some(0.0);
+            }
+            Some(Err(why)) => f.g_note = Some(why),
+            Some(Ok(t)) => {
+                f.sigma_s_prime.g = finite(t.sigma_s_prime);
+                f.sigma_a.g = finite(t.sigma_a);
+                f.albedo_prime.g = finite(t.albedo_prime);
+                if t.centre_applies {
+                    f.sigma_s_prime.value = t.centre[0];
+                    f.sigma_a.value = t.centre[1];
+                    f.albedo_prime.value = t.centre[2];
+                }
+                f.g_note = t.note;
+            }
+        }
+        self
+    }
+}
+
 fn finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
 }
@@ -216,8 +258,8 @@ pub fn fit_stage(
     })
 }
 
-/// [`fit_stage`], then [`propagate_spectro`] into the outcomes: the channels with every
-/// uncertainty term the measurement knows.
+/// [`fit_stage`], then [`propagate_spectro`] and the g term ([`with_g_term`]) into the outcomes:
+/// the channels with every uncertainty term the measurement knows.
 pub fn fit_and_propagate(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
@@ -226,7 +268,28 @@ pub fn fit_and_propagate(
 ) -> Rgb<ChannelOutcome> {
     let fits = fit_stage(profiles, spectro, settings, model);
     let errors = propagate_spectro(profiles, spectro, settings, model, &fits);
-    fits.zip(errors).map(|(f, e)| f.with_spectro(e))
+    let fits = fits.zip(errors).map(|(f, e)| f.with_spectro(e));
+    with_g_term(profiles, spectro, settings, fits, AlbedoAtG::FromRd)
+}
+
+/// The outcomes with the g term of `settings.g_prior` ([`crate::anisotropy`]; 0 when g is
+/// known). A plan that cannot be made (the tables cover no g of the range) leaves the terms
+/// unknown, with the reason in each channel's note.
+pub fn with_g_term(
+    profiles: &Rgb<ProfileData>,
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    fits: Rgb<ChannelOutcome>,
+    albedo_at_g: AlbedoAtG,
+) -> Rgb<ChannelOutcome> {
+    match GPlan::new(&settings.g_prior, settings.g) {
+        Ok(None) => fits.map(|f| f.with_g(None)),
+        Ok(Some(plan)) => {
+            let terms = propagate_g(profiles, spectro, settings, &fits, &plan, albedo_at_g);
+            fits.zip(terms).map(|(f, t)| f.with_g(t))
+        }
+        Err(e) => fits.map(|f| f.with_g(Some(Err(e.to_string())))),
+    }
 }
 
 /// The part of a channel's uncertainty that the spectrophotometer contributes \[mm⁻¹\].
@@ -318,6 +381,9 @@ pub fn channel_result(
             sigma_a_stderr: None,
             sigma_s_prime_stderr_spectro: None,
             sigma_a_stderr_spectro: None,
+            sigma_s_prime_stderr_g: None,
+            sigma_a_stderr_g: None,
+            albedo_prime_stderr_g: None,
             albedo_prime_stderr: spectro.uncertainty.albedo_prime_stderr[c],
             albedo_prime: spectro.albedo_prime[c],
             rd_total,
@@ -358,6 +424,11 @@ pub fn channel_result(
             } else {
                 None
             };
+            // The g term's note joins the fit's.
+            let problem = match (problem, &f.g_note) {
+                (Some(p), Some(n)) => Some(format!("{p}; {n}")),
+                (p, n) => p.or_else(|| n.clone()),
+            };
             ChannelResult {
                 status,
                 sigma_s_prime: finite(f.sigma_s_prime.value),
@@ -366,6 +437,9 @@ pub fn channel_result(
                 sigma_a_stderr: f.sigma_a.fit,
                 sigma_s_prime_stderr_spectro: f.sigma_s_prime.spectro,
                 sigma_a_stderr_spectro: f.sigma_a.spectro,
+                sigma_s_prime_stderr_g: f.sigma_s_prime.g,
+                sigma_a_stderr_g: f.sigma_a.g,
+                albedo_prime_stderr_g: f.albedo_prime.g,
                 albedo_prime_stderr: f.albedo_prime.spectro,
                 albedo_prime: finite(f.albedo_prime.value),
                 rd_total,

@@ -40,6 +40,7 @@
 #![forbid(unsafe_code)]
 
 pub mod accuracy;
+pub mod anisotropy;
 pub mod batch;
 pub mod camera;
 pub mod checks;

@@ -11,6 +11,7 @@ use scatterfit_optics::{AlbedoModel, AtG, Estimate, Method, ModelName, Rgb};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
+use crate::anisotropy::{GPlan, GPrior, known_g_record};
 use crate::error::{PipelineError, Result};
 use crate::fit::{
     ChannelOutcome, FitSettings, SpotShape, channel_result, fit_and_propagate, fit_stage,
@@ -44,6 +45,10 @@ pub struct Overrides {
     pub eta: Option<f64>,
     /// Fix the scale by the spectrophotometer.
     pub normalise_with_spectro: Option<bool>,
+    /// A known g instead of the manifest's `[fit] g` (`fit --g`, a study's g axis).
+    pub g: Option<f64>,
+    /// A g range instead of the manifest's `[fit] g_range`.
+    pub g_range: Option<[f64; 2]>,
     /// Allow the manifest to name files outside the sample folder (the input path policy,
     /// `scatterfit_io::inputs`; `--allow-outside-paths`).
     pub allow_outside_paths: bool,
@@ -195,6 +200,19 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         }
         _ => (SpotShape::Disk, 0.5 * diameter),
     };
+    // What is known about g (issue 15): an override replaces both manifest keys.
+    let g_prior = if o.g.is_some() || o.g_range.is_some() {
+        GPrior {
+            g: o.g,
+            range: o.g_range,
+        }
+    } else {
+        GPrior {
+            g: manifest.fit.g,
+            range: manifest.fit.g_range,
+        }
+    };
+    g_prior.check()?;
     let settings = FitSettings {
         method,
         model,
@@ -203,10 +221,32 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         spot_radius_mm,
         r_min_mm: manifest.fit.r_min_mm,
         normalise_with_spectro: normalise,
-        g: manifest.fit.g.unwrap_or(0.0),
+        g: values_g(&g_prior)?,
+        g_prior,
     };
     families(&settings)?;
     Ok(settings)
+}
+
+/// The g the values are computed at: the given g; for a range without a g the covered g nearest
+/// its middle ([`GPlan::nominal_g`]); else 0.
+///
+/// # Errors
+/// [`PipelineError::Input`] for a range the `mc` tables cover nowhere.
+pub fn values_g(prior: &GPrior) -> Result<f64> {
+    match (prior.g, prior.range) {
+        (Some(g), _) => Ok(g),
+        (None, Some(range)) => {
+            GPlan::nominal_g(scatterfit_mc::bundled_grid()?, range).ok_or_else(|| {
+                PipelineError::Input(format!(
+                    "fit.g_range = [{}, {}]: the `mc` tables cover no g in it; give a range that \
+                     reaches g = 0 or 0.8–0.9 (or a g)",
+                    range[0], range[1]
+                ))
+            })
+        }
+        (None, None) => Ok(0.0),
+    }
 }
 
 /// The profile model and the albedo model of `settings`, both at its g (issue 15).
@@ -550,6 +590,7 @@ impl Measurement {
                     .and_then(|p| crate::port::correct_spectrum(&s, &p.reading_fraction))
                     .unwrap_or(s)
             }),
+            g_uncertainty: Some(g_record(s)),
             spectro_port: self
                 .port
                 .as_ref()
@@ -561,6 +602,22 @@ impl Measurement {
                     problems: p.problems.clone(),
                 }),
         }
+    }
+}
+
+/// The result's record of how g entered ([`scatterfit_io::result_json::GUncertainty`]).
+pub fn g_record(settings: &FitSettings) -> scatterfit_io::result_json::GUncertainty {
+    match GPlan::new(&settings.g_prior, settings.g) {
+        Ok(Some(plan)) => plan.record(&settings.g_prior),
+        Ok(None) => known_g_record(settings.g),
+        // No plan: the range, nothing evaluated (the channels' notes say why).
+        Err(e) => scatterfit_io::result_json::GUncertainty {
+            source: settings.g_prior.source(),
+            g: Some(settings.g),
+            range: settings.g_prior.propagated_range(),
+            evaluated: Vec::new(),
+            not_covered: Some(e.to_string()),
+        },
     }
 }
 

@@ -4,10 +4,11 @@
 
 use scatterfit_fit::ProfileData;
 use scatterfit_io::result_json::{AlbedoSource, Inputs, MeasurementResult, RunOptions};
-use scatterfit_optics::{AlbedoModel, Method, ModelName, Rgb};
+use scatterfit_optics::{AlbedoModel, Method, ModelFamily, ModelName, Rgb};
 
+use crate::anisotropy::AlbedoAtG;
 use crate::error::Result;
-use crate::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage};
+use crate::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage, with_g_term};
 use crate::spectro::SpectroStage;
 
 /// What to fit a given profile with.
@@ -34,6 +35,10 @@ pub struct ProfileFitRequest {
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by Rd (proposed method).
     pub normalise_with_spectro: bool,
+    /// What is known about g (`--g`, `--g-range`; issue 15): the values' g and the g term, as for
+    /// a measurement ([`crate::anisotropy`]). With `rd` the term's α′ is inverted from it at each
+    /// g; without, α′ is held at the given value and the term is the profile's part only.
+    pub g_prior: crate::anisotropy::GPrior,
 }
 
 /// A given profile, fitted.
@@ -55,12 +60,16 @@ pub struct ProfileFit {
 /// [`crate::PipelineError::Input`] when the model cannot be loaded. Channels that cannot be fitted
 /// are [`ChannelOutcome::NotFitted`].
 pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> Result<ProfileFit> {
-    let model = scatterfit_mc::family(request.model)?;
+    request.g_prior.check()?;
+    let g = crate::measure::values_g(&request.g_prior)?;
+    let model = scatterfit_optics::AtG::new(scatterfit_mc::family(request.model)?, g)
+        .map_err(|e| crate::PipelineError::Input(format!("g: {e}")))?;
+    let model = &model;
     let albedo = request.albedo_prime.map_or(Rgb::default(), |a| a.map(Some));
     let rd = request.rd.unwrap_or_else(|| {
         albedo.map(|a| {
             a.map_or(f64::NAN, |a| {
-                model.rd_total(a, request.eta, 0.0).unwrap_or(f64::NAN)
+                model.rd_total(a, request.eta, g).unwrap_or(f64::NAN)
             })
         })
     });
@@ -73,9 +82,16 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
         spot: crate::fit::SpotShape::Disk,
         r_min_mm: request.r_min_mm,
         normalise_with_spectro: request.normalise_with_spectro,
-        g: 0.0,
+        g,
+        g_prior: request.g_prior,
     };
     let fits = fit_stage(profile, &spectro, &settings, model);
+    let albedo_at_g = if request.rd.is_some() {
+        AlbedoAtG::FromRd
+    } else {
+        AlbedoAtG::Fixed
+    };
+    let fits = with_g_term(profile, &spectro, &settings, fits, albedo_at_g);
     Ok(ProfileFit {
         request: request.clone(),
         settings,
@@ -118,6 +134,7 @@ impl ProfileFit {
                     model: Some(s.model),
                     normalise_with_spectro: Some(s.normalise_with_spectro),
                     r_min_mm: Some(s.r_min_mm()),
+                    g: Some(s.g),
                     ..RunOptions::default()
                 },
                 ..Inputs::default()
@@ -125,6 +142,7 @@ impl ProfileFit {
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: None,
             spectro_port: None,
+            g_uncertainty: Some(crate::measure::g_record(s)),
         }
     }
 }

@@ -224,6 +224,28 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
     Ok(rows)
 }
 
+/// Writes a synthesised twin (8-bit bracket) into `dir` as a sample folder with `fit` as its
+/// manifest's `[fit]` and no truth.json — what a user's rig would hand the tool; the twin's g (issue
+/// 15) is never written into the manifest (`fit` decides what the user states).
+///
+/// # Errors
+/// The folder cannot be written.
+pub fn write_twin_folder(
+    dir: &Path,
+    s: &scatterfit_synth::SyntheticSample,
+    fit: scatterfit_io::manifest::FitSection,
+    provenance: &str,
+) -> Result<(), scatterfit_io::sample_folder::SampleFolderError> {
+    let rig = &s.truth.rig;
+    let files = scatterfit_io::sample_folder::SampleFiles::new(&s.truth.name, &s.reading)
+        .bracket(&s.bracket.frames, &s.bracket.times_s)
+        .mm_per_pixel(rig.mm_per_pixel)
+        .spot_diameter_mm(2.0 * rig.spot_radius_mm)
+        .provenance(provenance)
+        .fit(fit);
+    scatterfit_io::sample_folder::write_sample_folder(dir, &files).map(|_| ())
+}
+
 /// Keeps one row per grid point and configuration (a padded triple repeats its last albedo).
 pub fn dedup(rows: &mut Vec<Row>) {
     let mut seen = std::collections::HashSet::new();

@@ -137,6 +137,7 @@ fn sigma_errors_match_refits_of_repeated_readings() {
         r_min_mm: Some(1.0),
         normalise_with_spectro: false,
         g: 0.0,
+        g_prior: Default::default(),
     };
     let nominal = stage(1.0, EPS);
     let data = profiles(&nominal);

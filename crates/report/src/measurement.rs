@@ -200,12 +200,20 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         Some(e) => format!("{:.4} ± {}", r.eta, sig4(e)),
         None => format!("{:.4}", r.eta),
     };
-    // The Henyey–Greenstein g the models were evaluated at (issue 15), when the result records it.
-    let g = r
-        .inputs
-        .options
-        .g
-        .map_or(String::new(), |g| format!(", g = {g} assumed"));
+    // The Henyey–Greenstein g the models were evaluated at (issue 15), when the result records it;
+    // how g entered the error bars follows the table (errors_note).
+    let g = match (&r.g_uncertainty, r.inputs.options.g) {
+        (Some(u), _) if u.source == scatterfit_io::result_json::GSource::Given => {
+            format!(", g = {} given", u.g.unwrap_or(0.0))
+        }
+        (Some(u), _) => match (u.g, u.range) {
+            (Some(g), Some([lo, hi])) => format!(", values at g = {g} (g in {lo}–{hi}: ± g)"),
+            (None, Some([lo, hi])) => format!(", g in {lo}–{hi} (± g)"),
+            _ => String::new(),
+        },
+        (None, Some(g)) => format!(", g = {g} assumed"),
+        (None, None) => String::new(),
+    };
     let _ = writeln!(
         t,
         "{}: η = {eta} ({}), method {}, model {}{g}",
@@ -216,7 +224,7 @@ pub fn summary_text(r: &MeasurementResult) -> String {
     );
     let _ = writeln!(
         t,
-        "  ch  {:<30} {:<32} {:<8} {:<10} {:>9} {:>6}",
+        "  ch  {:<40} {:<42} {:<8} {:<10} {:>9} {:>6}",
         "σ′s [mm⁻¹]", "σa [mm⁻¹]", "α′", "MSE", "fit [µs]", "rings"
     );
     for (ch, c) in r.channels.iter_channels() {
@@ -224,7 +232,7 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         let [sp, sa] = sigma_cells(c);
         let _ = writeln!(
             t,
-            "  {name}   {sp:<30} {sa:<32} {:<8} {:<10} {:>9.1} {:>6}",
+            "  {name}   {sp:<40} {sa:<42} {:<8} {:<10} {:>9.1} {:>6}",
             c.albedo_prime.map_or("—".into(), |a| format!("{a:.5}")),
             c.mse.map_or("—".into(), sig4),
             c.fit_time_s * 1e6,
@@ -245,9 +253,8 @@ pub fn summary_text(r: &MeasurementResult) -> String {
     if let Some(line) = quality_line(r) {
         let _ = writeln!(t, "  {line}");
     }
-    let errors = errors_note(std::slice::from_ref(r));
-    if !errors.is_empty() {
-        let _ = write!(t, "  {errors}");
+    for line in errors_note(std::slice::from_ref(r)).lines() {
+        let _ = writeln!(t, "  {line}");
     }
     if r.spectro_port.is_some() {
         let _ = write!(t, "  {}", port_note(std::slice::from_ref(r)));

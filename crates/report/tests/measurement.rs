@@ -100,9 +100,24 @@ fn a_measured_sample_gets_its_report_files() {
     assert_eq!(back.name, "wood-tile");
     let summary = summary_text(&written.result);
     assert!(summary.starts_with("wood-tile: η = "), "{summary}");
-    // The g the models assumed (issue 15): the manifest has none, so 0, and both say so.
+    let md = std::fs::read_to_string(out.join("result.md")).unwrap();
+    // The g the models assumed (issue 15): the manifest has none, so the values are at 0, g is
+    // taken as unknown over the default range, and both say so — the term in every channel.
     assert_eq!(back.inputs.options.g, Some(0.0));
-    assert!(summary.contains(", g = 0 assumed"), "{summary}");
+    assert!(
+        summary.contains(", values at g = 0 (g in 0–0.95: ± g)"),
+        "{summary}"
+    );
+    assert!(
+        summary.contains("not stated, so taken as unknown in 0–0.95"),
+        "{summary}"
+    );
+    let g = back.g_uncertainty.as_ref().unwrap();
+    assert_eq!(g.range, Some([0.0, 0.95]));
+    for ch in back.channels.iter() {
+        assert!(ch.sigma_a_stderr_g.unwrap() > 0.0);
+    }
+    assert!(md.contains("± g"), "{md}");
     for ch in back.channels.iter() {
         let sp = ch
             .sigma_s_prime
@@ -112,7 +127,6 @@ fn a_measured_sample_gets_its_report_files() {
             "σ′s {sp} not in\n{summary}"
         );
     }
-    let md = std::fs::read_to_string(out.join("result.md")).unwrap();
     assert!(md.contains("wood-tile"), "{md}");
 
     // fit.png: three 500 × 520 panels, each channel's fitted curve in its colour.

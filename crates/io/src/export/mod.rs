@@ -398,6 +398,9 @@ mod fixtures {
             sigma_a_stderr: Some(0.001),
             sigma_s_prime_stderr_spectro: None,
             sigma_a_stderr_spectro: None,
+            sigma_s_prime_stderr_g: None,
+            sigma_a_stderr_g: None,
+            albedo_prime_stderr_g: None,
             albedo_prime_stderr: None,
             albedo_prime: Some(sp / (sp + sa)),
             rd_total: Some(rd),
@@ -440,6 +443,7 @@ mod fixtures {
             version: "0.1.0".into(),
             rd_spectrum: None,
             spectro_port: None,
+            g_uncertainty: None,
         }
     }
 

@@ -228,6 +228,9 @@ pub struct CameraSection {
     pub saturation: Option<u16>,
 }
 
+/// The largest g a `[fit] g_range` may reach (the grid the `mc` tables are built for ends at 0.95).
+pub const G_RANGE_MAX: f64 = 0.95;
+
 /// `[fit]`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -249,10 +252,20 @@ pub struct FitSection {
     /// and the α′ inversion are evaluated at it (σs = σ′s/(1 − g)). Default 0 — isotropic
     /// scattering, what the paper and every model before issue 15 assume; the diffusion dipoles do
     /// not depend on g, photon beam diffusion and the `mc` tables do (the tables hold g = 0 and
-    /// 0.8–0.9; another g with `mc` is refused with the tables' coverage). Real translucent
+    /// 0.8–0.95; another g with `mc` is refused with the tables' coverage). Real translucent
     /// materials have g ≈ 0.7–0.95: assuming 0 for them biases σa high (BENCHMARKS.md, "The `mc`
     /// model over g").
     pub g: Option<f64>,
+    /// The range `[lo, hi]` (0 ≤ lo ≤ hi ≤ 0.95) the material's g is known to lie in (issue 15):
+    /// propagated into σ′s, σa and α′ as a separate "g" uncertainty term beside "fit" and
+    /// "spectro", from the g-aware `mc` model. With `g`, the values are computed at `g` (which must
+    /// lie in the range) and the term is the largest change of the estimate over the range;
+    /// without, the values are the middle of the estimates over the range and the term half their
+    /// spread. Absent with `g` given: g is known, the term is 0. **Absent with `g` absent (the
+    /// default): the values stay at g = 0 and the term is propagated over 0–0.95** — an unstated g
+    /// is not known, and real materials span that range: a σa computed at g = 0 for a
+    /// forward-scattering material is 5–25 % high, which the term then shows.
+    pub g_range: Option<[f64; 2]>,
 }
 
 /// A parsed, checked `sample.toml`. Paths are as written (relative to [`SampleManifest::dir`]).
@@ -587,6 +600,34 @@ pub fn parse_manifest(
             ),
         ));
     }
+    if let Some([lo, hi]) = m.fit.g_range {
+        if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo <= hi && hi <= G_RANGE_MAX) {
+            return Err(invalid(
+                "fit.g_range",
+                format!(
+                    "= [{}, {}]: must be [lo, hi] with 0 ≤ lo ≤ hi ≤ {G_RANGE_MAX} (the Henyey–Greenstein \
+                     g of real translucent materials: about 0.7–0.95; leave it out for the default \
+                     0–{G_RANGE_MAX})",
+                    num(lo),
+                    num(hi)
+                ),
+            ));
+        }
+        if let Some(g) = m.fit.g
+            && !(lo..=hi).contains(&g)
+        {
+            return Err(invalid(
+                "fit.g",
+                format!(
+                    "= {}: lies outside fit.g_range = [{}, {}]; give a g inside the range, or \
+                     drop one of the two",
+                    num(g),
+                    num(lo),
+                    num(hi)
+                ),
+            ));
+        }
+    }
     if m.fit.normalise_with_spectro == Some(true) && m.fit.method == Some(Method::Existing) {
         return Err(invalid(
             "fit.normalise_with_spectro",
@@ -643,6 +684,7 @@ r_max_px = 300
             r_min_mm: Some(1.5),
             normalise_with_spectro: Some(false),
             g: Some(0.85),
+            g_range: Some([0.7, 0.95]),
         };
         // None of these is what an absent key means.
         assert_ne!(m.fit.model.unwrap(), ModelName::default());
@@ -674,7 +716,7 @@ r_max_px = 300
     /// Each mistake names the key and says what to do.
     #[test]
     fn mistakes_name_the_key() {
-        let cases: [(&str, &str); 10] = [
+        let cases: [(&str, &str); 14] = [
             (
                 &GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = -1"),
                 "camera.mm_per_pixel",
@@ -711,6 +753,25 @@ r_max_px = 300
             (
                 &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng = \"fit\""),
                 "g",
+            ),
+            (
+                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng_range = [0.9, 0.7]"),
+                "fit.g_range",
+            ),
+            (
+                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng_range = [0.7, 0.99]"),
+                "fit.g_range",
+            ),
+            (
+                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng_range = [0.7]"),
+                "g_range",
+            ),
+            (
+                &GOOD.replace(
+                    "r_max_px = 300",
+                    "r_max_px = 300\ng = 0.5\ng_range = [0.7, 0.9]",
+                ),
+                "fit.g",
             ),
         ];
         for (text, key) in cases {

@@ -152,6 +152,9 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
     if let Some(g) = m.fit.g {
         t.push_str(&format!("g = {g}\n"));
     }
+    if let Some([lo, hi]) = m.fit.g_range {
+        t.push_str(&format!("g_range = [{lo}, {hi}]\n"));
+    }
     t
 }
 

@@ -124,6 +124,18 @@ pub struct ChannelResult {
     /// Standard error of α′ from the reading's repeatability (its Rd and η).
     #[serde(default)]
     pub albedo_prime_stderr: Option<f64>,
+    /// The part of σ′s's uncertainty that comes from the anisotropy g (issue 15): how far the
+    /// g-aware estimate moves over the stated range of g ([`MeasurementResult::g_uncertainty`]
+    /// says which range and which g were evaluated) \[mm⁻¹\]; `Some(0)` when g was given, `None`
+    /// when it could not be evaluated (or in a file written before the term).
+    #[serde(default)]
+    pub sigma_s_prime_stderr_g: Option<f64>,
+    /// The same for σa \[mm⁻¹\].
+    #[serde(default)]
+    pub sigma_a_stderr_g: Option<f64>,
+    /// The same for α′.
+    #[serde(default)]
+    pub albedo_prime_stderr_g: Option<f64>,
     /// Reduced albedo α′ = σ′s/(σ′s + σa): from the spectrophotometer (proposed method) or from the
     /// fitted coefficients (existing method).
     pub albedo_prime: Option<f64>,
@@ -180,14 +192,14 @@ pub struct ChannelResult {
 }
 
 impl ChannelResult {
-    /// σ′s with its uncertainty terms (the fit's and the spectrophotometer's standard errors), as
+    /// σ′s with its uncertainty terms (the fit's, the spectrophotometer's and g's), as
     /// the pipeline had it before the file flattened it; `None` without a value.
     pub fn sigma_s_prime_estimate(&self) -> Option<Estimate> {
         self.sigma_s_prime.map(|value| Estimate {
             value,
             fit: self.sigma_s_prime_stderr,
             spectro: self.sigma_s_prime_stderr_spectro,
-            g: None,
+            g: self.sigma_s_prime_stderr_g,
         })
     }
 
@@ -197,18 +209,19 @@ impl ChannelResult {
             value,
             fit: self.sigma_a_stderr,
             spectro: self.sigma_a_stderr_spectro,
-            g: None,
+            g: self.sigma_a_stderr_g,
         })
     }
 
-    /// α′ with the spectrophotometer's standard error (the proposed method's α′ is the reading's);
+    /// α′ with the spectrophotometer's standard error (the proposed method's α′ is the reading's)
+    /// and g's;
     /// `None` without a value.
     pub fn albedo_prime_estimate(&self) -> Option<Estimate> {
         self.albedo_prime.map(|value| Estimate {
             value,
             fit: None,
             spectro: self.albedo_prime_stderr,
-            g: None,
+            g: self.albedo_prime_stderr_g,
         })
     }
 }
@@ -350,6 +363,93 @@ pub struct MeasurementResult {
     /// the reading was taken as loss-free (no port given). Never written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spectro_port: Option<PortResult>,
+    /// How the anisotropy g entered the result (issue 15): given, or a range propagated into the
+    /// channels' `*_stderr_g` terms, with the g that were evaluated. Absent in files written before
+    /// the term (and by commands that fit no sample); never written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub g_uncertainty: Option<GUncertainty>,
+}
+
+/// Where the result's knowledge of g came from ([`GUncertainty::source`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GSource {
+    /// `[fit] g` (or `--g`) without a range: g is known, the g term is 0.
+    Given,
+    /// `[fit] g_range` (or `--g-range`): the stated range, with or without a g.
+    Range,
+    /// Neither: the values at g = 0 (the paper's isotropic assumption), the term over the default
+    /// range 0–0.95.
+    DefaultRange,
+}
+
+impl GSource {
+    /// The name in the file: `given`, `range`, `default_range`.
+    pub fn name(self) -> &'static str {
+        match self {
+            GSource::Given => "given",
+            GSource::Range => "range",
+            GSource::DefaultRange => "default_range",
+        }
+    }
+}
+
+/// How g entered a result ([`MeasurementResult::g_uncertainty`], issue 15).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GUncertainty {
+    /// Given, a stated range, or the default range.
+    pub source: GSource,
+    /// The g the values were computed at; `None` when they are the midpoint of the estimates over
+    /// the range (a range without a g).
+    pub g: Option<f64>,
+    /// The range of g propagated, \[lo, hi\]; `None` when g was given.
+    pub range: Option<[f64; 2]>,
+    /// The g at which the g-aware model (the `mc` tables) was evaluated for the term: the tables'
+    /// g nodes inside the range, and the range's ends where the tables cover them.
+    #[serde(default)]
+    pub evaluated: Vec<f64>,
+    /// The parts of the range the tables do not cover (not evaluated, never extrapolated), in
+    /// words; `None` when the whole range is covered.
+    #[serde(default)]
+    pub not_covered: Option<String>,
+}
+
+impl GUncertainty {
+    /// One line for people: "g = 0.85 given (no g term)", or "g not stated, so taken as unknown in
+    /// 0–0.95: values at g = 0; ± g from the g-aware `mc` model at g = 0, 0.8, 0.9, 0.95 (not evaluated,
+    /// no tables: …)".
+    pub fn describe(&self) -> String {
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|g| format!("{g}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        match (self.source, self.range) {
+            (GSource::Given, _) | (_, None) => {
+                format!("g = {} given (no g term)", self.g.unwrap_or(0.0))
+            }
+            (source, Some([lo, hi])) => {
+                let at = match self.g {
+                    Some(g) => format!("values at g = {g}"),
+                    None => "values at the middle of the estimates over the range".into(),
+                };
+                let what = if source == GSource::DefaultRange {
+                    "not stated, so taken as unknown in"
+                } else {
+                    "stated to lie in"
+                };
+                let mut t = format!(
+                    "g {what} {lo}–{hi}: {at}; ± g from the g-aware `mc` model at g = {}",
+                    list(&self.evaluated)
+                );
+                if let Some(n) = &self.not_covered {
+                    t.push_str(&format!(" (not evaluated, no tables: {n})"));
+                }
+                t
+            }
+        }
+    }
 }
 
 /// What the port correction did ([`MeasurementResult::spectro_port`]).
@@ -593,6 +693,9 @@ mod tests {
             sigma_a_stderr: Some(0.001),
             sigma_s_prime_stderr_spectro: None,
             sigma_a_stderr_spectro: None,
+            sigma_s_prime_stderr_g: None,
+            sigma_a_stderr_g: None,
+            albedo_prime_stderr_g: None,
             albedo_prime_stderr: None,
             albedo_prime: Some(sp / (sp + sa)),
             rd_total: Some(0.5),
@@ -633,6 +736,7 @@ mod tests {
             version: "0.1.0".into(),
             rd_spectrum: None,
             spectro_port: None,
+            g_uncertainty: None,
         }
     }
 

@@ -33,14 +33,15 @@ pub struct SampleExtras {
     pub files: Vec<String>,
 }
 
-/// The value's cells: the value, its fit term (when `fit`), its spectro term.
+/// The value's cells: the value, its fit term (when `fit`), its spectro term, its g term.
 fn valued_cells(v: &Valued, fit: bool) -> String {
     let term = |e: Option<f64>| format!("<td class=\"num err\">{}</td>", opt(e));
     format!(
-        "<td class=\"num\">{}</td>{}{}",
+        "<td class=\"num\">{}</td>{}{}{}",
         v.value_text(),
         if fit { term(v.fit) } else { String::new() },
-        term(v.spectro)
+        term(v.spectro),
+        term(v.g)
     )
 }
 
@@ -103,9 +104,10 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
         p,
         "<section id=\"table1\"><h2>Table 1: parameters</h2><p>η = {} <span class=\"err\">{}</span> \
          (from {})</p><div class=\"scroll\"><table><thead><tr><th rowspan=\"2\">channel</th>\
-         <th colspan=\"3\">σ′s [mm⁻¹]</th><th colspan=\"3\">σa [mm⁻¹]</th><th colspan=\"2\">α′</th>\
+         <th colspan=\"4\">σ′s [mm⁻¹]</th><th colspan=\"4\">σa [mm⁻¹]</th><th colspan=\"3\">α′</th>\
          <th rowspan=\"2\">Rd (spectro)</th></tr><tr><th>value</th><th>± fit</th><th>± spectro</th>\
-         <th>value</th><th>± fit</th><th>± spectro</th><th>value</th><th>± spectro</th></tr>\
+         <th>± g</th><th>value</th><th>± fit</th><th>± spectro</th><th>± g</th><th>value</th>\
+         <th>± spectro</th><th>± g</th></tr>\
          </thead><tbody>",
         view.eta.value_text(),
         view.eta.error_text(),
@@ -125,8 +127,9 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
     p.push_str(
         "</tbody></table></div><p class=\"muted\">± terms are one standard error: fit, from the \
          fit's Jacobian at the solution; spectro, the spectrophotometer's part (its η and α′ at the \
-         reading's repeatability, propagated through refits). Add them in quadrature for the \
-         total.</p><h3>The fits</h3><div class=\"scroll\"><table><thead><tr><th>channel</th>\
+         reading's repeatability, propagated through refits); g, the anisotropy's part (how far \
+         the estimate moves over the range of g; 0 where g was given). The total is fit and spectro \
+         in quadrature plus g (a bound, not a standard error).</p><h3>The fits</h3><div class=\"scroll\"><table><thead><tr><th>channel</th>\
          <th>MSE [mm⁻⁴]</th><th>rms ln residual</th><th>χ²/dof</th><th>rings used</th>\
          <th>inside the spot</th><th>below detection</th><th>invalid</th><th>solver</th>\
          <th>fit time [µs]</th></tr></thead><tbody>\n",
@@ -148,6 +151,9 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
         );
     }
     p.push_str("</tbody></table></div>");
+    if let Some(g) = &view.g {
+        let _ = write!(p, "<p>{}</p>", text(g));
+    }
     if let Some(port) = &view.port {
         let _ = write!(p, "<p>{}</p>", text(port));
     }

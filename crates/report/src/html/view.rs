@@ -18,6 +18,8 @@ pub(crate) struct Valued {
     pub fit: Option<f64>,
     /// The spectrophotometer's part (its η and α′ at the reading's repeatability, propagated).
     pub spectro: Option<f64>,
+    /// The anisotropy g's part (issue 15: how far the estimate moves over the range of g).
+    pub g: Option<f64>,
 }
 
 impl Valued {
@@ -26,22 +28,25 @@ impl Valued {
         self.value.map_or("—".into(), sig4)
     }
 
-    /// `± fit`, `± fit (fit) ± spectro (spectro)`, or empty.
+    /// `± fit (fit) ± spectro (spectro) ± g (g)`, the known terms only, or empty.
     pub fn error_text(&self) -> String {
-        match (self.fit, self.spectro) {
-            (Some(f), Some(s)) => format!("± {} (fit) ± {} (spectro)", sig4(f), sig4(s)),
-            (Some(f), None) => format!("± {} (fit)", sig4(f)),
-            (None, Some(s)) => format!("± {} (spectro)", sig4(s)),
-            (None, None) => String::new(),
-        }
+        [(self.fit, "fit"), (self.spectro, "spectro"), (self.g, "g")]
+            .into_iter()
+            .filter_map(|(v, name)| v.map(|v| format!("± {} ({name})", sig4(v))))
+            .collect::<Vec<_>>()
+            .join(" ")
     }
 
-    /// The total standard error: fit and spectro terms in quadrature.
+    /// The total uncertainty: fit and spectro in quadrature plus the g term
+    /// (`scatterfit_optics::Estimate::total`).
     pub fn total_error(&self) -> Option<f64> {
-        match (self.fit, self.spectro) {
-            (None, None) => None,
-            (f, s) => Some(f.unwrap_or(0.0).hypot(s.unwrap_or(0.0))),
+        scatterfit_optics::Estimate {
+            value: 0.0,
+            fit: self.fit,
+            spectro: self.spectro,
+            g: self.g,
         }
+        .total()
     }
 }
 
@@ -129,6 +134,8 @@ pub(crate) struct ResultView {
     pub version: String,
     /// The port correction, as a sentence, when one was made.
     pub port: Option<String>,
+    /// How g entered (issue 15), as a sentence, when the result records it.
+    pub g: Option<String>,
 }
 
 fn verdict_of(c: &ChannelResult) -> Verdict {
@@ -166,16 +173,19 @@ fn channel(name: &'static str, c: &ChannelResult) -> ChannelView {
             value: c.sigma_s_prime,
             fit: c.sigma_s_prime_stderr,
             spectro: c.sigma_s_prime_stderr_spectro,
+            g: c.sigma_s_prime_stderr_g,
         },
         sigma_a: Valued {
             value: c.sigma_a,
             fit: c.sigma_a_stderr,
             spectro: c.sigma_a_stderr_spectro,
+            g: c.sigma_a_stderr_g,
         },
         albedo_prime: Valued {
             value: c.albedo_prime,
             fit: None,
             spectro: c.albedo_prime_stderr,
+            g: c.albedo_prime_stderr_g,
         },
         rd_total: c.rd_total,
         mse: c.mse,
@@ -245,6 +255,7 @@ impl ResultView {
                 value: Some(r.eta),
                 fit: None,
                 spectro: r.eta_stderr,
+                g: None,
             },
             eta_source: r.eta_source.map_or_else(|| "—".into(), |e| e.name().into()),
             method: r.method.to_string(),
@@ -261,6 +272,7 @@ impl ResultView {
             options: serde_json::to_string_pretty(&i.options).unwrap_or_default(),
             version: r.version.clone(),
             port,
+            g: r.g_uncertainty.as_ref().map(|g| g.describe()),
         }
     }
 
