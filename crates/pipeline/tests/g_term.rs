@@ -6,10 +6,12 @@
 //! it would. Measured with the exact model (`mc`, `mc` α′) the values are computed at g = 0, which
 //! puts σa 3–10 % off (BENCHMARKS.md, "The g term: coverage when g is not known"); the fit and spectrophotometer terms
 //! know nothing of that. The g term over the default range 0–0.95 must: every σa's truth lies
-//! within value ± total ((fit ⊕ spectro) + g), and every one lies outside value ± (fit ⊕ spectro)
-//! — so the test fails without the term. Tolerance: the bars themselves (1 × total); on this seed
-//! the margins are 1.4–3.1 % of σa inside the total and 1.1–8.7 % outside fit ⊕ spectro, while the
-//! twin's error with g given is ≈ 1 % (BENCHMARKS.md "The rig twin at g ≠ 0").
+//! within value ± total ((fit ⊕ spectro) + g), and the two channels whose α′ is below 0.98 (G 0.973,
+//! B 0.913; the bias of assuming g = 0 grows as α′ falls) lie outside value ± (fit ⊕ spectro) — so
+//! the test fails without the term. R (α′ 0.993) is biased only ≈ 0.5 % on this seed, inside its
+//! fit ⊕ spectro of 1.9 %. Tolerance: the bars themselves (1 × total); on this seed the margins are
+//! 2.9–4.2 % of σa inside the total and 2.9–8.8 % outside fit ⊕ spectro, while the twin's error with
+//! g given is ≈ 1 % (BENCHMARKS.md "The rig twin at g ≠ 0").
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::GSource;
@@ -69,9 +71,16 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
         assert!(err <= total, "{}: {err} > {total}", ch.name());
         if err > without_g {
             outside_without_g += 1;
+        } else {
+            assert!(
+                m.albedo_prime()[c] >= 0.98,
+                "{}: α′ {} within fit ⊕ spectro without the g term",
+                ch.name(),
+                m.albedo_prime()[c]
+            );
         }
     }
-    assert_eq!(outside_without_g, 3);
+    assert!(outside_without_g >= 2);
 
     // Told g = 0.8 (known), the term is 0.
     let known = measure_sample(
