@@ -110,7 +110,37 @@ fn shape_errors(
     let gains = [channels[0].1, channels[1].1, channels[2].1];
     let b = render_bracket_fn(&|c, r| profiles[c](r), Some(gains), &rig, seed).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let inputs = write(dir.path(), &b.frames, &b.times_s);
+    let mut inputs = write(dir.path(), &b.frames, &b.times_s);
+    if std::env::var("CAMERA_TRUE_RESPONSE").is_ok() {
+        // Diagnosis: the camera's own tone curve as a given response (the midpoint of each
+        // code's interval of linear signal), to tell response errors from the merge's.
+        let inv = |v: f64| {
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if camera.tone(mid) < v {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        };
+        let g: Vec<f64> = (0..256)
+            .map(|z| {
+                let a = inv(((z as f64 - 0.5) / 255.0).max(0.0));
+                let b = inv(((z as f64 + 0.5) / 255.0).min(1.0));
+                (0.5 * (a + b)).max(1e-9).ln()
+            })
+            .collect();
+        let path = dir.path().join("response.csv");
+        scatterfit_io::response_csv::write_response_csv(
+            &path,
+            &scatterfit_io::response_csv::ResponseTable { g: vec![g; 3] },
+        )
+        .unwrap();
+        inputs.response = Some(path);
+    }
     let stage = read_and_merge(&inputs, &|_| {}).map_err(|e| format!("{e:#}"))?;
     if std::env::var("CAMERA_DEBUG").is_ok() {
         let e = stage.corrections.exposure.as_ref();
