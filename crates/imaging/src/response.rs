@@ -27,7 +27,7 @@ pub const MAX_RESPONSE_FALL: f64 = 0.05;
 
 /// Knot spacing of the response's final smoothing, in units of ln k (k: the bracket's median ratio
 /// of consecutive exposure times): knots 1.2 ln k apart in log exposure barely follow a ripple of
-/// period ln k, which the bracket's data cannot see (see [`gsolve`]). Measured on issue 16's sweep
+/// period ln k, which the bracket's data cannot see (see [`recover_response`]). Measured on issue 16's sweep
 /// (BENCHMARKS.md): 1.2 and 1.5 remove most of the ripple; 2 bends the S-curve; 1.2 keeps the
 /// S-curve's toe within 0.5 % from code 30 up, where 1.5 bends it by 0.9 %.
 pub const AMBIGUITY_KNOT_STEP: f64 = 1.2;
@@ -248,13 +248,6 @@ pub struct Calibration {
 /// its weight vector), leaving a (N·P + 255) × 256 problem in g that is solved by Householder QR —
 /// the same minimiser as the full (N·P + 257) × (256 + N) system, without forming normal equations.
 ///
-/// The solution is then refitted by a cubic spline with knots [`AMBIGUITY_KNOT_STEP`]·ln k apart
-/// in log exposure (`smooth_in_log_exposure`): with exposure times in a constant ratio k a ripple
-/// of g periodic in ln X with period ln k is invisible to the data (Grossberg & Nayar 2003's
-/// "fractal ambiguity"), held only by the smoothness rows, and it would reach the merged radiance
-/// as a ripple of the same period; the spline cannot carry it. The ln E_i and the residual below
-/// are those of the refitted g.
-///
 /// # Errors
 /// [`ImagingError::InvalidOption`] for a bad λ or mismatched lengths, [`ImagingError::SolveFailed`] if
 /// the system is rank deficient.
@@ -343,49 +336,54 @@ pub fn gsolve(z: &[u8], ln_dt: &[f64], lambda: f64, channel: usize) -> Result<Ch
     for v in &mut g {
         *v -= g128;
     }
-    // The component the data cannot see (a ripple of period ln k in ln X) taken out.
-    if let Some(s) = smooth_in_log_exposure(&g, ln_dt, AMBIGUITY_KNOT_STEP) {
-        g = s;
-    }
     if g.iter().any(|v| !v.is_finite()) {
         return Err(ImagingError::SolveFailed {
             channel,
             reason: "solution is not finite",
         });
     }
-    // Recover ln E_i and the data residual.
-    let mut ln_e = Vec::with_capacity(n);
-    let (mut ss, mut cnt) = (0.0, 0usize);
-    for i in 0..n {
-        let zi = &z[i * p..(i + 1) * p];
-        let (mut num, mut den) = (0.0, 0.0);
-        for j in 0..p {
-            let wj = hat_weight(zi[j]);
-            num += wj * wj * (g[zi[j] as usize] - ln_dt[j]);
-            den += wj * wj;
+    Ok(ChannelSolution::with_g(g, z, ln_dt))
+}
+
+impl ChannelSolution {
+    /// The solution for a given g: each pixel's ln E_i (the hat-weighted mean of eq. 6 with
+    /// weights w², as in [`gsolve`]'s elimination) and the weighted data residual.
+    fn with_g(g: [f64; LEVELS], z: &[u8], ln_dt: &[f64]) -> Self {
+        let p = ln_dt.len();
+        let n = z.len() / p;
+        let mut ln_e = Vec::with_capacity(n);
+        let (mut ss, mut cnt) = (0.0, 0usize);
+        for i in 0..n {
+            let zi = &z[i * p..(i + 1) * p];
+            let (mut num, mut den) = (0.0, 0.0);
+            for j in 0..p {
+                let wj = hat_weight(zi[j]);
+                num += wj * wj * (g[zi[j] as usize] - ln_dt[j]);
+                den += wj * wj;
+            }
+            if den == 0.0 {
+                ln_e.push(f64::NAN);
+                continue;
+            }
+            let le = num / den;
+            for j in 0..p {
+                let r = hat_weight(zi[j]) * (g[zi[j] as usize] - le - ln_dt[j]);
+                ss += r * r;
+                cnt += 1;
+            }
+            ln_e.push(le);
         }
-        if den == 0.0 {
-            ln_e.push(f64::NAN);
-            continue;
+        let rms_residual = if cnt > 0 {
+            (ss / cnt as f64).sqrt()
+        } else {
+            0.0
+        };
+        ChannelSolution {
+            g,
+            ln_e,
+            rms_residual,
         }
-        let le = num / den;
-        for j in 0..p {
-            let r = hat_weight(zi[j]) * (g[zi[j] as usize] - le - ln_dt[j]);
-            ss += r * r;
-            cnt += 1;
-        }
-        ln_e.push(le);
     }
-    let rms_residual = if cnt > 0 {
-        (ss / cnt as f64).sqrt()
-    } else {
-        0.0
-    };
-    Ok(ChannelSolution {
-        g,
-        ln_e,
-        rms_residual,
-    })
 }
 
 /// The least-squares g that never decreases: min |A g − b| subject to g(z) ≥ g(z − 1).
@@ -629,6 +627,13 @@ fn solve_least_squares(a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>>
 /// Recovers the camera response of each channel from an 8-bit bracket (Debevec & Malik 1997): picks
 /// [`CalibrateOptions::samples`] pixels per channel with [`select_samples`] and solves [`gsolve`].
 ///
+/// Each solution is then refitted by a cubic spline with knots [`AMBIGUITY_KNOT_STEP`]·ln k apart
+/// in log exposure (`smooth_in_log_exposure`): with exposure times in a constant ratio k a ripple
+/// of g periodic in ln X with period ln k is invisible to the data (Grossberg & Nayar 2003's
+/// "fractal ambiguity"), held only by the smoothness rows, and it would reach the merged radiance
+/// as a ripple of the same period; the spline cannot carry it. The solution's ln E_i and residual
+/// are those of the refitted g.
+///
 /// The recovered curve is checked: over the codes the samples use (1st to 99th percentile, codes 0
 /// and 255 left out) it must rise, and fall nowhere by more than [`MAX_RESPONSE_FALL`] of that rise
 /// (noise can make an estimate dip by a hair; exposure times in the wrong order make it run
@@ -675,7 +680,11 @@ pub fn recover_response(
                 z.push(f.data()[(s.y * f.width() + s.x) * f.channels() + c]);
             }
         }
-        let solution = gsolve(&z, &ln_dt, opts.lambda, c)?;
+        let mut solution = gsolve(&z, &ln_dt, opts.lambda, c)?;
+        // The component the data cannot see (a ripple of period ln k in ln X) taken out.
+        if let Some(g) = smooth_in_log_exposure(&solution.g, &ln_dt, AMBIGUITY_KNOT_STEP) {
+            solution = ChannelSolution::with_g(g, &z, &ln_dt);
+        }
         check_increasing(&solution.g, &z, c)?;
         solutions.push(solution);
         samples.push(picked);
@@ -896,7 +905,11 @@ mod tests {
         let ln_dt: Vec<f64> = times.iter().map(|t| t.ln()).collect();
         let period = (ln_dt[1] - ln_dt[0]).abs();
         let srgb = |s: f64| {
-            if s <= 0.003_130_8 { 12.92 * s } else { 1.055 * s.powf(1.0 / 2.4) - 0.055 }
+            if s <= 0.003_130_8 {
+                12.92 * s
+            } else {
+                1.055 * s.powf(1.0 / 2.4) - 0.055
+            }
         };
         let log = |s: f64| (500.0 * s).ln_1p() / 501f64.ln();
         let aces = |x: f64| x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14);
@@ -917,8 +930,15 @@ mod tests {
                     d(a).total_cmp(&d(b))
                 })
                 .unwrap_or(0);
-            eprintln!("{name}: the curve moved by {:.5} at most (code {at})", worst(&kept));
-            assert!(worst(&kept) < 5e-3, "{name}: the curve moved by {}", worst(&kept));
+            eprintln!(
+                "{name}: the curve moved by {:.5} at most (code {at})",
+                worst(&kept)
+            );
+            assert!(
+                worst(&kept) < 5e-3,
+                "{name}: the curve moved by {}",
+                worst(&kept)
+            );
             let mut rippled = truth;
             for z in 1..LEVELS - 1 {
                 rippled[z] += 0.01 * (std::f64::consts::TAU * truth[z] / period).sin();
