@@ -550,7 +550,7 @@ fn smooth_in_log_exposure(
     let period = steps[steps.len() / 2];
     let delta = knot_step * period;
     let (lo, hi) = (g[1], g[LEVELS - 2]);
-    if !(hi - lo > delta) {
+    if (hi - lo).is_nan() || hi - lo <= delta {
         return None;
     }
     // Interior knots in z where g crosses lo + kΔ.
@@ -590,8 +590,8 @@ fn smooth_in_log_exposure(
     }
     let coef = solve_least_squares(a, b)?;
     let mut out = *g;
-    for z in 1..LEVELS - 1 {
-        out[z] = basis(z as f64)
+    for (z, v) in out.iter_mut().enumerate().take(LEVELS - 1).skip(1) {
+        *v = basis(z as f64)
             .iter()
             .zip(coef.iter())
             .map(|(x, c)| x * c)
@@ -882,8 +882,8 @@ mod tests {
             0.5 * (lo + hi)
         };
         let mut g = [0.0; LEVELS];
-        for z in 1..LEVELS {
-            g[z] = inv(z as f64 / 255.0).ln();
+        for (z, v) in g.iter_mut().enumerate().skip(1) {
+            *v = inv(z as f64 / 255.0).ln();
         }
         g[0] = g[1] - 1.0;
         let g128 = g[128];
@@ -940,8 +940,8 @@ mod tests {
                 worst(&kept)
             );
             let mut rippled = truth;
-            for z in 1..LEVELS - 1 {
-                rippled[z] += 0.01 * (std::f64::consts::TAU * truth[z] / period).sin();
+            for (r, t) in rippled.iter_mut().zip(&truth).take(LEVELS - 1).skip(1) {
+                *r += 0.01 * (std::f64::consts::TAU * t / period).sin();
             }
             assert!(worst(&rippled) > 9e-3, "{name}");
             let smoothed = smooth_in_log_exposure(&rippled, &ln_dt, AMBIGUITY_KNOT_STEP).unwrap();
