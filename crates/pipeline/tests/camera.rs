@@ -110,7 +110,37 @@ fn shape_errors(
     let gains = [channels[0].1, channels[1].1, channels[2].1];
     let b = render_bracket_fn(&|c, r| profiles[c](r), Some(gains), &rig, seed).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let inputs = write(dir.path(), &b.frames, &b.times_s);
+    let mut inputs = write(dir.path(), &b.frames, &b.times_s);
+    if std::env::var("CAMERA_TRUE_RESPONSE").is_ok() {
+        // Diagnosis: the camera's own tone curve as a given response (the midpoint of each
+        // code's interval of linear signal), to tell response errors from the merge's.
+        let inv = |v: f64| {
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if camera.tone(mid) < v {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        };
+        let g: Vec<f64> = (0..256)
+            .map(|z| {
+                let a = inv(((z as f64 - 0.5) / 255.0).max(0.0));
+                let b = inv(((z as f64 + 0.5) / 255.0).min(1.0));
+                (0.5 * (a + b)).max(1e-9).ln()
+            })
+            .collect();
+        let path = dir.path().join("response.csv");
+        scatterfit_io::response_csv::write_response_csv(
+            &path,
+            &scatterfit_io::response_csv::ResponseTable { g: vec![g; 3] },
+        )
+        .unwrap();
+        inputs.response = Some(path);
+    }
     let stage = read_and_merge(&inputs, &|_| {}).map_err(|e| format!("{e:#}"))?;
     if std::env::var("CAMERA_DEBUG").is_ok() {
         let e = stage.corrections.exposure.as_ref();
@@ -228,6 +258,8 @@ fn sweep(stride: usize, min_measured: usize) {
     let mut worst: f64 = 0.0;
     let (mut measured, mut unmeasurable) = (0, 0);
     let mut all: Vec<f64> = Vec::new();
+    // The worst shape error per curve and noise level, for BENCHMARKS.md.
+    let mut by_curve: Vec<(String, f64)> = Vec::new();
     let only = std::env::var("CAMERA_CURVE").ok();
     for (ci, curve) in curves.iter().enumerate() {
         if only.as_deref().is_some_and(|o| o != curve.name()) {
@@ -254,10 +286,15 @@ fn sweep(stride: usize, min_measured: usize) {
                             }
                             measured += 1;
                             worst = worst.max(e[c]);
+                            let key = format!("{} {noise} e⁻", curve.name());
+                            match by_curve.iter_mut().find(|(k, _)| *k == key) {
+                                Some((_, w)) => *w = w.max(e[c]),
+                                None => by_curve.push((key, e[c])),
+                            }
                             all.push(e[c]);
                             // The bound this build meets (issue 16 asks for 1 %; BENCHMARKS.md
                             // "Real cameras" has the distribution and what limits it).
-                            let bound = if *curve == ToneCurve::Log { 0.30 } else { 0.04 };
+                            let bound = if *curve == ToneCurve::Log { 0.05 } else { 0.04 };
                             if e[c] > bound {
                                 failures.push(format!(
                                     "{} noise {noise}: Rd {} gain {}: shape error {:.4}",
@@ -287,12 +324,19 @@ fn sweep(stride: usize, min_measured: usize) {
         q(0.9),
         all.iter().filter(|e| **e <= 0.01).count()
     );
+    let worst_by: Vec<String> = by_curve
+        .iter()
+        .map(|(k, w)| format!("{k} {:.2} %", 100.0 * w))
+        .collect();
+    eprintln!("worst by curve and read noise: {}", worst_by.join(", "));
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     assert!(
         measured >= min_measured,
         "{measured} channels measured (at least {min_measured} expected)"
     );
-    assert!(q(0.5) <= 0.01, "median shape error {:.4}", q(0.5));
+    // The median: 0.90 % over the whole sweep (0.90 % on a third) before the response's spline
+    // refit, 0.34 % (0.49 %) with it (BENCHMARKS.md, "The response recovery and the sweep").
+    assert!(q(0.5) <= 0.006, "median shape error {:.4}", q(0.5));
 }
 
 /// Issue 16's failing case, made exactly: an sRGB-like 8-bit camera, 13 exposures 1/600–3 s, a
@@ -306,6 +350,22 @@ fn the_issues_dark_channel_measures() {
         let e = shape_errors(camera, [(0.02, 0.6), (0.2, 1.0), (0.41, 0.75)], seed).unwrap();
         assert!(e.iter().all(|&x| x < 0.02), "seed {seed}: {e:?}");
     }
+}
+
+/// The sweep's worst case before the noise-aware detection limit: a log curve (code 30 ≈ 30 e⁻)
+/// with 15 e⁻ read noise and a dark material (Rd 0.02) at gains 0.3–1 (the sweep's seed). With a
+/// fixed detection code 30 its last rings had a per-pixel signal-to-noise ratio near 2 and came out
+/// 15–25 % low; the limit measured on the bracket (code ≈ 75 here) leaves them out and the shape
+/// holds within 5 %, with every channel still measured.
+#[test]
+fn a_noisy_log_camera_gets_a_higher_detection_limit() {
+    let camera = CameraModel {
+        curve: ToneCurve::Log,
+        read_noise_e: 15.0,
+        ..CameraModel::default()
+    };
+    let e = shape_errors(camera, [(0.02, 0.3), (0.02, 0.6), (0.02, 1.0)], 411).unwrap();
+    assert!(e.iter().all(|&x| x < 0.05), "{e:?}");
 }
 
 /// Frames whose times were reversed, shuffled or duplicated are refused before any response is

@@ -100,8 +100,17 @@ pub struct Corrections {
 /// radiance: on the rig twin's steep profiles (α′ = 0.3–0.7, η = 2.4, exact forward model) a
 /// threshold of code 5 left σ′s errors up to 5.6 %, code 15 up to 3 %, code 30 up to 1.5 % with no
 /// loss elsewhere (BENCHMARKS.md, "the bias study"). Code 30 is about 200 photo-electrons on the
-/// twin's camera (a signal-to-noise ratio near 14 per pixel).
+/// twin's camera (a signal-to-noise ratio near 14 per pixel). It is the floor: a camera whose
+/// codes are noisier there (a log curve, high read noise) gets a higher code per channel, the
+/// lowest at which the noise measured on its bracket gives a signal-to-noise ratio of
+/// [`DETECTION_SNR`] per pixel (`merge::detection_codes`).
 pub const DETECTION_CODE: u8 = 30;
+
+/// The per-pixel signal-to-noise ratio a code must reach in the longest exposure to count as
+/// detected (`merge::detection_codes`). The twin's default camera reaches about 14 at code 30; a log
+/// curve with 15 e⁻ read noise puts code 30 at about 30 e⁻ (SNR 2) and reaches 10 near code 75.
+/// Below it the merged radiance of issue 16's sweep was biased by up to 25 % (BENCHMARKS.md).
+pub const DETECTION_SNR: f64 = 10.0;
 
 /// The 16-bit linear value at which a pixel counts as detected in the longest exposure.
 pub const DETECTION_DN_16BIT: f64 = 64.0;
