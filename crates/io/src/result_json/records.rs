@@ -28,7 +28,8 @@ impl GSource {
     }
 }
 
-/// How g entered a result ([`MeasurementResult::g_uncertainty`], issue 15).
+/// How g entered a result
+/// ([`MeasurementResult::g_uncertainty`](super::MeasurementResult::g_uncertainty), issue 15).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GUncertainty {
     /// Given, a stated range, or the default range.
@@ -86,7 +87,8 @@ impl GUncertainty {
     }
 }
 
-/// What the port correction did ([`MeasurementResult::spectro_port`]).
+/// What the port correction did
+/// ([`MeasurementResult::spectro_port`](super::MeasurementResult::spectro_port)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PortResult {
     /// Diameter of the measured aperture \[mm\].
@@ -103,7 +105,8 @@ pub struct PortResult {
     pub problems: scatterfit_optics::Rgb<Option<String>>,
 }
 
-/// A measured diffuse reflectance spectrum ([`MeasurementResult::rd_spectrum`]).
+/// A measured diffuse reflectance spectrum
+/// ([`MeasurementResult::rd_spectrum`](super::MeasurementResult::rd_spectrum)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RdSpectrum {
     /// Wavelengths \[nm\], increasing.
