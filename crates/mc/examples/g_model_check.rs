@@ -4,6 +4,7 @@
 //! ```text
 //! cargo run -p scatterfit-mc --example g_model_check -- mcml [MAX_G_STEP]
 //! cargo run -p scatterfit-mc --example g_model_check -- eta-loo
+//! cargo run -p scatterfit-mc --example g_model_check -- eta-coarse
 //! cargo run -p scatterfit-mc --example g_model_check -- table TABLE.json [MAX_G_STEP]
 //! cargo run --release -p scatterfit-mc --example g_model_check -- cost
 //! ```
@@ -17,6 +18,10 @@
 //!   interior table of 1.1–1.6 against the set without it, and the 0.2-spaced subset's prediction at
 //!   1.1, 1.3, 1.5 (what the g = 0.8 set, 0.2 apart, does between its tables): RMS relative
 //!   difference of Rd(r) over reduced-radius windows per α′, and of the total.
+//! * `eta-coarse`: the η layout of the sparse g nodes (0.95, and the 0.5 / 0.7 sets), η 1.0, 1.4,
+//!   1.8, 2.4 (with and without 1.05, 1.1, 1.2 added), taken from the shipped g = 0.8 and 0.9 sets,
+//!   against those sets' own tables at the η left out (1.2, 1.6, 2.0, 2.2): what Catmull-Rom over
+//!   0.4–0.6 in η costs.
 //! * `table`: the grid interpolated to the g and η of a table file (e.g. a 10⁵-photon study table at
 //!   g = 0.85 or 0.7, η = 1.4), against that table, by α′ and window.
 //! * `cost`: parsing the shipped grid, and one `eval` (the fit's hot path: model + 300 radii) at
@@ -35,6 +40,7 @@ fn main() {
     match args.first().map(String::as_str) {
         Some("mcml") => mcml(args.get(1).map(|s| s.parse().expect("MAX_G_STEP"))),
         Some("eta-loo") => eta_loo(),
+        Some("eta-coarse") => eta_coarse(),
         Some("cost") => cost(),
         Some("table") => table(
             &args[1],
@@ -271,6 +277,43 @@ fn eta_loo() {
         print_compare("0.2 grid", &coarse, &held, eta);
     }
     let _ = bundled::BUNDLED_G.len();
+}
+
+/// The sparse η layouts against the shipped g = 0.8 / 0.9 tables they leave out (module docs).
+fn eta_coarse() {
+    let grid = McGridSet::bundled().unwrap();
+    println!("| g | layout | η | α′ | [0.3,1) | [1,3) | [3,10) | [10,20) | total |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let layouts: [(&str, &[f64]); 2] = [
+        ("1.0/1.4/1.8/2.4", &[1.0, 1.4, 1.8, 2.4]),
+        ("+1.05/1.1/1.2", &[1.0, 1.05, 1.1, 1.2, 1.4, 1.8, 2.4]),
+    ];
+    for set in grid.nodes().iter().filter(|s| s.g() == 0.8 || s.g() == 0.9) {
+        let pick = |eta: f64| {
+            set.tables()
+                .iter()
+                .find(|t| (t.spec().eta - eta).abs() < 1e-6)
+                .cloned()
+        };
+        for (name, etas) in layouts {
+            let Some(sub) = etas.iter().map(|&e| pick(e)).collect::<Option<Vec<_>>>() else {
+                println!(
+                    "| {} | {name} | (a node is not shipped at this g) |",
+                    set.g()
+                );
+                continue;
+            };
+            let sub = McTableSet::new(sub).unwrap();
+            for held in [1.2, 1.6, 2.0, 2.2] {
+                if etas.contains(&held) {
+                    continue;
+                }
+                let Some(t) = pick(held) else { continue };
+                let label = format!("{} | {name}", set.g());
+                print_compare(&label, &sub, &McTableSet::new(vec![t]).unwrap(), held);
+            }
+        }
+    }
 }
 
 fn table(path: &str, max_step: Option<f64>) {

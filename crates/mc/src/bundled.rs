@@ -40,15 +40,22 @@ const BUNDLED_JSON: [&str; 17] = [
 ];
 
 /// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
-/// compact JSON). g = 0.8 at η 1.0, 1.1, 1.2–2.4 (0.2 apart), g = 0.9 at η 1.0–1.7 (0.1 apart) and
-/// 1.8–2.4 (0.2 apart), g = 0.95 at η 1.0, 1.4, 1.8 (0.4 apart: a first coarse set, issue 15);
+/// compact JSON). g = 0.8 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4 and 1.6–2.4 (0.2 apart), g = 0.9 at
+/// η 1.0, 1.05, 1.1–1.7 (0.1 apart) and 1.8–2.4 (0.2 apart), g = 0.95 at η 1.0, 1.4, 1.8, 2.4 (a
+/// first coarse set, issue 15: Catmull-Rom over 0.4–0.6 in η costs 0.4–2 % in shape above η 1.4
+/// and 3 % between 1.0 and 1.4, BENCHMARKS.md "The `mc` model over g");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
-/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 0.9 MB in all (the g = 0 set: 0.75 MB).
-pub const BUNDLED_G: [(f64, f64, &str); 24] = [
+/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 1.25 MB in all (the g = 0 set: 0.75 MB).
+pub const BUNDLED_G: [(f64, f64, &str); 28] = [
     (
         1.0,
         0.8,
         include_str!("../tables-g/mc-white-eta1.00-g0.80.json"),
+    ),
+    (
+        1.05,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.05-g0.80.json"),
     ),
     (
         1.1,
@@ -59,6 +66,11 @@ pub const BUNDLED_G: [(f64, f64, &str); 24] = [
         1.2,
         0.8,
         include_str!("../tables-g/mc-white-eta1.20-g0.80.json"),
+    ),
+    (
+        1.3,
+        0.8,
+        include_str!("../tables-g/mc-white-eta1.30-g0.80.json"),
     ),
     (
         1.4,
@@ -94,6 +106,11 @@ pub const BUNDLED_G: [(f64, f64, &str); 24] = [
         1.0,
         0.9,
         include_str!("../tables-g/mc-white-eta1.00-g0.90.json"),
+    ),
+    (
+        1.05,
+        0.9,
+        include_str!("../tables-g/mc-white-eta1.05-g0.90.json"),
     ),
     (
         1.1,
@@ -164,6 +181,11 @@ pub const BUNDLED_G: [(f64, f64, &str); 24] = [
         1.8,
         0.95,
         include_str!("../tables-g/mc-white-eta1.80-g0.95.json"),
+    ),
+    (
+        2.4,
+        0.95,
+        include_str!("../tables-g/mc-white-eta2.40-g0.95.json"),
     ),
 ];
 
@@ -239,7 +261,7 @@ mod tests {
     fn bundled_grid_parses() {
         let grid = McGridSet::bundled().unwrap();
         assert_eq!(grid.g_nodes(), vec![0.0, 0.8, 0.9, 0.95]);
-        for (set, n, top) in [(1, 9, 2.4), (2, 12, 2.4), (3, 3, 1.8)] {
+        for (set, n, top) in [(1, 11, 2.4), (2, 13, 2.4), (3, 4, 2.4)] {
             let set = &grid.nodes()[set];
             assert_eq!(set.tables().len(), n);
             assert_eq!(set.eta_range(), (1.0, top));

@@ -424,7 +424,7 @@ mod tests {
         assert!(grid.covers(0.0) && grid.covers(0.85) && grid.covers(0.93) && !grid.covers(0.5));
         assert_eq!(
             grid.coverage(),
-            "g = 0 (η 1–2.5); g 0.8–0.95 (tables at 0.8, 0.9, 0.95, linear in g between; η 1–1.8)"
+            "g = 0 (η 1–2.5); g 0.8–0.95 (tables at 0.8, 0.9, 0.95, linear in g between; η 1–2.4)"
         );
     }
 }
