@@ -13,64 +13,10 @@ use scatterfit_mc::model::{McProfile, McTable, McTableSet};
 use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation};
 use scatterfit_optics::{OpticalProperties, ProfileModel};
 
-const WINDOWS: [(f64, f64); 7] = [
-    (0.1, 0.5),
-    (0.5, 1.0),
-    (1.0, 2.0),
-    (2.0, 5.0),
-    (5.0, 10.0),
-    (10.0, 20.0),
-    (20.0, 50.0),
-];
+#[path = "common/windows.rs"]
+mod windows;
 
-/// The model averaged over the annulus [a, b] (8-point Gauss–Legendre in ln r).
-fn annulus_average(m: &dyn ProfileModel, a: f64, b: f64) -> f64 {
-    const GL4: [(f64, f64); 4] = [
-        (-0.861_136_311_594_053, 0.347_854_845_137_454),
-        (-0.339_981_043_584_856, 0.652_145_154_862_546),
-        (0.339_981_043_584_856, 0.652_145_154_862_546),
-        (0.861_136_311_594_053, 0.347_854_845_137_454),
-    ];
-    let mut s = 0.0;
-    // Two panels, so that tiny inner annuli and wide outer ones are both integrated well.
-    let mid = 0.5 * (a + b);
-    for (lo, hi) in [(a, mid), (mid, b)] {
-        for (x, w) in GL4 {
-            let r = 0.5 * (lo + hi) + 0.5 * (hi - lo) * x;
-            s += w * 0.5 * (hi - lo) * 2.0 * std::f64::consts::PI * r * m.rd(r);
-        }
-    }
-    s / (std::f64::consts::PI * (b * b - a * a))
-}
-
-/// Prints windowed comparisons: per bin (r_lo, r_hi, reference value, its relative s.e.).
-fn windows(model: &dyn ProfileModel, bins: &[(f64, f64, f64, f64)]) -> String {
-    let mut line = String::new();
-    for (lo, hi) in WINDOWS {
-        let (mut sw, mut swd, mut chi2, mut n) = (0.0, 0.0, 0.0, 0);
-        for &(a, b, v, rel) in bins {
-            let c = 0.5 * (a + b);
-            if c < lo || c >= hi || v <= 0.0 || rel > 0.3 {
-                continue;
-            }
-            let d = annulus_average(model, a, b) / v - 1.0;
-            let w = 1.0 / (rel * rel);
-            sw += w;
-            swd += w * d;
-            chi2 += d * d * w;
-            n += 1;
-        }
-        if n > 0 {
-            line += &format!(
-                " [{lo},{hi}): {:+.2}±{:.2}% ({:.0}/{n})",
-                100.0 * swd / sw,
-                100.0 / sw.sqrt(),
-                chi2
-            );
-        }
-    }
-    line
-}
+use windows::windows;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

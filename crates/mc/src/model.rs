@@ -14,8 +14,10 @@
 //! Similarity (pbrt's `TabulatedBSSRDF::Sr`, docs/physics.md §2.3): with σs = σ′s/(1 − g), σt = σa + σs and
 //! a = σs/σt, Rd(r) = σt² R̂(σt r; a) exactly (same η, g). For g = 0, σt = σ′t and a = α′.
 //!
-//! Interpolation: between albedos, Catmull-Rom (pbrt's `CatmullRomWeights`) in x = −√(1 − a) on the
-//! spline coefficients (so on S, after the analytic κ₀(a)ρ is taken out: C¹ in a); between η nodes,
+//! Interpolation: between albedos, cubic Hermite in x = −√(1 − a) on the spline coefficients (so on
+//! S, after the analytic κ₀(a)ρ is taken out: C¹ in a) and on ln Rd for the totals — Catmull-Rom
+//! derivatives inside (pbrt's `CatmullRomWeights`), the parabola through the three end nodes at the
+//! first and last node ([`Ends`]); between η nodes,
 //! Catmull-Rom in η on the same coefficients (linear with two tables); in ρ, the cubic B-spline itself
 //! (C²). Derivatives ∂Rd/∂σ′s, ∂Rd/∂σa are those of this interpolant: through σt (the σt² factor and
 //! ρ = σt r) and through a (the albedo weights' derivatives and dκ₀/da) — never finite differences.
@@ -509,8 +511,8 @@ impl McTable {
         &self.coefs[k * m..(k + 1) * m]
     }
 
-    /// Catmull-Rom weights (and their derivatives in a) of albedo `a` over the nodes, in
-    /// x = −√(1 − a).
+    /// Cubic Hermite weights (and their derivatives in a) of albedo `a` over the nodes, in
+    /// x = −√(1 − a): Catmull-Rom inside, parabolic at the first and last node ([`Ends`]).
     fn albedo_weights(&self, a: f64) -> Result<(usize, [f64; 4], [f64; 4])> {
         let al = &self.albedos;
         let (lo, hi) = (al[0], al[al.len() - 1]);
@@ -523,19 +525,22 @@ impl McTable {
             });
         }
         let x = |v: f64| -(1.0 - v).sqrt();
-        let (i, w, dw_dx) = catmull_rom_weights_d(al.len(), |k| x(al[k]), x(a));
+        let (i, w, dw_dx) = hermite_weights(al.len(), |k| x(al[k]), x(a), Ends::Parabola);
         let dx_da = 0.5 / (1.0 - a).sqrt();
         Ok((i, w, dw_dx.map(|d| d * dx_da)))
     }
 
-    /// Total diffuse reflectance Rd(a) (excluding R_sp): Catmull-Rom in √(1 − a) between the Monte
-    /// Carlo totals of the nodes.
+    /// Total diffuse reflectance Rd(a) (excluding R_sp): cubic Hermite in √(1 − a) with parabolic
+    /// ends ([`Ends::Parabola`]) on ln Rd between the Monte Carlo totals of the nodes. On ln Rd, as
+    /// the profile's coefficients are: toward a → 1 at η = 2 Rd itself bends so much within the last
+    /// interval that its interpolant was 1.5–2.3·10⁻³ high at α′ 0.9993–0.9998 (g 0.8–0.9) against
+    /// adding-doubling, ln Rd 4–6·10⁻⁴ (6·10⁻³ with the chord ends; BENCHMARKS.md).
     ///
     /// # Errors
     /// `OutOfTable` for a outside the tabulated albedos.
     pub fn rd_total(&self, a: f64) -> Result<f64> {
         let (i, w, _) = self.albedo_weights(a)?;
-        Ok(dot4(&w, |k| self.rd_total[i + k - 1]))
+        Ok(dot4(&w, |k| self.rd_total[i + k - 1].ln()).exp())
     }
 }
 
@@ -549,70 +554,80 @@ fn dot4(w: &[f64; 4], f: impl Fn(usize) -> f64) -> f64 {
 /// interpolant Σₖ w[k]·f(i − 1 + k); the end derivatives are one-sided (w[0] or w[3] is then 0).
 /// Cubic Hermite with finite-difference derivatives on non-uniform nodes; exact at the nodes.
 fn catmull_rom_weights(n: usize, node: impl Fn(usize) -> f64, x: f64) -> (usize, [f64; 4]) {
+    let (i, w, _) = hermite_weights(n, node, x, Ends::Chord);
+    (i, w)
+}
+
+/// How a cubic Hermite interpolant takes its derivative at the first and last node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Ends {
+    /// The end interval's chord (pbrt's Catmull-Rom): exact for straight lines only.
+    Chord,
+    /// The parabola through the three end nodes (the second-order one-sided difference, e.g.
+    /// Fornberg 1988, Math. Comp. 51:699, table 1): exact for quadratics, so the end interval is
+    /// as accurate as an interior one. Used in albedo, where the last interval of the tables
+    /// (toward a → 1) spans a wide range of 1 − α′ and Rd(√(1 − a)) is curved: with the chord the
+    /// totals were 1–1.5·10⁻³ high at α′ 0.9996–0.9998 for g 0.8–0.9 against adding-doubling,
+    /// with the parabola within 2.5·10⁻⁴ (BENCHMARKS.md, "The `mc` model over g").
+    Parabola,
+}
+
+/// Cubic Hermite weights at `x` over the `n` strictly increasing nodes with Catmull-Rom
+/// (finite-difference) derivatives inside and `ends` at the first and last node: (i, w, dw/dx)
+/// with x ∈ [node(i), node(i + 1)] and the interpolant Σₖ w[k]·f(i − 1 + k).
+fn hermite_weights(
+    n: usize,
+    node: impl Fn(usize) -> f64,
+    x: f64,
+    ends: Ends,
+) -> (usize, [f64; 4], [f64; 4]) {
     // First i with node(i + 1) > x, clamped to the last interval.
     let mut i = 0;
     while i + 2 < n && node(i + 1) <= x {
         i += 1;
     }
     let (x0, x1) = (node(i), node(i + 1));
-    let t = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
+    let h = x1 - x0;
+    let t = ((x - x0) / h).clamp(0.0, 1.0);
     let (t2, t3) = (t * t, t * t * t);
+    let inv = 1.0 / h;
+    // Value and x-derivative of the four Hermite basis functions: h00, h10 (times h), h01, h11.
     let mut w = [0.0, 2.0 * t3 - 3.0 * t2 + 1.0, -2.0 * t3 + 3.0 * t2, 0.0];
-    let w0 = t3 - 2.0 * t2 + t;
-    if i > 0 {
-        let w0 = w0 * (x1 - x0) / (x1 - node(i - 1));
-        w[0] = -w0;
-        w[2] += w0;
-    } else {
-        w[1] -= w0;
-        w[2] += w0;
-    }
-    let w3 = t3 - t2;
-    if i + 2 < n {
-        let w3 = w3 * (x1 - x0) / (node(i + 2) - x0);
-        w[1] -= w3;
-        w[3] = w3;
-    } else {
-        w[1] -= w3;
-        w[2] += w3;
-    }
-    (i, w)
-}
-
-/// [`catmull_rom_weights`] with the derivatives of the weights in x.
-fn catmull_rom_weights_d(
-    n: usize,
-    node: impl Fn(usize) -> f64,
-    x: f64,
-) -> (usize, [f64; 4], [f64; 4]) {
-    let (i, w) = catmull_rom_weights(n, &node, x);
-    let (x0, x1) = (node(i), node(i + 1));
-    let t = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
-    let inv = 1.0 / (x1 - x0);
-    let t2 = t * t;
     let mut d = [
         0.0,
         (6.0 * t2 - 6.0 * t) * inv,
         (-6.0 * t2 + 6.0 * t) * inv,
         0.0,
     ];
-    let d0 = (3.0 * t2 - 4.0 * t + 1.0) * inv;
-    if i > 0 {
-        let d0 = d0 * (x1 - x0) / (x1 - node(i - 1));
-        d[0] = -d0;
-        d[2] += d0;
+    // h·f′(x0) as weights on (f(i − 1), f(i), f(i + 1), f(i + 2)).
+    let start: [f64; 4] = if i > 0 {
+        let c = h / (x1 - node(i - 1));
+        [-c, 0.0, c, 0.0]
+    } else if ends == Ends::Parabola && n >= 3 {
+        // Parabola through x0, x1, x2: h f′(x0) = (1 + c)(f1 − f0) − c r (f2 − f1).
+        let h2 = node(i + 2) - x1;
+        let (c, r) = (h / (h + h2), h / h2);
+        [0.0, -(1.0 + c), 1.0 + c + c * r, -c * r]
     } else {
-        d[1] -= d0;
-        d[2] += d0;
-    }
-    let d3 = (3.0 * t2 - 2.0 * t) * inv;
-    if i + 2 < n {
-        let d3 = d3 * (x1 - x0) / (node(i + 2) - x0);
-        d[1] -= d3;
-        d[3] = d3;
+        [0.0, -1.0, 1.0, 0.0]
+    };
+    // h·f′(x1) likewise.
+    let end: [f64; 4] = if i + 2 < n {
+        let c = h / (node(i + 2) - x0);
+        [0.0, -c, 0.0, c]
+    } else if ends == Ends::Parabola && i > 0 {
+        // Parabola through x₋₁, x0, x1: h f′(x1) = (1 + c)(f1 − f0) − c r (f0 − f₋₁).
+        let h1 = x0 - node(i - 1);
+        let (c, r) = (h / (h1 + h), h / h1);
+        [c * r, -(1.0 + c + c * r), 1.0 + c, 0.0]
     } else {
-        d[1] -= d3;
-        d[2] += d3;
+        [0.0, -1.0, 1.0, 0.0]
+    };
+    let (b0, db0) = (t3 - 2.0 * t2 + t, (3.0 * t2 - 4.0 * t + 1.0) * inv);
+    let (b1, db1) = (t3 - t2, (3.0 * t2 - 2.0 * t) * inv);
+    for k in 0..4 {
+        w[k] += b0 * start[k] + b1 * end[k];
+        d[k] += db0 * start[k] + db1 * end[k];
     }
     (i, w, d)
 }
@@ -729,8 +744,8 @@ impl McTableSet {
         Ok(catmull_rom_weights(n, |k| self.tables[k].spec.eta, eta))
     }
 
-    /// Total diffuse reflectance Rd(a, η) (excluding R_sp) by Monte Carlo: Catmull-Rom in √(1 − a)
-    /// over the albedo nodes, then Catmull-Rom in η on ln Rd over the tables (on the default η grid
+    /// Total diffuse reflectance Rd(a, η) (excluding R_sp) by Monte Carlo: cubic Hermite in √(1 − a)
+    /// on ln Rd over the albedo nodes ([`McTable::rd_total`]), then Catmull-Rom in η on ln Rd over the tables (on the default η grid
     /// within 0.2 % of adding-doubling between tables, BENCHMARKS.md). a is the single-scattering
     /// albedo (α′ for g = 0; for g ≠ 0, α′ = a(1 − g)/(1 − ag)).
     ///
@@ -1055,7 +1070,7 @@ mod tests {
         let nodes = [0.0, 0.3, 0.7, 1.2, 2.0, 2.1];
         for i in 0..100 {
             let x = 0.001 + 2.098 * i as f64 / 99.0;
-            let (k, _, d) = catmull_rom_weights_d(nodes.len(), |j| nodes[j], x);
+            let (k, _, d) = hermite_weights(nodes.len(), |j| nodes[j], x, Ends::Chord);
             let h = 1e-7;
             let (kp, wp) = catmull_rom_weights(nodes.len(), |j| nodes[j], x + h);
             let (km, wm) = catmull_rom_weights(nodes.len(), |j| nodes[j], x - h);
@@ -1066,6 +1081,29 @@ mod tests {
                 assert!((d[q] - (wp[q] - wm[q]) / (2.0 * h)).abs() < 1e-6, "x = {x}");
             }
         }
+    }
+
+    /// With parabolic ends the interpolant reproduces any quadratic exactly on uniform nodes (as
+    /// the albedo nodes are, in √(1 − a)), in the end intervals too — the chord ends do not: that
+    /// was their error toward a → 1 — and so does its derivative.
+    #[test]
+    fn parabolic_ends_are_exact_for_quadratics() {
+        let nodes = [0.0, 0.35, 0.7, 1.05, 1.4, 1.75, 2.1];
+        let f = |x: f64| 1.0 - 2.5 * x + 3.0 * x * x;
+        let mut chord_worst = 0.0f64;
+        for i in 0..200 {
+            let x = 2.1 * i as f64 / 199.0;
+            let (k, w, d) = hermite_weights(nodes.len(), |j| nodes[j], x, Ends::Parabola);
+            let val = |w: &[f64; 4]| dot4(w, |q| f(nodes[k + q - 1]));
+            assert!((val(&w) - f(x)).abs() < 1e-12, "x = {x}");
+            assert!((val(&d) - (-2.5 + 6.0 * x)).abs() < 1e-9, "x = {x}");
+            let (_, wc) = catmull_rom_weights(nodes.len(), |j| nodes[j], x);
+            chord_worst = chord_worst.max((val(&wc) - f(x)).abs());
+        }
+        assert!(
+            chord_worst > 1e-3,
+            "the chord ends were exact: {chord_worst}"
+        );
     }
 
     /// The model's analytic derivatives (of the interpolant: albedo weights, κ₀(a), the spline in

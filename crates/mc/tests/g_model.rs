@@ -337,3 +337,39 @@ fn totals_increase_with_albedo_at_each_g() {
         }
     }
 }
+
+/// Weak absorption, where the tables' last albedo interval lies (α′ 0.999–0.99993; at g 0.8/0.9 one
+/// interval spans 1 − α′ from 5·10⁻⁵ to 1.1·10⁻³): the `mc` family's totals against adding-doubling
+/// (`iad_totals_weak.csv`) at g 0, 0.8, 0.9 and η 1.0, 1.4, 2.0 (table nodes, so no η
+/// interpolation), within 3 standard errors of the last node's Monte Carlo total (2.2·10⁻⁴ at g = 0,
+/// 4.6·10⁻⁴ at g ≠ 0; the nodes below it are 1.2–2.1·10⁻⁴) plus twice the quadrature uncertainty.
+/// A guard on the whole chain; the end condition itself is tested exactly in `model.rs`
+/// (`parabolic_ends_are_exact_for_quadratics`).
+#[test]
+fn weak_absorption_totals_match_adding_doubling() {
+    let mc = family(ModelName::Mc).unwrap();
+    let mut worst: f64 = 0.0;
+    for line in include_str!("../../../data/reference/iad_totals_weak.csv")
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('g'))
+    {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let (g, eta, ap, want, q) = (v[0], v[1], v[2], v[5], (v[5] - v[7]).abs());
+        // (The g = 0 tables end at α′ 0.9999.)
+        let Ok(got) = mc.rd_total(ap, eta, g) else {
+            assert!(g == 0.0 && ap > 0.9999, "g {g} η {eta} α′ {ap} refused");
+            continue;
+        };
+        let se = if g == 0.0 { 2.2e-4 } else { 4.6e-4 };
+        eprintln!(
+            "g {g} η {eta} α′ {ap}: model {got:.6}, adding-doubling {want:.6} ({:+.2e})",
+            got - want
+        );
+        assert!(
+            (got - want).abs() < 3.0 * se + 2.0 * q,
+            "g {g} η {eta} α′ {ap}: total {got} vs adding-doubling {want}"
+        );
+        worst = worst.max((got - want).abs());
+    }
+    eprintln!("largest |model − adding-doubling|: {worst:.2e}");
+}

@@ -10,8 +10,11 @@
 //! the twin's noise from the method's error at α′ → 1.
 //!
 //! ```text
-//! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G] [paper|quick] [MATERIAL,…]
+//! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G] [paper|quick] [MATERIAL,…] [PHOTONS×]
 //! ```
+//!
+//! `PHOTONS×` multiplies the twin's photon budget (its Monte Carlo noise falls as 1/√×): a channel
+//! whose error falls with it was limited by the twin, not by the method.
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
@@ -36,6 +39,12 @@ fn main() {
         RigSpec::quick()
     };
     rig.g = g;
+    if let Some(x) = std::env::args().nth(4) {
+        let x: f64 = x.parse().expect("PHOTONS×");
+        rig.steps_budget *= x;
+        rig.max_photons = (rig.max_photons as f64 * x) as u64;
+        rig.min_photons = (rig.min_photons as f64 * x) as u64;
+    }
     println!("| material | ch | α′ | σ′s: g = 0 assumed | g = {g} | σa: g = 0 assumed | g = {g} |");
     println!("|---|---|---|---|---|---|---|");
     // Materials as the third argument, comma-separated (default: wood-tile, sulfur, skin2).

@@ -1,0 +1,67 @@
+//! The `mc` model over (η, g) at one material against a direct run of this crate's MCML engine
+//! (`Simulation`, pencil beam, half-space; a different tracer from the white runs the tables come
+//! from): mean relative difference ± standard error and χ²/bins per window of reduced radius
+//! ρ′ = σ′t r, and the totals. For the channels whose error on the rig twin stays above the target
+//! with g given (issue 15): is it the model's or the twin's?
+//!
+//! ```text
+//! cargo run --release -p scatterfit-mc --example g_point_check -- ALBEDO_PRIME ETA G PHOTONS [SEED]
+//! ```
+//! Reduced units: σ′t = 1 mm⁻¹, so r is in reduced mean free paths.
+
+#[path = "common/windows.rs"]
+mod windows;
+
+use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation, bundled_grid};
+use scatterfit_optics::{OpticalProperties, ProfileModel};
+use windows::windows;
+
+fn main() {
+    let args: Vec<f64> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("a number"))
+        .collect();
+    let [a, eta, g, photons] = args[..4] else {
+        panic!("usage: g_point_check ALBEDO_PRIME ETA G PHOTONS [SEED]")
+    };
+    let seed = args.get(4).map_or(1, |&s| s as u64);
+    let edges: Vec<f64> = std::iter::once(0.0)
+        .chain((0..=60).map(|i| 0.1 * 500f64.powf(i as f64 / 60.0)))
+        .collect();
+    let grid = RadialGrid::from_edges(edges.clone()).expect("grid");
+    let t0 = std::time::Instant::now();
+    let half = Sample::slab(
+        Layer::from_reduced(a, 1.0 - a, g, eta, f64::INFINITY).expect("layer"),
+        1.0,
+    )
+    .expect("sample");
+    let d = Simulation::new(half, Beam::pencil(), grid, photons as u64, seed)
+        .expect("simulation")
+        .run();
+    let bins: Vec<(f64, f64, f64, f64)> = d
+        .rd_profile
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let rel = if e.value > 0.0 {
+                e.stderr / e.value
+            } else {
+                f64::INFINITY
+            };
+            (edges[i], edges[i + 1], e.value, rel)
+        })
+        .collect();
+    let p = OpticalProperties::new(a, 1.0 - a, eta)
+        .and_then(|p| p.with_g(g))
+        .expect("props");
+    let m = bundled_grid().expect("grid").profile(&p).expect("model");
+    println!(
+        "α′ {a} η {eta} g {g}: engine total {:.5} ± {:.5}, model {:.5} (z {:+.1}) [{:.0} s]\n{}",
+        d.rd_total.value,
+        d.rd_total.stderr,
+        m.rd_total(),
+        (m.rd_total() - d.rd_total.value) / d.rd_total.stderr,
+        t0.elapsed().as_secs_f64(),
+        windows(&m, &bins).replace(" [", "\n  [")
+    );
+}
