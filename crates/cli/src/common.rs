@@ -51,8 +51,12 @@ pub fn parse_rgb(text: &str) -> Result<[f64; 3], String> {
     let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
     match (parts.len(), values.as_slice()) {
         (3, &[r, g, b]) if [r, g, b].iter().all(|v| v.is_finite()) => Ok([r, g, b]),
+        // One number: say how to give it for every channel (the example is the user's own value).
+        (1, &[v]) => Err(format!(
+            "`{text}` is one number; give one per channel, R,G,B (e.g. {v},{v},{v})"
+        )),
         _ => Err(format!(
-            "`{text}` is not three numbers R,G,B (e.g. 1.979,1.893,1.992)"
+            "`{text}` is not three numbers R,G,B (one per channel, comma-separated)"
         )),
     }
 }

@@ -127,6 +127,15 @@ fn synth_then_measure() {
     let out = fit_g(&["--g", "0.5", "--g-range", "0.8,0.9"]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(out.stderr.contains("g range"), "{}", out.stderr);
+    // A g the `mc` tables do not cover is refused before any fit, naming what they hold (it used
+    // to fail every channel with "the fit did not converge").
+    let out = fit_g(&["--model", "mc", "--g", "0.5"]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("not covered") && out.stderr.contains("build_g_tables"),
+        "{}",
+        out.stderr
+    );
     // The proposed method without α′ is bad usage.
     let out = run_cached(dir.path(), &["fit", "wood/profile.csv", "--eta", &eta]);
     assert_eq!(out.code, 2);

@@ -113,19 +113,15 @@ pub fn errors_note(results: &[MeasurementResult]) -> String {
         .filter_map(|r| r.g_uncertainty.as_ref().map(|g| g.describe()))
         .collect();
     if descriptions.iter().all(|d| *d == descriptions[0]) {
-        t.push_str(&format!("{}.\n", upper_first(&descriptions[0])));
+        // (Not capitalised: the sentence starts with the symbol g, which "G" — the green
+        // channel in these tables — would misread.)
+        t.push_str(&format!("Anisotropy: {}.\n", descriptions[0]));
     } else {
         for (r, d) in with_g.iter().zip(&descriptions) {
             t.push_str(&format!("g ({}): {d}.\n", crate::escape::one_line(&r.name)));
         }
     }
     t
-}
-
-fn upper_first(s: &str) -> String {
-    let mut c = s.chars();
-    c.next()
-        .map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
 }
 
 /// The line on the fit and spectrophotometer terms.

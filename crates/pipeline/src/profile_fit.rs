@@ -62,6 +62,13 @@ pub struct ProfileFit {
 pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> Result<ProfileFit> {
     request.g_prior.check()?;
     let g = crate::measure::values_g(&request.g_prior)?;
+    // A g the Monte Carlo tables do not cover is refused here, before any fit, as a manifest's is
+    // (the family itself would only answer NaN, and every channel's fit would fail obscurely).
+    if request.model == scatterfit_optics::ModelName::Mc {
+        scatterfit_mc::bundled_grid()?
+            .albedo_prime_range(g)
+            .map_err(|e| crate::PipelineError::Input(e.to_string()))?;
+    }
     let model = scatterfit_optics::AtG::new(scatterfit_mc::family(request.model)?, g)
         .map_err(|e| crate::PipelineError::Input(format!("g: {e}")))?;
     let model = &model;
