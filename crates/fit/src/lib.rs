@@ -513,7 +513,13 @@ impl<'a> PreparedFit<'a> {
             correlation: corr,
             unconstrained,
             converged,
-            termination: termination_text(termination),
+            termination: if termination.was_successful() && !problem.valid {
+                // The solver's own criterion was met, but on a model that answered non-finite
+                // values: not a convergence (the message said "did not converge: converged (…)").
+                "stopped on non-finite model values (the parameters left the model's domain)".into()
+            } else {
+                termination_text(termination)
+            },
             evaluations,
             fit_time_s,
             prepare_time_s: self.prepare_time_s,

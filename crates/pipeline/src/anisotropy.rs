@@ -306,7 +306,7 @@ fn estimate_at(
     }
     let r = scatterfit_fit::fit_channel(data, &input, &model, opts).map_err(|e| e.to_string())?;
     if !r.converged {
-        return Err(format!("the fit did not converge ({})", r.termination));
+        return Err(format!("the fit failed ({})", r.termination));
     }
     Ok([r.sigma_s_prime.value, r.sigma_a.value, r.albedo_prime])
 }

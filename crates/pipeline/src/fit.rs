@@ -413,7 +413,7 @@ pub fn channel_result(
                 ChannelStatus::Unconstrained
             };
             let problem = if !r.converged {
-                Some(format!("the fit did not converge: {}", r.termination))
+                Some(format!("the fit failed: {}", r.termination))
             } else if !r.unconstrained.is_empty() {
                 Some(format!(
                     "the profile does not constrain {} (standard error of its logarithm above {}): \

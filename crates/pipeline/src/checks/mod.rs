@@ -325,7 +325,7 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
         reasons.push(Reason {
             kind: ReasonKind::FitFailed,
             severity: Verdict::Failed,
-            message: format!("the fit did not converge: {}", r.termination),
+            message: format!("the fit failed: {}", r.termination),
         });
     }
     if !r.unconstrained.is_empty() {
