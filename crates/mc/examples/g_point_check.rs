@@ -38,19 +38,7 @@ fn main() {
     let d = Simulation::new(half, Beam::pencil(), grid, photons as u64, seed)
         .expect("simulation")
         .run();
-    let bins: Vec<(f64, f64, f64, f64)> = d
-        .rd_profile
-        .iter()
-        .enumerate()
-        .map(|(i, e)| {
-            let rel = if e.value > 0.0 {
-                e.stderr / e.value
-            } else {
-                f64::INFINITY
-            };
-            (edges[i], edges[i + 1], e.value, rel)
-        })
-        .collect();
+    let bins = windows::engine_bins(&d, &edges);
     let p = OpticalProperties::new(a, 1.0 - a, eta)
         .and_then(|p| p.with_g(g))
         .expect("props");

@@ -91,19 +91,7 @@ fn main() {
         let d = Simulation::new(half, Beam::pencil(), grid.clone(), direct_photons, seed)
             .expect("simulation")
             .run();
-        let b: Vec<(f64, f64, f64, f64)> = d
-            .rd_profile
-            .iter()
-            .enumerate()
-            .map(|(i, e)| {
-                let rel = if e.value > 0.0 {
-                    e.stderr / e.value
-                } else {
-                    f64::INFINITY
-                };
-                (edges[i], edges[i + 1], e.value, rel)
-            })
-            .collect();
+        let b = windows::engine_bins(&d, &edges);
         let p = OpticalProperties::new(a, 1.0 - a, eta).expect("props");
         let m = McProfile::new(&set, &p).expect("model");
         println!(

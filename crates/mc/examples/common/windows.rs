@@ -1,6 +1,7 @@
 //! Windowed comparison of a profile model with a reference's radial bins (the `mc` examples that
 //! check the model against MCML or the engine).
 
+use scatterfit_mc::SimulationResult;
 use scatterfit_optics::ProfileModel;
 
 pub const WINDOWS: [(f64, f64); 7] = [
@@ -60,4 +61,20 @@ pub fn windows(model: &dyn ProfileModel, bins: &[(f64, f64, f64, f64)]) -> Strin
         }
     }
     line
+}
+
+/// A simulation's profile as bins (r_lo, r_hi, value, relative standard error) over `edges`.
+pub fn engine_bins(d: &SimulationResult, edges: &[f64]) -> Vec<(f64, f64, f64, f64)> {
+    d.rd_profile
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let rel = if e.value > 0.0 {
+                e.stderr / e.value
+            } else {
+                f64::INFINITY
+            };
+            (edges[i], edges[i + 1], e.value, rel)
+        })
+        .collect()
 }
