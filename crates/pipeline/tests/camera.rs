@@ -361,7 +361,11 @@ fn sweep(stride: usize, min_measured: usize) {
     assert!(q(0.5) <= 0.006, "median shape error {:.4}", q(0.5));
     // The 90th percentile: 1.35 % over the whole sweep before the response's forward-direction
     // toe and the exposure estimate's independent selection, 0.91 % with them.
-    assert!(q(0.9) <= 0.01, "90th percentile of the shape error {:.4}", q(0.9));
+    assert!(
+        q(0.9) <= 0.01,
+        "90th percentile of the shape error {:.4}",
+        q(0.9)
+    );
 }
 
 /// Issue 16's failing case, made exactly: an sRGB-like 8-bit camera, 13 exposures 1/600–3 s, a
