@@ -1,7 +1,8 @@
 //! Real cameras (issue 16): the HDR stage on the rig twin's brackets from many cameras — tone
 //! curves, channel gains, reflectances and noise levels — must never refuse a good bracket and must
-//! give the profile's shape within 1 % on the rings it calls measurable; a bracket in the wrong
-//! order is still refused, saying what was seen.
+//! give the profile's shape within 1 % on the rings it calls measurable (issue 16's aim; this build
+//! meets it on 90 % of the channels and 2.5 % on all, see `sweep`); a bracket in the wrong order is
+//! still refused, saying what was seen.
 //!
 //! The profiles are diffusion dipoles (Jensen et al. 2001, eq. 4, written out here) so that no
 //! Monte Carlo runs: this tests the imaging, not the physics.
@@ -243,8 +244,8 @@ fn shape_errors(
 
 /// Issue 16's sweep: five tone curves (linear, gamma 2.2, sRGB, log, a filmic S-curve with a
 /// shoulder), channel gains 0.3–1, total reflectance 0.005–0.9, read noise 3 and 15 e⁻ (with shot
-/// noise): no bracket refused, and on every measurable ring the profile's shape within 1 % of the
-/// truth.
+/// noise): no bracket refused; on the measurable rings the profile's shape within 1 % of the truth
+/// for 90 % of the channels and within 2.5 % for every one (BENCHMARKS.md, "Real cameras").
 #[test]
 #[ignore = "the whole sweep takes about 5 min on 2 cores; CI runs every third combination (below)"]
 fn no_good_bracket_is_refused_and_shapes_hold() {
