@@ -36,6 +36,6 @@ pub use order::check_bracket_order;
 pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{
     CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,
-    MAX_RESPONSE_SAMPLES, ResponseCurve, SamplePixel, gsolve, hat_weight, min_response_samples,
-    recover_response, select_samples,
+    MAX_RESPONSE_SAMPLES, ResponseCurve, SamplePixel, TOE_TRUST_HI, TOE_TRUST_LO, forward_toe,
+    gsolve, hat_weight, min_response_samples, recover_response, select_samples,
 };

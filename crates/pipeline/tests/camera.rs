@@ -1,7 +1,8 @@
 //! Real cameras (issue 16): the HDR stage on the rig twin's brackets from many cameras — tone
 //! curves, channel gains, reflectances and noise levels — must never refuse a good bracket and must
-//! give the profile's shape within 1 % on the rings it calls measurable; a bracket in the wrong
-//! order is still refused, saying what was seen.
+//! give the profile's shape within 1 % on the rings it calls measurable (issue 16's aim; this build
+//! meets it on 90 % of the channels and 2.5 % on all, see `sweep`); a bracket in the wrong order is
+//! still refused, saying what was seen.
 //!
 //! The profiles are diffusion dipoles (Jensen et al. 2001, eq. 4, written out here) so that no
 //! Monte Carlo runs: this tests the imaging, not the physics.
@@ -111,9 +112,9 @@ fn shape_errors(
     let b = render_bracket_fn(&|c, r| profiles[c](r), Some(gains), &rig, seed).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let mut inputs = write(dir.path(), &b.frames, &b.times_s);
-    if std::env::var("CAMERA_TRUE_RESPONSE").is_ok() {
-        // Diagnosis: the camera's own tone curve as a given response (the midpoint of each
-        // code's interval of linear signal), to tell response errors from the merge's.
+    // The camera's own tone curve as a response: the midpoint of each code's interval of linear
+    // signal.
+    let true_g = || -> Vec<f64> {
         let inv = |v: f64| {
             let (mut lo, mut hi) = (0.0, 1.0);
             for _ in 0..60 {
@@ -126,13 +127,17 @@ fn shape_errors(
             }
             0.5 * (lo + hi)
         };
-        let g: Vec<f64> = (0..256)
+        (0..256)
             .map(|z| {
                 let a = inv(((z as f64 - 0.5) / 255.0).max(0.0));
                 let b = inv(((z as f64 + 0.5) / 255.0).min(1.0));
                 (0.5 * (a + b)).max(1e-9).ln()
             })
-            .collect();
+            .collect()
+    };
+    if std::env::var("CAMERA_TRUE_RESPONSE").is_ok() {
+        // Diagnosis: the true response given, to tell response errors from the merge's.
+        let g = true_g();
         let path = dir.path().join("response.csv");
         scatterfit_io::response_csv::write_response_csv(
             &path,
@@ -142,6 +147,22 @@ fn shape_errors(
         inputs.response = Some(path);
     }
     let stage = read_and_merge(&inputs, &|_| {}).map_err(|e| format!("{e:#}"))?;
+    if std::env::var("CAMERA_DEBUG_G").is_ok()
+        && let Some(r) = &stage.response
+    {
+        // The recovered response against the truth, both on the gauge g(128) = 0 [% in X].
+        let t = true_g();
+        for (c, g) in r.tables().iter().enumerate() {
+            let d: Vec<String> = [5usize, 10, 20, 30, 40, 50, 60, 80, 100, 160, 200, 240]
+                .iter()
+                .map(|&z| {
+                    let e = (g[z] - g[128]) - (t[z] - t[128]);
+                    format!("z{z} {:+.1}", 100.0 * e)
+                })
+                .collect();
+            eprintln!("  g error channel {c}: {}", d.join(" "));
+        }
+    }
     if std::env::var("CAMERA_DEBUG").is_ok() {
         let e = stage.corrections.exposure.as_ref();
         eprintln!(
@@ -223,8 +244,8 @@ fn shape_errors(
 
 /// Issue 16's sweep: five tone curves (linear, gamma 2.2, sRGB, log, a filmic S-curve with a
 /// shoulder), channel gains 0.3–1, total reflectance 0.005–0.9, read noise 3 and 15 e⁻ (with shot
-/// noise): no bracket refused, and on every measurable ring the profile's shape within 1 % of the
-/// truth.
+/// noise): no bracket refused; on the measurable rings the profile's shape within 1 % of the truth
+/// for 90 % of the channels and within 2.5 % for every one (BENCHMARKS.md, "Real cameras").
 #[test]
 #[ignore = "the whole sweep takes about 5 min on 2 cores; CI runs every third combination (below)"]
 fn no_good_bracket_is_refused_and_shapes_hold() {
@@ -292,9 +313,11 @@ fn sweep(stride: usize, min_measured: usize) {
                                 None => by_curve.push((key, e[c])),
                             }
                             all.push(e[c]);
-                            // The bound this build meets (issue 16 asks for 1 %; BENCHMARKS.md
-                            // "Real cameras" has the distribution and what limits it).
-                            let bound = if *curve == ToneCurve::Log { 0.05 } else { 0.04 };
+                            // The bound this build meets on every channel (issue 16 asks for
+                            // 1 %; 111 of 120 meet it, BENCHMARKS.md "Real cameras" has the rest
+                            // and what limits them). Main before the forward-direction toe had
+                            // 3.1 % (sRGB) and 3.5 % (log).
+                            let bound = 0.025;
                             if e[c] > bound {
                                 failures.push(format!(
                                     "{} noise {noise}: Rd {} gain {}: shape error {:.4}",
@@ -337,6 +360,13 @@ fn sweep(stride: usize, min_measured: usize) {
     // The median: 0.90 % over the whole sweep (0.90 % on a third) before the response's spline
     // refit, 0.34 % (0.49 %) with it (BENCHMARKS.md, "The response recovery and the sweep").
     assert!(q(0.5) <= 0.006, "median shape error {:.4}", q(0.5));
+    // The 90th percentile: 1.35 % over the whole sweep before the response's forward-direction
+    // toe and the exposure estimate's independent selection, 0.91 % with them.
+    assert!(
+        q(0.9) <= 0.01,
+        "90th percentile of the shape error {:.4}",
+        q(0.9)
+    );
 }
 
 /// Issue 16's failing case, made exactly: an sRGB-like 8-bit camera, 13 exposures 1/600–3 s, a

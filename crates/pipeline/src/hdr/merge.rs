@@ -79,14 +79,38 @@ pub(super) fn merge_8bit(
                 .iter()
                 .map(|g| g.iter().map(|v| v.exp()).collect())
                 .collect();
+            let p = bufs.len();
+            // The noise-aware detection code per channel: the expected exposure a pixel must have.
+            let det = detection_codes(&bufs, &times_used, &response);
             let est = estimate_exposures(
                 &times_used,
                 n,
                 &|j, i| {
+                    let l = &lin[if lin.len() == 1 { 0 } else { i % ch }];
+                    let floor = usize::from(det[i % ch]);
                     let z = bufs[j].data()[i];
-                    (DETECTION_CODE..=230)
-                        .contains(&z)
-                        .then(|| lin[if lin.len() == 1 { 0 } else { i % ch }][usize::from(z)])
+                    if z == 0 || z > 230 {
+                        return None;
+                    }
+                    // Well exposed (above the channel's noise-aware detection code) by what a
+                    // third frame predicts, not by this frame's own code:
+                    // selecting on the noisy code itself truncates its noise (pixels that noise
+                    // lifted over the threshold kept, those it pushed under dropped) and biases the
+                    // ratio of the pair it belongs to (frame j is compared with j ± 1, so frame
+                    // j ± 2 is independent of both).
+                    let r = if j + 2 < p {
+                        j + 2
+                    } else if j >= 2 {
+                        j - 2
+                    } else {
+                        return (usize::from(z) >= floor).then(|| l[usize::from(z)]);
+                    };
+                    let zr = bufs[r].data()[i];
+                    if zr == 0 || zr == u8::MAX {
+                        return None;
+                    }
+                    let expected = l[usize::from(zr)] * times_used[j] / times_used[r];
+                    (expected >= l[floor]).then(|| l[usize::from(z)])
                 },
                 recovered,
             );
