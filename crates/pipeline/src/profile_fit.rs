@@ -61,6 +61,7 @@ pub struct ProfileFit {
 /// are [`ChannelOutcome::NotFitted`].
 pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> Result<ProfileFit> {
     request.g_prior.check()?;
+    crate::measure::check_g_fit(&request.g_prior, request.model)?;
     let g = crate::measure::values_g(&request.g_prior)?;
     let model = scatterfit_optics::AtG::new(scatterfit_mc::family(request.model)?, g)
         .map_err(|e| crate::PipelineError::Input(format!("g: {e}")))?;
@@ -142,7 +143,7 @@ impl ProfileFit {
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: None,
             spectro_port: None,
-            g_uncertainty: Some(crate::measure::g_record(s)),
+            g_uncertainty: Some(crate::measure::g_record(s, &self.fits)),
         }
     }
 }
