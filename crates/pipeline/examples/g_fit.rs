@@ -32,7 +32,7 @@ fn main() {
     rig.g = g;
     let dir = tempfile::tempdir().unwrap();
     println!(
-        "| material | η | ch | α′ | truth g | fitted g ± sd | sd fit / model | shape of Δg 0.05 | determined | σ′s err | σa err | (σa ± total) |"
+        "| material | η | ch | α′ | truth g | fitted g ± sd | sd fit / spectro / model | shape of Δg 0.05 | determined | σ′s err | σa err | (σa ± total) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (k, name) in names.iter().enumerate() {
@@ -81,7 +81,10 @@ fn main() {
                         (Some(g), Some(sd)) => format!("{g:.3} ± {sd:.3}"),
                         _ => format!("({:.3} ± {:.3}, not printed)", gf.g, gf.stderr),
                     },
-                    format!("{:.3} / {:.3}", gf.stderr_fit, gf.stderr_model),
+                    format!(
+                        "{:.3} / {:.3} / {:.3}",
+                        gf.stderr_fit, gf.stderr_spectro, gf.stderr_model
+                    ),
                     format!("{:.2} %", 100.0 * gf.shape_change),
                     if f.determined {
                         "yes".to_string()

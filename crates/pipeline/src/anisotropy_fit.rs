@@ -24,8 +24,16 @@
 //! fitted from the rig's profile?"); what limits g is the model's own shape error. A change of g by
 //! Δg = 0.05 changes the refitted profile's shape by an RMS S (measured here, per channel, from the
 //! fits at ĝ ± 0.05); a smooth shape error δ of the model projects onto it as at most
-//! |Δg| = 0.05·δ/S. With δ = [`MODEL_SHAPE_NOISE`] (the `mc` tables' noise budget, 0.3 %):
-//! sd_model(g) = 0.05·δ/S, and sd(g) = √(sd_fit² + sd_model²).
+//! |Δg| = 0.05·δ/S. δ is measured from the data: the RMS of the fit's log residuals at ĝ beyond the
+//! rings' own noise, √(max(0, rms² − mean σ_ln²)), and never less than [`MODEL_SHAPE_NOISE`] (the
+//! `mc` tables' noise budget, 0.3 %): sd_model(g) = 0.05·δ/S. (With δ fixed at 0.3 % the rig twin at
+//! g = 0.8 had four channels "determined" 2–4 sd(g) from the truth; with the measured misfit none
+//! is: BENCHMARKS.md.)
+//!
+//! **The spectrophotometer's part.** α′(g) comes from the reading's Rd, so an error in the reading
+//! moves the minimum: the scan is repeated with the reading (η and Rd together, as
+//! [`crate::fit::propagate_spectro`]) at −1 and +1 standard deviation, and sd_spectro(g) is half
+//! the distance between the two minima. sd(g) = √(sd_fit² + sd_model² + sd_spectro²).
 //!
 //! **The rule** ([`G_DETERMINED_SD`], [`ALBEDO_DETERMINED_MAX`]): g is determined when the
 //! minimum lies inside the searched range (at least one scan step from either end of the g the
@@ -59,7 +67,8 @@ pub const G_DETERMINED_SD: f64 = 0.05;
 /// read 1.2–1.4 % at α′ 0.993–0.999 and put ĝ 0.92–0.94; BENCHMARKS.md, the twin table).
 pub const ALBEDO_DETERMINED_MAX: f64 = 0.98;
 
-/// The `mc` model's relative shape noise δ (RMS over the profile): the tables' noise budget, and
+/// The smallest relative shape error δ (RMS over the profile) assumed for the model: the tables'
+/// noise budget, and
 /// the interpolant's error in g against a table built at g = 0.85 (0.2–0.4 %; BENCHMARKS.md,
 /// "The `mc` model over g").
 pub const MODEL_SHAPE_NOISE: f64 = 0.003;
@@ -79,8 +88,10 @@ pub struct GFit {
     pub stderr: f64,
     /// The fit's part (curvature of χ², scaled by the reduced χ²).
     pub stderr_fit: f64,
-    /// The model's part (0.05·δ/S).
+    /// The model's part (0.05·δ/S, δ the fit's misfit beyond the rings' noise, at least 0.3 %).
     pub stderr_model: f64,
+    /// The spectrophotometer's part (the minimum's shift with the reading at ± its error).
+    pub stderr_spectro: f64,
     /// corr(σ′s, g) in the joint covariance.
     pub corr_sigma_s_prime: f64,
     /// S: the RMS shape change (ln) of Δg = 0.05 after refitting the other unknowns.
@@ -111,6 +122,7 @@ impl GFit {
             g_stderr: d.then_some(self.stderr),
             g_stderr_fit: d.then_some(self.stderr_fit),
             g_stderr_model: d.then_some(self.stderr_model),
+            g_stderr_spectro: d.then_some(self.stderr_spectro),
             corr_sigma_s_prime_g: d
                 .then_some(self.corr_sigma_s_prime)
                 .filter(|c| c.is_finite()),
@@ -229,8 +241,31 @@ fn parabola(p: [(f64, f64); 3]) -> Option<(f64, f64)> {
     Some((vertex, a))
 }
 
-/// The profile likelihood over `points` for one channel ([module docs](self)).
-pub fn fit_g(channel: &ChannelAtG<'_>, points: &[f64]) -> Result<GFit, String> {
+/// The g of χ²'s smallest value over `points` (the parabola's vertex through it and its
+/// neighbours; the end point itself at an end): where a perturbed reading puts the minimum.
+fn scan_minimum(channel: &ChannelAtG<'_>, points: &[f64]) -> Option<f64> {
+    let scan: Vec<(f64, f64)> = points
+        .iter()
+        .filter_map(|&g| channel.fit(g).ok().map(|r| (g, chi2(&r))))
+        .collect();
+    let i = (0..scan.len()).min_by(|&a, &b| scan[a].1.total_cmp(&scan[b].1))?;
+    if i == 0 || i + 1 == scan.len() {
+        return Some(scan[i].0);
+    }
+    Some(
+        parabola([scan[i - 1], scan[i], scan[i + 1]])
+            .map_or(scan[i].0, |(v, _)| v.clamp(scan[i - 1].0, scan[i + 1].0)),
+    )
+}
+
+/// The profile likelihood over `points` for one channel ([module docs](self)); `perturbed`: the
+/// channel with the spectrophotometer's reading at −1 and +1 standard deviation (empty when the
+/// reading does not enter, or has no error), whose minima give sd(g)'s spectrophotometer part.
+pub fn fit_g(
+    channel: &ChannelAtG<'_>,
+    points: &[f64],
+    perturbed: &[ChannelAtG<'_>],
+) -> Result<GFit, String> {
     // The scan: runs of g the tables answered, with no failed point between.
     let mut scan: Vec<(f64, FitReport)> = Vec::new();
     let mut run_of: Vec<usize> = Vec::new();
@@ -274,6 +309,7 @@ pub fn fit_g(channel: &ChannelAtG<'_>, points: &[f64]) -> Result<GFit, String> {
         stderr: f64::NAN,
         stderr_fit: f64::NAN,
         stderr_model: f64::NAN,
+        stderr_spectro: f64::NAN,
         corr_sigma_s_prime: f64::NAN,
         shape_change: f64::NAN,
         searched,
@@ -326,8 +362,28 @@ pub fn fit_g(channel: &ChannelAtG<'_>, points: &[f64]) -> Result<GFit, String> {
     } else {
         signals.iter().sum::<f64>() / signals.len() as f64
     };
-    let sd_model = SHAPE_DG * MODEL_SHAPE_NOISE / shape;
-    let sd = sd_fit.hypot(sd_model);
+    // δ: the model's noise, or the misfit the data show beyond the rings' own noise if larger.
+    let noise2 = at
+        .fitted
+        .iter()
+        .map(|f| f.sigma_ln * f.sigma_ln)
+        .sum::<f64>()
+        / at.fitted.len().max(1) as f64;
+    let misfit = (at.rms_log_residual.powi(2) - noise2).max(0.0).sqrt();
+    let delta = MODEL_SHAPE_NOISE.max(misfit);
+    let sd_model = SHAPE_DG * delta / shape;
+    // The reading's part: half the distance between the minima at the reading ∓ its error.
+    let sd_spectro = match perturbed {
+        [lo_reading, hi_reading] => match (
+            scan_minimum(lo_reading, points),
+            scan_minimum(hi_reading, points),
+        ) {
+            (Some(a), Some(b)) => 0.5 * (b - a).abs(),
+            _ => f64::NAN,
+        },
+        _ => 0.0,
+    };
+    let sd = sd_fit.hypot(sd_model).hypot(sd_spectro);
     // corr(σ′s, g) along the profile path.
     let (g0, g1) = (scan[i - 1].0, scan[i + 1].0);
     let slope = (scan[i + 1].1.sigma_s_prime.value - scan[i - 1].1.sigma_s_prime.value) / (g1 - g0);
@@ -353,6 +409,7 @@ pub fn fit_g(channel: &ChannelAtG<'_>, points: &[f64]) -> Result<GFit, String> {
     fit.stderr = sd;
     fit.stderr_fit = sd_fit;
     fit.stderr_model = sd_model;
+    fit.stderr_spectro = sd_spectro;
     fit.corr_sigma_s_prime = corr;
     fit.shape_change = shape;
     fit.term = Some(term);
@@ -364,14 +421,14 @@ pub fn fit_g(channel: &ChannelAtG<'_>, points: &[f64]) -> Result<GFit, String> {
              follows the tables' noise, not g"
         ))
     } else if !sd.is_finite() {
-        Some("the shape signal of g could not be measured".into())
+        Some("sd(g) could not be computed (a scan at the minimum or at the perturbed readings failed)".into())
     } else if sd > G_DETERMINED_SD {
         Some(format!(
-            "sd(g) = {sd:.3} > {G_DETERMINED_SD} (the fit's part {sd_fit:.3}; the model's \
-             {sd_model:.3}: Δg = 0.05 changes the profile's shape by {:.2} % RMS against the \
-             model's {:.1} % noise)",
+            "sd(g) = {sd:.3} > {G_DETERMINED_SD} (the fit's part {sd_fit:.3}; the \
+             spectrophotometer's {sd_spectro:.3}; the model's {sd_model:.3}: Δg = 0.05 changes \
+             the profile's shape by {:.2} % RMS against the model's {:.2} % misfit)",
             100.0 * shape,
-            100.0 * MODEL_SHAPE_NOISE
+            100.0 * delta
         ))
     } else {
         None
@@ -412,18 +469,37 @@ pub fn fit_g_channels(
                 Ok(g) => *g,
                 Err(e) => return Some(Err(e.to_string())),
             };
-            let channel = ChannelAtG {
+            let proposed = settings.method == Method::Proposed;
+            let at = |eta: f64, rd: f64| ChannelAtG {
                 data,
                 input: ChannelInput {
-                    eta: spectro.eta,
+                    eta,
                     albedo_prime: spectro.albedo_prime[c],
-                    rd_total: Some(spectro.rd[c]),
+                    rd_total: Some(rd),
                 },
                 albedo_at_g,
                 opts,
-                proposed: settings.method == Method::Proposed,
+                proposed,
             };
-            Some(fit_g(&channel, &scan_points(grid, range)))
+            let channel = at(spectro.eta, spectro.rd[c]);
+            // The reading at ∓ its error (η and Rd together, as `propagate_spectro`): it moves
+            // α′(g) and so the minimum (the existing method reads η only).
+            let u = &spectro.uncertainty;
+            let perturbed: Vec<ChannelAtG<'_>> = if u.repeatability > 0.0 {
+                (0..2)
+                    .map(|k| {
+                        let rd = if proposed && albedo_at_g == AlbedoAtG::FromRd {
+                            u.rd_pm[c][k]
+                        } else {
+                            spectro.rd[c]
+                        };
+                        at(u.eta_pm[k], rd)
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            Some(fit_g(&channel, &scan_points(grid, range), &perturbed))
         })
 }
 

@@ -66,13 +66,16 @@ pub struct GFitRecord {
     pub determined: bool,
     /// The fitted g (the minimum of χ²(g)); `None` where not determined.
     pub g: Option<f64>,
-    /// Its standard error: the fit's and the model's parts in quadrature; `None` where not
-    /// determined.
+    /// Its standard error: the fit's, the model's and the spectrophotometer's parts in
+    /// quadrature; `None` where not determined.
     pub g_stderr: Option<f64>,
     /// The fit's part: from the curvature of χ²(g), scaled by the reduced χ² when above 1.
     pub g_stderr_fit: Option<f64>,
     /// The model's part: the `mc` tables' shape noise read as a change of g.
     pub g_stderr_model: Option<f64>,
+    /// The spectrophotometer's part: how far the minimum moves with the reading at ± its error.
+    #[serde(default)]
+    pub g_stderr_spectro: Option<f64>,
     /// The correlation of σ′s and g in the joint covariance.
     pub corr_sigma_s_prime_g: Option<f64>,
     /// The RMS change of the profile's shape (ln, after refitting the other unknowns) that
