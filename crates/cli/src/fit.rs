@@ -47,9 +47,13 @@ pub struct Args {
     #[arg(long)]
     pub normalise_with_spectro: bool,
     /// The material's Henyey–Greenstein g, known or assumed, in (−1, 1): the model is evaluated at
-    /// it (as the manifest's `[fit] g`). Alone, g is known and its error term is 0.
-    #[arg(long, value_name = "G", value_parser = crate::numeric::parse_finite)]
-    pub g: Option<f64>,
+    /// it (as the manifest's `[fit] g`). Alone, g is known and its error term is 0. Or `fit`
+    /// (needs --model mc): g fitted per channel from the profile within --g-range (default: what
+    /// the `mc` tables cover at η, 0.8–0.95 today), printed with its standard error where the data
+    /// determine it (sd(g) ≤ 0.05, the minimum inside the range); elsewhere "not determined" and
+    /// the range's ± g term.
+    #[arg(long, value_name = "G|fit", value_parser = parse_g)]
+    pub g: Option<GArg>,
     /// The range LO,HI (0 ≤ LO ≤ HI ≤ 0.95) the material's g lies in (as `[fit] g_range`),
     /// propagated into σ′s, σa and α′ as a separate "± g" term from the g-aware `mc` model; with
     /// --g the values are at that g, without it the middle of the estimates over the range.
@@ -68,6 +72,25 @@ pub struct Args {
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--g`: a number or `fit`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GArg {
+    /// A known or assumed g.
+    Value(f64),
+    /// Fit g from the profile.
+    Fit,
+}
+
+/// Parses `--g G|fit`.
+pub fn parse_g(text: &str) -> Result<GArg, String> {
+    if text.trim() == "fit" {
+        return Ok(GArg::Fit);
+    }
+    crate::numeric::parse_finite(text)
+        .map(GArg::Value)
+        .map_err(|_| format!("`{text}` is neither a Henyey–Greenstein g in (−1, 1) nor `fit`"))
 }
 
 /// Parses `--g-range LO,HI`: two finite numbers (the range's rule is checked with the other
@@ -159,8 +182,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         r_min_mm: args.r_min_mm,
         normalise_with_spectro: args.normalise_with_spectro,
         g_prior: scatterfit_pipeline::anisotropy::GPrior {
-            g: args.g,
+            g: match args.g {
+                Some(GArg::Value(g)) => Some(g),
+                _ => None,
+            },
             range: args.g_range,
+            fit: args.g == Some(GArg::Fit),
         },
     };
     let fitted = fit_profile(&data, &request)?;

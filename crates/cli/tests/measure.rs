@@ -136,6 +136,25 @@ fn synth_then_measure() {
         "{}",
         out.stderr
     );
+    // `--g fit` needs the g-aware model (bad usage with the default dipole), and runs with it: the
+    // result records the fit of g per channel, and a channel either gives g with its error or says
+    // why not.
+    let out = fit_g(&["--g", "fit"]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(out.stderr.contains("mc"), "{}", out.stderr);
+    let out = fit_g(&["--g", "fit", "--model", "mc"]);
+    assert!(out.code == 0 || out.code == 1, "{}", out.stderr);
+    let j: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(j["g_uncertainty"]["source"], "fit");
+    let r = &j["g_uncertainty"]["fitted"]["r"];
+    assert!(
+        r["g"].is_number() == (r["determined"] == true)
+            && (r["g"].is_number() || r["reason"].is_string()),
+        "{r}"
+    );
+    let out = fit_g(&["--g", "fitt"]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("nor `fit`"), "{}", out.stderr);
     // The proposed method without α′ is bad usage.
     let out = run_cached(dir.path(), &["fit", "wood/profile.csv", "--eta", &eta]);
     assert_eq!(out.code, 2);

@@ -108,6 +108,17 @@ pub fn errors_note(results: &[MeasurementResult]) -> String {
          Henyey–Greenstein g, from the g-aware `mc` model (0 where g was given; issue 15); a bound, \
          not a standard error: add it to the quadrature sum of the others for the total.\n",
     );
+    if with_g.iter().any(|r| {
+        r.g_uncertainty
+            .as_ref()
+            .is_some_and(|g| g.source == crate::result_json::GSource::Fit)
+    }) {
+        t.push_str(
+            "Where g is fitted from the profile (g = \"fit\"), a channel whose g the data determine \
+             has its values at the fitted g and ± g is how far they move over its standard error; \
+             elsewhere ± g is the searched range's term.\n",
+        );
+    }
     let descriptions: Vec<String> = with_g
         .iter()
         .filter_map(|r| r.g_uncertainty.as_ref().map(|g| g.describe()))

@@ -141,6 +141,7 @@ fn main() {
                     g_prior: GPrior {
                         g: None,
                         range: Some([0.0, 0.95]),
+                        fit: false,
                     },
                     ..measured.settings
                 })

@@ -98,7 +98,7 @@ fn main() {
                 fit: FitSection {
                     model: Some(ModelName::Mc),
                     albedo_model: Some(AlbedoModel::Mc),
-                    g: Some(g),
+                    g: Some(scatterfit_io::manifest::GSetting::Value(g)),
                     ..Default::default()
                 },
             },

@@ -54,14 +54,21 @@ const SAME_G: f64 = 1e-9;
 pub struct GPrior {
     /// A known or assumed g: the values are computed at it.
     pub g: Option<f64>,
-    /// The range g lies in, `[lo, hi]` with 0 ≤ lo ≤ hi ≤ 0.95.
+    /// The range g lies in, `[lo, hi]` with 0 ≤ lo ≤ hi ≤ 0.95; with [`GPrior::fit`] the range
+    /// searched.
     pub range: Option<[f64; 2]>,
+    /// `g = "fit"`: g fitted per channel from the profile ([`crate::anisotropy_fit`]); where the
+    /// data do not determine it, the range's term (the values the middle of the estimates).
+    pub fit: bool,
 }
 
 impl GPrior {
     /// Where the knowledge came from: g alone is [`GSource::Given`], a range (with or without a g)
     /// [`GSource::Range`], neither [`GSource::DefaultRange`].
     pub fn source(&self) -> GSource {
+        if self.fit {
+            return GSource::Fit;
+        }
         match (self.g, self.range) {
             (Some(_), None) => GSource::Given,
             (_, Some(_)) => GSource::Range,
@@ -73,6 +80,11 @@ impl GPrior {
     /// stated, `None` when g is given (known: no term).
     pub fn propagated_range(&self) -> Option<[f64; 2]> {
         match self.source() {
+            GSource::Fit => self.range.or_else(|| {
+                scatterfit_mc::bundled_grid()
+                    .ok()
+                    .and_then(crate::anisotropy_fit::default_search_range)
+            }),
             GSource::Given => None,
             GSource::Range => self.range,
             GSource::DefaultRange => Some(DEFAULT_G_RANGE),
@@ -81,7 +93,7 @@ impl GPrior {
 
     /// True when the values are the middle of the estimates over the range (a range, no g).
     pub fn is_centred(&self) -> bool {
-        self.g.is_none() && self.range.is_some()
+        self.g.is_none() && (self.range.is_some() || self.fit)
     }
 
     /// Checks the prior as the manifest does (for values from the command line or a program).
@@ -90,6 +102,11 @@ impl GPrior {
     /// [`PipelineError::Input`] naming the option: a range not in 0 ≤ lo ≤ hi ≤ 0.95, a g outside
     /// (−1, 1) or outside the range.
     pub fn check(&self) -> Result<()> {
+        if self.fit && self.g.is_some() {
+            return Err(PipelineError::Input(
+                "g: give a number or \"fit\", not both".into(),
+            ));
+        }
         if let Some(g) = self.g
             && !(g.is_finite() && g > -1.0 && g < 1.0)
         {
@@ -199,6 +216,7 @@ impl GPlan {
             range: Some(self.range),
             evaluated: self.points.clone(),
             not_covered: self.not_covered.clone(),
+            fitted: None,
         }
     }
 }
@@ -211,6 +229,7 @@ pub fn known_g_record(g: f64) -> GUncertainty {
         range: None,
         evaluated: Vec::new(),
         not_covered: None,
+        fitted: None,
     }
 }
 
@@ -460,6 +479,7 @@ mod tests {
         let known = GPrior {
             g: Some(0.85),
             range: None,
+            fit: false,
         };
         assert_eq!(known.source(), GSource::Given);
         assert_eq!(known.propagated_range(), None);
@@ -470,20 +490,41 @@ mod tests {
         let range = GPrior {
             g: None,
             range: Some([0.7, 0.95]),
+            fit: false,
         };
         assert!(range.is_centred() && range.check().is_ok());
+        // g = "fit" without a range searches the grid's widest covered interval, centred.
+        let fit = GPrior {
+            fit: true,
+            ..GPrior::default()
+        };
+        assert_eq!(fit.source(), GSource::Fit);
+        let grid = scatterfit_mc::bundled_grid().unwrap();
+        assert_eq!(
+            fit.propagated_range(),
+            crate::anisotropy_fit::default_search_range(grid)
+        );
+        assert!(fit.is_centred() && fit.check().is_ok());
         for bad in [
             GPrior {
                 g: Some(0.5),
                 range: Some([0.7, 0.9]),
+                fit: false,
             },
             GPrior {
                 g: None,
                 range: Some([0.9, 0.7]),
+                fit: false,
             },
             GPrior {
                 g: None,
                 range: Some([0.0, 0.99]),
+                fit: false,
+            },
+            GPrior {
+                g: Some(0.85),
+                range: None,
+                fit: true,
             },
         ] {
             assert!(bad.check().is_err(), "{bad:?}");

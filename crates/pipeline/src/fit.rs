@@ -95,6 +95,8 @@ pub struct ChannelFit {
     /// What the user should know about the g term (g where it could not be evaluated, or why
     /// there is none).
     pub g_note: Option<String>,
+    /// With `g = "fit"`: the fit of g ([`crate::anisotropy_fit`]), determined or not.
+    pub g_fit: Option<crate::anisotropy_fit::GFit>,
 }
 
 impl ChannelFit {
@@ -118,6 +120,7 @@ impl ChannelFit {
                 g: None,
             },
             g_note: None,
+            g_fit: None,
             report,
         }
     }
@@ -211,6 +214,61 @@ impl ChannelOutcome {
     }
 }
 
+impl ChannelOutcome {
+    /// The same outcome with g fitted (`g = "fit"`, [`crate::anisotropy_fit`]): where the data
+    /// determine g, the fit at ĝ replaces the report and the values (the spectrophotometer's term
+    /// stays the one computed at the settings' g), and the g term is how far the values move over
+    /// ĝ ± sd(g); where not, `fallback` — the searched range's term ([`ChannelOutcome::with_g`]).
+    /// The fit of g is kept either way, with its reason.
+    #[must_use]
+    pub fn with_g_fit(
+        self,
+        fitted: Option<std::result::Result<crate::anisotropy_fit::GFit, String>>,
+        fallback: Option<std::result::Result<GTerm, String>>,
+    ) -> Self {
+        let determined = match &fitted {
+            Some(Ok(g)) if g.determined => Some(g.clone()),
+            _ => None,
+        };
+        let Some(g) = determined else {
+            let mut out = self.with_g(fallback);
+            if let ChannelOutcome::Fitted(f) = &mut out {
+                f.g_fit = match fitted {
+                    Some(Ok(g)) => Some(g),
+                    Some(Err(why)) => {
+                        f.g_note = Some(match f.g_note.take() {
+                            Some(n) => format!("g could not be fitted: {why}; {n}"),
+                            None => format!("g could not be fitted: {why}"),
+                        });
+                        None
+                    }
+                    None => None,
+                };
+            }
+            return out;
+        };
+        let ChannelOutcome::Fitted(mut f) = self else {
+            return self;
+        };
+        if let (Some(report), Some(term)) = (&g.report, g.term) {
+            let fresh = ChannelFit::new(report.clone(), f.albedo_prime.spectro);
+            let spectro = (f.sigma_s_prime.spectro, f.sigma_a.spectro);
+            f.sigma_s_prime = fresh.sigma_s_prime;
+            f.sigma_a = fresh.sigma_a;
+            f.albedo_prime = fresh.albedo_prime;
+            f.sigma_s_prime.spectro = spectro.0;
+            f.sigma_a.spectro = spectro.1;
+            f.sigma_s_prime.g = finite(term[0]);
+            f.sigma_a.g = finite(term[1]);
+            f.albedo_prime.g = finite(term[2]);
+            f.report = report.clone();
+            f.g_note = None;
+        }
+        f.g_fit = Some(g);
+        ChannelOutcome::Fitted(f)
+    }
+}
+
 fn finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
 }
@@ -284,6 +342,20 @@ pub fn with_g_term(
 ) -> Rgb<ChannelOutcome> {
     match GPlan::new(&settings.g_prior, settings.g) {
         Ok(None) => fits.map(|f| f.with_g(None)),
+        Ok(Some(plan)) if settings.g_prior.fit => {
+            let terms = propagate_g(profiles, spectro, settings, &fits, &plan, albedo_at_g);
+            let fitted = crate::anisotropy_fit::fit_g_channels(
+                profiles,
+                spectro,
+                settings,
+                &fits,
+                plan.range,
+                albedo_at_g,
+            );
+            fits.zip(fitted)
+                .zip(terms)
+                .map(|((f, g), t)| f.with_g_fit(g, t))
+        }
         Ok(Some(plan)) => {
             let terms = propagate_g(profiles, spectro, settings, &fits, &plan, albedo_at_g);
             fits.zip(terms).map(|(f, t)| f.with_g(t))

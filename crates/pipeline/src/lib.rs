@@ -41,6 +41,7 @@
 
 pub mod accuracy;
 pub mod anisotropy;
+pub mod anisotropy_fit;
 pub mod batch;
 pub mod camera;
 pub mod checks;

@@ -49,6 +49,8 @@ pub struct Overrides {
     pub g: Option<f64>,
     /// A g range instead of the manifest's `[fit] g_range`.
     pub g_range: Option<[f64; 2]>,
+    /// Fit g instead of the manifest's `[fit] g` (`g = "fit"`; issue 15).
+    pub g_fit: bool,
     /// Allow the manifest to name files outside the sample folder (the input path policy,
     /// `scatterfit_io::inputs`; `--allow-outside-paths`).
     pub allow_outside_paths: bool,
@@ -201,18 +203,27 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         _ => (SpotShape::Disk, 0.5 * diameter),
     };
     // What is known about g (issue 15): an override replaces both manifest keys.
-    let g_prior = if o.g.is_some() || o.g_range.is_some() {
+    let g_prior = if o.g.is_some() || o.g_range.is_some() || o.g_fit {
         GPrior {
             g: o.g,
             range: o.g_range,
+            fit: o.g_fit,
         }
     } else {
         GPrior {
-            g: manifest.fit.g,
+            g: manifest
+                .fit
+                .g
+                .and_then(scatterfit_io::manifest::GSetting::value),
             range: manifest.fit.g_range,
+            fit: manifest
+                .fit
+                .g
+                .is_some_and(scatterfit_io::manifest::GSetting::is_fit),
         }
     };
     g_prior.check()?;
+    check_g_fit(&g_prior, model)?;
     let settings = FitSettings {
         method,
         model,
@@ -228,13 +239,33 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
     Ok(settings)
 }
 
-/// The g the values are computed at: the given g; for a range without a g the covered g nearest
-/// its middle ([`GPlan::nominal_g`]); else 0.
+/// `g = "fit"` needs the g-aware `mc` model (the diffusion dipoles do not depend on g, and
+/// photon beam diffusion's g enters only its near field).
+///
+/// # Errors
+/// [`PipelineError::Input`] naming `fit.g` and what to do.
+pub fn check_g_fit(prior: &GPrior, model: ModelName) -> Result<()> {
+    if prior.fit && model != ModelName::Mc {
+        return Err(PipelineError::Input(format!(
+            "fit.g = \"fit\": fitting g needs the g-aware Monte Carlo model, not {model}; set \
+             fit.model = \"mc\" (or --model mc), or give g as a number or a fit.g_range"
+        )));
+    }
+    Ok(())
+}
+
+/// The g the values are computed at: the given g; for a range without a g (or `g = "fit"`: the
+/// range searched) the covered g nearest its middle ([`GPlan::nominal_g`]); else 0.
 ///
 /// # Errors
 /// [`PipelineError::Input`] for a range the `mc` tables cover nowhere.
 pub fn values_g(prior: &GPrior) -> Result<f64> {
-    match (prior.g, prior.range) {
+    match (
+        prior.g,
+        prior
+            .range
+            .or(prior.propagated_range().filter(|_| prior.fit)),
+    ) {
         (Some(g), _) => Ok(g),
         (None, Some(range)) => {
             let grid = scatterfit_mc::bundled_grid()?;
@@ -593,7 +624,7 @@ impl Measurement {
                     .and_then(|p| crate::port::correct_spectrum(&s, &p.reading_fraction))
                     .unwrap_or(s)
             }),
-            g_uncertainty: Some(g_record(s)),
+            g_uncertainty: Some(g_record(s, &self.fits)),
             spectro_port: self
                 .port
                 .as_ref()
@@ -608,10 +639,24 @@ impl Measurement {
     }
 }
 
-/// The result's record of how g entered ([`scatterfit_io::result_json::GUncertainty`]).
-pub fn g_record(settings: &FitSettings) -> scatterfit_io::result_json::GUncertainty {
+/// The result's record of how g entered ([`scatterfit_io::result_json::GUncertainty`]), with
+/// each channel's fit of g for `g = "fit"` (from `fits`).
+pub fn g_record(
+    settings: &FitSettings,
+    fits: &Rgb<ChannelOutcome>,
+) -> scatterfit_io::result_json::GUncertainty {
     match GPlan::new(&settings.g_prior, settings.g) {
-        Ok(Some(plan)) => plan.record(&settings.g_prior),
+        Ok(Some(plan)) => {
+            let mut record = plan.record(&settings.g_prior);
+            if settings.g_prior.fit {
+                record.fitted = Some(fits.as_ref().map(|f| {
+                    f.fit()
+                        .and_then(|f| f.g_fit.as_ref())
+                        .map(crate::anisotropy_fit::GFit::record)
+                }));
+            }
+            record
+        }
         Ok(None) => known_g_record(settings.g),
         // No plan: the range, nothing evaluated (the channels' notes say why).
         Err(e) => scatterfit_io::result_json::GUncertainty {
@@ -620,6 +665,7 @@ pub fn g_record(settings: &FitSettings) -> scatterfit_io::result_json::GUncertai
             range: settings.g_prior.propagated_range(),
             evaluated: Vec::new(),
             not_covered: Some(e.to_string()),
+            fitted: None,
         },
     }
 }
@@ -660,6 +706,7 @@ mod tests {
         let prior = GPrior {
             g: None,
             range: Some([0.3, 0.6]),
+            fit: false,
         };
         let message = values_g(&prior).unwrap_err().to_string();
         assert!(message.contains("[0.3, 0.6]"), "{message}");
@@ -672,6 +719,7 @@ mod tests {
         let reaching = GPrior {
             g: None,
             range: Some([0.3, 0.85]),
+            fit: false,
         };
         assert!(values_g(&reaching).is_ok());
     }

@@ -61,6 +61,7 @@ pub struct ProfileFit {
 /// are [`ChannelOutcome::NotFitted`].
 pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> Result<ProfileFit> {
     request.g_prior.check()?;
+    crate::measure::check_g_fit(&request.g_prior, request.model)?;
     let g = crate::measure::values_g(&request.g_prior)?;
     // A g the Monte Carlo tables do not cover is refused here, before any fit, as a manifest's is
     // (the family itself would only answer NaN, and every channel's fit would fail obscurely).
@@ -149,7 +150,7 @@ impl ProfileFit {
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: None,
             spectro_port: None,
-            g_uncertainty: Some(crate::measure::g_record(s)),
+            g_uncertainty: Some(crate::measure::g_record(s, &self.fits)),
         }
     }
 }

@@ -9,7 +9,7 @@ use scatterfit_pipeline::{AlbedoModel, ModelFamily, ModelName, PipelineError};
 fn manifest(model: ModelName, g: Option<f64>) -> SampleManifest {
     let mut m = SampleManifest::default();
     m.fit.model = Some(model);
-    m.fit.g = g;
+    m.fit.g = g.map(scatterfit_io::manifest::GSetting::Value);
     m
 }
 

@@ -206,6 +206,24 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         (Some(u), _) if u.source == scatterfit_io::result_json::GSource::Given => {
             format!(", g = {} given", u.g.unwrap_or(0.0))
         }
+        (Some(u), _) if u.source == scatterfit_io::result_json::GSource::Fit => {
+            let fitted = u.fitted.as_ref().map_or(String::new(), |f| {
+                let parts: Vec<String> = f
+                    .iter_channels()
+                    .filter_map(|(c, f)| {
+                        f.as_ref().map(|f| match (f.g, f.g_stderr) {
+                            (Some(g), Some(sd)) => format!("{} {g:.3} ± {sd:.3}", c.name()),
+                            _ => format!("{} not determined", c.name()),
+                        })
+                    })
+                    .collect();
+                format!(": {}", parts.join(", "))
+            });
+            let within = u
+                .range
+                .map_or(String::new(), |[lo, hi]| format!(" in {lo}–{hi}"));
+            format!(", g fitted{within}{fitted}")
+        }
         (Some(u), _) => match (u.g, u.range) {
             (Some(g), Some([lo, hi])) => format!(", values at g = {g} (g in {lo}–{hi}: ± g)"),
             (None, Some([lo, hi])) => format!(", g in {lo}–{hi} (± g)"),

@@ -36,7 +36,9 @@
 //! model = "dipole"              # dipole | better-dipole | pbd | mc
 //! # albedo_model = "diffusion"  # diffusion | mc (default: mc for the mc model, else diffusion)
 //! r_max_px = 300                # the paper's cut-off
-//! # g = 0.85                    # Henyey–Greenstein g of the material, known or assumed (default 0)
+//! # g = 0.85                    # Henyey–Greenstein g of the material, known or assumed (default 0),
+//! #                             # or "fit": fitted per channel from the profile where it determines g
+//! # g_range = [0.7, 0.95]       # the range g lies in: a "± g" term; with g = "fit" the search range
 //! ```
 //!
 //! Paths are relative to the manifest's folder. Unknown keys are refused (a misspelt key would
@@ -231,6 +233,79 @@ pub struct CameraSection {
 /// The largest g a `[fit] g_range` may reach (the grid the `mc` tables are built for ends at 0.95).
 pub const G_RANGE_MAX: f64 = 0.95;
 
+/// `[fit] g`: a known or assumed Henyey–Greenstein g, or `"fit"` (issue 15).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GSetting {
+    /// A known or assumed g in (−1, 1): the models are evaluated at it.
+    Value(f64),
+    /// `"fit"`: g fitted per channel from the profile (where the data determine it).
+    Fit,
+}
+
+impl GSetting {
+    /// The number, for a [`GSetting::Value`].
+    pub fn value(self) -> Option<f64> {
+        match self {
+            GSetting::Value(g) => Some(g),
+            GSetting::Fit => None,
+        }
+    }
+
+    /// True for `"fit"`.
+    pub fn is_fit(self) -> bool {
+        self == GSetting::Fit
+    }
+}
+
+impl std::fmt::Display for GSetting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            GSetting::Value(g) => write!(f, "{g}"),
+            GSetting::Fit => f.write_str("\"fit\""),
+        }
+    }
+}
+
+impl Serialize for GSetting {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            GSetting::Value(g) => s.serialize_f64(*g),
+            GSetting::Fit => s.serialize_str("fit"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for GSetting {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = GSetting;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(
+                    "a Henyey–Greenstein g in (−1, 1) (e.g. 0.85) or \"fit\" (fit g from the profile)",
+                )
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<GSetting, E> {
+                Ok(GSetting::Value(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<GSetting, E> {
+                Ok(GSetting::Value(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<GSetting, E> {
+                Ok(GSetting::Value(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<GSetting, E> {
+                if v == "fit" {
+                    Ok(GSetting::Fit)
+                } else {
+                    Err(E::invalid_value(serde::de::Unexpected::Str(v), &self))
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
 /// `[fit]`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -255,7 +330,13 @@ pub struct FitSection {
     /// 0.8–0.95; another g with `mc` is refused with the tables' coverage). Real translucent
     /// materials have g ≈ 0.7–0.95: assuming 0 for them biases σa high (BENCHMARKS.md, "The `mc`
     /// model over g").
-    pub g: Option<f64>,
+    ///
+    /// `g = "fit"` ([`GSetting::Fit`]) fits g per channel from the profile instead (a 1-D profile
+    /// likelihood over g with the `mc` model, which it needs: `model = "mc"`), within `g_range`
+    /// (default: what the `mc` tables cover at the sample's η), and prints it only where the data
+    /// determine it; elsewhere the channel gets the range's "± g" term (ARCHITECTURE.md, "Fitting
+    /// g").
+    pub g: Option<GSetting>,
     /// The range `[lo, hi]` (0 ≤ lo ≤ hi ≤ 0.95) the material's g is known to lie in (issue 15):
     /// propagated into σ′s, σa and α′ as a separate "g" uncertainty term beside "fit" and
     /// "spectro", from the g-aware `mc` model. With `g`, the values are computed at `g` (which must
@@ -588,7 +669,7 @@ pub fn parse_manifest(
             format!("= {}: must be ≥ 0 mm", num(r)),
         ));
     }
-    if let Some(g) = m.fit.g
+    if let Some(g) = m.fit.g.and_then(GSetting::value)
         && !(g.is_finite() && g > -1.0 && g < 1.0)
     {
         return Err(invalid(
@@ -613,7 +694,7 @@ pub fn parse_manifest(
                 ),
             ));
         }
-        if let Some(g) = m.fit.g
+        if let Some(g) = m.fit.g.and_then(GSetting::value)
             && !(lo..=hi).contains(&g)
         {
             return Err(invalid(
@@ -683,7 +764,7 @@ r_max_px = 300
             r_max_px: Some(250.0),
             r_min_mm: Some(1.5),
             normalise_with_spectro: Some(false),
-            g: Some(0.85),
+            g: Some(GSetting::Value(0.85)),
             g_range: Some([0.7, 0.95]),
         };
         // None of these is what an absent key means.
@@ -699,6 +780,12 @@ r_max_px = 300
         assert_eq!(back.camera, m.camera);
         assert_eq!(back.fit, m.fit, "{text}");
         assert_eq!(back.name, m.name);
+        // `g = "fit"` too (issue 15).
+        let mut fitted = m.clone();
+        fitted.fit.g = Some(GSetting::Fit);
+        let text = manifest_to_toml(&fitted, "");
+        assert!(text.contains("g = \"fit\""), "{text}");
+        assert_eq!(parse(&text).unwrap().fit, fitted.fit);
         // Every model and albedo model survives the round trip.
         for model in ModelName::ALL {
             for albedo in AlbedoModel::ALL {
@@ -716,7 +803,7 @@ r_max_px = 300
     /// Each mistake names the key and says what to do.
     #[test]
     fn mistakes_name_the_key() {
-        let cases: [(&str, &str); 14] = [
+        let cases: [(&str, &str); 15] = [
             (
                 &GOOD.replace("mm_per_pixel = 0.05", "mm_per_pixel = -1"),
                 "camera.mm_per_pixel",
@@ -751,8 +838,12 @@ r_max_px = 300
                 "fit.g",
             ),
             (
-                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng = \"fit\""),
-                "g",
+                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng = \"fitt\""),
+                "`fit.g`: invalid value: string \"fitt\", expected a Henyey–Greenstein g in (−1, 1) (e.g. 0.85) or \"fit\"",
+            ),
+            (
+                &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng = true"),
+                "or \"fit\"",
             ),
             (
                 &GOOD.replace("r_max_px = 300", "r_max_px = 300\ng_range = [0.9, 0.7]"),

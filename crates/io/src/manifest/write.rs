@@ -150,6 +150,7 @@ pub fn manifest_to_toml(m: &SampleManifest, extra_comment: &str) -> String {
         t.push_str(&format!("normalise_with_spectro = {b}\n"));
     }
     if let Some(g) = m.fit.g {
+        // A number, or "fit" (quoted).
         t.push_str(&format!("g = {g}\n"));
     }
     if let Some([lo, hi]) = m.fit.g_range {

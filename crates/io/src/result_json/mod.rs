@@ -31,7 +31,7 @@ pub use names::{AlbedoSource, EtaSource, ResponseKind};
 
 mod records;
 
-pub use records::{GSource, GUncertainty, PortResult, RdSpectrum};
+pub use records::{GFitRecord, GSource, GUncertainty, PortResult, RdSpectrum};
 
 /// What can go wrong reading or writing a result file.
 #[derive(Debug, thiserror::Error)]

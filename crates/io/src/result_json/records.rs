@@ -15,6 +15,9 @@ pub enum GSource {
     /// Neither: the values at g = 0 (the paper's isotropic assumption), the term over the default
     /// range 0–0.95.
     DefaultRange,
+    /// `[fit] g = "fit"` (or `--g fit`): g fitted per channel from the profile
+    /// ([`GUncertainty::fitted`]); where the data do not determine it, the range's term.
+    Fit,
 }
 
 impl GSource {
@@ -24,6 +27,7 @@ impl GSource {
             GSource::Given => "given",
             GSource::Range => "range",
             GSource::DefaultRange => "default_range",
+            GSource::Fit => "fit",
         }
     }
 }
@@ -47,6 +51,60 @@ pub struct GUncertainty {
     /// words; `None` when the whole range is covered.
     #[serde(default)]
     pub not_covered: Option<String>,
+    /// With `g = "fit"`: each channel's fit of g (absent otherwise, and for a channel with no fit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fitted: Option<scatterfit_optics::Rgb<Option<GFitRecord>>>,
+}
+
+/// One channel's fit of g (issue 15, `[fit] g = "fit"`): a profile likelihood over g with the
+/// `mc` model. The g and its errors are given only where the data determine g
+/// ([`GFitRecord::determined`]); elsewhere [`GFitRecord::reason`] says why not, and the channel's
+/// values carry the search range's "± g" term instead.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GFitRecord {
+    /// Whether the data determine g (the rule: ARCHITECTURE.md, "Fitting g").
+    pub determined: bool,
+    /// The fitted g (the minimum of χ²(g)); `None` where not determined.
+    pub g: Option<f64>,
+    /// Its standard error: the fit's, the model's and the spectrophotometer's parts in
+    /// quadrature; `None` where not determined.
+    pub g_stderr: Option<f64>,
+    /// The fit's part: from the curvature of χ²(g), scaled by the reduced χ² when above 1.
+    pub g_stderr_fit: Option<f64>,
+    /// The model's part: the `mc` tables' shape noise read as a change of g.
+    pub g_stderr_model: Option<f64>,
+    /// The spectrophotometer's part: how far the minimum moves with the reading at ± its error.
+    #[serde(default)]
+    pub g_stderr_spectro: Option<f64>,
+    /// The correlation of σ′s and g in the joint covariance.
+    pub corr_sigma_s_prime_g: Option<f64>,
+    /// The RMS change of the profile's shape (ln, after refitting the other unknowns) that
+    /// Δg = 0.05 makes at the fitted g: the signal g is read from.
+    pub shape_change: Option<f64>,
+    /// The range searched, \[lo, hi\] (the part of the stated or default range the tables answer
+    /// at the sample's η).
+    pub searched: Option<[f64; 2]>,
+    /// Why g is not given; `None` where it is.
+    pub reason: Option<String>,
+}
+
+impl GFitRecord {
+    /// "0.893 ± 0.021 (corr. with σ′s −0.62)" or "not determined (reason)".
+    pub fn describe(&self) -> String {
+        match (self.determined, self.g, self.g_stderr) {
+            (true, Some(g), Some(sd)) => {
+                let mut t = format!("{g:.3} ± {sd:.3}");
+                if let Some(c) = self.corr_sigma_s_prime_g {
+                    t.push_str(&format!(" (corr. with σ′s {c:+.2})"));
+                }
+                t
+            }
+            _ => format!(
+                "not determined ({})",
+                self.reason.as_deref().unwrap_or("no fit")
+            ),
+        }
+    }
 }
 
 impl GUncertainty {
@@ -61,6 +119,33 @@ impl GUncertainty {
                 .join(", ")
         };
         match (self.source, self.range) {
+            (GSource::Fit, range) => {
+                let within = range.map_or(String::new(), |[lo, hi]| format!(" within {lo}–{hi}"));
+                let mut t = format!(
+                    "g fitted per channel from the profile{within} (the `mc` model's profile \
+                     likelihood)"
+                );
+                if let Some(fitted) = &self.fitted {
+                    let parts: Vec<String> = fitted
+                        .iter_channels()
+                        .filter_map(|(c, f)| {
+                            f.as_ref().map(|f| format!("{} {}", c.name(), f.describe()))
+                        })
+                        .collect();
+                    if !parts.is_empty() {
+                        t.push_str(&format!(": {}", parts.join("; ")));
+                    }
+                }
+                t.push_str(&format!(
+                    "; ± g: where g is fitted, the values at it and sd(g) propagated; where not, the \
+                     middle of the estimates over the range and half their spread (g = {})",
+                    list(&self.evaluated)
+                ));
+                if let Some(n) = &self.not_covered {
+                    t.push_str(&format!(" (not evaluated, no tables: {n})"));
+                }
+                t
+            }
             (GSource::Given, _) | (_, None) => {
                 format!("g = {} given (no g term)", self.g.unwrap_or(0.0))
             }
