@@ -20,29 +20,41 @@ use scatterfit_synth::{RigSpec, synthesize};
 /// σa's relative error per channel of `name`: the port's reading taken as loss-free, the port's
 /// reading corrected (the manifest names the port), and the loss-free reading (the twin's baseline).
 fn errors(name: &str, illuminated_mm: f64, aperture_mm: f64, seed: u64) -> [[f64; 3]; 3] {
-    errors_both(name, illuminated_mm, aperture_mm, seed).map(|run| run.map(|(_, sa)| sa))
+    errors_both(
+        name,
+        illuminated_mm,
+        aperture_mm,
+        seed,
+        &RigSpec::quick(),
+        None,
+    )
+    .map(|run| run.map(|(_, sa)| sa))
 }
 
-/// σ′s's and σa's relative errors per channel, as [`errors`].
+/// σ′s's and σa's relative errors per channel, as [`errors`], on `rig` (its Monte Carlo profiles
+/// cached in `cache` when given).
 fn errors_both(
     name: &str,
     illuminated_mm: f64,
     aperture_mm: f64,
     seed: u64,
+    rig: &RigSpec,
+    cache: Option<&std::path::Path>,
 ) -> [[(f64, f64); 3]; 3] {
     let m = by_name(name).unwrap();
-    let rig = RigSpec::quick();
+    let t = std::time::Instant::now();
     let s = synthesize(
         m.name,
         m.sigma_s_prime,
         m.sigma_a,
         m.eta,
-        &rig,
+        rig,
         seed,
-        None,
+        cache,
         &|_, _, _| {},
     )
     .unwrap();
+    eprintln!("{name}: twin in {:.0} s", t.elapsed().as_secs_f64());
     let port = Port::new(illuminated_mm, aperture_mm).unwrap();
     let read: [f64; 3] = std::array::from_fn(|c| {
         let layer =
@@ -182,18 +194,56 @@ fn an_8_mm_port_lit_over_14_mm_is_corrected() {
 #[test]
 #[ignore = "study: prints BENCHMARKS.md's table (cargo test -p scatterfit-pipeline --test port -- --ignored --nocapture)"]
 fn port_study() {
-    let materials = [
-        "ketchup",
-        "skin1",
-        "brown-leather",
-        "skin2",
-        "potato",
-        "wood-tile",
-        "apple",
-        "sulfur",
-        "pink-plastic",
-        "marble",
-    ];
+    port_study_on(&QUICK_STUDY_MATERIALS, &RigSpec::quick(), None);
+}
+
+/// The quick-rig study's materials, α′ 0.02–0.9996.
+const QUICK_STUDY_MATERIALS: [&str; 10] = [
+    "ketchup",
+    "skin1",
+    "brown-leather",
+    "skin2",
+    "potato",
+    "wood-tile",
+    "apple",
+    "sulfur",
+    "pink-plastic",
+    "marble",
+];
+
+/// The port study on the paper's rig (1024² px at 0.05 mm/px: a 51 mm field, 4× the quick rig's,
+/// and ten times its photons), for the materials whose light travels farthest — where the quick
+/// rig's own baseline is off because its 12.8 mm field is too small. Materials from
+/// `$PORT_MATERIALS` (comma-separated; default: those with a channel at α′ ≥ 0.97), profiles cached
+/// in `$PORT_CACHE` when set (so the second port reuses the twins). Prints the same table as
+/// [`port_study`]; about 2–4 min per material on a shared 2-core machine.
+#[test]
+#[ignore = "study: the paper-rig table (PORT_MATERIALS=a,b cargo test --release -p scatterfit-pipeline --test port port_study_paper -- --ignored --nocapture)"]
+fn port_study_paper() {
+    let names: Vec<String> = std::env::var("PORT_MATERIALS").map_or_else(
+        |_| {
+            [
+                "potato",
+                "sulfur",
+                "marble",
+                "apple",
+                "pink-plastic",
+                "wood-tile",
+                "skin2",
+            ]
+            .map(String::from)
+            .to_vec()
+        },
+        |v| v.split(',').map(str::to_string).collect(),
+    );
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let cache = std::env::var_os("PORT_CACHE").map(std::path::PathBuf::from);
+    port_study_on(&names, &RigSpec::paper(), cache.as_deref());
+}
+
+/// Prints the port study's table for `materials` on `rig` (seeds 20, 21, … in the quick study's
+/// material order, so a material has the same seed in both studies).
+fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Path>) {
     println!(
         "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline |"
     );
@@ -201,9 +251,13 @@ fn port_study() {
     let pct = |x: f64| format!("{:+.1} %", 100.0 * x);
     for (ill, ap) in [(14.0, 8.0), (8.0, 8.0)] {
         let mut left = Vec::new();
-        for (k, name) in materials.iter().enumerate() {
+        for name in materials {
             let m = by_name(name).unwrap();
-            let [raw, cor, base] = errors_both(name, ill, ap, 20 + k as u64);
+            let k = QUICK_STUDY_MATERIALS
+                .iter()
+                .position(|q| q == name)
+                .unwrap_or(QUICK_STUDY_MATERIALS.len());
+            let [raw, cor, base] = errors_both(name, ill, ap, 20 + k as u64, rig, cache);
             for c in 0..3 {
                 println!(
                     "| {ill} / {ap} mm | {name} | {} | {:.4} | {} / {} / {} | {} / {} / {} |",
