@@ -18,8 +18,8 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use rayon::prelude::*;
 use scatterfit_pipeline::study::{
-    Row, StudySample, combos, dedup, g_axis_markdown, g_given_combo, has_g_axis, rows_csv,
-    samples, study_sample, summary_markdown,
+    Row, StudySample, combos, dedup, g_axis_markdown, g_given_combo, has_g_axis, rows_csv, samples,
+    study_sample, summary_markdown,
 };
 
 use crate::common::{JobsArgs, cache_dir};
@@ -248,11 +248,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             g_axis_markdown(&rows, &combos, &args.g)
         );
         for &g in &args.g {
-            let at: Vec<Row> = rows
-                .iter()
-                .filter(|r| r.g == Some(g))
-                .cloned()
-                .collect();
+            let at: Vec<Row> = rows.iter().filter(|r| r.g == Some(g)).cloned().collect();
             t.push_str(&format!(
                 "## Twins at g = {g}: every configuration\n\n{}",
                 summary_markdown(&at, &combos)

@@ -600,7 +600,12 @@ mod tests {
             let (lo, hi) = set.eta_range();
             assert!(mc_covers(lo, set.g()).unwrap(), "g {} η {lo}", set.g());
             assert!(mc_covers(0.5 * (lo + hi), set.g()).unwrap());
-            assert!(!mc_covers(hi + 0.05, set.g()).unwrap(), "g {} η {}", set.g(), hi + 0.05);
+            assert!(
+                !mc_covers(hi + 0.05, set.g()).unwrap(),
+                "g {} η {}",
+                set.g(),
+                hi + 0.05
+            );
         }
         let uncovered = (0..99)
             .map(|k| f64::from(k) / 100.0)
@@ -647,7 +652,10 @@ mod tests {
         assert!(t.contains(
             "| mc + mc α′, proposed, g given | 0.5 | 0 (1 not covered) | not covered | not covered | not covered |"
         ));
-        assert!(t.contains("| mc + mc α′, proposed | 0.8 | 1 | 8.00 % / 8.0 % |"), "{t}");
+        assert!(
+            t.contains("| mc + mc α′, proposed | 0.8 | 1 | 8.00 % / 8.0 % |"),
+            "{t}"
+        );
         assert!(t.contains("| mc + mc α′, proposed, g given | 0.8 | 1 | 0.40 % / 0.4 % |"));
         assert!(!t.contains("dipole"));
         let csv = rows_csv(&rows);
