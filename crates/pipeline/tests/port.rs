@@ -327,8 +327,16 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
             .iter()
             .filter(|t| (0.3..=0.9999).contains(&t.0))
             .collect();
-        let mut sp: Vec<f64> = in_range.iter().map(|t| t.1).filter(|v| v.is_finite()).collect();
-        let mut sa: Vec<f64> = in_range.iter().map(|t| t.2).filter(|v| v.is_finite()).collect();
+        let mut sp: Vec<f64> = in_range
+            .iter()
+            .map(|t| t.1)
+            .filter(|v| v.is_finite())
+            .collect();
+        let mut sa: Vec<f64> = in_range
+            .iter()
+            .map(|t| t.2)
+            .filter(|v| v.is_finite())
+            .collect();
         sp.sort_by(f64::total_cmp);
         sa.sort_by(f64::total_cmp);
         println!(
