@@ -233,7 +233,7 @@ pub struct SamplesArgs {
     pub jobs: JobsArgs,
 }
 
-/// How many samples are measured at once (`batch`, `compare`, `demo`).
+/// How many samples are measured at once (`batch`, `compare`, `demo`, `study`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct JobsArgs {
     #[arg(short = 'j', long, value_name = "N", value_parser = parse_jobs, help = JOBS_HELP)]
@@ -247,7 +247,8 @@ impl JobsArgs {
     }
 }
 
-/// Samples measured at once [1, 256] (`-j`): the help text shared by `batch`, `compare`, `demo`.
+/// Samples measured at once \[1, 256\] (`-j`): the help text shared by `batch`, `compare`, `demo`,
+/// `study`.
 pub const JOBS_HELP: &str = "Samples measured at the same time: a count, 1 to 256 (default: one \
      per core). Fewer are run at once when that many would not fit the memory budget \
      ($SCATTERFIT_MAX_MEMORY_MIB, default 8192 MiB; each sample holds its decoded bracket and \

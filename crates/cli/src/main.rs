@@ -88,7 +88,8 @@ enum Command {
     /// 16-bit, DNG raw) and a real rig's effects (--glare, --vignetting with a flat frame,
     /// --exposure-error, --gaussian-spot, --spot-image), each off by default.
     Synth(synth::Args),
-    /// The bias study: rig-twin samples over α′ and η fitted with every model and method.
+    /// The bias study: rig-twin samples over α′ and η (and g, with --g) fitted with every model and
+    /// method.
     Study(study::Args),
     /// Export a measured result as a pbrt-v4, Mitsuba 3, Blender or JSON material.
     Export(export::Args),

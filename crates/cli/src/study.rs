@@ -6,6 +6,10 @@
 //! Every grid point is one channel; three albedos at the same η share a sample. σ′t is the same for
 //! all (default 2 mm⁻¹, a mean free path of 0.5 mm, like the paper's materials), so σ′s = α′σ′t and
 //! σa = (1 − α′)σ′t. The study owns its output folder (a `.scatterfit-study` marker).
+//!
+//! `--g` gives the study a g axis (issue 15): the twins are made at each Henyey–Greenstein g, fitted
+//! every way assuming g = 0 and once more with the g-aware `mc` model told the true g
+//! (`scatterfit_pipeline::study::g_given_combo`); `study.md` gains a table per model over g.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -14,12 +18,13 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use rayon::prelude::*;
 use scatterfit_pipeline::study::{
-    Row, StudySample, combos, dedup, rows_csv, samples, study_sample, summary_markdown,
+    Row, StudySample, combos, dedup, g_axis_markdown, g_given_combo, has_g_axis, rows_csv, samples,
+    study_sample, summary_markdown,
 };
 
-use crate::common::cache_dir;
+use crate::common::{JobsArgs, cache_dir};
 use crate::output::{errln, out, outln};
-use crate::twin::{Material, synthesize, write_sample};
+use crate::twin::{Material, synthesize_on, write_sample};
 
 /// Arguments of `scatterfit study`.
 #[derive(Debug, clap::Args)]
@@ -44,12 +49,19 @@ pub struct Args {
     /// Small fast samples (256 × 256 px at 0.1 mm/px, a tenth of the photons).
     #[arg(long)]
     pub quick: bool,
+    /// Henyey–Greenstein g of the twins, each in [0, 0.95] (default 0: the isotropic study). Any
+    /// g ≠ 0 gives the study a g axis: every twin is made at each g, fitted every way assuming
+    /// g = 0 (what a manifest without `[fit] g` gets) and once more with the g-aware `mc` model
+    /// told the true g ("g given"; "not covered" where the `mc` tables do not answer at that η
+    /// and g); study.md gains a table per model over g. A twin at g costs about 1/(1 − g) times
+    /// the Monte Carlo time of one at g = 0 (g = 0.95: 20×).
+    #[arg(long = "g", value_name = "G", value_delimiter = ',', default_values_t = [0.0])]
+    pub g: Vec<f64>,
     /// Seed of the rig twin.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Samples measured at the same time [1, 256] (default: one per core).
-    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
-    pub jobs: Option<u16>,
+    #[command(flatten)]
+    pub jobs: JobsArgs,
     /// Leave out photon beam diffusion (its fits take milliseconds, not microseconds).
     #[arg(long)]
     pub no_pbd: bool,
@@ -70,8 +82,8 @@ pub struct Args {
 const MARKER: &str = ".scatterfit-study";
 
 fn check_args(args: &Args) -> anyhow::Result<()> {
-    if args.etas.is_empty() || args.albedos.is_empty() {
-        bail!("give at least one η and one α′");
+    if args.etas.is_empty() || args.albedos.is_empty() || args.g.is_empty() {
+        bail!("give at least one η, one α′ and one g");
     }
     if let Some(e) = args.etas.iter().find(|e| !(1.0..=2.5).contains(*e)) {
         bail!(
@@ -83,6 +95,19 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
         bail!(
             "--albedos: {} is outside [0.3, 0.9999]",
             crate::numeric::show(*a)
+        );
+    }
+    let g_max = scatterfit_io::manifest::G_RANGE_MAX;
+    if let Some(g) = args.g.iter().find(|g| !(0.0..=g_max).contains(*g)) {
+        bail!(
+            "--g: {} is outside [0, {g_max}] (the range a g may be stated in)",
+            crate::numeric::show(*g)
+        );
+    }
+    if let Some(k) = (1..args.g.len()).find(|&k| args.g[..k].contains(&args.g[k])) {
+        bail!(
+            "--g: {} is given twice; give each g once",
+            crate::numeric::show(args.g[k])
         );
     }
     if !(0.2..=20.0).contains(&args.sigma_t_prime) {
@@ -120,13 +145,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let quiet = args.quiet || args.json;
     let cache = cache_dir(args.cache_dir.as_deref());
     // Samples: three albedos per η each (the last triple padded with its last albedo).
-    let samples: Vec<StudySample> = samples(out, &args.etas, &args.albedos);
+    let g_axis = has_g_axis(&args.g);
+    let samples: Vec<StudySample> = samples(out, &args.etas, &args.albedos, &args.g);
     if !quiet {
         errln!(
-            "study: {} samples ({} η × {} α′) on the {} rig, Monte Carlo cached in {}",
+            "study: {} samples ({} η × {} α′{}) on the {} rig, Monte Carlo cached in {}",
             samples.len(),
             args.etas.len(),
             args.albedos.len(),
+            if g_axis {
+                format!(" × {} g", args.g.len())
+            } else {
+                String::new()
+            },
             if args.quick { "quick" } else { "paper's" },
             cache
                 .as_deref()
@@ -140,13 +171,41 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             sigma_a: sample.sigma_a(args.sigma_t_prime),
             eta: sample.eta,
         };
-        let s = synthesize(&m, args.seed, cache.as_deref(), quiet, args.quick)?;
+        let mut rig = if args.quick {
+            scatterfit_synth::RigSpec::quick()
+        } else {
+            scatterfit_synth::RigSpec::paper()
+        };
+        rig.g = sample.twin_g();
+        let s = synthesize_on(&m, &rig, args.seed, cache.as_deref(), quiet)?;
         write_sample(&sample.dir, &s)?;
     }
     let synth_s = t0.elapsed().as_secs_f64();
-    let combos = combos(args.no_pbd);
+    let assuming_g_0 = combos(args.no_pbd);
+    let mut combos = assuming_g_0.clone();
+    if g_axis {
+        combos.push(g_given_combo());
+    }
+    // As many samples at once as `-j` asks and the memory budget allows (as `batch`).
+    let plan = scatterfit_pipeline::batch::BatchRequest::new(
+        samples.iter().map(|s| s.dir.clone()),
+        scatterfit_pipeline::Overrides::default(),
+    )
+    .jobs(args.jobs.count())
+    .plan();
+    if plan.reduced() && !quiet {
+        errln!(
+            "note: fitting {} sample(s) at a time instead of {}: that many would need about {} of \
+             memory, more than the budget of {} ({}=<MiB> raises it)",
+            plan.jobs,
+            plan.requested,
+            scatterfit_io::budget::describe_bytes(plan.memory_needed),
+            scatterfit_io::budget::describe_bytes(plan.memory_budget),
+            scatterfit_io::budget::MEMORY_BUDGET_ENV
+        );
+    }
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.jobs.map_or(0, usize::from))
+        .num_threads(plan.jobs)
         .build()?;
     let bar = crate::common::bar(
         samples.len() as u64,
@@ -178,7 +237,33 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     // A padded triple repeats its last albedo: keep one row per grid point and configuration.
     dedup(&mut rows);
-    let summary = summary_markdown(&rows, &combos);
+    let summary = if g_axis {
+        let mut t = format!(
+            "## The g axis (twins at g = {})\n\n{}",
+            args.g
+                .iter()
+                .map(|g| g.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            g_axis_markdown(&rows, &combos, &args.g)
+        );
+        for &g in &args.g {
+            let at: Vec<Row> = rows.iter().filter(|r| r.g == Some(g)).cloned().collect();
+            t.push_str(&format!(
+                "## Twins at g = {g}: every configuration\n\n{}",
+                summary_markdown(&at, &combos)
+            ));
+        }
+        t
+    } else {
+        summary_markdown(&rows, &combos)
+    };
+    // The figure: the first g's twins fitted assuming g = 0 (the isotropic study's figure without --g).
+    let first_g: Vec<Row> = rows
+        .iter()
+        .filter(|r| r.g.is_none_or(|g| g == args.g[0]) && r.g_given != Some(true))
+        .cloned()
+        .collect();
     let csv = rows_csv(&rows);
     for (name, text) in [("study.csv", csv), ("study.md", summary.clone())] {
         let p = out.join(name);
@@ -186,7 +271,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("writing {}", p.display()))?;
     }
     scatterfit_report::write_figure(
-        &scatterfit_report::study::study_figure(&rows, &combos),
+        &scatterfit_report::study::study_figure(&first_g, &assuming_g_0),
         Some(&out.join("study.svg")),
         Some(&out.join("study.png")),
     )?;

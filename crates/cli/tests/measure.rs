@@ -400,6 +400,19 @@ fn study_and_the_mc_model() {
     for f in ["study.md", "study.csv", "study.png", "study.svg"] {
         assert!(d.join("s").join(f).exists(), "{f}");
     }
+    // Without --g the study has no g axis: its rows and CSV are those of before issue 15.
+    for r in rows.as_array().unwrap() {
+        assert!(r.get("g").is_none() && r.get("g_given").is_none(), "{r}");
+    }
+    let csv = std::fs::read_to_string(d.join("s").join("study.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",albedo_prime_error"));
+    // A g axis outside what a g may be stated in, or with a g twice, is bad input (exit 2) before
+    // any Monte Carlo work.
+    for (g, says) in [("0.97", "outside [0, 0.95]"), ("0.8,0.8", "given twice")] {
+        let out = run_cached(d, &["study", "--g", g, "-o", "bad-g", "--quiet"]);
+        assert_eq!(out.code, 2, "--g {g}: {}", out.stderr);
+        assert!(out.stderr.contains(says), "--g {g}: {}", out.stderr);
+    }
 
     synth_quick(d, "wood-tile", "w");
     let out = run_cached(d, &["measure", "w", "--model", "mc", "--json", "--quiet"]);
