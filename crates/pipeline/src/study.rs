@@ -305,6 +305,7 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
             settings.g_prior = GPrior {
                 g: Some(truth.g),
                 range: None,
+                fit: false,
             };
         }
         let m = base.refit_values_only(settings)?;
