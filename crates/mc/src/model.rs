@@ -17,7 +17,7 @@
 //! Interpolation: between albedos, cubic Hermite in x = −√(1 − a) on the spline coefficients (so on
 //! S, after the analytic κ₀(a)ρ is taken out: C¹ in a) and on ln Rd for the totals — Catmull-Rom
 //! derivatives inside (pbrt's `CatmullRomWeights`), the parabola through the three end nodes at the
-//! first and last node ([`Ends`]); between η nodes,
+//! first and last node (`Ends`); between η nodes,
 //! Catmull-Rom in η on the same coefficients (linear with two tables); in ρ, the cubic B-spline itself
 //! (C²). Derivatives ∂Rd/∂σ′s, ∂Rd/∂σa are those of this interpolant: through σt (the σt² factor and
 //! ρ = σt r) and through a (the albedo weights' derivatives and dκ₀/da) — never finite differences.
@@ -531,7 +531,7 @@ impl McTable {
     }
 
     /// Total diffuse reflectance Rd(a) (excluding R_sp): cubic Hermite in √(1 − a) with parabolic
-    /// ends ([`Ends::Parabola`]) on ln Rd between the Monte Carlo totals of the nodes. On ln Rd, as
+    /// ends (`Ends::Parabola`) on ln Rd between the Monte Carlo totals of the nodes. On ln Rd, as
     /// the profile's coefficients are: toward a → 1 at η = 2 Rd itself bends so much within the last
     /// interval that its interpolant was 1.5–2.3·10⁻³ high at α′ 0.9993–0.9998 (g 0.8–0.9) against
     /// adding-doubling, ln Rd 4–6·10⁻⁴ (6·10⁻³ with the chord ends; BENCHMARKS.md).
