@@ -29,7 +29,7 @@
 //! which is what their user needs to know. Parts of the range the tables do not cover are not
 //! evaluated (never extrapolated) and are named in the result ([`GPlan::not_covered`]).
 
-use scatterfit_fit::{ChannelInput, FitOptions, ProfileData, Start};
+use scatterfit_fit::{ChannelInput, FitOptions, FitReport, ProfileData, Start};
 use scatterfit_io::result_json::{GSource, GUncertainty};
 use scatterfit_mc::McGridSet;
 use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
@@ -348,16 +348,9 @@ pub fn propagate_g(
         .zip(profiles.as_ref())
         .map_with_channel(|c, (outcome, data)| {
             let report = outcome.report().filter(|r| r.converged)?;
-            let opts = match &opts {
-                Ok(o) => FitOptions {
-                    start: Some(Start {
-                        sigma_s_prime: report.sigma_s_prime.value,
-                        sigma_a: Some(report.sigma_a.value),
-                        scale: None,
-                    }),
-                    ..*o
-                },
-                Err(e) => return Some(Err(e.to_string())),
+            let opts = match warm_start(&opts, report) {
+                Ok(o) => o,
+                Err(e) => return Some(Err(e)),
             };
             let input = ChannelInput {
                 eta: spectro.eta,
@@ -437,6 +430,23 @@ fn list(v: &[f64]) -> String {
         .map(|g| format!("{g}"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// The fit's options started from a converged fit's solution (σ′s, σa; the scale refitted): the
+/// refits at other g begin where the main fit ended.
+pub(crate) fn warm_start<E: std::fmt::Display>(
+    opts: &std::result::Result<FitOptions, E>,
+    report: &FitReport,
+) -> std::result::Result<FitOptions, String> {
+    let o = opts.as_ref().map_err(|e| e.to_string())?;
+    Ok(FitOptions {
+        start: Some(Start {
+            sigma_s_prime: report.sigma_s_prime.value,
+            sigma_a: Some(report.sigma_a.value),
+            scale: None,
+        }),
+        ..*o
+    })
 }
 
 #[cfg(test)]

@@ -45,13 +45,13 @@
 //! Where g is not determined it is not printed, and the channel gets the searched range's "± g"
 //! term ([`crate::anisotropy`]), as `g_range` alone gives.
 
-use scatterfit_fit::{ChannelInput, FitOptions, FitReport, ProfileData, Start};
+use scatterfit_fit::{ChannelInput, FitOptions, FitReport, ProfileData};
 use scatterfit_io::result_json::GFitRecord;
 use scatterfit_mc::McGridSet;
 use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
 use serde::Serialize;
 
-use crate::anisotropy::AlbedoAtG;
+use crate::anisotropy::{AlbedoAtG, warm_start};
 use crate::fit::{ChannelOutcome, FitSettings};
 use crate::spectro::SpectroStage;
 
@@ -454,16 +454,9 @@ pub fn fit_g_channels(
         .zip(profiles.as_ref())
         .map_with_channel(|c, (outcome, data)| {
             let report = outcome.report().filter(|r| r.converged)?;
-            let opts = match &opts {
-                Ok(o) => FitOptions {
-                    start: Some(Start {
-                        sigma_s_prime: report.sigma_s_prime.value,
-                        sigma_a: Some(report.sigma_a.value),
-                        scale: None,
-                    }),
-                    ..*o
-                },
-                Err(e) => return Some(Err(e.to_string())),
+            let opts = match warm_start(&opts, report) {
+                Ok(o) => o,
+                Err(e) => return Some(Err(e)),
             };
             let grid = match &grid {
                 Ok(g) => *g,
