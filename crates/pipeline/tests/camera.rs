@@ -114,27 +114,7 @@ fn shape_errors(
     let mut inputs = write(dir.path(), &b.frames, &b.times_s);
     // The camera's own tone curve as a response: the midpoint of each code's interval of linear
     // signal.
-    let true_g = || -> Vec<f64> {
-        let inv = |v: f64| {
-            let (mut lo, mut hi) = (0.0, 1.0);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if camera.tone(mid) < v {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            0.5 * (lo + hi)
-        };
-        (0..256)
-            .map(|z| {
-                let a = inv(((z as f64 - 0.5) / 255.0).max(0.0));
-                let b = inv(((z as f64 + 0.5) / 255.0).min(1.0));
-                (0.5 * (a + b)).max(1e-9).ln()
-            })
-            .collect()
-    };
+    let true_g = || camera.true_log_response().to_vec();
     if std::env::var("CAMERA_TRUE_RESPONSE").is_ok() {
         // Diagnosis: the true response given, to tell response errors from the merge's.
         let g = true_g();

@@ -12,23 +12,7 @@ use scatterfit_synth::rig::{CameraModel, RigSpec, ToneCurve};
 /// The true response: each code's midpoint of linear signal (as the camera test's
 /// `CAMERA_TRUE_RESPONSE`).
 fn true_response(camera: &CameraModel) -> ResponseCurve {
-    let inv = |v: f64| {
-        let (mut lo, mut hi) = (0.0, 1.0);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if camera.tone(mid) < v {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        0.5 * (lo + hi)
-    };
-    let g: [f64; 256] = std::array::from_fn(|z| {
-        let a = inv(((z as f64 - 0.5) / 255.0).max(0.0));
-        let b = inv(((z as f64 + 0.5) / 255.0).min(1.0));
-        (0.5 * (a + b)).max(1e-9).ln()
-    });
+    let g = camera.true_log_response();
     ResponseCurve::from_log_exposure(vec![g]).unwrap()
 }
 

@@ -143,6 +143,29 @@ impl CameraModel {
         self.curve.apply(s, self.tone_knee)
     }
 
+    /// The camera's true 8-bit response as ln(relative exposure) per code: the midpoint of each
+    /// code's interval of linear signal under [`CameraModel::tone`] (inverted by bisection) — what
+    /// Debevec & Malik's g(Z) recovers, for tests that separate response errors from the merge's.
+    pub fn true_log_response(&self) -> [f64; 256] {
+        let inv = |v: f64| {
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if self.tone(mid) < v {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        };
+        std::array::from_fn(|z| {
+            let a = inv(((z as f64 - 0.5) / 255.0).max(0.0));
+            let b = inv(((z as f64 + 0.5) / 255.0).min(1.0));
+            (0.5 * (a + b)).max(1e-9).ln()
+        })
+    }
+
     /// A named camera of `synth --camera NAME`: a [`ToneCurve`] name (8-bit, the default camera's
     /// sensor), `linear16` (linear 16-bit PNG, black level 1024 DN, white 65535) or `dng` (14-bit
     /// raw, black level 512 DN, white 16383, written as DNG).
