@@ -63,12 +63,24 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
     request.g_prior.check()?;
     crate::measure::check_g_fit(&request.g_prior, request.model)?;
     let g = crate::measure::values_g(&request.g_prior)?;
-    // A g the Monte Carlo tables do not cover is refused here, before any fit, as a manifest's is
-    // (the family itself would only answer NaN, and every channel's fit would fail obscurely).
+    // A g — or an η at that g — the Monte Carlo tables do not cover is refused here, before any
+    // fit, as a manifest's g is (the family itself would only answer NaN, and every channel's fit
+    // would fail obscurely). η is probed with a model at a mid albedo: the tables' η range does
+    // not depend on it.
     if request.model == scatterfit_optics::ModelName::Mc {
-        scatterfit_mc::bundled_grid()?
-            .albedo_prime_range(g)
+        let grid = scatterfit_mc::bundled_grid()?;
+        grid.albedo_prime_range(g)
             .map_err(|e| crate::PipelineError::Input(e.to_string()))?;
+        let probe = scatterfit_optics::OpticalProperties::new(0.9, 0.1, request.eta)
+            .and_then(|p| p.with_g(g))
+            .map_err(|e| crate::PipelineError::Input(format!("--eta {}: {e}", request.eta)))?;
+        grid.profile(&probe).map_err(|e| {
+            crate::PipelineError::Input(format!(
+                "--eta {}: the `mc` tables at g = {g} do not reach it ({e}); they cover {}",
+                request.eta,
+                grid.coverage()
+            ))
+        })?;
     }
     let model = scatterfit_optics::AtG::new(scatterfit_mc::family(request.model)?, g)
         .map_err(|e| crate::PipelineError::Input(format!("g: {e}")))?;
