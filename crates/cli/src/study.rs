@@ -270,8 +270,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
     }
+    let mut figure = scatterfit_report::study::study_figure(&first_g, &assuming_g_0);
+    if g_axis {
+        // Say which twins the figure shows: study.md has the g axis's tables.
+        figure.title = format!(
+            "{} at g = {}, fitted assuming g = 0 (the g axis: study.md)",
+            figure.title, args.g[0]
+        );
+    }
     scatterfit_report::write_figure(
-        &scatterfit_report::study::study_figure(&first_g, &assuming_g_0),
+        &figure,
         Some(&out.join("study.svg")),
         Some(&out.join("study.png")),
     )?;
