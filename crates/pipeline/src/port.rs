@@ -65,6 +65,14 @@ pub fn port_of(
 /// Corrects the stage's Rd (hence α′ and its uncertainty) for the port's edge loss, by iterating
 /// fit ↔ F per channel (module docs). Returns the corrected stage and what was done; a channel
 /// that cannot be fitted keeps its reading, with the reason.
+///
+/// The reading's uncertainty goes through the same fixed point: the readings × (1 ∓ ε) at η∓
+/// (`SpectroUncertainty::rd_pm`, `eta_pm`) are corrected too, and their corrected Rd become the
+/// stage's perturbed readings, from which α′'s standard error and the refits of the spectro term
+/// follow. This matters: F falls as α′ rises (the light spreads further), so the corrected Rd
+/// moves more than the reading — by A = (d ln Rd/d ln(1 − α′)) / (d ln(Rd·F)/d ln(1 − α′)),
+/// 2–4 for an 8 mm port at α′ ≥ 0.996 (BENCHMARKS.md, "The port's conditioning") — and a bar
+/// computed from the corrected Rd as if it were a loss-free reading would be that much too small.
 pub fn correct_port(
     data: &Rgb<ProfileData>,
     read: &SpectroStage,
@@ -78,97 +86,51 @@ pub fn correct_port(
     let mut rounds = Rgb::from_fn(|_| 0);
     let mut problems: Rgb<Option<String>> = Rgb::from_fn(|_| None);
     let mut rd = read.rd;
+    let mut rd_pm: Rgb<Option<[f64; 2]>> = Rgb::default();
+    let mut warnings = Vec::new();
+    let u = &read.uncertainty;
     for ch in Channel::ALL {
-        let data = &data[ch];
         let Ok(opts) = &opts else {
             problems[ch] = Some("no fit options".into());
             continue;
         };
-        let rd_read = read.rd[ch];
-        let mut rd_c = rd_read;
-        let mut albedo_prime = match albedo.albedo_from_rd(rd_c, read.eta, 0.0) {
-            Ok(a) => a,
-            Err(e) => {
-                problems[ch] = Some(format!("α′ from Rd = {rd_c:.4}: {e}"));
-                continue;
-            }
+        let point = FixedPoint {
+            data: &data[ch],
+            opts,
+            model,
+            albedo,
+            port,
         };
-        for round in 1..=MAX_ROUNDS {
-            rounds[ch] = round;
-            let input = ChannelInput {
-                eta: read.eta,
-                albedo_prime: Some(albedo_prime),
-                rd_total: Some(rd_c),
-            };
-            let report = match scatterfit_fit::fit_channel(data, &input, model, opts) {
-                Ok(r) if r.converged => r,
-                Ok(_) => {
-                    problems[ch] = Some("the fit did not converge".into());
-                    break;
+        match point.solve(read.rd[ch], read.eta) {
+            Ok(solved) => {
+                rd[ch] = solved.rd;
+                fraction[ch] = Some(solved.reading_fraction);
+                rounds[ch] = solved.rounds;
+                if u.repeatability > 0.0 {
+                    let pm: Result<Vec<f64>, (usize, String)> = (0..2)
+                        .map(|k| point.solve(u.rd_pm[ch][k], u.eta_pm[k]).map(|s| s.rd))
+                        .collect();
+                    // Without the perturbed fixed points the stage keeps ε on the corrected Rd,
+                    // which understates the bar (see above); the warning says so.
+                    match pm {
+                        Ok(pm) => rd_pm[ch] = Some([pm[0], pm[1]]),
+                        Err((_, e)) => warnings.push(format!(
+                            "channel {}: the port correction of the reading ± its repeatability \
+                             failed ({e}), so its spectro uncertainty is the loss-free one's, \
+                             which understates it",
+                            ch.name()
+                        )),
+                    }
                 }
-                Err(e) => {
-                    problems[ch] = Some(e.to_string());
-                    break;
-                }
-            };
-            let f =
-                OpticalProperties::new(report.sigma_s_prime.value, report.sigma_a.value, read.eta)
-                    .and_then(|p| model.profile(&p))
-                    .map(|m| port.reading_of(&*m).reading_fraction);
-            let f = match f {
-                Ok(f) if f.is_finite() && f > 0.0 && f <= 1.0 + 1e-9 => f.min(1.0),
-                Ok(f) => {
-                    problems[ch] =
-                        Some(format!("the port's reading fraction {f} is not in (0, 1]"));
-                    break;
-                }
-                Err(e) => {
-                    problems[ch] = Some(e.to_string());
-                    break;
-                }
-            };
-            let target = rd_read / f;
-            fraction[ch] = Some(f);
-            if ((target - rd_c) / rd_c).abs() < TOLERANCE {
-                break;
             }
-            // Step towards the target, halving the step while its Rd lies beyond what the albedo
-            // model can invert (an early round's F, from a fit at a too-low α′, can overshoot;
-            // damped, the next rounds approach the fixed point from inside the model's range).
-            let mut step = target - rd_c;
-            let mut next = None;
-            for _ in 0..40 {
-                if let Ok(a) = albedo.albedo_from_rd(rd_c + step, read.eta, 0.0) {
-                    next = Some((rd_c + step, a));
-                    break;
-                }
-                step *= 0.5;
+            Err((round, e)) => {
+                rounds[ch] = round;
+                problems[ch] = Some(e);
             }
-            let Some((rd_next, a_next)) = next else {
-                problems[ch] = Some(format!(
-                    "the corrected Rd ({target:.4}) lies beyond what the {} albedo model can \
-                     invert at η = {:.4}",
-                    albedo.name(),
-                    read.eta
-                ));
-                break;
-            };
-            rd_c = rd_next;
-            albedo_prime = a_next;
-            if round == MAX_ROUNDS {
-                problems[ch] = Some(format!(
-                    "not converged in {MAX_ROUNDS} rounds (Rd {rd_c:.4}, the port's F asks for \
-                     {target:.4}: beyond the albedo model's range?)"
-                ));
-            }
-        }
-        if problems[ch].is_none() {
-            rd[ch] = rd_c;
-        } else {
-            fraction[ch] = None;
         }
     }
-    let corrected = read.with_rd(rd, albedo);
+    let mut corrected = read.with_corrected_rd(rd, rd_pm, albedo);
+    corrected.warnings.extend(warnings);
     let correction = PortCorrection {
         illuminated_mm: port.illuminated_mm(),
         aperture_mm: port.aperture_mm(),
@@ -178,6 +140,97 @@ pub fn correct_port(
         problems,
     };
     (corrected, correction)
+}
+
+/// One channel's fit ↔ F iteration (see [`correct_port`]).
+struct FixedPoint<'a> {
+    data: &'a ProfileData,
+    opts: &'a scatterfit_fit::FitOptions,
+    model: &'a dyn ModelFamily,
+    albedo: &'a dyn ModelFamily,
+    port: Port,
+}
+
+/// A converged [`FixedPoint`].
+struct Solved {
+    /// The corrected Rd, reading / F.
+    rd: f64,
+    /// F of the last round's fit.
+    reading_fraction: f64,
+    /// Rounds taken.
+    rounds: usize,
+}
+
+impl FixedPoint<'_> {
+    /// The corrected Rd of a reading `rd_read` at η = `eta`; on failure the round it stopped in
+    /// and why.
+    fn solve(&self, rd_read: f64, eta: f64) -> Result<Solved, (usize, String)> {
+        let (model, albedo) = (self.model, self.albedo);
+        let mut rd_c = rd_read;
+        let mut target = rd_read;
+        let mut albedo_prime = albedo
+            .albedo_from_rd(rd_c, eta, 0.0)
+            .map_err(|e| (0, format!("α′ from Rd = {rd_c:.4}: {e}")))?;
+        for round in 1..=MAX_ROUNDS {
+            let fail = |e: String| (round, e);
+            let input = ChannelInput {
+                eta,
+                albedo_prime: Some(albedo_prime),
+                rd_total: Some(rd_c),
+            };
+            let report = match scatterfit_fit::fit_channel(self.data, &input, model, self.opts) {
+                Ok(r) if r.converged => r,
+                Ok(_) => return Err(fail("the fit did not converge".into())),
+                Err(e) => return Err(fail(e.to_string())),
+            };
+            let f = OpticalProperties::new(report.sigma_s_prime.value, report.sigma_a.value, eta)
+                .and_then(|p| model.profile(&p))
+                .map(|m| self.port.reading_of(&*m).reading_fraction)
+                .map_err(|e| fail(e.to_string()))?;
+            if !(f.is_finite() && f > 0.0 && f <= 1.0 + 1e-9) {
+                return Err(fail(format!(
+                    "the port's reading fraction {f} is not in (0, 1]"
+                )));
+            }
+            let f = f.min(1.0);
+            target = rd_read / f;
+            if ((target - rd_c) / rd_c).abs() < TOLERANCE {
+                return Ok(Solved {
+                    rd: rd_c,
+                    reading_fraction: f,
+                    rounds: round,
+                });
+            }
+            // Step towards the target, halving the step while its Rd lies beyond what the albedo
+            // model can invert (an early round's F, from a fit at a too-low α′, can overshoot;
+            // damped, the next rounds approach the fixed point from inside the model's range).
+            let mut step = target - rd_c;
+            let mut next = None;
+            for _ in 0..40 {
+                if let Ok(a) = albedo.albedo_from_rd(rd_c + step, eta, 0.0) {
+                    next = Some((rd_c + step, a));
+                    break;
+                }
+                step *= 0.5;
+            }
+            let Some((rd_next, a_next)) = next else {
+                return Err(fail(format!(
+                    "the corrected Rd ({target:.4}) lies beyond what the {} albedo model can \
+                     invert at η = {eta:.4}",
+                    albedo.name(),
+                )));
+            };
+            rd_c = rd_next;
+            albedo_prime = a_next;
+        }
+        Err((
+            MAX_ROUNDS,
+            format!(
+                "not converged in {MAX_ROUNDS} rounds (Rd {rd_c:.4}, the port's F asks for \
+                 {target:.4}: beyond the albedo model's range?)"
+            ),
+        ))
+    }
 }
 
 /// The measured reflectance spectrum corrected for the port's edge loss: Rd(λ) / F(λ), with F

@@ -135,6 +135,33 @@ impl SpectroStage {
     }
 }
 
+impl SpectroStage {
+    /// As [`SpectroStage::with_rd`], with the perturbed readings given per channel where they are
+    /// not Rd × (1 ∓ ε): the port correction's (`crate::port::correct_port`) corrected Rd of the
+    /// readings × (1 ∓ ε) at η∓, which move more than ε·Rd. α′'s perturbed values and standard
+    /// error follow from them; a channel with `None` keeps Rd × (1 ∓ ε).
+    pub fn with_corrected_rd(
+        &self,
+        rd: Rgb<f64>,
+        rd_pm: Rgb<Option<[f64; 2]>>,
+        albedo: &dyn ModelFamily,
+    ) -> SpectroStage {
+        let mut stage = self.with_rd(rd, albedo);
+        let u = &mut stage.uncertainty;
+        for c in Channel::ALL {
+            let Some(pm) = rd_pm[c] else { continue };
+            u.rd_pm[c] = pm;
+            u.albedo_pm[c] =
+                std::array::from_fn(|k| albedo.albedo_from_rd(pm[k], u.eta_pm[k], ISOTROPIC).ok());
+            u.albedo_prime_stderr[c] = match u.albedo_pm[c] {
+                [Some(a0), Some(a1)] => Some(0.5 * (a1 - a0).abs()),
+                _ => None,
+            };
+        }
+        stage
+    }
+}
+
 /// What the stage is computed from.
 struct Reading {
     file: Option<PathBuf>,
