@@ -88,6 +88,17 @@ pub struct Args {
     /// `camera.spot_image` (the fit's kernel is then measured, not assumed).
     #[arg(long)]
     pub spot_image: bool,
+    /// The spectrophotometer's measuring port: the diameter of the aperture it measures through
+    /// [mm, 1 to 100] (common: 4, 8, 25). The reading is then what that port collects (the Monte
+    /// Carlo engine lights the port's disc uniformly and tallies what leaves inside the aperture:
+    /// light that spreads beyond it is lost, the edge loss) and the manifest's `[spectro]` names
+    /// the port, so that `measure` corrects for it. Default: a loss-free reading.
+    #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
+    pub aperture_mm: Option<f64>,
+    /// The diameter of the disc the instrument lights [mm, 1 to 100], when it is not the
+    /// aperture's (e.g. 14 for an 8 mm aperture lit over 14 mm).
+    #[arg(long, value_name = "MM", requires = "aperture_mm", value_parser = crate::numeric::parse_finite)]
+    pub illuminated_mm: Option<f64>,
     /// Overwrite existing files in the folder.
     #[arg(long)]
     pub force: bool,
@@ -197,6 +208,23 @@ fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
     Ok(rig)
 }
 
+/// The port the flags describe (`None`: a loss-free reading).
+fn port_from(args: &Args) -> anyhow::Result<Option<scatterfit_optics::port::Port>> {
+    let Some(aperture) = args.aperture_mm else {
+        return Ok(None);
+    };
+    let lit = args.illuminated_mm.unwrap_or(aperture);
+    for (flag, v) in [("--aperture-mm", aperture), ("--illuminated-mm", lit)] {
+        crate::numeric::ensure(
+            (1.0..=100.0).contains(&v),
+            flag,
+            v,
+            "a port diameter in millimetres, 1 to 100",
+        )?;
+    }
+    Ok(Some(scatterfit_optics::port::Port::new(lit, aperture)?))
+}
+
 #[derive(Serialize)]
 struct Summary<'a> {
     output_dir: &'a std::path::Path,
@@ -208,6 +236,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let m = material_from(&args)?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
     let rig = rig_from(&args)?;
+    let port = port_from(&args)?;
     let mut names = file_names(rig.times_s.len(), true);
     if args.camera == "dng" {
         for n in &mut names {
@@ -224,13 +253,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     check_output_files(&args.output_dir, &names, args.force)?;
     let cache = args.cache.dir();
-    let sample = synthesize_on(
+    let mut sample = synthesize_on(
         &m,
         &rig,
         args.seed,
         cache.as_deref(),
         args.quiet || args.json,
     )?;
+    if let Some(port) = &port {
+        if !(args.quiet || args.json) {
+            crate::output::errln!(
+                "tracing the reading through the port ({} mm aperture lit over {} mm)…",
+                port.aperture_mm(),
+                port.illuminated_mm()
+            );
+        }
+        sample = sample
+            .read_through_port(port)
+            .with_context(|| format!("the port reading of {}", m.name))?;
+    }
     write_sample_with(
         &args.output_dir,
         &sample,
@@ -258,6 +299,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             2.0 * rig.spot_radius_mm
         )?;
         outln!("truth    η = {:.4}", sample.truth.eta)?;
+        if let Some(p) = &sample.truth.port {
+            let f = p.reading_fraction;
+            outln!(
+                "port     {} mm aperture lit over {} mm reads F = {:.4} / {:.4} / {:.4} of Rd \
+                 (R/G/B; named in the manifest's [spectro], so measure corrects it)",
+                p.aperture_mm,
+                p.illuminated_mm,
+                f[0],
+                f[1],
+                f[2]
+            )?;
+        }
         if sample.truth.g != 0.0 {
             outln!(
                 "         g = {} (in truth.json only: the manifest does not state it)",

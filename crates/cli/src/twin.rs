@@ -109,6 +109,11 @@ pub fn write_sample_with(
         spot_image: s.bracket.spot_image.as_ref().map(frame),
         spot_profile: (rig.effects.gaussian_spot && s.bracket.spot_image.is_none())
             .then_some(scatterfit_io::manifest::SpotProfileName::Gaussian),
+        spectro_port_mm: s
+            .truth
+            .port
+            .as_ref()
+            .map(|p| [p.illuminated_mm, p.aperture_mm]),
     };
     write_sample_folder_with(
         dir,

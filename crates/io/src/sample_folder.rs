@@ -249,8 +249,9 @@ pub fn file_names(frames: usize, truth: bool) -> Vec<String> {
     v
 }
 
-/// What a real camera adds to a sample folder (issue 16): linear frames instead of the 8-bit ones, a
-/// flat frame, a spot image, and the `[camera]` keys that name them. Default: nothing.
+/// What a real rig adds to a sample folder: linear frames instead of the 8-bit ones, a flat frame,
+/// a spot image and the `[camera]` keys that name them (issue 16), and the spectrophotometer's port
+/// (issue 15). Default: nothing.
 #[derive(Debug, Clone, Default)]
 pub struct CameraFiles {
     /// Linear 16-bit frames (written instead of [`SampleFiles::frames`] when not empty), shortest
@@ -265,6 +266,9 @@ pub struct CameraFiles {
     pub spot_image: Option<CameraFrame>,
     /// `camera.spot_profile` (e.g. "gaussian").
     pub spot_profile: Option<crate::manifest::SpotProfileName>,
+    /// The spectrophotometer's port, [lit disc, aperture] diameters \[mm\]: written as
+    /// `spectro.illuminated_mm` and `spectro.aperture_mm` (the reading was made through it).
+    pub spectro_port_mm: Option<[f64; 2]>,
 }
 
 /// The frame files of a bracket of `frames` frames: `frame_NN.png`, or `.dng`.
@@ -374,6 +378,8 @@ pub fn write_sample_folder_with(
         name: Some(s.name.to_string()),
         spectro: SpectroSection {
             file: Some("spectro.csv".into()),
+            illuminated_mm: extra.spectro_port_mm.map(|p| p[0]),
+            aperture_mm: extra.spectro_port_mm.map(|p| p[1]),
             ..Default::default()
         },
         camera: CameraSection {

@@ -13,6 +13,10 @@
 //! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G] [paper|quick] [MATERIAL,…] [PHOTONS×]
 //! ```
 //!
+//! A material named `range-etaX` (for example `range-eta1.0`, `range-eta2.4`) is issue 15's
+//! target range at η = X: R at α′ 0.3 (σ′s 1 mm⁻¹), G at α′ 0.99 (σ′s 1.5 mm⁻¹), B at α′ 0.9999
+//! (σ′s 3 mm⁻¹, so that its light, which travels 1/σtr ≈ 19 mm, stays inside the paper rig's field).
+//!
 //! `PHOTONS×` multiplies the twin's photon budget (its Monte Carlo noise falls as 1/√×): a channel
 //! whose error falls with it was limited by the twin, not by the method.
 
@@ -53,7 +57,10 @@ fn main() {
         |a| a.split(',').map(str::to_string).collect(),
     );
     for (k, name) in names.iter().enumerate() {
-        let m = by_name(name).unwrap();
+        let m = match name.strip_prefix("range-eta") {
+            Some(eta) => range_material(name, eta.parse().expect("range-etaX: X is η")),
+            None => *by_name(name).unwrap(),
+        };
         let t = std::time::Instant::now();
         let s = synthesize(
             m.name,
@@ -104,7 +111,12 @@ fn main() {
             },
         )
         .unwrap();
-        let at_g = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
+        // A surface without a specular part (η = 1) gives no η to measure: a user gives it.
+        let overrides = Overrides {
+            eta: (m.eta < 1.001).then_some(m.eta),
+            ..Overrides::default()
+        };
+        let at_g = measure_sample(&folder, &overrides, &|_| {}).unwrap();
         let at_0 = at_g
             .refit_with(FitSettings {
                 g: 0.0,
@@ -129,5 +141,18 @@ fn main() {
                 err(b.sigma_a, m.sigma_a[c]),
             );
         }
+    }
+}
+
+/// Issue 15's target range at one η (module docs): α′ 0.3, 0.99 and 0.9999.
+fn range_material(name: &str, eta: f64) -> scatterfit_synth::materials::PublishedMaterial {
+    let sigma_s_prime = [1.0, 1.5, 3.0];
+    let albedo = [0.3, 0.99, 0.9999];
+    scatterfit_synth::materials::PublishedMaterial {
+        name: Box::leak(name.to_string().into_boxed_str()),
+        source: "issue 15's range",
+        sigma_s_prime,
+        sigma_a: std::array::from_fn(|c| sigma_s_prime[c] * (1.0 / albedo[c] - 1.0)),
+        eta,
     }
 }

@@ -212,7 +212,8 @@ fn errors_both(
 /// d ln(Rd·F)/d ln(1 − α′) at fixed σ′s of the `mc` model (g = 0) behind `port`: how the port's
 /// reading moves with α′ (central differences at ±1 % of 1 − α′). Small where F falls nearly as
 /// fast as Rd rises (an 8 mm port at α′ ≥ 0.996: −0.01 … −0.04, against −0.04 … −0.12 for Rd
-/// alone), so a reading's error reaches 1 − α′, hence σa, amplified by its inverse.
+/// alone), so a reading's error reaches 1 − α′, hence σa, amplified by its inverse. NaN where the
+/// model does not answer (α′ below the tables' 0.02).
 fn reading_slope(
     grid: &scatterfit_mc::McGridSet,
     port: &Port,
@@ -222,18 +223,24 @@ fn reading_slope(
 ) -> f64 {
     use scatterfit_optics::{OpticalProperties, ProfileModel};
     let a = sigma_s_prime / (sigma_s_prime + sigma_a);
-    let ln_reading = |one_minus_a: f64| {
+    let ln_reading = |one_minus_a: f64| -> Option<f64> {
         let p = OpticalProperties::new(
             sigma_s_prime,
             sigma_s_prime * one_minus_a / (1.0 - one_minus_a),
             eta,
         )
-        .unwrap();
-        let m = grid.profile(&p).unwrap();
-        (m.rd_total() * port.reading_of(&m).reading_fraction).ln()
+        .ok()?;
+        let m = grid.profile(&p).ok()?;
+        Some((m.rd_total() * port.reading_of(&m).reading_fraction).ln())
     };
     let h = 0.01;
-    (ln_reading((1.0 - a) * (1.0 + h)) - ln_reading((1.0 - a) * (1.0 - h))) / (2.0 * h)
+    match (
+        ln_reading((1.0 - a) * (1.0 + h)),
+        ln_reading((1.0 - a) * (1.0 - h)),
+    ) {
+        (Some(up), Some(down)) => (up - down) / (2.0 * h),
+        _ => f64::NAN,
+    }
 }
 
 /// An 8 mm aperture lit over 14 mm (issue 15's first case), two materials whose light travels

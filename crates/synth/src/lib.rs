@@ -10,6 +10,7 @@
 
 pub mod materials;
 pub mod mishaps;
+pub mod port;
 pub mod rig;
 pub mod spectro;
 
@@ -104,14 +105,7 @@ pub fn synthesize(
     let bracket = rig::render_bracket(&profiles, rig, seed)?;
     let rd: [f64; 3] = std::array::from_fn(|c| profiles[c].rd_total.value);
     let reading = spectro::reading_for(rd, eta)?;
-    let xyz10 =
-        colour::spectrum_to_xyz(reading.wavelengths_nm(), reading.sce(), Observer::TenDegree)
-            .map_err(|_| SynthError::InvalidParameter {
-                name: "spectrum",
-                value: 0.0,
-                reason: "the synthetic SCE spectrum does not cover 400–700 nm",
-            })?;
-    let lab10 = colour::xyz_to_lab(xyz10, Observer::TenDegree.d65_white());
+    let lab10 = lab10_of(&reading)?;
     let channels = std::array::from_fn(|c| ChannelTruth {
         sigma_s_prime: sigma_s_prime[c],
         sigma_a: sigma_a[c],
@@ -129,6 +123,7 @@ pub fn synthesize(
         center_px: bracket.center_px,
         rig: rig.clone(),
         seed,
+        port: None,
     };
     Ok(SyntheticSample {
         reading,
@@ -136,4 +131,16 @@ pub fn synthesize(
         bracket,
         truth,
     })
+}
+
+/// L\*a\*b\* of a reading's SCE spectrum (D65, 10° observer, the instrument default).
+fn lab10_of(reading: &SpectroReading) -> Result<Lab, SynthError> {
+    let xyz10 =
+        colour::spectrum_to_xyz(reading.wavelengths_nm(), reading.sce(), Observer::TenDegree)
+            .map_err(|_| SynthError::InvalidParameter {
+                name: "spectrum",
+                value: 0.0,
+                reason: "the synthetic SCE spectrum does not cover 400–700 nm",
+            })?;
+    Ok(colour::xyz_to_lab(xyz10, Observer::TenDegree.d65_white()))
 }

@@ -293,6 +293,10 @@ pub struct Truth {
     pub rig: RigSpec,
     /// Seed.
     pub seed: u64,
+    /// The spectrophotometer's port the reading was made through (`synth --aperture-mm`); absent:
+    /// the reading is the loss-free total.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub port: Option<crate::port::PortTruth>,
 }
 
 /// A frame the twin camera wrote: 8-bit codes or linear raw values.
