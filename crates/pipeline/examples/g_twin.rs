@@ -76,8 +76,16 @@ fn main() {
         eprintln!("{name}: synthesised in {:.0} s", t.elapsed().as_secs_f64());
         let grid = scatterfit_mc::bundled_grid().unwrap();
         for (c, ct) in s.truth.channels.iter().enumerate() {
-            let model = grid.rd_total(ct.albedo_prime, m.eta, g).unwrap();
-            let back = grid.albedo_from_rd(ct.rd_total, m.eta, g).unwrap();
+            let (Ok(model), Ok(back)) = (
+                grid.rd_total(ct.albedo_prime, m.eta, g),
+                grid.albedo_from_rd(ct.rd_total, m.eta, g),
+            ) else {
+                eprintln!(
+                    "  {c}: α′ {:.5}, twin Rd {:.5} ± {:.5}: beyond the tables at g = {g}",
+                    ct.albedo_prime, ct.rd_total, ct.rd_total_stderr
+                );
+                continue;
+            };
             eprintln!(
                 "  {c}: α′ {:.5}, twin Rd {:.5} ± {:.5}, model Rd {:.5} (z {:+.1}), α′ from twin Rd {:.5} → σa {:+.2} %",
                 ct.albedo_prime,
