@@ -7,8 +7,10 @@
 //!
 //! ```text
 //! cargo run --release -p scatterfit-mc --example build_g_tables -- --out DIR \
-//!     [--photons P] [--seed S] [--g G,G,…] [--eta E,E,…]
+//!     [--photons P] [--seed S] [--g G,G,…] [--eta E,E,…] [--spacing reduced]
 //! ```
+//! `--spacing reduced` spaces the albedo nodes equally in √(1 − α′) instead of √(1 − a)
+//! (`scatterfit_mc::AlbedoSpacing`), halving the last interval toward α′ → 1 at g = 0.9.
 //! Defaults: P = 1e6 full-length photons (16 P and 4 P in the shorter strata), seed 1, and the
 //! chosen grid in the order most needed first: g = 0.9 and 0.8 over the η grid, then g = 0.5,
 //! 0.95, 0.7 (BENCHMARKS.md, "Anisotropic white tables", says why and what it costs). The η grid
@@ -44,6 +46,14 @@ fn main() {
     let photons = value("--photons").map_or(1e6, |p| p.parse::<f64>().expect("photons")) as u64;
     let seed: u64 = value("--seed").map_or(1, |s| s.parse().expect("seed"));
     let gs = value("--g").map_or(G_GRID.to_vec(), list);
+    let reduced = match value("--spacing") {
+        None => false,
+        Some("reduced") => true,
+        Some(other) => {
+            eprintln!("--spacing {other}: the builder knows `reduced` (default: √(1 − a))");
+            std::process::exit(2);
+        }
+    };
     let etas = value("--eta").map_or(
         (0..8)
             .map(|i| 1.0 + 0.2 * i as f64)
@@ -60,6 +70,9 @@ fn main() {
             }
             let mut spec = layout::g_spec(eta, g, photons);
             spec.seed = seed;
+            if reduced {
+                spec.albedo_spacing = scatterfit_mc::AlbedoSpacing::SqrtOneMinusReducedAlbedo;
+            }
             let t0 = std::time::Instant::now();
             let tally = simulate(&spec.white().expect("white spec"), &|_| {}).expect("simulate");
             let secs = t0.elapsed().as_secs_f64();

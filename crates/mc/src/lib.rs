@@ -57,7 +57,7 @@ pub use family::{albedo_family, bundled_grid, bundled_tables, family};
 pub use fresnel::{FresnelSample, fresnel_mcml};
 pub use grid::RadialGrid;
 pub use grid_g::{McGridProfile, McGridSet};
-pub use model::{McProfile, McTable, McTableSet, McTableSpec};
+pub use model::{AlbedoSpacing, McProfile, McTable, McTableSet, McTableSpec};
 pub use phase::{hg_cdf_cos, hg_pdf_cos, sample_hg_cos};
 pub use report::{SimulationReport, TableSummary};
 pub use sample::{Layer, Sample};

@@ -44,8 +44,12 @@ pub struct McTableSpec {
     pub eta: f64,
     /// Henyey–Greenstein asymmetry g.
     pub g: f64,
-    /// Number of albedo nodes, equally spaced in √(1 − a) from `albedo_min` to `albedo_max`.
+    /// Number of albedo nodes, from `albedo_min` to `albedo_max`, spaced as `albedo_spacing` says.
     pub albedo_count: usize,
+    /// How the albedo nodes are spaced (default: equally in √(1 − a); absent from the files of
+    /// tables built that way, so their specs and cache names are unchanged).
+    #[serde(default, skip_serializing_if = "AlbedoSpacing::is_default")]
+    pub albedo_spacing: AlbedoSpacing,
     /// Smallest single-scattering albedo.
     pub albedo_min: f64,
     /// Largest single-scattering albedo.
@@ -64,6 +68,29 @@ pub struct McTableSpec {
     pub seed: u64,
     /// The smoother.
     pub smooth: SmoothParams,
+}
+
+/// How a table's albedo nodes are spaced between its smallest and largest single-scattering
+/// albedo a.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AlbedoSpacing {
+    /// Equally in √(1 − a) (the g = 0 tables, and the g ≠ 0 tables shipped first).
+    #[default]
+    SqrtOneMinusA,
+    /// Equally in √(1 − α′), α′ = a(1 − g)/(1 − ag) the reduced albedo. At g ≠ 0 the first spacing
+    /// crowds the nodes toward α′ → 1 less than at g = 0 (1 − a ≈ (1 − g)(1 − α′) there): at
+    /// g = 0.9 only two of 64 nodes lie above α′ 0.998, and the far field between them is 1–5 %
+    /// off (BENCHMARKS.md, "Weak absorption"). This spacing gives a g ≠ 0 table the g = 0 table's
+    /// node density in α′, where the profile's shape is set (issue 15).
+    SqrtOneMinusReducedAlbedo,
+}
+
+impl AlbedoSpacing {
+    /// Whether this is the default spacing (serde: omitted from files).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 impl McTableSpec {
@@ -92,6 +119,7 @@ impl McTableSpec {
             eta,
             g,
             albedo_count: 64,
+            albedo_spacing: AlbedoSpacing::SqrtOneMinusA,
             albedo_min: 0.02,
             albedo_max: 0.9999,
             rho_min: 0.01,
@@ -106,18 +134,30 @@ impl McTableSpec {
         Ok(spec)
     }
 
-    /// The albedo nodes.
+    /// The albedo nodes (single-scattering albedos a, increasing), spaced as `albedo_spacing` says.
     pub fn albedos(&self) -> Vec<f64> {
+        let g = self.g;
+        // To and from the variable the nodes are equally spaced in (a or α′, docs on
+        // `AlbedoSpacing`; α′ = a(1 − g)/(1 − ag) ⇔ a = α′/(1 − g + gα′)).
+        let reduced = self.albedo_spacing == AlbedoSpacing::SqrtOneMinusReducedAlbedo;
+        let to = |a: f64| {
+            if reduced {
+                a * (1.0 - g) / (1.0 - a * g)
+            } else {
+                a
+            }
+        };
+        let from = |v: f64| if reduced { v / (1.0 - g + g * v) } else { v };
         let (x0, x1) = (
-            (1.0 - self.albedo_max).sqrt(),
-            (1.0 - self.albedo_min).sqrt(),
+            (1.0 - to(self.albedo_max)).sqrt(),
+            (1.0 - to(self.albedo_min)).sqrt(),
         );
         let n = self.albedo_count.max(2);
         (0..n)
             .rev()
             .map(|i| {
                 let x = x0 + (x1 - x0) * i as f64 / (n - 1) as f64;
-                1.0 - x * x
+                from(1.0 - x * x)
             })
             .collect()
     }
@@ -1015,6 +1055,60 @@ mod tests {
         spec.radial_bins = 120;
         spec.rho_max = 60.0;
         spec
+    }
+
+    /// `AlbedoSpacing::SqrtOneMinusReducedAlbedo`: at g = 0.9 the nodes' reduced albedos
+    /// (α′ = a(1 − g)/(1 − ag), computed here from each node) are equally spaced in √(1 − α′) and
+    /// the end nodes are the spec's own ends; at g = 0 the two spacings coincide; the default is
+    /// left out of the spec's JSON (so the shipped tables' specs and cache names do not change)
+    /// and the other one round-trips.
+    #[test]
+    fn reduced_albedo_spacing_is_even_in_sqrt_one_minus_albedo_prime() {
+        let mut spec = McTableSpec::new(1.4, 0.9, 1000).unwrap();
+        spec.albedo_min = 0.2 / (0.1 + 0.9 * 0.2);
+        spec.albedo_max = 0.99995 / (0.1 + 0.9 * 0.99995);
+        let plain = spec.albedos();
+        spec.albedo_spacing = AlbedoSpacing::SqrtOneMinusReducedAlbedo;
+        let nodes = spec.albedos();
+        assert_eq!(nodes.len(), 64);
+        assert!((nodes[0] - spec.albedo_min).abs() < 1e-12);
+        assert!((nodes[63] - spec.albedo_max).abs() < 1e-12);
+        let x: Vec<f64> = nodes
+            .iter()
+            .map(|&a| (1.0 - a * 0.1 / (1.0 - 0.9 * a)).sqrt())
+            .collect();
+        let step = x[0] - x[1];
+        for w in x.windows(2) {
+            assert!(((w[0] - w[1]) / step - 1.0).abs() < 1e-9, "{w:?} vs {step}");
+        }
+        // Toward α′ → 1 the last interval, in √(1 − α′), is about half the old spacing's (whose
+        // nodes above α′ 0.998 are two: 0.99995 and 0.99886).
+        let top = |v: &[f64]| {
+            let x = |a: f64| (1.0 - a * 0.1 / (1.0 - 0.9 * a)).sqrt();
+            x(v[62]) - x(v[63])
+        };
+        assert!(
+            top(&nodes) < 0.55 * top(&plain),
+            "{} vs {}",
+            top(&nodes),
+            top(&plain)
+        );
+        let json = serde_json::to_string(&spec).unwrap();
+        assert!(json.contains("sqrt_one_minus_reduced_albedo"), "{json}");
+        assert_eq!(serde_json::from_str::<McTableSpec>(&json).unwrap(), spec);
+        let g0 = McTableSpec::new(1.4, 0.0, 1000).unwrap();
+        assert!(
+            !serde_json::to_string(&g0)
+                .unwrap()
+                .contains("albedo_spacing")
+        );
+        let reduced = McTableSpec {
+            albedo_spacing: AlbedoSpacing::SqrtOneMinusReducedAlbedo,
+            ..g0.clone()
+        };
+        for (a, b) in reduced.albedos().iter().zip(g0.albedos()) {
+            assert!((a - b).abs() < 1e-15, "{a} vs {b}");
+        }
     }
 
     fn small_set(etas: &[f64]) -> McTableSet {
