@@ -7,7 +7,9 @@
 //! ```text
 //! cargo run --release -p scatterfit-mc --example g_point_check -- ALBEDO_PRIME ETA G PHOTONS [SEED]
 //! ```
-//! Reduced units: σ′t = 1 mm⁻¹, so r is in reduced mean free paths.
+//! Reduced units: σ′t = 1 mm⁻¹, so r is in reduced mean free paths. With `G_TABLE=FILE` (a table
+//! built by `build_g_tables`, at this η and g), that table's profile and total are printed too, for
+//! a table not yet in the shipped grid (e.g. one with another albedo spacing).
 
 #[path = "common/windows.rs"]
 mod windows;
@@ -52,4 +54,16 @@ fn main() {
         t0.elapsed().as_secs_f64(),
         windows(&m, &bins).replace(" [", "\n  [")
     );
+    if let Some(file) = std::env::var_os("G_TABLE") {
+        let table = scatterfit_mc::McTable::load(std::path::Path::new(&file)).expect("G_TABLE");
+        let set = scatterfit_mc::McTableSet::new(vec![table]).expect("a set of one table");
+        let t = scatterfit_mc::McProfile::new(&set, &p).expect("the table answers");
+        println!(
+            "G_TABLE {}: total {:.5} (z {:+.1})\n{}",
+            file.to_string_lossy(),
+            t.rd_total(),
+            (t.rd_total() - d.rd_total.value) / d.rd_total.stderr,
+            windows(&t, &bins).replace(" [", "\n  [")
+        );
+    }
 }
