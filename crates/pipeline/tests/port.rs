@@ -7,7 +7,7 @@
 //! Fixed seeds; tolerances below.
 
 use scatterfit_io::manifest::FitSection;
-use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
+use scatterfit_io::sample_folder::{CameraFiles, SampleFiles, write_sample_folder_with};
 use scatterfit_mc::port::simulate_port_reading;
 use scatterfit_mc::{Layer, Sample};
 use scatterfit_optics::port::Port;
@@ -121,37 +121,14 @@ fn errors_both(
     let mut out = [[(0.0, 0.0); 3]; 3];
     for (k, with_port) in [false, true, false].into_iter().enumerate() {
         let folder = dir.path().join(format!("{name}-{k}"));
-        write_sample_folder(
+        write_twin(
             &folder,
-            &SampleFiles {
-                name: m.name,
-                reading: if k == 2 { &s.reading } else { &reading },
-                lab10: None,
-                frames: &s.bracket.frames,
-                times_s: &s.bracket.times_s,
-                mm_per_pixel: rig.mm_per_pixel,
-                spot_diameter_mm: 2.0 * rig.spot_radius_mm,
-                truth_json: None,
-                provenance: "test",
-                fit: FitSection {
-                    model: Some(ModelName::Mc),
-                    albedo_model: Some(AlbedoModel::Mc),
-                    ..Default::default()
-                },
-            },
-        )
-        .unwrap();
-        if with_port {
-            let toml = folder.join("sample.toml");
-            let text = std::fs::read_to_string(&toml).unwrap().replacen(
-                "[spectro]\n",
-                &format!(
-                    "[spectro]\naperture_mm = {aperture_mm}\nilluminated_mm = {illuminated_mm}\n"
-                ),
-                1,
-            );
-            std::fs::write(&toml, text).unwrap();
-        }
+            &s,
+            rig,
+            if k == 2 { &s.reading } else { &reading },
+            None,
+            with_port.then_some([illuminated_mm, aperture_mm]),
+        );
         let meas = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
         assert_eq!(meas.port.is_some(), with_port);
         let result = meas.to_result(None);
@@ -207,6 +184,44 @@ fn errors_both(
         errors: out,
         reading_noise_sigma_a,
     }
+}
+
+/// Writes the twin `s` (made on `rig`) as a sample folder with `reading` as its spectrophotometer
+/// reading, to be measured with the `mc` model and albedo model at `g` (`None`: the default g
+/// range), the manifest naming the port `[lit, aperture]` \[mm\] when given.
+fn write_twin(
+    folder: &std::path::Path,
+    s: &scatterfit_synth::SyntheticSample,
+    rig: &RigSpec,
+    reading: &scatterfit_optics::spectro::SpectroReading,
+    g: Option<scatterfit_io::manifest::GSetting>,
+    port: Option<[f64; 2]>,
+) {
+    write_sample_folder_with(
+        folder,
+        &SampleFiles {
+            name: &s.truth.name,
+            reading,
+            lab10: None,
+            frames: &s.bracket.frames,
+            times_s: &s.bracket.times_s,
+            mm_per_pixel: rig.mm_per_pixel,
+            spot_diameter_mm: 2.0 * rig.spot_radius_mm,
+            truth_json: None,
+            provenance: "test",
+            fit: FitSection {
+                model: Some(ModelName::Mc),
+                albedo_model: Some(AlbedoModel::Mc),
+                g,
+                ..Default::default()
+            },
+        },
+        &CameraFiles {
+            spectro_port_mm: port,
+            ..Default::default()
+        },
+    )
+    .unwrap();
 }
 
 /// d ln(Rd·F)/d ln(1 − α′) at fixed σ′s of the `mc` model (g = 0) behind `port`: how the port's
@@ -320,34 +335,14 @@ fn the_port_corrected_albedo_error_follows_the_reading() {
         )
         .unwrap();
         let folder = dir.path().join(format!("s{k}"));
-        write_sample_folder(
+        write_twin(
             &folder,
-            &SampleFiles {
-                name: m.name,
-                reading: &scaled,
-                lab10: None,
-                frames: &s.bracket.frames,
-                times_s: &s.bracket.times_s,
-                mm_per_pixel: rig.mm_per_pixel,
-                spot_diameter_mm: 2.0 * rig.spot_radius_mm,
-                truth_json: None,
-                provenance: "test",
-                fit: FitSection {
-                    model: Some(ModelName::Mc),
-                    albedo_model: Some(AlbedoModel::Mc),
-                    g: Some(scatterfit_io::manifest::GSetting::Value(0.0)),
-                    ..Default::default()
-                },
-            },
-        )
-        .unwrap();
-        let toml = folder.join("sample.toml");
-        let text = std::fs::read_to_string(&toml).unwrap().replacen(
-            "[spectro]\n",
-            "[spectro]\naperture_mm = 8\nilluminated_mm = 8\n",
-            1,
+            &s,
+            &rig,
+            &scaled,
+            Some(scatterfit_io::manifest::GSetting::Value(0.0)),
+            Some([8.0, 8.0]),
         );
-        std::fs::write(&toml, text).unwrap();
         measure_sample(&folder, &Overrides::default(), &|_| {})
             .unwrap()
             .to_result(None)
