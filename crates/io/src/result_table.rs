@@ -182,6 +182,14 @@ pub fn port_note(results: &[MeasurementResult]) -> String {
                 diameter(p.aperture_mm),
                 diameter(p.illuminated_mm)
             ));
+            if let Some([lo, hi]) = r.g_uncertainty.as_ref().and_then(|g| g.range) {
+                t.push_str(&format!(
+                    "  The ± g term (g in {lo}–{hi}) keeps this correction's Rd; the port's \
+                     reading fraction itself changes with g (2–9 % between g = 0 and 0.8 at α′ ≥ \
+                     0.99 behind an 8 mm port), so here the term understates: state [fit] g if \
+                     it is known.\n"
+                ));
+            }
             for (ch, problem) in p.problems.iter_channels() {
                 if let Some(problem) = problem {
                     t.push_str(&format!(
@@ -426,6 +434,45 @@ mod tests {
     fn csv_quotes_problems() {
         assert_eq!(csv_text("a, b"), "\"a, b\"");
         assert_eq!(csv_text("plain"), "plain");
+    }
+
+    /// The port's line under the table: what it read per channel, a channel left as read, and —
+    /// only when a g range was propagated (g not given) — that the g term keeps the correction's
+    /// Rd and so understates; no port: the loss-free sentence.
+    #[test]
+    fn the_port_note_says_what_was_corrected_and_what_the_g_term_misses() {
+        let json = r#"{ "name": "s", "eta": 1.3, "method": "proposed", "model": "mc",
+          "channels": {
+            "r": { "status": "ok", "sigma_s_prime": 1.0, "sigma_a": 0.01, "albedo_prime": 0.99 },
+            "g": { "status": "ok", "sigma_s_prime": 1.0, "sigma_a": 0.02, "albedo_prime": 0.98 },
+            "b": { "status": "ok", "sigma_s_prime": 1.0, "sigma_a": 0.03, "albedo_prime": 0.97 } },
+          "spectro_port": { "aperture_mm": 8, "illuminated_mm": 14,
+            "rd_read": { "r": 0.5, "g": 0.4, "b": 0.3 },
+            "reading_fraction": { "r": 0.871, "g": 0.98, "b": null },
+            "problems": { "r": null, "g": null, "b": "the fit did not converge" } },
+          "g_uncertainty": { "source": "default_range", "g": 0.0, "range": [0.0, 0.95] },
+          "version": "0.1.0" }"#;
+        let r =
+            crate::result_json::parse_result_json(json, std::path::Path::new("r.json")).unwrap();
+        let note = port_note(std::slice::from_ref(&r));
+        assert!(
+            note.contains("8 mm aperture lit over 14 mm read 87.1 / 98.0 / — %"),
+            "{note}"
+        );
+        assert!(
+            note.contains("B left as read: the fit did not converge"),
+            "{note}"
+        );
+        assert!(
+            note.contains("g in 0–0.95") && note.contains("understates"),
+            "{note}"
+        );
+        let mut given = r.clone();
+        given.g_uncertainty.as_mut().unwrap().range = None;
+        assert!(!port_note(std::slice::from_ref(&given)).contains("understates"));
+        let mut no_port = r;
+        no_port.spectro_port = None;
+        assert!(port_note(&[no_port]).contains("loss-free"));
     }
 
     /// A hostile sample name cannot make a formula in result.csv, break a row of result.md or

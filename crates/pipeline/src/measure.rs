@@ -423,7 +423,20 @@ fn measure_from(
     )?;
     let (spectro, port) = match port {
         Some(p) => {
-            let (s, c) = crate::port::correct_port(&data, &spectro, &settings, model, albedo, p);
+            let (mut s, c) =
+                crate::port::correct_port(&data, &spectro, &settings, model, albedo, p);
+            if let Some([lo, hi]) = settings.g_prior.propagated_range() {
+                // The g term refits at each g from the Rd corrected here, at the values' g; the
+                // port's F is not recomputed at each g (BENCHMARKS.md, "The port's
+                // conditioning"): say so rather than let the term look complete.
+                s.warnings.push(format!(
+                    "the port correction used F of the model at g = {}; the ± g term (g in \
+                     {lo}–{hi}) keeps that corrected Rd, but F itself changes with g (by 2–9 % \
+                     between g = 0 and 0.8 at α′ ≥ 0.99 behind an 8 mm port), so with a port the \
+                     g term understates; give [fit] g if it is known",
+                    settings.g
+                ));
+            }
             (s, Some(c))
         }
         None => (spectro, None),
