@@ -1,7 +1,7 @@
 //! Real cameras (issue 16): the HDR stage on the rig twin's brackets from many cameras — tone
 //! curves, channel gains, reflectances and noise levels — must never refuse a good bracket and must
 //! give the profile's shape within 1 % on the rings it calls measurable (issue 16's aim; this build
-//! meets it on 90 % of the channels and 2.5 % on all, see `sweep`); a bracket in the wrong order is
+//! meets it on 116 of 120 channels and 1.5 % on all, see `sweep`); a bracket in the wrong order is
 //! still refused, saying what was seen.
 //!
 //! The profiles are diffusion dipoles (Jensen et al. 2001, eq. 4, written out here) so that no
@@ -75,6 +75,10 @@ fn write(dir: &Path, frames: &[ImageBuf<u8>], times: &[f64]) -> HdrInputs {
     if let Ok(n) = std::env::var("CAMERA_SAMPLES") {
         inputs.samples = n.parse().ok();
     }
+    if std::env::var("CAMERA_NO_EXPOSURE").is_ok() {
+        // Diagnosis: the nominal times, no estimate from the frames.
+        inputs.exposure_correction = scatterfit_io::manifest::ExposureCorrection::Never;
+    }
     if let Ok(l) = std::env::var("CAMERA_LAMBDA") {
         inputs.lambda = l.parse().unwrap_or(10.0);
     }
@@ -141,6 +145,12 @@ fn shape_errors(
                 })
                 .collect();
             eprintln!("  g error channel {c}: {}", d.join(" "));
+            if std::env::var("CAMERA_DEBUG_G").as_deref() == Ok("2") {
+                let d: Vec<String> = (20..=250)
+                    .map(|z| format!("{:+.1}", 100.0 * ((g[z] - g[128]) - (t[z] - t[128]))))
+                    .collect();
+                eprintln!("    codes 20..=250: {}", d.join(" "));
+            }
         }
     }
     if std::env::var("CAMERA_DEBUG").is_ok() {
@@ -224,8 +234,8 @@ fn shape_errors(
 
 /// Issue 16's sweep: five tone curves (linear, gamma 2.2, sRGB, log, a filmic S-curve with a
 /// shoulder), channel gains 0.3–1, total reflectance 0.005–0.9, read noise 3 and 15 e⁻ (with shot
-/// noise): no bracket refused; on the measurable rings the profile's shape within 1 % of the truth
-/// for 90 % of the channels and within 2.5 % for every one (BENCHMARKS.md, "Real cameras").
+/// noise): no bracket refused; on the measurable rings the profile's shape within 0.8 % of the
+/// truth for 90 % of the channels and within 1.5 % for every one (BENCHMARKS.md, "Real cameras").
 #[test]
 #[ignore = "the whole sweep takes about 5 min on 2 cores; CI runs every third combination (below)"]
 fn no_good_bracket_is_refused_and_shapes_hold() {
@@ -294,10 +304,13 @@ fn sweep(stride: usize, min_measured: usize) {
                             }
                             all.push(e[c]);
                             // The bound this build meets on every channel (issue 16 asks for
-                            // 1 %; 111 of 120 meet it, BENCHMARKS.md "Real cameras" has the rest
-                            // and what limits them). Main before the forward-direction toe had
-                            // 3.1 % (sRGB) and 3.5 % (log).
-                            let bound = 0.025;
+                            // 1 %; 116 of 120 meet it, the others are one gamma 2.2 channel at
+                            // 1.00 % and three log-curve channels at 1.2–1.4 %: BENCHMARKS.md
+                            // "Real cameras" has what limits them).
+                            // Before the merge's expected-signal floor and the response's comb:
+                            // 2.08 % (log, 15 e⁻); before the forward-direction toe 3.1 % (sRGB)
+                            // and 3.5 % (log).
+                            let bound = 0.015;
                             if e[c] > bound {
                                 failures.push(format!(
                                     "{} noise {noise}: Rd {} gain {}: shape error {:.4}",
@@ -338,12 +351,14 @@ fn sweep(stride: usize, min_measured: usize) {
         "{measured} channels measured (at least {min_measured} expected)"
     );
     // The median: 0.90 % over the whole sweep (0.90 % on a third) before the response's spline
-    // refit, 0.34 % (0.49 %) with it (BENCHMARKS.md, "The response recovery and the sweep").
-    assert!(q(0.5) <= 0.006, "median shape error {:.4}", q(0.5));
+    // refit, 0.34 % (0.49 %) with it, 0.25 % (0.23 %) now (BENCHMARKS.md, "The response recovery
+    // and the sweep").
+    assert!(q(0.5) <= 0.004, "median shape error {:.4}", q(0.5));
     // The 90th percentile: 1.35 % over the whole sweep before the response's forward-direction
-    // toe and the exposure estimate's independent selection, 0.91 % with them.
+    // toe and the exposure estimate's independent selection, 0.91 % with them, 0.62 % (0.58 % on
+    // a third) with the merge's expected-signal floor and the response's comb.
     assert!(
-        q(0.9) <= 0.01,
+        q(0.9) <= 0.008,
         "90th percentile of the shape error {:.4}",
         q(0.9)
     );

@@ -127,6 +127,7 @@ fn the_two_halves_are_read_and_merge() {
     let merge_opts = MergeOptions {
         clipped_fill: inputs.clipped_fill,
         weighting: inputs.weighting,
+        expected_floor: split.corrections.expected_floor,
     };
     let direct = merge(&frames, &times, &response, None, &merge_opts).unwrap();
     // Values (bit patterns, so NaN = NaN) that differ from the direct merge's.

@@ -151,10 +151,25 @@ pub(super) fn merge_8bit(
         CameraFrame::U8(b) => Some(b),
         CameraFrame::U16(_) => None,
     });
+    // The noise-aware detection codes: where the linearised signal reaches a signal-to-noise
+    // ratio of DETECTION_SNR per pixel. A fraction of their exposure is the merge's expected-signal
+    // floor: a frame counts at a pixel only where the radiance around it predicts at least that,
+    // so that readings censored at code 0 do not lift faint pixels (imaging::merge's second pass).
+    let codes = detection_codes(&bufs, &times_used, &response);
+    let mut floor = [DETECTION_CODE; 4];
+    for (c, (f, &det)) in floor.iter_mut().zip(&codes).enumerate() {
+        let g = &response.tables()[if response.channels() == 1 { 0 } else { c }];
+        let x_floor = EXPECTED_FLOOR_FRACTION * g[usize::from(det)].exp();
+        *f = (1..=det)
+            .find(|&z| g[usize::from(z)].exp() >= x_floor)
+            .unwrap_or(det);
+    }
     let opts = MergeOptions {
         clipped_fill: cx.inputs.clipped_fill,
         weighting: cx.inputs.weighting,
+        expected_floor: Some(floor),
     };
+    corrections.expected_floor = Some(floor);
     let mut hdr = scatterfit_imaging::merge(&bufs, &times_used, &response, dark.as_ref(), &opts)
         .map_err(imaging("merging the bracket"))?;
     if let Some((path, CameraFrame::U8(f))) = cx.flat {
@@ -169,7 +184,6 @@ pub(super) fn merge_8bit(
         )?);
     }
     let t_max = times_used.iter().copied().fold(0.0f64, f64::max);
-    let codes = detection_codes(&bufs, &times_used, &response);
     let detection_limit = (0..hdr.radiance.channels())
         .map(|c| {
             let g = &response.tables()[if response.channels() == 1 { 0 } else { c }];

@@ -93,6 +93,11 @@ pub struct Corrections {
     /// The spot's centroid per frame ([`crate::checks::registration`]; not written).
     #[serde(skip)]
     pub registration: Option<crate::checks::Registration>,
+    /// 8-bit merges: the expected-signal floor per channel given to the merge
+    /// ([`scatterfit_imaging::MergeOptions::expected_floor`]: the code whose exposure is
+    /// [`EXPECTED_FLOOR_FRACTION`] of the noise-aware detection code's; not written).
+    #[serde(skip)]
+    pub expected_floor: Option<[u8; 4]>,
 }
 
 /// The 8-bit code at which a pixel counts as detected in the longest exposure. Below it the tone
@@ -111,6 +116,17 @@ pub const DETECTION_CODE: u8 = 30;
 /// curve with 15 e⁻ read noise puts code 30 at about 30 e⁻ (SNR 2) and reaches 10 near code 75.
 /// Below it the merged radiance of issue 16's sweep was biased by up to 25 % (BENCHMARKS.md).
 pub const DETECTION_SNR: f64 = 10.0;
+
+/// The merge's expected-signal floor as a fraction of the detection code's exposure X(z_det)
+/// (`imaging::MergeOptions::expected_floor`): a frame whose expected exposure at a pixel is below
+/// 0.3·X(z_det) is left out there. At the detection code the signal-to-noise ratio is
+/// [`DETECTION_SNR`] = 10, so at 0.3 of it at least 3 (read noise) to 5.5 (shot noise): a reading
+/// is then negative (censored at code 0) with probability ≈ 0.1 % or less, and the frames between keep
+/// counting. With the detection code itself as the floor the far field's ring medians, which the
+/// second-spot check uses, moved by 5 % on the checks test's twin (a tenth-strength second spot
+/// was no longer found; likely because those pixels kept their longest frame alone, whose codes
+/// are coarse there).
+pub const EXPECTED_FLOOR_FRACTION: f64 = 0.3;
 
 /// The 16-bit linear value at which a pixel counts as detected in the longest exposure.
 pub const DETECTION_DN_16BIT: f64 = 64.0;
