@@ -529,6 +529,22 @@ fn nnls(r: &DMatrix<f64>, c: &DVector<f64>, passive: &[bool]) -> Option<DVector<
     Some(x)
 }
 
+/// The bracket's period in ln exposure: the median step between consecutive distinct ln Δt (the
+/// period of the response's "fractal ambiguity", docs/physics.md §7.1a); `None` with fewer than two
+/// distinct times.
+fn bracket_period(ln_dt: &[f64]) -> Option<f64> {
+    let mut steps: Vec<f64> = ln_dt
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|d| *d > 1e-9)
+        .collect();
+    if steps.is_empty() {
+        return None;
+    }
+    steps.sort_by(f64::total_cmp);
+    Some(steps[steps.len() / 2])
+}
+
 /// Least squares min |A x − b| by Householder QR (A has full column rank or `None`).
 /// The recovered g refitted with a cubic regression spline whose knots lie a fixed step apart in
 /// log exposure, `knot_step` times ln k (k: the bracket's median ratio of consecutive exposure
@@ -550,16 +566,7 @@ fn smooth_in_log_exposure(
     ln_dt: &[f64],
     knot_step: f64,
 ) -> Option<[f64; LEVELS]> {
-    let mut steps: Vec<f64> = ln_dt
-        .windows(2)
-        .map(|w| (w[1] - w[0]).abs())
-        .filter(|d| *d > 1e-9)
-        .collect();
-    if steps.is_empty() {
-        return None;
-    }
-    steps.sort_by(f64::total_cmp);
-    let period = steps[steps.len() / 2];
+    let period = bracket_period(ln_dt)?;
     let delta = knot_step * period;
     let (lo, hi) = (g[1], g[LEVELS - 2]);
     if (hi - lo).is_nan() || hi - lo <= delta {
@@ -648,16 +655,7 @@ const COMB_LO: usize = 10;
 /// Codes 230–254 must be filtered all the same: through a log curve they span a whole period. `None` (keep g) when the bracket has fewer than two distinct
 /// times, the curve spans less than three periods, or the result would not rise.
 fn comb_in_log_exposure(g: &[f64; LEVELS], ln_dt: &[f64]) -> Option<[f64; LEVELS]> {
-    let mut steps: Vec<f64> = ln_dt
-        .windows(2)
-        .map(|w| (w[1] - w[0]).abs())
-        .filter(|d| *d > 1e-9)
-        .collect();
-    if steps.is_empty() {
-        return None;
-    }
-    steps.sort_by(f64::total_cmp);
-    let period = steps[steps.len() / 2];
+    let period = bracket_period(ln_dt)?;
     let (z_lo, z_hi) = (COMB_LO, LEVELS - 2);
     let (u_lo, u_hi) = (g[z_lo], g[z_hi]);
     let span = u_hi - u_lo;
