@@ -35,10 +35,14 @@ pub const AMBIGUITY_KNOT_STEP: f64 = 1.2;
 /// Codes at and above this (up to [`TOE_TRUST_HI`]) are trusted as Debevec & Malik's least squares
 /// gives them; below it [`recover_response`] replaces g by the inverse of the mean code at known
 /// exposure ([`forward_toe`]). Chosen so that the trusted codes' noise is small against their
-/// signal for every camera of issue 16's sweep (at code 100, 15 e⁻ read noise is < 0.5 % of the
-/// exposure through sRGB or gamma 2.2 and ~1.5 % through the log curve), and low enough that every
-/// pixel brighter than the longest frame's code 100 has two such frames.
-pub const TOE_TRUST_LO: u8 = 100;
+/// signal for every camera of issue 16's sweep (at code 120, 15 e⁻ read noise is < 0.5 % of the
+/// exposure through sRGB or gamma 2.2 and ~1.3 % through the log curve), and low enough that every
+/// pixel brighter than the longest frame's code 120 has two such frames (codes 120–230 span
+/// ln(230/120) = 0.65 in ln X even for a linear camera, more than the bracket's step ln 1.87).
+/// Measured on the sweep (BENCHMARKS.md, "Real cameras"): at 100 the least squares' own
+/// regression bias at codes 90–110 (±0.4 % waves on the log curve) left two log channels at
+/// 1.07 % and 1.31 %; at 120 every channel is within 1 %.
+pub const TOE_TRUST_LO: u8 = 120;
 
 /// Bins of ln X̂ (0.02 wide) on each side of a bin that [`forward_toe`]'s local-linear smoothing of
 /// the mean code takes in.
@@ -923,7 +927,7 @@ pub fn recover_response(
 /// `SECOND_ORDER_MAX`. The result is blended into the trusted g over the 20 codes below [`TOE_TRUST_LO`]; codes
 /// below the lowest mean code (the noise floor: E\[Z\] at no light is above 0 when read noise
 /// reaches code 1) keep g capped at the lowest crossing. `None` (keep g) when fewer than 2 000
-/// such readings exist (about 150 pixels brighter than code 100 somewhere) or the crossing of a code in 30..[`TOE_TRUST_LO`] is not found.
+/// such readings exist (about 150 pixels brighter than code [`TOE_TRUST_LO`] somewhere) or the crossing of a code in 30..[`TOE_TRUST_LO`] is not found.
 pub fn forward_toe(
     frames: &[ImageBuf<u8>],
     times_s: &[f64],
