@@ -258,8 +258,13 @@ pub struct ChannelSolution {
 /// The outcome of [`recover_response`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Calibration {
-    /// The recovered response, gauge g(128) = 0 per channel.
+    /// The recovered response, gauge g(128) = 0 per channel: X(z) unbiased for the mean of the
+    /// readings at one exposure (what the merge averages).
     pub response: ResponseCurve,
+    /// The same response with the toe to first order only ([`forward_toe`]): unbiased for the
+    /// *median* of the readings at one exposure, for statistics of medians (the pipeline's
+    /// exposure estimate takes the median of pixel ratios). Equal to `response` above the toe.
+    pub median_response: ResponseCurve,
     /// The sample pixels used, per channel.
     pub samples: Vec<Vec<SamplePixel>>,
     /// Each channel's solution (g, ln E of the samples, residual).
@@ -854,6 +859,7 @@ pub fn recover_response(
     let ln_dt: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();
     let mut samples = Vec::new();
     let mut solutions = Vec::new();
+    let mut medians = Vec::new();
     for c in 0..frames[0].channels() {
         let picked = select_samples(frames, times_s, c, opts.samples)?;
         if picked.len() < min {
@@ -879,10 +885,14 @@ pub fn recover_response(
             solution = ChannelSolution::with_g(g, &z, &ln_dt);
         }
         // The toe: the inverse of the mean code at known exposure, not the mean exposure at a
-        // given code (which noise pulls towards the dark pixels' exposures).
-        if let Some(g) = forward_toe(frames, times_s, c, &solution.g) {
-            solution = ChannelSolution::with_g(g, &z, &ln_dt);
+        // given code (which noise pulls towards the dark pixels' exposures); to second order for
+        // the merge, to first order for medians.
+        let mut median_g = solution.g;
+        if let Some((first, second)) = forward_toe_both(frames, times_s, c, &solution.g) {
+            solution = ChannelSolution::with_g(second, &z, &ln_dt);
+            median_g = first;
         }
+        medians.push(median_g);
 
         check_increasing(&solution.g, &z, c)?;
         solutions.push(solution);
@@ -893,6 +903,7 @@ pub fn recover_response(
     };
     Ok(Calibration {
         response,
+        median_response: ResponseCurve { g: medians },
         samples,
         solutions,
     })
@@ -934,18 +945,18 @@ pub fn forward_toe(
     c: usize,
     g: &[f64; LEVELS],
 ) -> Option<[f64; LEVELS]> {
-    forward_toe_to_order(frames, times_s, c, g, true)
+    forward_toe_both(frames, times_s, c, g).map(|(_, second)| second)
 }
 
-/// [`forward_toe`], with the second-order term or without it (the first-order inverse of the mean
-/// code; kept for the test that shows what the term does).
-fn forward_toe_to_order(
+/// [`forward_toe`] to first order (the inverse of the mean code: unbiased for the *median* of a
+/// pixel's linearised readings, which statistics of medians need) and with the second-order term
+/// (unbiased for their mean, which the merge needs), from one pass over the pixels.
+fn forward_toe_both(
     frames: &[ImageBuf<u8>],
     times_s: &[f64],
     c: usize,
     g: &[f64; LEVELS],
-    second_order: bool,
-) -> Option<[f64; LEVELS]> {
+) -> Option<([f64; LEVELS], [f64; LEVELS])> {
     let ch = frames[0].channels();
     let n = frames[0].data().len() / ch;
     let step = (n / 262_144).max(1);
@@ -1111,8 +1122,7 @@ fn forward_toe_to_order(
     };
     let toe = out;
     let h = SECOND_ORDER_STEP;
-    let end = if second_order { top } else { 0 };
-    for z in (first + h).max(SECOND_ORDER_FROM)..end {
+    for z in (first + h).max(SECOND_ORDER_FROM)..top {
         // X″/X = g″ + g′² (g = ln X), from a least-squares parabola through g over z ± h.
         let (mut s, mut sd, mut sd2, mut sd3, mut sd4, mut t0, mut t1, mut t2) =
             (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
@@ -1147,16 +1157,19 @@ fn forward_toe_to_order(
         };
         out[z] = toe[z] + a * (1.0 - rel).ln();
     }
-    for z in 0..first {
-        out[z] = out[z].min(out[first]);
-    }
-    // Non-decreasing (the blend of two rising curves rises; rounding aside).
-    for z in 1..LEVELS {
-        if out[z] < out[z - 1] {
-            out[z] = out[z - 1];
+    let finish = |mut out: [f64; LEVELS]| {
+        for z in 0..first {
+            out[z] = out[z].min(out[first]);
         }
-    }
-    Some(out)
+        // Non-decreasing (the blend of two rising curves rises; rounding aside).
+        for z in 1..LEVELS {
+            if out[z] < out[z - 1] {
+                out[z] = out[z - 1];
+            }
+        }
+        out
+    };
+    Some((finish(toe), finish(out)))
 }
 
 /// Refuses a recovered curve that does not rise over the codes the samples use (1st to 99th
@@ -1487,7 +1500,16 @@ mod tests {
         if let Some(s) = comb_in_log_exposure(&g0, &ln_dt) {
             g0 = s;
         }
-        let g1 = forward_toe_to_order(&frames, &times, 0, &g0, false).expect("a toe");
+        let (g1, g2_again) = forward_toe_both(&frames, &times, 0, &g0).expect("a toe");
+        assert_eq!(
+            g2_again, g2,
+            "recover_response's toe is the second-order one"
+        );
+        assert_eq!(
+            g1,
+            cal.median_response.tables()[0],
+            "and its median response the first"
+        );
         // True code of the longest frame's expected signal: the log curve at rate·Δt.
         let (longest, t_long) = (&frames[12], times[12]);
         let expected_code = |r: f64| 255.0 * log((r * t_long / 20_000.0).min(1.0));

@@ -27,9 +27,11 @@ pub enum McError {
     /// A Henyey–Greenstein g that the (η, g) grid of tables neither holds nor interpolates
     /// ([`crate::McGridSet`]).
     #[error(
-        "g = {given} is not covered by the Monte Carlo tables: they hold {tabulated}; use one of \
-         those g, or build tables at this g with `cargo run --release -p scatterfit-mc --example \
-         build_g_tables -- --out DIR --g {given}` (crates/mc/tables-g/README.md)"
+        "g = {given} is not covered by the Monte Carlo tables: they hold {tabulated}; use a g \
+         they cover (a g above the last node is not extrapolated: the nearest node is the closest \
+         the tool can model), or add tables at this g to the build (`cargo run --release -p \
+         scatterfit-mc --example build_g_tables -- --out DIR --g {given}`, then listed in \
+         crates/mc/src/bundled.rs and the tool rebuilt: crates/mc/tables-g/README.md)"
     )]
     AnisotropyNotTabulated {
         /// The g asked for.

@@ -135,26 +135,18 @@ pub fn estimate_exposures(
     let mut ln_t = vec![0.0; p];
     let mut pairs = Vec::with_capacity(p.saturating_sub(1));
     for j in 0..p.saturating_sub(1) {
-        let mut r: Vec<(f64, f64, f64)> = (0..n)
+        let mut r: Vec<f64> = (0..n)
             .step_by(step)
             .filter_map(|i| {
                 let (a, b) = (linear(j, i)?, linear(j + 1, i)?);
-                (a > 0.0 && b > 0.0).then(|| ((b / a).ln(), a, b))
+                (a > 0.0 && b > 0.0).then(|| (b / a).ln())
             })
             .collect();
         pairs.push(r.len());
         let nominal = (times_s[j + 1] / times_s[j]).ln();
         let step_ln = if r.len() >= 100 {
-            // The ratio of the sums, the outermost 1 % of log ratios on each side left out (a hot
-            // or defective pixel). Not the median of the log ratios: the merge averages linear
-            // values, and the response's toe is made unbiased for that mean (`forward_toe`'s
-            // second-order term), which the median of a skewed ratio is not.
-            r.sort_by(|x, y| x.0.total_cmp(&y.0));
-            let cut = r.len() / 100;
-            let (sa, sb) = r[cut..r.len() - cut]
-                .iter()
-                .fold((0.0, 0.0), |(sa, sb), &(_, a, b)| (sa + a, sb + b));
-            (sb / sa).ln()
+            r.sort_by(f64::total_cmp);
+            r[r.len() / 2]
         } else {
             nominal
         };

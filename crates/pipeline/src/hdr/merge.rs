@@ -51,20 +51,25 @@ pub(super) fn merge_8bit(
         .inputs
         .samples
         .unwrap_or_else(|| default_response_samples(bufs.len()));
-    let recover = |t: &[f64]| -> Result<(ResponseCurve, Vec<f64>)> {
+    // The recovered response (unbiased for the mean of a pixel's readings: the merge), its
+    // first-order toe (unbiased for their median: the exposure estimate's medians), the residuals.
+    let recover = |t: &[f64]| -> Result<(ResponseCurve, ResponseCurve, Vec<f64>)> {
         let opts = CalibrateOptions::new(samples, cx.inputs.lambda)
             .map_err(imaging("the response recovery's options"))?;
         let cal = scatterfit_imaging::recover_response(&bufs, t, &opts).map_err(
             imaging("recovering the camera response (or give a known one: --response for merge, camera.response in sample.toml for measure)"),
         )?;
         let rms = cal.solutions.iter().map(|s| s.rms_residual).collect();
-        Ok((cal.response, rms))
+        Ok((cal.response, cal.median_response, rms))
     };
-    let (mut response, kind, mut rms) = match &cx.inputs.response {
-        Some(path) => (load_response(path)?, ResponseKind::Given, Vec::new()),
+    let (mut response, mut median_response, kind, mut rms) = match &cx.inputs.response {
+        Some(path) => {
+            let r = load_response(path)?;
+            (r.clone(), r, ResponseKind::Given, Vec::new())
+        }
         None => {
-            let (r, rms) = recover(cx.times)?;
-            (r, ResponseKind::Recovered, rms)
+            let (r, m, rms) = recover(cx.times)?;
+            (r, m, ResponseKind::Recovered, rms)
         }
     };
     // Exposure times from the frames: ratios of linearised codes in the well-exposed range.
@@ -74,7 +79,8 @@ pub(super) fn merge_8bit(
         let ch = bufs[0].channels();
         let n = bufs[0].data().len();
         for round in 0..if recovered { 4 } else { 1 } {
-            let lin: Vec<Vec<f64>> = response
+            // The median of the pixels' ratios: the median-unbiased linearisation.
+            let lin: Vec<Vec<f64>> = median_response
                 .tables()
                 .iter()
                 .map(|g| g.iter().map(|v| v.exp()).collect())
@@ -129,7 +135,7 @@ pub(super) fn merge_8bit(
                 *t *= f;
             }
             if recovered {
-                (response, rms) = recover(&times_used)?;
+                (response, median_response, rms) = recover(&times_used)?;
             }
             if est.max_correction < 2e-4 {
                 break;
