@@ -137,8 +137,8 @@ pub enum ModelArg {
     /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (slow: ~2 ms per
     /// evaluation).
     Pbd,
-    /// Monte Carlo tables shipped with scatterfit (exact transport; g = 0, η 1.0–2.5, α′ up to
-    /// 0.9999).
+    /// Monte Carlo tables shipped with scatterfit (exact transport, Henyey–Greenstein g 0–0.95
+    /// with --g or `[fit] g`; η 1.0–2.5 at g = 0 and 1.0–2.4 at g ≠ 0; α′ up to 0.9999).
     Mc,
 }
 
@@ -190,6 +190,19 @@ pub struct FitArgs {
     /// Proposed method: fix the profile's scale by the spectrophotometer's Rd instead of fitting it.
     #[arg(long)]
     pub normalise_with_spectro: bool,
+    /// The material's Henyey–Greenstein g, known or assumed (replaces the manifest's `[fit] g`
+    /// and `g_range`): the `mc` model is evaluated at it and its ± g term is 0 (the tables cover
+    /// g 0–0.95; another g is refused naming what they hold). Or `fit` (needs --model mc): g
+    /// fitted per channel from the profile within --g-range, printed with its standard error
+    /// only where the data determine it. Without --g and --g-range, the manifest's keys; with
+    /// neither there, the values at g = 0 and a ± g term over 0–0.95 (g not stated is g not known).
+    #[arg(long, value_name = "G|fit", value_parser = parse_g)]
+    pub g: Option<GArg>,
+    /// The range LO,HI (0 ≤ LO ≤ HI ≤ 0.95) the material's g lies in (replaces `[fit] g_range`):
+    /// propagated into σ′s, σa and α′ as the ± g term; with --g the values are at that g, without
+    /// it the middle of the estimates over the range.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_g_range)]
+    pub g_range: Option<[f64; 2]>,
     /// Let a manifest name files outside its sample folder (`../dark.png`, an absolute path, a
     /// link that leaves the folder). Without it they are refused before any work: whoever can
     /// write a manifest could otherwise make scatterfit read any file you can.
@@ -217,9 +230,46 @@ impl FitArgs {
             albedo_model: self.albedo_model.map(Into::into),
             eta: self.eta,
             normalise_with_spectro: self.normalise_with_spectro.then_some(true),
+            g: match self.g {
+                Some(GArg::Value(g)) => Some(g),
+                _ => None,
+            },
+            g_range: self.g_range,
+            g_fit: self.g == Some(GArg::Fit),
             allow_outside_paths: self.allow_outside_paths,
-            ..Overrides::default()
         })
+    }
+}
+
+/// `--g`: a number or `fit`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GArg {
+    /// A known or assumed g.
+    Value(f64),
+    /// Fit g from the profile.
+    Fit,
+}
+
+/// Parses `--g G|fit`.
+pub fn parse_g(text: &str) -> Result<GArg, String> {
+    if text.trim() == "fit" {
+        return Ok(GArg::Fit);
+    }
+    crate::numeric::parse_finite(text)
+        .map(GArg::Value)
+        .map_err(|_| format!("`{text}` is neither a Henyey–Greenstein g in (−1, 1) nor `fit`"))
+}
+
+/// Parses `--g-range LO,HI`: two finite numbers (the range's rule is checked with the other
+/// options).
+pub fn parse_g_range(text: &str) -> Result<[f64; 2], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
+    match (parts.len(), values.as_slice()) {
+        (2, &[lo, hi]) if lo.is_finite() && hi.is_finite() => Ok([lo, hi]),
+        _ => Err(format!(
+            "`{text}` is not a range LO,HI of g (e.g. 0.7,0.95)"
+        )),
     }
 }
 

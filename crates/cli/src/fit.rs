@@ -12,7 +12,7 @@ use scatterfit_optics::{Method, Rgb};
 use scatterfit_pipeline::profile::channel_from_table;
 use scatterfit_pipeline::profile_fit::{ProfileFitRequest, fit_profile};
 
-use crate::common::parse_rgb;
+use crate::common::{GArg, parse_g, parse_g_range, parse_rgb};
 use crate::common::{MethodArg, ModelArg};
 use crate::output::out;
 
@@ -72,38 +72,6 @@ pub struct Args {
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
-}
-
-/// `--g`: a number or `fit`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum GArg {
-    /// A known or assumed g.
-    Value(f64),
-    /// Fit g from the profile.
-    Fit,
-}
-
-/// Parses `--g G|fit`.
-pub fn parse_g(text: &str) -> Result<GArg, String> {
-    if text.trim() == "fit" {
-        return Ok(GArg::Fit);
-    }
-    crate::numeric::parse_finite(text)
-        .map(GArg::Value)
-        .map_err(|_| format!("`{text}` is neither a Henyey–Greenstein g in (−1, 1) nor `fit`"))
-}
-
-/// Parses `--g-range LO,HI`: two finite numbers (the range's rule is checked with the other
-/// options).
-pub fn parse_g_range(text: &str) -> Result<[f64; 2], String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
-    match (parts.len(), values.as_slice()) {
-        (2, &[lo, hi]) if lo.is_finite() && hi.is_finite() => Ok([lo, hi]),
-        _ => Err(format!(
-            "`{text}` is not a range LO,HI of g (e.g. 0.7,0.95)"
-        )),
-    }
 }
 
 /// Runs `scatterfit fit`.

@@ -67,6 +67,33 @@ fn synth_then_measure() {
     let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert_eq!(v["name"], "wood-tile");
     assert!(dir.path().join("out/fit.png").exists());
+    // `measure --g` as `[fit] g` (issue 15): a known g makes the ± g term 0 and the `mc` model is
+    // evaluated at it; a g outside (−1, 1) and `--g fit` without the `mc` model are bad usage.
+    let out = run_cached(
+        dir.path(),
+        &[
+            "measure", "wood", "-o", "g09", "--model", "mc", "--g", "0.9", "--json", "--quiet",
+        ],
+    );
+    assert!(out.code == 0 || out.code == 1, "{}", out.stderr);
+    let k: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(k["g_uncertainty"]["source"], "given");
+    assert_eq!(k["g_uncertainty"]["g"].as_f64(), Some(0.9));
+    assert_eq!(
+        k["channels"]["r"]["sigma_s_prime_stderr_g"].as_f64(),
+        Some(0.0)
+    );
+    for (extra, says) in [
+        (&["--g", "1.2"][..], "g"),
+        (&["--g", "fit"][..], "mc"),
+        (&["--g-range", "0.9,0.2"][..], "g range"),
+    ] {
+        let mut args = vec!["measure", "wood", "-o", "gbad", "--quiet"];
+        args.extend_from_slice(extra);
+        let out = run_cached(dir.path(), &args);
+        assert_eq!(out.code, 2, "{extra:?}: {}", out.stderr);
+        assert!(out.stderr.contains(says), "{extra:?}: {}", out.stderr);
+    }
 
     // `fit` on the profile the measurement wrote, with the α′ it found, gives the same σ′s.
     let a: Vec<String> = ["r", "g", "b"]
