@@ -208,7 +208,9 @@ fn synth_then_measure() {
 
     // A short bracket (3 of the 13 frames, 1/600 s, 0.07 s, 3 s) is measured too: the response
     // recovery takes Debevec & Malik's minimum ⌈256/(P − 1)⌉ = 128 sample pixels there, not the
-    // 100 that suit long brackets (which it refused), and σ′s stays within the 5 % target.
+    // 100 that suit long brackets (which it refused), and σ′s stays within the 5 % target. A
+    // response recovered from steps that wide (42×) is suspect, though (exit 1, every channel's
+    // quality saying why): the bracket cannot see a ripple of its own period.
     let csv = read_text(&dir.path().join("wood/exposures.csv"));
     let lines: Vec<&str> = csv.lines().collect();
     let short = [lines[0], lines[1], lines[7], lines[13]].join("\n");
@@ -217,8 +219,20 @@ fn synth_then_measure() {
         dir.path(),
         &["measure", "wood", "-o", "short", "--json", "--quiet"],
     );
-    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(out.code, 1, "{}", out.stderr);
     let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    for c in ["r", "g", "b"] {
+        let q = &v["channels"][c]["quality"];
+        assert_eq!(q["verdict"], "suspect", "{q}");
+        assert!(
+            q["reasons"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|r| r["kind"] == "response_steps"),
+            "{q}"
+        );
+    }
     let got = v["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
     assert!((got / want - 1.0).abs() < 0.05, "3 frames: {got} vs {want}");
     // Every number has its uncertainty: η's and, per channel, α′'s and the spectrophotometer's part

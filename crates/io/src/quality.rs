@@ -62,6 +62,9 @@ pub enum ReasonKind {
     /// Consecutive exposures too far apart for the frames' codes to overlap (a gap in the
     /// bracket: some radiances are well exposed in no frame).
     BracketGap,
+    /// The camera response was recovered from exposures too far apart to pin it: a ripple of the
+    /// bracket's period in log exposure is invisible to such a bracket (the fractal ambiguity).
+    ResponseSteps,
     /// A value outside its documented range.
     OutOfRange,
     /// The fit gave no parameters or did not converge.

@@ -96,6 +96,13 @@ fn shape_errors(
     let eta = 1.3;
     let mut rig = RigSpec::quick();
     rig.camera = camera;
+    if let Ok(b) = std::env::var("CAMERA_BRACKET") {
+        // Diagnosis: another bracket, "N,K": N frames from 1/600 s, each K times the last.
+        let v: Vec<f64> = b.split(',').map(|x| x.parse().unwrap()).collect();
+        rig.times_s = (0..v[0] as usize)
+            .map(|k| v[1].powi(k as i32) / 600.0)
+            .collect();
+    }
     let profiles: Vec<_> = channels
         .iter()
         .map(|&(rd, _)| dipole(albedo_for(rd, eta), eta))

@@ -193,6 +193,16 @@ pub const MAX_STEP_8BIT: f64 = 64.0;
 /// overlap across 256× (8 stops).
 pub const MAX_STEP_LINEAR: f64 = 256.0;
 
+/// The largest *typical* (median) ratio of consecutive times from which a camera response is
+/// recovered without a check: with times in a constant ratio k the bracket cannot see a ripple of
+/// the response periodic in ln X with period ln k (the fractal ambiguity, docs/physics.md §7.1a),
+/// and the wider the steps the less of the curve holds it. Measured on issue 16's sweep (five tone
+/// curves, two noise levels, BENCHMARKS.md "Real cameras"): worst shape error 0.93 % at 1.87×,
+/// 2.8 % at 2.5× (a filmic S-curve), 13–15 % at 3.5× (S-curve; a log curve at 15 e⁻), and some
+/// good dark brackets refused at 4× — while the same brackets through the true response are
+/// within 1 %. So a response recovered from steps wider than this makes every channel suspect.
+pub const MAX_STEP_RECOVERED: f64 = 2.6;
+
 /// The bracket's overlap: consecutive exposures more than [`MAX_STEP_8BIT`] (8-bit frames through
 /// a recovered or given response) or [`MAX_STEP_LINEAR`] (linear frames) apart, or a recovered
 /// response from fewer than 3 frames, make every channel suspect: the merge then interpolates
@@ -215,6 +225,25 @@ pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
                  recovery is barely constrained — take a bracket of 5 or more exposures, at most \
                  {MAX_STEP_8BIT:.0}× apart",
                 times.len()
+            ),
+        ));
+    }
+    let mut steps: Vec<f64> = times
+        .windows(2)
+        .filter(|w| w[0] > 0.0 && w[1] > w[0])
+        .map(|w| w[1] / w[0])
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    if m.hdr.response_kind == ResponseKind::Recovered
+        && times.len() >= 3
+        && let Some(&median) = steps.get(steps.len() / 2)
+        && median > MAX_STEP_RECOVERED
+    {
+        reasons.push(suspect(
+            ReasonKind::ResponseSteps,
+            format!(
+                "the camera response was recovered from exposures {median:.1}× apart ({:.1}                  stops): beyond {MAX_STEP_RECOVERED}× a recovered response can carry a ripple                  the bracket cannot see (up to 13 % in the profile's shape at 3.5× on a filmic                  tone curve) — shoot steps of 2× (1 stop) or less, give the camera's response                  (camera.response), or use linear 16-bit or RAW frames",
+                median.log2()
             ),
         ));
     }

@@ -25,9 +25,9 @@ use crate::measure::Measurement;
 mod frames;
 
 pub use frames::{
-    CodeRange, MAX_FRAME_SHIFT_PX, MAX_STEP_8BIT, MAX_STEP_LINEAR, PLATEAU_MIN_SAMPLES,
-    REGISTRATION_MIN_PIXELS, Registration, bracket_reasons, code_range, code_reasons, registration,
-    registration_reasons,
+    CodeRange, MAX_FRAME_SHIFT_PX, MAX_STEP_8BIT, MAX_STEP_LINEAR, MAX_STEP_RECOVERED,
+    PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS, Registration, bracket_reasons, code_range,
+    code_reasons, registration, registration_reasons,
 };
 
 /// A fit whose rms log residual exceeds this is suspect: the profile differs from the model by
