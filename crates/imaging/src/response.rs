@@ -42,7 +42,7 @@ pub const AMBIGUITY_KNOT_STEP: f64 = 1.2;
 /// Measured on the sweep (BENCHMARKS.md, "Real cameras"): at 100 the least squares' own
 /// regression bias at codes 90–110 (±0.4 % waves on the log curve) left two log channels at
 /// 1.07 % and 1.31 %; at 120 every channel is within 1 %.
-pub const TOE_TRUST_LO: u8 = 100;
+pub const TOE_TRUST_LO: u8 = 120;
 
 /// Bins of ln X̂ (0.02 wide) on each side of a bin that [`forward_toe`]'s local-linear smoothing of
 /// the mean code takes in.
