@@ -39,6 +39,23 @@ const BUNDLED_JSON: [&str; 17] = [
     include_str!("../tables/mc-white-eta2.50.json"),
 ];
 
+/// One entry of [`BUNDLED_G`]: (η, g, the table's compact JSON from `../tables-g/`).
+macro_rules! g_table {
+    ($eta:literal, $g:literal, $eta_name:literal, $g_name:literal) => {
+        (
+            $eta,
+            $g,
+            include_str!(concat!(
+                "../tables-g/mc-white-eta",
+                $eta_name,
+                "-g",
+                $g_name,
+                ".json"
+            )),
+        )
+    };
+}
+
 /// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
 /// compact JSON). g = 0.8 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4 and 1.6–2.4 (0.2 apart), g = 0.9 at
 /// η 1.0, 1.05, 1.1–1.7 (0.1 apart) and 1.8–2.4 (0.2 apart), g = 0.95 at η 1.0, 1.4, 1.8, 2.4 (a
@@ -46,147 +63,36 @@ const BUNDLED_JSON: [&str; 17] = [
 /// and 3 % between 1.0 and 1.4, BENCHMARKS.md "The `mc` model over g");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
 /// (`examples/common/g_tables_layout.rs`). About 45 KB each, 1.25 MB in all (the g = 0 set: 0.75 MB).
+#[rustfmt::skip]
 pub const BUNDLED_G: [(f64, f64, &str); 28] = [
-    (
-        1.0,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.00-g0.80.json"),
-    ),
-    (
-        1.05,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.05-g0.80.json"),
-    ),
-    (
-        1.1,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.10-g0.80.json"),
-    ),
-    (
-        1.2,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.20-g0.80.json"),
-    ),
-    (
-        1.3,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.30-g0.80.json"),
-    ),
-    (
-        1.4,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.40-g0.80.json"),
-    ),
-    (
-        1.6,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.60-g0.80.json"),
-    ),
-    (
-        1.8,
-        0.8,
-        include_str!("../tables-g/mc-white-eta1.80-g0.80.json"),
-    ),
-    (
-        2.0,
-        0.8,
-        include_str!("../tables-g/mc-white-eta2.00-g0.80.json"),
-    ),
-    (
-        2.2,
-        0.8,
-        include_str!("../tables-g/mc-white-eta2.20-g0.80.json"),
-    ),
-    (
-        2.4,
-        0.8,
-        include_str!("../tables-g/mc-white-eta2.40-g0.80.json"),
-    ),
-    (
-        1.0,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.00-g0.90.json"),
-    ),
-    (
-        1.05,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.05-g0.90.json"),
-    ),
-    (
-        1.1,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.10-g0.90.json"),
-    ),
-    (
-        1.2,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.20-g0.90.json"),
-    ),
-    (
-        1.3,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.30-g0.90.json"),
-    ),
-    (
-        1.4,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.40-g0.90.json"),
-    ),
-    (
-        1.5,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.50-g0.90.json"),
-    ),
-    (
-        1.6,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.60-g0.90.json"),
-    ),
-    (
-        1.7,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.70-g0.90.json"),
-    ),
-    (
-        1.8,
-        0.9,
-        include_str!("../tables-g/mc-white-eta1.80-g0.90.json"),
-    ),
-    (
-        2.0,
-        0.9,
-        include_str!("../tables-g/mc-white-eta2.00-g0.90.json"),
-    ),
-    (
-        2.2,
-        0.9,
-        include_str!("../tables-g/mc-white-eta2.20-g0.90.json"),
-    ),
-    (
-        2.4,
-        0.9,
-        include_str!("../tables-g/mc-white-eta2.40-g0.90.json"),
-    ),
-    (
-        1.0,
-        0.95,
-        include_str!("../tables-g/mc-white-eta1.00-g0.95.json"),
-    ),
-    (
-        1.4,
-        0.95,
-        include_str!("../tables-g/mc-white-eta1.40-g0.95.json"),
-    ),
-    (
-        1.8,
-        0.95,
-        include_str!("../tables-g/mc-white-eta1.80-g0.95.json"),
-    ),
-    (
-        2.4,
-        0.95,
-        include_str!("../tables-g/mc-white-eta2.40-g0.95.json"),
-    ),
+    g_table!(1.0, 0.8, "1.00", "0.80"),
+    g_table!(1.05, 0.8, "1.05", "0.80"),
+    g_table!(1.1, 0.8, "1.10", "0.80"),
+    g_table!(1.2, 0.8, "1.20", "0.80"),
+    g_table!(1.3, 0.8, "1.30", "0.80"),
+    g_table!(1.4, 0.8, "1.40", "0.80"),
+    g_table!(1.6, 0.8, "1.60", "0.80"),
+    g_table!(1.8, 0.8, "1.80", "0.80"),
+    g_table!(2.0, 0.8, "2.00", "0.80"),
+    g_table!(2.2, 0.8, "2.20", "0.80"),
+    g_table!(2.4, 0.8, "2.40", "0.80"),
+    g_table!(1.0, 0.9, "1.00", "0.90"),
+    g_table!(1.05, 0.9, "1.05", "0.90"),
+    g_table!(1.1, 0.9, "1.10", "0.90"),
+    g_table!(1.2, 0.9, "1.20", "0.90"),
+    g_table!(1.3, 0.9, "1.30", "0.90"),
+    g_table!(1.4, 0.9, "1.40", "0.90"),
+    g_table!(1.5, 0.9, "1.50", "0.90"),
+    g_table!(1.6, 0.9, "1.60", "0.90"),
+    g_table!(1.7, 0.9, "1.70", "0.90"),
+    g_table!(1.8, 0.9, "1.80", "0.90"),
+    g_table!(2.0, 0.9, "2.00", "0.90"),
+    g_table!(2.2, 0.9, "2.20", "0.90"),
+    g_table!(2.4, 0.9, "2.40", "0.90"),
+    g_table!(1.0, 0.95, "1.00", "0.95"),
+    g_table!(1.4, 0.95, "1.40", "0.95"),
+    g_table!(1.8, 0.95, "1.80", "0.95"),
+    g_table!(2.4, 0.95, "2.40", "0.95"),
 ];
 
 /// The largest g step the shipped grid interpolates across: 0.1 (between g = 0.8 and 0.9, and 0.9
