@@ -556,6 +556,16 @@ impl McTable {
     fn albedo_weights(&self, a: f64) -> Result<(usize, [f64; 4], [f64; 4])> {
         let al = &self.albedos;
         let (lo, hi) = (al[0], al[al.len() - 1]);
+        // An end reached through a round trip (α′ ↔ a at g: a table's first node mapped to α′
+        // and back lands an ulp or two outside) is that end.
+        let tol = 1e-12;
+        let a = if a < lo && a >= lo - tol {
+            lo
+        } else if a > hi && a <= hi + tol {
+            hi
+        } else {
+            a
+        };
         if !(a >= lo && a <= hi) {
             return Err(McError::OutOfTable {
                 name: "albedo (σs/σt)",

@@ -309,6 +309,25 @@ fn g_to_zero_and_refusals() {
     ));
 }
 
+/// The ends of a g's α′ range answer (a table's first node mapped to α′ and back lands an ulp
+/// outside it: the reduced-albedo layout's α′ 0.2 at g 0.8 was refused as a = 0.5555555555555557
+/// below 0.5555555555555558), and a step beyond them is refused.
+#[test]
+fn the_albedo_ranges_ends_answer() {
+    let grid = McGridSet::bundled().unwrap();
+    for g in grid.g_nodes() {
+        let (lo, hi) = grid.albedo_prime_range(g).unwrap();
+        for ap in [lo, hi] {
+            assert!(grid.rd_total(ap, 1.4, g).is_ok(), "g {g} α′ {ap}");
+        }
+        assert!(grid.rd_total(lo - 1e-6, 1.4, g).is_err(), "g {g}");
+        assert!(
+            grid.rd_total(hi + 0.5 * (1.0 - hi), 1.4, g).is_err(),
+            "g {g}"
+        );
+    }
+}
+
 /// Rd_total(α′) increases with α′ at every tabulated and interpolated g, over the whole α′ range
 /// and at η on and between the tables; the inversion round-trips.
 #[test]
