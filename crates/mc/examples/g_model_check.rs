@@ -54,10 +54,36 @@ fn main() {
 
 fn grid(max_step: Option<f64>) -> McGridSet {
     let g = McGridSet::bundled().expect("bundled grid");
-    match max_step {
-        Some(s) => McGridSet::new(g.nodes().to_vec(), s).expect("grid"),
-        None => g,
+    // `G_EXTRA_DIR=DIR`: tables in DIR (`build_g_tables --out DIR`) join the grid as nodes at g
+    // the shipped grid does not hold (a set per g; only their η answer) — to measure a node set
+    // before it ships.
+    let mut nodes = g.nodes().to_vec();
+    if let Ok(dir) = std::env::var("G_EXTRA_DIR") {
+        let mut extra: Vec<McTable> = std::fs::read_dir(&dir)
+            .expect("G_EXTRA_DIR")
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "json"))
+            .map(|p| McTable::load(&p).expect("table"))
+            .filter(|t| !g.g_nodes().iter().any(|&n| (n - t.spec().g).abs() < 1e-9))
+            .collect();
+        extra.sort_by(|a, b| {
+            (a.spec().g, a.spec().eta)
+                .partial_cmp(&(b.spec().g, b.spec().eta))
+                .expect("finite")
+        });
+        let mut gs: Vec<f64> = extra.iter().map(|t| t.spec().g).collect();
+        gs.dedup();
+        for gv in gs {
+            let set: Vec<McTable> = extra
+                .iter()
+                .filter(|t| t.spec().g == gv)
+                .cloned()
+                .collect();
+            eprintln!("extra node g = {gv}: {} tables", set.len());
+            nodes.push(McTableSet::new(set).expect("set"));
+        }
     }
+    McGridSet::new(nodes, max_step.unwrap_or(g.max_step())).expect("grid")
 }
 
 /// ∫ 2πr Rd(r) dr over [lo, hi] (Simpson in ln r, 400 steps).
