@@ -49,7 +49,7 @@ pub struct Args {
     /// The material's Henyey–Greenstein g, known or assumed, in (−1, 1): the model is evaluated at
     /// it (as the manifest's `[fit] g`). Alone, g is known and its error term is 0. Or `fit`
     /// (needs --model mc): g fitted per channel from the profile within --g-range (default: what
-    /// the `mc` tables cover at η, 0.8–0.95 today), printed with its standard error where the data
+    /// the `mc` tables cover at η, 0–0.95), printed with its standard error where the data
     /// determine it (sd(g) ≤ 0.05, the minimum inside the range); elsewhere "not determined" and
     /// the range's ± g term.
     #[arg(long, value_name = "G|fit", value_parser = parse_g)]

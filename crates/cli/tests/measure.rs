@@ -156,7 +156,7 @@ fn synth_then_measure() {
     assert!(out.stderr.contains("g range"), "{}", out.stderr);
     // A g the `mc` tables do not cover is refused before any fit, naming what they hold (it used
     // to fail every channel with "the fit did not converge").
-    let out = fit_g(&["--model", "mc", "--g", "0.5"]);
+    let out = fit_g(&["--model", "mc", "--g", "0.97"]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(
         out.stderr.contains("not covered") && out.stderr.contains("build_g_tables"),

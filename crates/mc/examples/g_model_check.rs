@@ -74,11 +74,7 @@ fn grid(max_step: Option<f64>) -> McGridSet {
         let mut gs: Vec<f64> = extra.iter().map(|t| t.spec().g).collect();
         gs.dedup();
         for gv in gs {
-            let set: Vec<McTable> = extra
-                .iter()
-                .filter(|t| t.spec().g == gv)
-                .cloned()
-                .collect();
+            let set: Vec<McTable> = extra.iter().filter(|t| t.spec().g == gv).cloned().collect();
             eprintln!("extra node g = {gv}: {} tables", set.len());
             nodes.push(McTableSet::new(set).expect("set"));
         }

@@ -57,14 +57,54 @@ macro_rules! g_table {
 }
 
 /// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
-/// compact JSON). g = 0.8 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4 and 1.6–2.4 (0.2 apart), g = 0.9 at
-/// η 1.0, 1.05, 1.1–1.7 (0.1 apart) and 1.8–2.4 (0.2 apart), g = 0.95 at η 1.0, 1.4, 1.8, 2.4 (a
-/// first coarse set, issue 15: Catmull-Rom over 0.4–0.6 in η costs 0.4–2 % in shape above η 1.4
-/// and 3 % between 1.0 and 1.4, BENCHMARKS.md "The `mc` model over g");
+/// compact JSON). g = 0.3, 0.5, 0.7 and 0.9 at η 1.0, 1.05, 1.1–1.8 (0.1 apart) and 2.0–2.4 (0.2
+/// apart), g = 0.8 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4 and 1.6–2.4 (0.2 apart), g = 0.95 at η 1.0,
+/// 1.4, 1.8, 2.4 (a coarse set, issue 15: Catmull-Rom over 0.4–0.6 in η costs 0.4–2 % in shape
+/// above η 1.4 and 3 % between 1.0 and 1.4, BENCHMARKS.md "The `mc` model over g");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
-/// (`examples/common/g_tables_layout.rs`). About 45 KB each, 1.25 MB in all (the g = 0 set: 0.75 MB).
+/// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)).
+/// About 45 KB each, 3.0 MB in all (the g = 0 set: 0.75 MB).
 #[rustfmt::skip]
-pub const BUNDLED_G: [(f64, f64, &str); 28] = [
+pub const BUNDLED_G: [(f64, f64, &str); 67] = [
+    g_table!(1.0, 0.3, "1.00", "0.30"),
+    g_table!(1.05, 0.3, "1.05", "0.30"),
+    g_table!(1.1, 0.3, "1.10", "0.30"),
+    g_table!(1.2, 0.3, "1.20", "0.30"),
+    g_table!(1.3, 0.3, "1.30", "0.30"),
+    g_table!(1.4, 0.3, "1.40", "0.30"),
+    g_table!(1.5, 0.3, "1.50", "0.30"),
+    g_table!(1.6, 0.3, "1.60", "0.30"),
+    g_table!(1.7, 0.3, "1.70", "0.30"),
+    g_table!(1.8, 0.3, "1.80", "0.30"),
+    g_table!(2.0, 0.3, "2.00", "0.30"),
+    g_table!(2.2, 0.3, "2.20", "0.30"),
+    g_table!(2.4, 0.3, "2.40", "0.30"),
+    g_table!(1.0, 0.5, "1.00", "0.50"),
+    g_table!(1.05, 0.5, "1.05", "0.50"),
+    g_table!(1.1, 0.5, "1.10", "0.50"),
+    g_table!(1.2, 0.5, "1.20", "0.50"),
+    g_table!(1.3, 0.5, "1.30", "0.50"),
+    g_table!(1.4, 0.5, "1.40", "0.50"),
+    g_table!(1.5, 0.5, "1.50", "0.50"),
+    g_table!(1.6, 0.5, "1.60", "0.50"),
+    g_table!(1.7, 0.5, "1.70", "0.50"),
+    g_table!(1.8, 0.5, "1.80", "0.50"),
+    g_table!(2.0, 0.5, "2.00", "0.50"),
+    g_table!(2.2, 0.5, "2.20", "0.50"),
+    g_table!(2.4, 0.5, "2.40", "0.50"),
+    g_table!(1.0, 0.7, "1.00", "0.70"),
+    g_table!(1.05, 0.7, "1.05", "0.70"),
+    g_table!(1.1, 0.7, "1.10", "0.70"),
+    g_table!(1.2, 0.7, "1.20", "0.70"),
+    g_table!(1.3, 0.7, "1.30", "0.70"),
+    g_table!(1.4, 0.7, "1.40", "0.70"),
+    g_table!(1.5, 0.7, "1.50", "0.70"),
+    g_table!(1.6, 0.7, "1.60", "0.70"),
+    g_table!(1.7, 0.7, "1.70", "0.70"),
+    g_table!(1.8, 0.7, "1.80", "0.70"),
+    g_table!(2.0, 0.7, "2.00", "0.70"),
+    g_table!(2.2, 0.7, "2.20", "0.70"),
+    g_table!(2.4, 0.7, "2.40", "0.70"),
     g_table!(1.0, 0.8, "1.00", "0.80"),
     g_table!(1.05, 0.8, "1.05", "0.80"),
     g_table!(1.1, 0.8, "1.10", "0.80"),
@@ -95,9 +135,11 @@ pub const BUNDLED_G: [(f64, f64, &str); 28] = [
     g_table!(2.4, 0.95, "2.40", "0.95"),
 ];
 
-/// The largest g step the shipped grid interpolates across: 0.1 (between g = 0.8 and 0.9, and 0.9
-/// and 0.95; measured, BENCHMARKS.md "The `mc` model over g"). The gap from g = 0 to 0.8 is refused.
-pub const BUNDLED_MAX_G_STEP: f64 = 0.1 + 1e-9;
+/// The largest g step the shipped grid interpolates across: 0.3 (between g = 0 and 0.3; 0.2 between
+/// 0.3, 0.5 and 0.7; 0.1 above). Measured against tables built between the nodes (g 0.15, 0.4, 0.6
+/// at η 1.4; BENCHMARKS.md "The `mc` model over g"): ≤ 0.6 % RMS over 0.3–10 reduced mean free
+/// paths at α′ ≥ 0.5 (1–3 % at α′ 0.3, where the profile is short), totals within 9·10⁻⁴.
+pub const BUNDLED_MAX_G_STEP: f64 = 0.3 + 1e-9;
 
 impl McGridSet {
     /// The shipped grid: the g = 0 set ([`McTableSet::bundled`]) and the anisotropic tables
@@ -162,12 +204,19 @@ mod tests {
     }
 
     /// Every embedded anisotropic table parses, sits at its (η, g) (the file name's), and the
-    /// grid has the nodes g = 0, 0.8, 0.9, 0.95 with the η ranges of the README.
+    /// grid has the nodes g = 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95 with the η ranges of the README.
     #[test]
     fn bundled_grid_parses() {
         let grid = McGridSet::bundled().unwrap();
-        assert_eq!(grid.g_nodes(), vec![0.0, 0.8, 0.9, 0.95]);
-        for (set, n, top) in [(1, 11, 2.4), (2, 13, 2.4), (3, 4, 2.4)] {
+        assert_eq!(grid.g_nodes(), vec![0.0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
+        for (set, n, top) in [
+            (1, 13, 2.4),
+            (2, 13, 2.4),
+            (3, 13, 2.4),
+            (4, 11, 2.4),
+            (5, 13, 2.4),
+            (6, 4, 2.4),
+        ] {
             let set = &grid.nodes()[set];
             assert_eq!(set.tables().len(), n);
             assert_eq!(set.eta_range(), (1.0, top));

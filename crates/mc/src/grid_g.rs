@@ -12,13 +12,16 @@
 //! **Interpolation in g.** Linear in g on ln Rd(r) (the profile) and on Rd (the total), between the
 //! two bracketing nodes, and only where they are at most [`McGridSet::max_step`] apart; a g within
 //! [`G_NODE_TOLERANCE`] of a node is that node's set, unchanged (so g = 0 gives exactly the g = 0
-//! tables' numbers). Measured (BENCHMARKS.md, "The `mc` model over g"; `examples/g_model_check.rs`):
-//! at g = 0.85 (η 1.4) the interpolant is within 0.2–0.4 % of a 10⁵-photon table built there over
-//! 1–10 mean free paths at α′ ≥ 0.9 (that table's own noise), totals within 7·10⁻⁴, and adding-
-//! doubling's totals are linear in g between 0.8 and 0.9 to 1.4·10⁻⁵. Across the gap from g = 0 to
-//! 0.8 the same interpolation is 1–6 % off MCML at g = 0.5 over 0.5–10 mean free paths (totals
-//! +0.8 … +2.6·10⁻³), ten times the tables' noise, so the shipped grid refuses g in (0, 0.8) and
-//! above 0.9 with [`McError::AnisotropyNotTabulated`] rather than interpolate or extrapolate.
+//! tables' numbers). The shipped nodes are 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95 (`max_step` 0.3), so
+//! every g in 0–0.95 is answered and nothing beyond is extrapolated. Measured (BENCHMARKS.md, "The
+//! `mc` model over g" and "The g tables rebuilt, and the whole g range"; `examples/g_model_check.rs`):
+//! at g = 0.85 (η 1.4) the interpolant is within 0.2–0.4 % of a table built there over 1–10 mean
+//! free paths at α′ ≥ 0.9; halfway between the low nodes (g 0.15, 0.4, 0.6, η 1.4) within 0.6 % RMS
+//! over 0.3–10 mean free paths at α′ ≥ 0.5 of 10⁶-photon tables built there (1–5 % at α′ 0.3 in
+//! the short profile's far windows); totals within 7.1·10⁻⁴ (g 0.15) and 1.6·10⁻⁴ (0.4, 0.6) of
+//! adding-doubling's. Before the low nodes, interpolating across 0–0.8 was 1–6 % off MCML at
+//! g = 0.5, so a grid with such a gap (wider than `max_step`) refuses the g inside it with
+//! [`McError::AnisotropyNotTabulated`].
 //!
 //! Derivatives: Rd = Rd_lo^(1−t) Rd_hi^t, so ∂Rd/∂θ = Rd [(1 − t) ∂Rd_lo/∂θ / Rd_lo + t ∂Rd_hi/∂θ /
 //! Rd_hi] for θ = σ′s, σa (t depends on g only) — the derivatives of the interpolant, exactly.
@@ -92,6 +95,18 @@ impl McGridSet {
     /// The sets, by increasing g.
     pub fn nodes(&self) -> &[McTableSet] {
         &self.nodes
+    }
+
+    /// The grid of the nodes whose g `keep` accepts, with the same `max_step` (a grid with fewer
+    /// nodes: to measure what a node adds, or to hold code to a grid with a gap).
+    ///
+    /// # Errors
+    /// `InvalidParameter` when no node is kept.
+    pub fn with_nodes(&self, keep: impl Fn(f64) -> bool) -> Result<Self> {
+        Self::new(
+            self.nodes.iter().filter(|s| keep(s.g())).cloned().collect(),
+            self.max_step,
+        )
     }
 
     /// The g of the nodes.
@@ -400,7 +415,8 @@ mod tests {
             .unwrap()
             .with_g(0.8)
             .unwrap();
-        let node = McProfile::new(&grid.nodes()[1], &p).unwrap();
+        let k = grid.g_nodes().iter().position(|&g| g == 0.8).unwrap();
+        let node = McProfile::new(&grid.nodes()[k], &p).unwrap();
         assert_eq!(grid.profile(&p).unwrap(), McGridProfile::Node(node));
     }
 
@@ -409,21 +425,34 @@ mod tests {
     #[test]
     fn places_on_the_grid() {
         let grid = McGridSet::bundled().unwrap();
-        assert_eq!(grid.place(0.8 + 1e-12).unwrap(), Place::Node(1));
+        assert_eq!(grid.g_nodes(), [0.0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
+        assert_eq!(grid.place(0.8 + 1e-12).unwrap(), Place::Node(4));
         match grid.place(0.825).unwrap() {
-            Place::Between(1, t) => assert!((t - 0.25).abs() < 1e-12),
+            Place::Between(4, t) => assert!((t - 0.25).abs() < 1e-12),
             p => panic!("{p:?}"),
         }
-        for g in [0.3, 0.96, f64::NAN] {
+        match grid.place(0.15).unwrap() {
+            Place::Between(0, t) => assert!((t - 0.5).abs() < 1e-12),
+            p => panic!("{p:?}"),
+        }
+        for g in [-0.1, 0.96, f64::NAN] {
             assert!(matches!(
                 grid.place(g),
                 Err(McError::AnisotropyNotTabulated { .. })
             ));
         }
-        assert_eq!(grid.covered(), [(0.0, 0.0), (0.8, 0.95)]);
-        assert!(grid.covers(0.0) && grid.covers(0.85) && grid.covers(0.93) && !grid.covers(0.5));
+        assert_eq!(grid.covered(), [(0.0, 0.95)]);
+        assert!(grid.covers(0.0) && grid.covers(0.5) && grid.covers(0.93) && !grid.covers(0.97));
         assert_eq!(
             grid.coverage(),
+            "g 0–0.95 (tables at 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95, linear in g between; η 1–2.4)"
+        );
+        // A grid with a gap names each run.
+        let gapped = grid.with_nodes(|g| g == 0.0 || g >= 0.8).unwrap();
+        assert_eq!(gapped.covered(), [(0.0, 0.0), (0.8, 0.95)]);
+        assert!(!gapped.covers(0.5));
+        assert_eq!(
+            gapped.coverage(),
             "g = 0 (η 1–2.5); g 0.8–0.95 (tables at 0.8, 0.9, 0.95, linear in g between; η 1–2.4)"
         );
     }

@@ -453,28 +453,36 @@ pub(crate) fn warm_start<E: std::fmt::Display>(
 mod tests {
     use super::*;
 
-    /// The plan on the shipped grid (g = 0 and 0.8–0.95): the default range is evaluated at 0,
-    /// 0.8, 0.9 and 0.95 and names the gap; a range inside 0.8–0.9 at its ends and the values' g;
-    /// a range between the tables is refused; a range without a g has its nominal g at the covered
-    /// point nearest its middle.
+    /// The plan on the shipped grid (g 0–0.95, nodes 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95): the
+    /// default range is evaluated at every node and nothing is left out; a range between nodes at
+    /// its ends and the values' g; a range without a g has its nominal g at its middle. On a grid
+    /// with a gap (the shipped one without its low nodes, as it was until 2026-11-27) the gap is
+    /// named, a range inside it refused, and the nominal g is the covered point nearest the middle.
     #[test]
     fn plans_on_the_shipped_grid() {
         let grid = scatterfit_mc::bundled_grid().unwrap();
         let p = GPlan::on_grid(grid, DEFAULT_G_RANGE, Some(0.0)).unwrap();
-        assert_eq!(p.points, [0.0, 0.8, 0.9, 0.95]);
-        assert_eq!(p.not_covered.as_deref(), Some("0–0.8 (exclusive)"));
+        assert_eq!(p.points, [0.0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
+        assert_eq!(p.not_covered, None);
         let p = GPlan::on_grid(grid, [0.82, 0.88], Some(0.85)).unwrap();
         assert_eq!(p.points, [0.82, 0.85, 0.88]);
         assert_eq!(p.not_covered, None);
-        let p = GPlan::on_grid(grid, [0.7, 0.95], None).unwrap();
+        let p = GPlan::on_grid(grid, [0.4, 0.6], None).unwrap();
+        assert_eq!(p.points, [0.4, 0.5, 0.6]);
+        assert_eq!(GPlan::nominal_g(grid, [0.7, 0.95]), Some(0.825));
+        assert_eq!(GPlan::nominal_g(grid, DEFAULT_G_RANGE), Some(0.475));
+        let gapped = grid.with_nodes(|g| g == 0.0 || g >= 0.8).unwrap();
+        let p = GPlan::on_grid(&gapped, DEFAULT_G_RANGE, Some(0.0)).unwrap();
+        assert_eq!(p.points, [0.0, 0.8, 0.9, 0.95]);
+        assert_eq!(p.not_covered.as_deref(), Some("0–0.8 (exclusive)"));
+        let p = GPlan::on_grid(&gapped, [0.7, 0.95], None).unwrap();
         assert_eq!(p.points, [0.8, 0.9, 0.95]);
         assert_eq!(p.not_covered.as_deref(), Some("0.7–0.8 (exclusive of 0.8)"));
-        assert!(GPlan::on_grid(grid, [0.3, 0.6], None).is_err());
-        assert_eq!(GPlan::nominal_g(grid, [0.7, 0.95]), Some(0.825));
-        assert_eq!(GPlan::nominal_g(grid, DEFAULT_G_RANGE), Some(0.8));
-        assert_eq!(GPlan::nominal_g(grid, [0.3, 0.6]), None);
+        assert!(GPlan::on_grid(&gapped, [0.3, 0.6], None).is_err());
+        assert_eq!(GPlan::nominal_g(&gapped, DEFAULT_G_RANGE), Some(0.8));
+        assert_eq!(GPlan::nominal_g(&gapped, [0.3, 0.6]), None);
         // A range that ends beyond the grid names the rest.
-        let two = McGridSet::new(grid.nodes()[..3].to_vec(), grid.max_step()).unwrap();
+        let two = gapped.with_nodes(|g| g <= 0.9).unwrap();
         let p = GPlan::on_grid(&two, DEFAULT_G_RANGE, Some(0.0)).unwrap();
         assert_eq!(p.points, [0.0, 0.8, 0.9]);
         assert_eq!(

@@ -73,8 +73,18 @@ pub const ALBEDO_DETERMINED_MAX: f64 = 0.98;
 /// "The `mc` model over g").
 pub const MODEL_SHAPE_NOISE: f64 = 0.003;
 
-/// The scan's step in g (the nodes of the tables and the range's ends are added).
+/// The scan's step in g from [`SCAN_FINE_FROM`] up (the nodes of the tables and the range's ends
+/// are added).
 pub const SCAN_STEP: f64 = 0.01;
+
+/// The scan's step in g below [`SCAN_FINE_FROM`]: the profile's shape changes with g more slowly
+/// there (at g 0.5 the reduced profile is within 1–6 % of g = 0's over 0.5–10 mean free paths,
+/// at 0.9 within 8–60 %; BENCHMARKS.md "The `mc` model over g"), the minimum is refined by a
+/// parabola through its neighbours, and a sample's scan stays a few hundred fits.
+pub const SCAN_STEP_COARSE: f64 = 0.05;
+
+/// Where the scan's fine step starts.
+pub const SCAN_FINE_FROM: f64 = 0.7;
 
 /// The Δg whose shape change is the signal (the Fisher study's).
 const SHAPE_DG: f64 = 0.05;
@@ -134,7 +144,7 @@ impl GFit {
 }
 
 /// The default search range for `g = "fit"` without a `g_range`: the widest interval of g the
-/// grid covers (today 0.8–0.95); `None` when it covers single nodes only.
+/// grid covers (0–0.95 since the g 0.3/0.5/0.7 tables); `None` when it covers single nodes only.
 pub fn default_search_range(grid: &McGridSet) -> Option<[f64; 2]> {
     grid.covered()
         .into_iter()
@@ -143,13 +153,22 @@ pub fn default_search_range(grid: &McGridSet) -> Option<[f64; 2]> {
         .map(|(a, b)| [a, b])
 }
 
-/// The scan's points in `range`: steps of [`SCAN_STEP`], the grid's nodes inside and the ends,
-/// each where the grid covers it (η is checked when the model is evaluated).
+/// The scan's points in `range`: steps of [`SCAN_STEP_COARSE`] below [`SCAN_FINE_FROM`] and of
+/// [`SCAN_STEP`] from it, the grid's nodes inside and the ends, each where the grid covers it (η is
+/// checked when the model is evaluated).
 pub fn scan_points(grid: &McGridSet, range: [f64; 2]) -> Vec<f64> {
     let [lo, hi] = range;
-    let steps = ((hi - lo) / SCAN_STEP).floor() as usize;
-    let mut points: Vec<f64> = (0..=steps)
-        .map(|k| lo + k as f64 * SCAN_STEP)
+    let steps = |a: f64, b: f64, step: f64| -> Vec<f64> {
+        if b < a {
+            return Vec::new();
+        }
+        let n = ((b - a) / step + 1e-9).floor() as usize;
+        (0..=n).map(|k| a + k as f64 * step).collect()
+    };
+    let fine_from = SCAN_FINE_FROM.clamp(lo, hi);
+    let mut points: Vec<f64> = steps(lo, fine_from, SCAN_STEP_COARSE)
+        .into_iter()
+        .chain(steps(fine_from, hi, SCAN_STEP))
         .chain(grid.g_nodes().into_iter().filter(|&g| g >= lo && g <= hi))
         .chain([lo, hi])
         .map(|g| (g * 1e9).round() / 1e9)
@@ -513,23 +532,32 @@ mod tests {
     }
 
     /// The default range and the scan on the shipped grid: the widest covered interval, steps of
-    /// 0.01 with the nodes and ends, nothing the grid does not cover.
+    /// 0.05 below 0.7 and 0.01 from it with the nodes and ends, nothing the grid does not cover.
     #[test]
     fn range_and_scan_on_the_shipped_grid() {
         let grid = scatterfit_mc::bundled_grid().unwrap();
         let [lo, hi] = default_search_range(grid).unwrap();
         assert!(lo >= 0.0 && hi > lo && grid.covers(lo) && grid.covers(hi));
-        let points = scan_points(grid, [0.7, 0.93]);
-        assert!(
-            points
-                .iter()
-                .all(|&g| grid.covers(g) && (0.7..=0.93).contains(&g))
-        );
-        assert!(
-            points
-                .windows(2)
-                .all(|w| w[1] - w[0] <= SCAN_STEP + 1e-9 || !grid.covers(0.5 * (w[0] + w[1])))
-        );
-        assert!(points.contains(&0.93));
+        for range in [[0.7, 0.93], [0.12, 0.93], [0.0, 0.95], [0.2, 0.6]] {
+            let points = scan_points(grid, range);
+            assert!(
+                points
+                    .iter()
+                    .all(|&g| grid.covers(g) && (range[0]..=range[1]).contains(&g)),
+                "{range:?}: {points:?}"
+            );
+            assert!(
+                points.windows(2).all(|w| {
+                    let step = if w[0] >= SCAN_FINE_FROM - 1e-9 {
+                        SCAN_STEP
+                    } else {
+                        SCAN_STEP_COARSE
+                    };
+                    w[1] - w[0] <= step + 1e-9 || !grid.covers(0.5 * (w[0] + w[1]))
+                }),
+                "{range:?}: {points:?}"
+            );
+            assert!(points.contains(&range[0]) && points.contains(&range[1]));
+        }
     }
 }

@@ -722,17 +722,10 @@ mod tests {
     /// the shipped one without them: g = 0 and 0.8–0.95.
     #[test]
     fn a_range_the_tables_miss_names_what_they_cover() {
-        let shipped = scatterfit_mc::bundled_grid().unwrap();
-        let grid = scatterfit_mc::McGridSet::new(
-            shipped
-                .nodes()
-                .iter()
-                .filter(|s| s.g() == 0.0 || s.g() >= 0.8)
-                .cloned()
-                .collect(),
-            shipped.max_step(),
-        )
-        .unwrap();
+        let grid = scatterfit_mc::bundled_grid()
+            .unwrap()
+            .with_nodes(|g| g == 0.0 || g >= 0.8)
+            .unwrap();
         let prior = GPrior {
             g: None,
             range: Some([0.3, 0.6]),

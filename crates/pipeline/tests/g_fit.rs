@@ -4,7 +4,7 @@
 //! Quick-rig twins simulated by the Monte Carlo engine at Henyey–Greenstein g = 0.9 — profile and
 //! spectrophotometer reading, an independent truth the `mc` tables never saw — measured with the
 //! `mc` model and `g = "fit"` over the default range (what the tables cover at the twin's η:
-//! 0.8–0.95):
+//! 0–0.95):
 //! - the profile likelihood finds the truth: skin1 (seed 8; η 1.3) G at α′ 0.838 and sulfur
 //!   (seed 10; η 1.116) B at α′ 0.957 have their χ²(g) minimum within k = 2 statistical standard
 //!   errors (the fit's and the spectrophotometer's parts of sd(g)) of the truth 0.9 (on these seeds

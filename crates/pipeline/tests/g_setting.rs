@@ -30,18 +30,25 @@ fn manifest_g_reaches_the_settings_and_is_checked_against_the_tables() {
             .g,
         0.5
     );
-    // g = 0.5 with the mc model (or the mc albedo inversion) is outside the tables.
-    let mut with_mc_albedo = manifest(ModelName::Dipole, Some(0.5));
+    // g = 0.97 with the mc model (or the mc albedo inversion) is beyond the tables (they end at
+    // 0.95); 0.5 is a node since 2026-11-27.
+    let mut with_mc_albedo = manifest(ModelName::Dipole, Some(0.97));
     with_mc_albedo.fit.albedo_model = Some(AlbedoModel::Mc);
-    for m in [manifest(ModelName::Mc, Some(0.5)), with_mc_albedo] {
+    for m in [manifest(ModelName::Mc, Some(0.97)), with_mc_albedo] {
         let e = fit_settings(&m, &o).unwrap_err();
         assert!(matches!(e, PipelineError::Input(_)), "{e}");
         let text = e.to_string();
         assert!(
-            text.contains("fit.g") && text.contains("0.8") && text.contains("build_g_tables"),
+            text.contains("fit.g") && text.contains("0.95") && text.contains("build_g_tables"),
             "{text}"
         );
     }
+    assert_eq!(
+        fit_settings(&manifest(ModelName::Mc, Some(0.5)), &o)
+            .unwrap()
+            .g,
+        0.5
+    );
 }
 
 /// What the settings' g does to the models: the `mc` family at g = 0.85 (through `AtG`, as the

@@ -326,8 +326,8 @@ pub struct FitSection {
     /// The material's Henyey–Greenstein asymmetry g, known or assumed (issue 15): the forward model
     /// and the α′ inversion are evaluated at it (σs = σ′s/(1 − g)). Default 0 — isotropic
     /// scattering, what the paper and every model before issue 15 assume; the diffusion dipoles do
-    /// not depend on g, photon beam diffusion and the `mc` tables do (the tables hold g = 0 and
-    /// 0.8–0.95; another g with `mc` is refused with the tables' coverage). Real translucent
+    /// not depend on g, photon beam diffusion and the `mc` tables do (the tables cover g 0–0.95;
+    /// another g with `mc` is refused with the tables' coverage). Real translucent
     /// materials have g ≈ 0.7–0.95: assuming 0 for them biases σa high (BENCHMARKS.md, "The `mc`
     /// model over g").
     ///
