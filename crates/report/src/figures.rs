@@ -134,14 +134,33 @@ pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
         .to_vec();
     Figure {
         title: format!(
-            "{} — radial profile and {} fit ({} method, η = {:.4})",
-            result.name, result.model, result.method, result.eta
+            "{} — radial profile and {} fit ({} method, η = {:.4}{})",
+            result.name,
+            result.model,
+            result.method,
+            result.eta,
+            g_in_title(result.g_uncertainty.as_ref())
         ),
         x_label: "r [mm]".into(),
         y_label: "Rd(r) [relative]".into(),
         panels,
         log_y: true,
         log_x: false,
+    }
+}
+
+/// The anisotropy the fit assumed, for a figure's title: ", g = 0.85" where the values are at a
+/// g ≠ 0, ", g fitted" or ", g in 0.7–0.95" (values the middle of a range); nothing at g = 0.
+fn g_in_title(u: Option<&scatterfit_io::result_json::GUncertainty>) -> String {
+    use scatterfit_io::result_json::GSource;
+    match u {
+        Some(u) if u.source == GSource::Fit => ", g fitted".into(),
+        Some(u) => match (u.g, u.range) {
+            (Some(g), _) if g != 0.0 => format!(", g = {g}"),
+            (None, Some([lo, hi])) => format!(", g in {lo}–{hi}"),
+            _ => String::new(),
+        },
+        None => String::new(),
     }
 }
 
@@ -189,5 +208,53 @@ pub fn compare_figure(existing: &Measurement, proposed: &Measurement, name: &str
         panels,
         log_y: true,
         log_x: false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use scatterfit_io::result_json::{GSource, GUncertainty};
+
+    fn record(source: GSource, g: Option<f64>, range: Option<[f64; 2]>) -> GUncertainty {
+        GUncertainty {
+            source,
+            g,
+            range,
+            evaluated: Vec::new(),
+            not_covered: None,
+            fitted: None,
+        }
+    }
+
+    /// The fit figure's title says which g the values are at: a given g ≠ 0, a range's middle, a
+    /// fit; nothing for g = 0 (given, or the default range's values).
+    #[test]
+    fn the_title_names_the_g_assumed() {
+        assert_eq!(g_in_title(None), "");
+        assert_eq!(
+            g_in_title(Some(&record(GSource::Given, Some(0.7), None))),
+            ", g = 0.7"
+        );
+        assert_eq!(
+            g_in_title(Some(&record(GSource::Given, Some(0.0), None))),
+            ""
+        );
+        assert_eq!(
+            g_in_title(Some(&record(
+                GSource::DefaultRange,
+                Some(0.0),
+                Some([0.0, 0.95])
+            ))),
+            ""
+        );
+        assert_eq!(
+            g_in_title(Some(&record(GSource::Range, None, Some([0.7, 0.95])))),
+            ", g in 0.7–0.95"
+        );
+        assert_eq!(
+            g_in_title(Some(&record(GSource::Fit, None, Some([0.0, 0.95])))),
+            ", g fitted"
+        );
     }
 }
