@@ -65,6 +65,11 @@ pub enum ReasonKind {
     /// The camera response was recovered from exposures too far apart to pin it: a ripple of the
     /// bracket's period in log exposure is invisible to such a bracket (the fractal ambiguity).
     ResponseSteps,
+    /// g is not known, but the anisotropy's uncertainty term could be evaluated over only part
+    /// of its range, or not at all (the `mc` tables at some g do not cover the material's η): the
+    /// error bars leave out what g can do to the values (5–25 % in σa for forward-scattering
+    /// materials; issue 15).
+    GTermIncomplete,
     /// A value outside its documented range.
     OutOfRange,
     /// The fit gave no parameters or did not converge.

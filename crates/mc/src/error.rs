@@ -39,6 +39,27 @@ pub enum McError {
         /// What the grid covers, in words.
         tabulated: String,
     },
+    /// η lies outside the tables of a g node the query needs (the nodes at g ≠ 0 span a
+    /// narrower η range than g = 0's).
+    #[error(
+        "η = {eta:.4} at g = {g}: the Monte Carlo tables at g = {node} cover η {min}–{max} only \
+         (the whole grid: {tabulated}); at this η give a g the tables cover, or use a diffusion \
+         model (`--model dipole`), which does not depend on g"
+    )]
+    EtaNotTabulatedAtG {
+        /// The η asked for.
+        eta: f64,
+        /// The g asked for.
+        g: f64,
+        /// The g node whose tables do not reach η.
+        node: f64,
+        /// That node's lowest η.
+        min: f64,
+        /// That node's highest η.
+        max: f64,
+        /// What the grid covers, in words.
+        tabulated: String,
+    },
     /// A query falls outside what a profile table covers.
     #[error("{name} = {value} is outside the table's range [{min}, {max}]")]
     OutOfTable {

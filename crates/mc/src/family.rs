@@ -21,12 +21,27 @@ use crate::grid_g::McGridSet;
 use crate::model::{McProfile, McTableSet};
 
 /// An [`McError`] from a table lookup as the optics vocabulary's error (a lookup only fails with
-/// `OutOfTable`, `AnisotropyNotTabulated` or `InvalidParameter`).
+/// `OutOfTable`, `AnisotropyNotTabulated`, `EtaNotTabulatedAtG` or `InvalidParameter`).
 fn lookup_error(e: McError) -> OpticsError {
     match e {
         McError::AnisotropyNotTabulated { given, tabulated } => {
             OpticsError::AnisotropyNotTabulated { given, tabulated }
         }
+        McError::EtaNotTabulatedAtG {
+            eta,
+            g,
+            node,
+            min,
+            max,
+            tabulated,
+        } => OpticsError::EtaNotTabulatedAtG {
+            eta,
+            g,
+            node,
+            min,
+            max,
+            tabulated,
+        },
         McError::OutOfTable {
             name,
             value,

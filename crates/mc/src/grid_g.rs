@@ -214,12 +214,48 @@ impl McGridSet {
         })
     }
 
+    /// The η range the grid answers at g: the intersection of the bracketing nodes' ranges.
+    ///
+    /// # Errors
+    /// `AnisotropyNotTabulated` for a g the grid does not cover.
+    pub fn eta_range_at(&self, g: f64) -> Result<(f64, f64)> {
+        Ok(self
+            .weights(g)?
+            .iter()
+            .map(|(set, _)| set.eta_range())
+            .fold((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi), (a, b)| {
+                (lo.max(a), hi.min(b))
+            }))
+    }
+
+    /// Checks that every node g needs has tables at η (with the sets' edge tolerance,
+    /// [`crate::model::ETA_EDGE_TOLERANCE`]), so that a query beyond a g node's η range is refused
+    /// naming the node and its range rather than as a bare table bound.
+    fn check_eta(&self, eta: f64, g: f64) -> Result<()> {
+        for (set, _) in self.weights(g)? {
+            let (min, max) = set.eta_range();
+            let tol = crate::model::ETA_EDGE_TOLERANCE;
+            if eta.is_finite() && !(eta >= min - tol && eta <= max + tol) {
+                return Err(McError::EtaNotTabulatedAtG {
+                    eta,
+                    g,
+                    node: set.g(),
+                    min,
+                    max,
+                    tabulated: self.coverage(),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The model for `props` at its own g ([`OpticalProperties::g`]).
     ///
     /// # Errors
-    /// `AnisotropyNotTabulated` for a g the grid does not cover; `OutOfTable` for η or α′ outside a
-    /// node's tables.
+    /// `AnisotropyNotTabulated` for a g the grid does not cover; `EtaNotTabulatedAtG` for η
+    /// outside the tables of a node g needs; `OutOfTable` for α′ outside a node's tables.
     pub fn profile(&self, props: &OpticalProperties) -> Result<McGridProfile> {
+        self.check_eta(props.eta(), props.g())?;
         Ok(match self.place(props.g())? {
             Place::Node(k) => McGridProfile::Node(McProfile::new(&self.nodes[k], props)?),
             Place::Between(k, t) => {
@@ -243,6 +279,7 @@ impl McGridSet {
     /// # Errors
     /// As [`McGridSet::profile`].
     pub fn rd_total(&self, albedo_prime: f64, eta: f64, g: f64) -> Result<f64> {
+        self.check_eta(eta, g)?;
         let mut sum = 0.0;
         for (set, w) in self.weights(g)? {
             sum += w * set.rd_total(albedo_from_reduced(albedo_prime, set.g()), eta)?;
@@ -273,6 +310,7 @@ impl McGridSet {
     /// `OutOfTable` (`rd_total`) for an Rd outside the totals at the ends of the α′ range, else as
     /// [`McGridSet::rd_total`].
     pub fn albedo_from_rd(&self, rd: f64, eta: f64, g: f64) -> Result<f64> {
+        self.check_eta(eta, g)?;
         if let Place::Node(k) = self.place(g)? {
             let set = &self.nodes[k];
             let a = set.albedo_from_rd_total(rd, eta)?;
@@ -418,6 +456,60 @@ mod tests {
         let k = grid.g_nodes().iter().position(|&g| g == 0.8).unwrap();
         let node = McProfile::new(&grid.nodes()[k], &p).unwrap();
         assert_eq!(grid.profile(&p).unwrap(), McGridProfile::Node(node));
+    }
+
+    /// A node whose tables stop short of η is refused by name: on a grid of the shipped g = 0 set
+    /// and the g = 0.8 set cut at η 2.0, η 2.2 answers at g = 0, and at g 0.5 and 0.8 (both need
+    /// the 0.8 node) the profile, the total and the α′ inversion each refuse with
+    /// `EtaNotTabulatedAtG`, naming the node, its η range and what to do; `eta_range_at` says the
+    /// same range, and η within the sets' edge tolerance of 2.0 still answers.
+    #[test]
+    fn a_node_that_stops_short_of_eta_is_named() {
+        let grid = McGridSet::bundled().unwrap();
+        let node = |g: f64| {
+            let k = grid.g_nodes().iter().position(|&n| n == g).unwrap();
+            grid.nodes()[k].clone()
+        };
+        let cut = McTableSet::new(
+            node(0.8)
+                .tables()
+                .iter()
+                .filter(|t| t.spec().eta <= 2.0 + 1e-9)
+                .cloned()
+                .collect(),
+        )
+        .unwrap();
+        let grid = McGridSet::new(vec![node(0.0), cut], 0.8).unwrap();
+        let props = |eta: f64, g: f64| {
+            OpticalProperties::new(1.0, 0.01, eta)
+                .unwrap()
+                .with_g(g)
+                .unwrap()
+        };
+        assert!(grid.profile(&props(2.2, 0.0)).is_ok());
+        assert!(grid.rd_total(0.99, 2.2, 0.0).is_ok());
+        assert_eq!(grid.eta_range_at(0.5).unwrap(), (1.0, 2.0));
+        assert!(grid.profile(&props(2.0 + 0.004, 0.8)).is_ok());
+        for g in [0.5, 0.8] {
+            let errors = [
+                grid.profile(&props(2.2, g)).err().unwrap(),
+                grid.rd_total(0.99, 2.2, g).unwrap_err(),
+                grid.albedo_from_rd(0.3, 2.2, g).unwrap_err(),
+            ];
+            for e in errors {
+                assert!(
+                    matches!(
+                        e,
+                        McError::EtaNotTabulatedAtG { node, max, .. } if node == 0.8 && max == 2.0
+                    ),
+                    "{e}"
+                );
+                let text = e.to_string();
+                for want in ["η = 2.2000", "g = 0.8 cover η 1–2", "--model dipole"] {
+                    assert!(text.contains(want), "{text} lacks {want}");
+                }
+            }
+        }
     }
 
     /// The weights: a node within the tolerance is that node; between nodes at most `max_step`

@@ -99,6 +99,27 @@ pub enum OpticsError {
         /// What the grid covers, in words.
         tabulated: String,
     },
+    /// η outside the Monte Carlo tables of a g node the query needs (`scatterfit_mc::McGridSet`:
+    /// the nodes at g ≠ 0 span a narrower η range than g = 0's).
+    #[error(
+        "η = {eta:.4} at g = {g}: the Monte Carlo tables at g = {node} cover η {min}–{max} only \
+         (the whole grid: {tabulated}); at this η give a g the tables cover, or use a diffusion \
+         model (`--model dipole`), which does not depend on g"
+    )]
+    EtaNotTabulatedAtG {
+        /// The η asked for.
+        eta: f64,
+        /// The g asked for.
+        g: f64,
+        /// The g node whose tables do not reach η.
+        node: f64,
+        /// That node's lowest η.
+        min: f64,
+        /// That node's highest η.
+        max: f64,
+        /// What the grid covers, in words.
+        tabulated: String,
+    },
     /// A spectrum that does not cover the range a colour computation needs.
     #[error("spectrum: {0}")]
     Spectrum(String),

@@ -360,7 +360,17 @@ pub fn propagate_g(
             let mut evaluated = Vec::new();
             let mut estimates = Vec::new();
             let mut failed = Vec::new();
+            // Points whose tables do not reach the material's η, grouped by the tables' η range
+            // (one clause for all of them, not one long message per g).
+            let mut eta_gaps: Vec<((f64, f64), Vec<f64>)> = Vec::new();
             for &g in &plan.points {
+                if let Some(range) = eta_not_covered(g, input.eta) {
+                    match eta_gaps.iter_mut().find(|(r, _)| *r == range) {
+                        Some((_, gs)) => gs.push(g),
+                        None => eta_gaps.push((range, vec![g])),
+                    }
+                    continue;
+                }
                 match estimate_at(g, data, &input, albedo_at_g, &opts, proposed) {
                     Ok(e) => {
                         evaluated.push(g);
@@ -369,6 +379,16 @@ pub fn propagate_g(
                     Err(e) => failed.push(format!("g = {g}: {e}")),
                 }
             }
+            for ((lo, hi), gs) in eta_gaps.into_iter().rev() {
+                failed.insert(
+                    0,
+                    format!(
+                        "g = {}: the `mc` tables there cover η {lo}–{hi}, not η = {:.4}",
+                        list(&gs),
+                        input.eta
+                    ),
+                );
+            }
             let note = (!failed.is_empty()).then(|| {
                 format!(
                     "the g term is evaluated at g = {} only ({})",
@@ -376,6 +396,14 @@ pub fn propagate_g(
                     failed.join("; ")
                 )
             });
+            // One point has no spread: a term of 0 there would read as "g does not matter".
+            if estimates.len() == 1 && plan.points.len() > 1 {
+                return Some(Err(format!(
+                    "the g term could not be evaluated: only at g = {} ({})",
+                    list(&evaluated),
+                    failed.join("; ")
+                )));
+            }
             if estimates.is_empty() {
                 return Some(Err(format!(
                     "the g term could not be evaluated: {}",
@@ -423,6 +451,15 @@ pub fn propagate_g(
                 note,
             }))
         })
+}
+
+/// The η range of the bundled grid's tables at g when they do not reach `eta` (within the sets'
+/// edge tolerance); `None` when they do, or when g itself is not covered (its estimate then fails
+/// with its own message).
+fn eta_not_covered(g: f64, eta: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = scatterfit_mc::bundled_grid().ok()?.eta_range_at(g).ok()?;
+    let tol = scatterfit_mc::model::ETA_EDGE_TOLERANCE;
+    (!(eta >= lo - tol && eta <= hi + tol)).then_some((lo, hi))
 }
 
 fn list(v: &[f64]) -> String {

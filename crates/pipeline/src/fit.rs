@@ -95,6 +95,11 @@ pub struct ChannelFit {
     /// What the user should know about the g term (g where it could not be evaluated, or why
     /// there is none).
     pub g_note: Option<String>,
+    /// Why the g term of an unknown g covers only part of its range, or none of it (the `mc`
+    /// tables do not answer at some g for this material): the channel is then suspect
+    /// ([`crate::checks::fit_reasons`], `g_term_incomplete`). `None` when g is known or the term
+    /// is whole.
+    pub g_term_gap: Option<String>,
     /// With `g = "fit"`: the fit of g ([`crate::anisotropy_fit`]), determined or not.
     pub g_fit: Option<crate::anisotropy_fit::GFit>,
 }
@@ -120,6 +125,7 @@ impl ChannelFit {
                 g: None,
             },
             g_note: None,
+            g_term_gap: None,
             g_fit: None,
             report,
         }
@@ -197,8 +203,12 @@ impl ChannelOutcome {
                 f.sigma_a.g = Some(0.0);
                 f.albedo_prime.g = Some(0.0);
             }
-            Some(Err(why)) => f.g_note = Some(why),
+            Some(Err(why)) => {
+                f.g_term_gap = Some(why.clone());
+                f.g_note = Some(why);
+            }
             Some(Ok(t)) => {
+                f.g_term_gap.clone_from(&t.note);
                 f.sigma_s_prime.g = finite(t.sigma_s_prime);
                 f.sigma_a.g = finite(t.sigma_a);
                 f.albedo_prime.g = finite(t.albedo_prime);
@@ -263,6 +273,7 @@ impl ChannelOutcome {
             f.albedo_prime.g = finite(term[2]);
             f.report = report.clone();
             f.g_note = None;
+            f.g_term_gap = None;
         }
         f.g_fit = Some(g);
         ChannelOutcome::Fitted(f)

@@ -98,3 +98,74 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
         assert_eq!(known.channels[ch].sigma_a_stderr_g, Some(0.0));
     }
 }
+
+/// A material whose η the `mc` tables at g ≠ 0 do not reach (η 2.6: the grid stops at 2.5): with g
+/// unknown, the g term cannot be evaluated, and the channel must not look complete — no ± g (not a
+/// 0), and every channel suspect with `g_term_incomplete`, whose message names the η and says what
+/// to do. Told g (here 0, the twin's), the same measurement is `ok`: the reason is the unknown g,
+/// not the η. (Before this check such a channel read "± 0.000 g" and `ok` — red aluminum, η 2.41, at
+/// g = 0.85 was 18 % off in σa behind a 0.6 % bar.)
+#[test]
+fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
+    use scatterfit_io::quality::{ReasonKind, Verdict};
+    let dir = tempfile::tempdir().unwrap();
+    let m = by_name("wood-tile").unwrap();
+    let s = synthesize(
+        m.name,
+        m.sigma_s_prime,
+        m.sigma_a,
+        2.6,
+        &RigSpec::quick(),
+        3,
+        None,
+        &|_, _, _| {},
+    )
+    .unwrap();
+    let folder = dir.path().join(m.name);
+    write_twin_folder(&folder, &s, FitSection::default(), "g_term test").unwrap();
+    let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
+    let q = measured.quality();
+    let r = measured.to_result(None);
+    for ch in Channel::ALL {
+        let c = &r.channels[ch];
+        assert!(c.sigma_a.is_some(), "{}: no value", ch.name());
+        assert_eq!(c.sigma_a_stderr_g, None, "{}", ch.name());
+        assert_eq!(
+            q[ch].verdict,
+            Verdict::Suspect,
+            "{}: {:?}",
+            ch.name(),
+            q[ch]
+        );
+        let reason = q[ch]
+            .reasons
+            .iter()
+            .find(|r| r.kind == ReasonKind::GTermIncomplete)
+            .unwrap_or_else(|| panic!("{}: {:?}", ch.name(), q[ch]));
+        for want in ["g is not known", "2.6", "--g"] {
+            assert!(
+                reason.message.contains(want),
+                "{} lacks {want}",
+                reason.message
+            );
+        }
+    }
+    let known = measure_sample(
+        &folder,
+        &Overrides {
+            g: Some(0.0),
+            ..Overrides::default()
+        },
+        &|_| {},
+    )
+    .unwrap();
+    for (ch, q) in Channel::ALL.iter().zip(known.quality().into_array()) {
+        assert!(
+            q.reasons
+                .iter()
+                .all(|r| r.kind != ReasonKind::GTermIncomplete),
+            "{}: {q:?}",
+            ch.name()
+        );
+    }
+}

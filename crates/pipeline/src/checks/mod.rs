@@ -337,6 +337,21 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
             ),
         ));
     }
+    // An unknown g whose term could not be evaluated over its whole range: the error bars would
+    // look complete and are not (issue 15: never a 10 % bias behind a 0.3 % bar).
+    if let ChannelOutcome::Fitted(f) = outcome
+        && let Some(gap) = &f.g_term_gap
+    {
+        reasons.push(suspect(
+            ReasonKind::GTermIncomplete,
+            format!(
+                "g is not known and {gap}, so the error bars leave out part of what g does to the \
+                 values (σa computed at g = 0 is 5–25 % off for a forward-scattering material): \
+                 give g if it is known (`[fit] g`, `--g`), or a g range the tables cover \
+                 (`[fit] g_range`, `--g-range`)"
+            ),
+        ));
+    }
     // (a) Fit quality.
     if r.rms_log_residual.is_finite() && r.rms_log_residual > MAX_RMS_LOG_RESIDUAL {
         reasons.push(suspect(
