@@ -363,11 +363,27 @@ pub fn propagate_g(
             // Points whose tables do not reach the material's η, grouped by the tables' η range
             // (one clause for all of them, not one long message per g).
             let mut eta_gaps: Vec<((f64, f64), Vec<f64>)> = Vec::new();
+            // Likewise the points whose tables hold no α′ with the reading's Rd, by the α′ range.
+            let mut rd_gaps: Vec<(RdGapKey, Vec<f64>, Vec<f64>)> = Vec::new();
             for &g in &plan.points {
                 if let Some(range) = eta_not_covered(g, input.eta) {
                     match eta_gaps.iter_mut().find(|(r, _)| *r == range) {
                         Some((_, gs)) => gs.push(g),
                         None => eta_gaps.push((range, vec![g])),
+                    }
+                    continue;
+                }
+                if proposed
+                    && albedo_at_g == AlbedoAtG::FromRd
+                    && let Some(rd) = input.rd_total
+                    && let Some((key, total)) = rd_not_covered(g, rd, input.eta)
+                {
+                    match rd_gaps.iter_mut().find(|(k, _, _)| *k == key) {
+                        Some((_, gs, totals)) => {
+                            gs.push(g);
+                            totals.push(total);
+                        }
+                        None => rd_gaps.push((key, vec![g], vec![total])),
                     }
                     continue;
                 }
@@ -378,6 +394,29 @@ pub fn propagate_g(
                     }
                     Err(e) => failed.push(format!("g = {g}: {e}")),
                 }
+            }
+            for ((above, end), gs, totals) in rd_gaps.into_iter().rev() {
+                let (lo, hi) = totals
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+                        (a.min(t), b.max(t))
+                    });
+                let totals = if hi - lo > 5e-5 {
+                    format!("{lo:.4}–{hi:.4}")
+                } else {
+                    format!("{lo:.4}")
+                };
+                failed.insert(
+                    0,
+                    format!(
+                        "g = {}: Rd = {:.4} is {} the totals the `mc` tables hold there (at their {} \
+                         α′, {end}: Rd {totals})",
+                        list(&gs),
+                        input.rd_total.unwrap_or(f64::NAN),
+                        if above { "above" } else { "below" },
+                        if above { "highest" } else { "lowest" },
+                    ),
+                );
             }
             for ((lo, hi), gs) in eta_gaps.into_iter().rev() {
                 failed.insert(
@@ -460,6 +499,29 @@ fn eta_not_covered(g: f64, eta: f64) -> Option<(f64, f64)> {
     let (lo, hi) = scatterfit_mc::bundled_grid().ok()?.eta_range_at(g).ok()?;
     let tol = scatterfit_mc::model::ETA_EDGE_TOLERANCE;
     (!(eta >= lo - tol && eta <= hi + tol)).then_some((lo, hi))
+}
+
+/// Which end of the tables' totals a reading lies beyond: (above the highest, that end's α′ in
+/// words).
+type RdGapKey = (bool, String);
+
+/// When the reading's Rd lies outside the totals the bundled grid holds at g and η: which end
+/// (with its α′) and the total there; `None` when Rd is inside, or when the grid cannot say (the
+/// estimate then fails with its own message).
+fn rd_not_covered(g: f64, rd: f64, eta: f64) -> Option<(RdGapKey, f64)> {
+    let grid = scatterfit_mc::bundled_grid().ok()?;
+    let (lo, hi) = grid.albedo_prime_range(g).ok()?;
+    let (r_lo, r_hi) = (
+        grid.rd_total(lo, eta, g).ok()?,
+        grid.rd_total(hi, eta, g).ok()?,
+    );
+    if rd < r_lo {
+        Some(((false, format!("{lo:.3}")), r_lo))
+    } else if rd > r_hi {
+        Some(((true, format!("{hi:.5}")), r_hi))
+    } else {
+        None
+    }
 }
 
 fn list(v: &[f64]) -> String {

@@ -256,7 +256,14 @@ pub fn summary_text(r: &MeasurementResult) -> String {
             c.fit_time_s * 1e6,
             c.rings_used
         );
-        if let Some(p) = &c.problem {
+        // A note a reason already quotes (the g term's, in `g_term_incomplete`) is not repeated.
+        if let Some(p) = &c.problem
+            && !c
+                .quality
+                .iter()
+                .flat_map(|q| &q.reasons)
+                .any(|r| r.message.contains(p.as_str()))
+        {
             let _ = writeln!(t, "      note: {}", scatterfit_io::escape::one_line(p));
         }
         for reason in c.quality.iter().flat_map(|q| &q.reasons) {

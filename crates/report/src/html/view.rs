@@ -158,7 +158,7 @@ fn channel(name: &'static str, c: &ChannelResult) -> ChannelView {
         })
         .collect();
     if let Some(p) = &c.problem
-        && !reasons.iter().any(|r| &r.message == p)
+        && !reasons.iter().any(|r| r.message.contains(p.as_str()))
     {
         reasons.push(ReasonView {
             severity: "note",
