@@ -57,15 +57,29 @@ macro_rules! g_table {
 }
 
 /// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
-/// compact JSON). g = 0.3, 0.5, 0.7 and 0.9 at η 1.0, 1.05, 1.1–1.8 (0.1 apart) and 2.0–2.4 (0.2
-/// apart), g = 0.8 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4 and 1.6–2.4 (0.2 apart), g = 0.95 at η 1.0,
-/// 1.4, 1.8, 2.4 (a coarse set, issue 15: Catmull-Rom over 0.4–0.6 in η costs 0.4–2 % in shape
-/// above η 1.4 and 3 % between 1.0 and 1.4, BENCHMARKS.md "The `mc` model over g");
+/// compact JSON). g = 0.15, 0.3, 0.5, 0.7 and 0.9 at η 1.0, 1.05, 1.1–1.8 (0.1 apart), 2.0–2.4 (0.2
+/// apart) and 2.5, g = 0.8 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4, 1.6–2.4 (0.2 apart) and 2.5, g = 0.95
+/// at η 1.0, 1.4, 1.8, 2.4, 2.5 (a coarse set, issue 15: Catmull-Rom over 0.4–0.6 in η costs 0.4–2 %
+/// in shape above η 1.4 and 3 % between 1.0 and 1.4, BENCHMARKS.md "The `mc` model over g");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
 /// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)).
-/// About 45 KB each, 3.0 MB in all (the g = 0 set: 0.75 MB).
+/// About 45 KB each, 3.8 MB in all (the g = 0 set: 0.75 MB).
 #[rustfmt::skip]
-pub const BUNDLED_G: [(f64, f64, &str); 72] = [
+pub const BUNDLED_G: [(f64, f64, &str); 86] = [
+    g_table!(1.0, 0.15, "1.00", "0.15"),
+    g_table!(1.05, 0.15, "1.05", "0.15"),
+    g_table!(1.1, 0.15, "1.10", "0.15"),
+    g_table!(1.2, 0.15, "1.20", "0.15"),
+    g_table!(1.3, 0.15, "1.30", "0.15"),
+    g_table!(1.4, 0.15, "1.40", "0.15"),
+    g_table!(1.5, 0.15, "1.50", "0.15"),
+    g_table!(1.6, 0.15, "1.60", "0.15"),
+    g_table!(1.7, 0.15, "1.70", "0.15"),
+    g_table!(1.8, 0.15, "1.80", "0.15"),
+    g_table!(2.0, 0.15, "2.00", "0.15"),
+    g_table!(2.2, 0.15, "2.20", "0.15"),
+    g_table!(2.4, 0.15, "2.40", "0.15"),
+    g_table!(2.5, 0.15, "2.50", "0.15"),
     g_table!(1.0, 0.3, "1.00", "0.30"),
     g_table!(1.05, 0.3, "1.05", "0.30"),
     g_table!(1.1, 0.3, "1.10", "0.30"),
@@ -140,11 +154,12 @@ pub const BUNDLED_G: [(f64, f64, &str); 72] = [
     g_table!(2.4, 0.95, "2.40", "0.95"),
 ];
 
-/// The largest g step the shipped grid interpolates across: 0.3 (between g = 0 and 0.3; 0.2 between
-/// 0.3, 0.5 and 0.7; 0.1 above). Measured against tables built between the nodes (g 0.15, 0.4, 0.6
-/// at η 1.4; BENCHMARKS.md "The `mc` model over g"): ≤ 0.6 % RMS over 0.3–10 reduced mean free
-/// paths at α′ ≥ 0.5 (1–3 % at α′ 0.3, where the profile is short), totals within 9·10⁻⁴.
-pub const BUNDLED_MAX_G_STEP: f64 = 0.3 + 1e-9;
+/// The largest g step the shipped grid interpolates across: 0.2 (between 0.3, 0.5 and 0.7; 0.15
+/// between 0, 0.15 and 0.3; 0.1 and 0.05 above). Measured against tables built between the nodes
+/// (BENCHMARKS.md "The g tables rebuilt, and the whole g range", and "η 2.5 at g ≠ 0 and a g 0.15
+/// node"): ≤ 0.6 % RMS over 0.3–10 reduced mean free paths at α′ ≥ 0.5 (1–3 % at α′ 0.3, where the
+/// profile is short), totals within 9·10⁻⁴.
+pub const BUNDLED_MAX_G_STEP: f64 = 0.2 + 1e-9;
 
 impl McGridSet {
     /// The shipped grid: the g = 0 set ([`McTableSet::bundled`]) and the anisotropic tables
@@ -209,18 +224,22 @@ mod tests {
     }
 
     /// Every embedded anisotropic table parses, sits at its (η, g) (the file name's), and the
-    /// grid has the nodes g = 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95 with the η ranges of the README.
+    /// grid has the nodes g = 0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95 with the η ranges of the README.
     #[test]
     fn bundled_grid_parses() {
         let grid = McGridSet::bundled().unwrap();
-        assert_eq!(grid.g_nodes(), vec![0.0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
+        assert_eq!(
+            grid.g_nodes(),
+            vec![0.0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]
+        );
         for (set, n, top) in [
-            (1, 13, 2.4),
-            (2, 13, 2.4),
-            (3, 13, 2.4),
-            (4, 11, 2.4),
-            (5, 13, 2.4),
-            (6, 4, 2.4),
+            (1, 14, 2.5),
+            (2, 14, 2.5),
+            (3, 14, 2.5),
+            (4, 14, 2.5),
+            (5, 12, 2.5),
+            (6, 14, 2.5),
+            (7, 4, 2.4),
         ] {
             let set = &grid.nodes()[set];
             assert_eq!(set.tables().len(), n);

@@ -12,7 +12,7 @@
 //! **Interpolation in g.** Linear in g on ln Rd(r) (the profile) and on Rd (the total), between the
 //! two bracketing nodes, and only where they are at most [`McGridSet::max_step`] apart; a g within
 //! [`G_NODE_TOLERANCE`] of a node is that node's set, unchanged (so g = 0 gives exactly the g = 0
-//! tables' numbers). The shipped nodes are 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95 (`max_step` 0.3), so
+//! tables' numbers). The shipped nodes are 0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95 (`max_step` 0.2), so
 //! every g in 0–0.95 is answered and nothing beyond is extrapolated. Measured (BENCHMARKS.md, "The
 //! `mc` model over g" and "The g tables rebuilt, and the whole g range"; `examples/g_model_check.rs`):
 //! at g = 0.85 (η 1.4) the interpolant is within 0.2–0.4 % of a table built there over 1–10 mean
@@ -517,14 +517,14 @@ mod tests {
     #[test]
     fn places_on_the_grid() {
         let grid = McGridSet::bundled().unwrap();
-        assert_eq!(grid.g_nodes(), [0.0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
-        assert_eq!(grid.place(0.8 + 1e-12).unwrap(), Place::Node(4));
+        assert_eq!(grid.g_nodes(), [0.0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
+        assert_eq!(grid.place(0.8 + 1e-12).unwrap(), Place::Node(5));
         match grid.place(0.825).unwrap() {
-            Place::Between(4, t) => assert!((t - 0.25).abs() < 1e-12),
+            Place::Between(5, t) => assert!((t - 0.25).abs() < 1e-12),
             p => panic!("{p:?}"),
         }
-        match grid.place(0.15).unwrap() {
-            Place::Between(0, t) => assert!((t - 0.5).abs() < 1e-12),
+        match grid.place(0.4).unwrap() {
+            Place::Between(2, t) => assert!((t - 0.5).abs() < 1e-12),
             p => panic!("{p:?}"),
         }
         for g in [-0.1, 0.96, f64::NAN] {
@@ -537,7 +537,7 @@ mod tests {
         assert!(grid.covers(0.0) && grid.covers(0.5) && grid.covers(0.93) && !grid.covers(0.97));
         assert_eq!(
             grid.coverage(),
-            "g 0–0.95 (tables at 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95, linear in g between; η 1–2.4)"
+            "g 0–0.95 (tables at 0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95, linear in g between; η 1–2.4)"
         );
         // A grid with a gap names each run.
         let gapped = grid.with_nodes(|g| g == 0.0 || g >= 0.8).unwrap();

@@ -141,14 +141,14 @@ fn check_against_mcml(model: &dyn ModelFamily, g: f64, eta: f64, ap: f64, delta:
     worst
 }
 
-/// At the tabulated g (0.3, 0.5, 0.7, 0.8 and 0.9), the `mc` family (`mc::family`) against
+/// At the tabulated g (0.15, 0.3, 0.5, 0.7, 0.8 and 0.9), the `mc` family (`mc::family`) against
 /// adding-doubling's totals (within the tables' 3·10⁻⁴ noise budget + twice the quadrature
 /// uncertainty), and where MCML's profiles exist (g 0.5, 0.8, 0.9) against them over the fit's
 /// windows (within 4 s.e. ⊕ 0.3 % model noise), at η 1.0, 1.4, 2.0 and α′ 0.5, 0.9, 0.99.
 #[test]
 fn tabulated_g_matches_mcml_and_adding_doubling() {
     let mc = family(ModelName::Mc).unwrap();
-    for g in [0.3, 0.5, 0.7, 0.8, 0.9] {
+    for g in [0.15, 0.3, 0.5, 0.7, 0.8, 0.9] {
         for eta in [1.0, 1.4, 2.0] {
             for ap in [0.5, 0.9, 0.99] {
                 if [0.5, 0.8, 0.9].contains(&g) {
@@ -171,14 +171,14 @@ fn tabulated_g_matches_mcml_and_adding_doubling() {
     }
 }
 
-/// The η = 2.5 tables at the g nodes 0.3–0.9 (red aluminum's η 2.41 lies between 2.4 and 2.5):
+/// The η = 2.5 tables at the g nodes 0.15–0.9 (red aluminum's η 2.41 lies between 2.4 and 2.5):
 /// the totals against adding-doubling's at η 2.5 and α′ 0.5, 0.9, 0.99 (`iad_totals_g.csv`), within
 /// the tables' 3·10⁻⁴ noise budget + twice the quadrature uncertainty, and g = 0.85 (between the 0.8
 /// and 0.9 nodes) at η 2.41 is answered, the profile's total the family's.
 #[test]
 fn eta_2_5_tables_match_adding_doubling() {
     let mc = family(ModelName::Mc).unwrap();
-    for g in [0.3, 0.5, 0.7, 0.8, 0.9] {
+    for g in [0.15, 0.3, 0.5, 0.7, 0.8, 0.9] {
         for ap in [0.5, 0.9, 0.99] {
             let (want, q) = adding_doubling(g, 2.5, ap);
             let got = mc.rd_total(ap, 2.5, g).unwrap();
@@ -194,7 +194,8 @@ fn eta_2_5_tables_match_adding_doubling() {
     assert!((mc.profile(&p).unwrap().rd_total() / total - 1.0).abs() < 1e-12);
 }
 
-/// Between the low g nodes (g 0.15, 0.4, 0.6: halfway from 0 to 0.3, 0.3 to 0.5, 0.5 to 0.7), the
+/// Between the low g nodes (g 0.075, 0.225, 0.4, 0.6: halfway from 0 to 0.15, 0.15 to 0.3, 0.3 to
+/// 0.5, 0.5 to 0.7), the
 /// interpolated totals against adding-doubling's (`iad_totals_g.csv`, computed at those g) at η 1.0,
 /// 1.4, 2.0 and α′ 0.5, 0.9, 0.99, within the tables' 3·10⁻⁴ noise budget plus the measured
 /// g-interpolation error of the total (≤ 9·10⁻⁴ against tables built at those g, BENCHMARKS.md) plus
@@ -203,7 +204,7 @@ fn eta_2_5_tables_match_adding_doubling() {
 fn between_low_g_nodes_totals_match_adding_doubling() {
     let mc = family(ModelName::Mc).unwrap();
     let mut worst: f64 = 0.0;
-    for g in [0.15, 0.4, 0.6] {
+    for g in [0.075, 0.225, 0.4, 0.6] {
         for eta in [1.0, 1.4, 2.0] {
             for ap in [0.5, 0.9, 0.99] {
                 let (want, q) = adding_doubling(g, eta, ap);

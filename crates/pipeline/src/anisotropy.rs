@@ -552,7 +552,7 @@ pub(crate) fn warm_start<E: std::fmt::Display>(
 mod tests {
     use super::*;
 
-    /// The plan on the shipped grid (g 0–0.95, nodes 0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95): the
+    /// The plan on the shipped grid (g 0–0.95, nodes 0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95): the
     /// default range is evaluated at every node and nothing is left out; a range between nodes at
     /// its ends and the values' g; a range without a g has its nominal g at its middle. On a grid
     /// with a gap (the shipped one without its low nodes, as it was until 2026-11-27) the gap is
@@ -561,7 +561,7 @@ mod tests {
     fn plans_on_the_shipped_grid() {
         let grid = scatterfit_mc::bundled_grid().unwrap();
         let p = GPlan::on_grid(grid, DEFAULT_G_RANGE, Some(0.0)).unwrap();
-        assert_eq!(p.points, [0.0, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
+        assert_eq!(p.points, [0.0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95]);
         assert_eq!(p.not_covered, None);
         let p = GPlan::on_grid(grid, [0.82, 0.88], Some(0.85)).unwrap();
         assert_eq!(p.points, [0.82, 0.85, 0.88]);

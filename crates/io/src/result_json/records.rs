@@ -109,8 +109,8 @@ impl GFitRecord {
 
 impl GUncertainty {
     /// One line for people: "g = 0.85 given (no g term)", or "g not stated, so taken as unknown in
-    /// 0–0.95: values at g = 0; ± g from the g-aware `mc` model at g = 0, 0.3, 0.5, 0.7, 0.8, 0.9,
-    /// 0.95", with "(not evaluated, no tables: …)" where the tables miss part of the range.
+    /// 0–0.95: values at g = 0; ± g from the g-aware `mc` model at g = 0, 0.15, 0.3, 0.5, 0.7, 0.8,
+    /// 0.9, 0.95", with "(not evaluated, no tables: …)" where the tables miss part of the range.
     pub fn describe(&self) -> String {
         let list = |v: &[f64]| {
             v.iter()
