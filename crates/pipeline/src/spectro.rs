@@ -297,6 +297,33 @@ pub fn from_reading(
 /// measurement assumes; the diffusion dipoles do not depend on it).
 const ISOTROPIC: f64 = 0.0;
 
+/// A reading beyond the totals a tabulated albedo model holds, in words with what to do (the bare
+/// table bound says neither which end nor why); `None` for any other error.
+fn beyond_the_totals(rd: f64, e: &scatterfit_optics::OpticsError) -> Option<String> {
+    let scatterfit_optics::OpticsError::OutOfTable {
+        name: "rd_total",
+        min,
+        max,
+        ..
+    } = *e
+    else {
+        return None;
+    };
+    Some(if rd < min {
+        format!(
+            "Rd is below {min:.4}, the lowest total its tables hold (at their lowest α′): the \
+             channel absorbs more than they cover (the g ≠ 0 tables start at α′ 0.2, g = 0's at \
+             0.02) — use an albedo model without tables (`--albedo-model dipole`)"
+        )
+    } else {
+        format!(
+            "Rd is above {max:.4}, the highest total its tables hold (at their highest α′): more \
+             than a non-absorbing material at this η reflects — check the reading (SCE, not SCI; \
+             fractions, not percent) and η"
+        )
+    })
+}
+
 fn from_rd(reading: Reading, albedo: &dyn ModelFamily) -> SpectroStage {
     let Reading {
         file,
@@ -313,9 +340,10 @@ fn from_rd(reading: Reading, albedo: &dyn ModelFamily) -> SpectroStage {
     let inverted = rd.map_with_channel(|c, rd| {
         albedo.albedo_from_rd(rd, eta, ISOTROPIC).map_err(|e| {
             format!(
-                "channel {}: α′ from Rd = {rd:.4} by the {} total: {e}",
+                "channel {}: α′ from Rd = {rd:.4} by the {} total: {}",
                 c.name(),
-                albedo.name()
+                albedo.name(),
+                beyond_the_totals(rd, &e).unwrap_or_else(|| e.to_string())
             )
         })
     });

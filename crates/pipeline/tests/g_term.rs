@@ -169,3 +169,65 @@ fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
         );
     }
 }
+
+/// Ketchup's G and B (α′ 0.07 and 0.02) absorb more than the g ≠ 0 tables hold (they start at α′
+/// 0.2). With g unknown their g term has only g = 0 — no term, the channels suspect, the reason naming
+/// the reading's Rd against the tables' lowest totals; with g = 0.8 given and the `mc` α′ their α′
+/// cannot be inverted, and the failure says which end of the tables the reading lies beyond and what
+/// to do, not a bare table bound. R (α′ 0.75) is measured and `ok` both ways.
+#[test]
+fn a_reading_below_the_g_tables_says_so() {
+    use scatterfit_io::quality::{ReasonKind, Verdict};
+    let dir = tempfile::tempdir().unwrap();
+    let m = by_name("ketchup").unwrap();
+    let s = synthesize(
+        m.name,
+        m.sigma_s_prime,
+        m.sigma_a,
+        m.eta,
+        &RigSpec::quick(),
+        5,
+        None,
+        &|_, _, _| {},
+    )
+    .unwrap();
+    let folder = dir.path().join(m.name);
+    let fit = FitSection {
+        model: Some(ModelName::Mc),
+        albedo_model: Some(AlbedoModel::Mc),
+        ..Default::default()
+    };
+    write_twin_folder(&folder, &s, fit, "g_term test").unwrap();
+    let unknown = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
+    let q = unknown.quality();
+    assert_eq!(q[Channel::R].verdict, Verdict::Ok, "{:?}", q[Channel::R]);
+    for ch in [Channel::G, Channel::B] {
+        let r = q[ch]
+            .reasons
+            .iter()
+            .find(|r| r.kind == ReasonKind::GTermIncomplete)
+            .unwrap_or_else(|| panic!("{}: {:?}", ch.name(), q[ch]));
+        assert!(
+            r.message.contains("below the totals") && r.message.contains("lowest α′, 0.200"),
+            "{}",
+            r.message
+        );
+    }
+    let given = measure_sample(
+        &folder,
+        &Overrides {
+            g: Some(0.8),
+            ..Overrides::default()
+        },
+        &|_| {},
+    )
+    .unwrap()
+    .to_result(None);
+    assert!(given.channels[Channel::R].sigma_a.is_some());
+    for ch in [Channel::G, Channel::B] {
+        let p = given.channels[ch].problem.as_deref().unwrap();
+        for want in ["Rd is below", "lowest total", "--albedo-model dipole"] {
+            assert!(p.contains(want), "{p} lacks {want}");
+        }
+    }
+}
