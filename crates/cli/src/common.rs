@@ -138,7 +138,7 @@ pub enum ModelArg {
     /// evaluation).
     Pbd,
     /// Monte Carlo tables shipped with scatterfit (exact transport, Henyey–Greenstein g 0–0.95
-    /// with --g or `[fit] g`; η 1.0–2.5 at g = 0 and 1.0–2.4 at g ≠ 0; α′ up to 0.9999).
+    /// with --g or `[fit] g`; η 1.0–2.5; α′ up to 0.9999, and from 0.2 at g ≠ 0).
     Mc,
 }
 

@@ -63,9 +63,9 @@ macro_rules! g_table {
 /// in shape above η 1.4 and 3 % between 1.0 and 1.4, BENCHMARKS.md "The `mc` model over g");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
 /// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)).
-/// About 45 KB each, 3.8 MB in all (the g = 0 set: 0.75 MB).
+/// About 45 KB each, 3.9 MB in all (the g = 0 set: 0.75 MB).
 #[rustfmt::skip]
-pub const BUNDLED_G: [(f64, f64, &str); 86] = [
+pub const BUNDLED_G: [(f64, f64, &str); 87] = [
     g_table!(1.0, 0.15, "1.00", "0.15"),
     g_table!(1.05, 0.15, "1.05", "0.15"),
     g_table!(1.1, 0.15, "1.10", "0.15"),
@@ -152,6 +152,7 @@ pub const BUNDLED_G: [(f64, f64, &str); 86] = [
     g_table!(1.4, 0.95, "1.40", "0.95"),
     g_table!(1.8, 0.95, "1.80", "0.95"),
     g_table!(2.4, 0.95, "2.40", "0.95"),
+    g_table!(2.5, 0.95, "2.50", "0.95"),
 ];
 
 /// The largest g step the shipped grid interpolates across: 0.2 (between 0.3, 0.5 and 0.7; 0.15
@@ -239,7 +240,7 @@ mod tests {
             (4, 14, 2.5),
             (5, 12, 2.5),
             (6, 14, 2.5),
-            (7, 4, 2.4),
+            (7, 5, 2.5),
         ] {
             let set = &grid.nodes()[set];
             assert_eq!(set.tables().len(), n);

@@ -168,7 +168,7 @@ impl ModelFamily for McGridSet {
     }
 }
 
-/// The shipped (η, g) grid ([`McGridSet::bundled`]: g = 0, η 1.0–2.5; g 0.8–0.9, η 1.0–2.4),
+/// The shipped (η, g) grid ([`McGridSet::bundled`]: g 0–0.95 at η 1.0–2.5),
 /// parsed once per process.
 ///
 /// # Errors
@@ -194,7 +194,8 @@ pub fn bundled_tables() -> Result<&'static McTableSet> {
 /// The forward model called `name`: the classical dipole (Jensen et al. 2001), the better dipole
 /// (d'Eon 2012), photon beam diffusion (Habel et al. 2013) or the Monte Carlo tables shipped with
 /// scatterfit over (η, g) ([`bundled_grid`]: g = 0 at η 1.0–2.5, exactly the g = 0 tables'
-/// numbers; g 0.8–0.9 at η 1.0–2.4; other g refused). The one place a name becomes a model.
+/// numbers; g up to 0.95 at η 1.0–2.5, linear in g between nodes; other g refused). The one place a
+/// name becomes a model.
 ///
 /// # Errors
 /// [`McError::BundledTables`] when the Monte Carlo tables cannot be loaded.

@@ -120,7 +120,7 @@ impl McGridSet {
     }
 
     /// The g values and η ranges the grid covers, in words (for error messages), e.g.
-    /// "g = 0 (η 1–2.5); g 0.8–0.9 interpolated (η 1–2.4)".
+    /// "g 0–0.95 (tables at 0, 0.15, …, 0.95, linear in g between; η 1–2.5)".
     pub fn coverage(&self) -> String {
         let mut parts = Vec::new();
         for (k, end) in self.runs() {
@@ -537,7 +537,7 @@ mod tests {
         assert!(grid.covers(0.0) && grid.covers(0.5) && grid.covers(0.93) && !grid.covers(0.97));
         assert_eq!(
             grid.coverage(),
-            "g 0–0.95 (tables at 0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95, linear in g between; η 1–2.4)"
+            "g 0–0.95 (tables at 0, 0.15, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95, linear in g between; η 1–2.5)"
         );
         // A grid with a gap names each run.
         let gapped = grid.with_nodes(|g| g == 0.0 || g >= 0.8).unwrap();
@@ -545,7 +545,7 @@ mod tests {
         assert!(!gapped.covers(0.5));
         assert_eq!(
             gapped.coverage(),
-            "g = 0 (η 1–2.5); g 0.8–0.95 (tables at 0.8, 0.9, 0.95, linear in g between; η 1–2.4)"
+            "g = 0 (η 1–2.5); g 0.8–0.95 (tables at 0.8, 0.9, 0.95, linear in g between; η 1–2.5)"
         );
     }
 }
