@@ -21,30 +21,49 @@ use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
 
-#[test]
-fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
+/// A quick-rig twin of the built-in material `name` at η and the twin's g (seed `seed`), written as a
+/// sample folder with the `[fit]` section `fit` (the manifest states no g, as a user who does not
+/// know it would), in a fresh temporary folder (kept alive by the first value).
+fn twin(
+    name: &str,
+    eta: Option<f64>,
+    g: f64,
+    seed: u64,
+    fit: FitSection,
+) -> (tempfile::TempDir, std::path::PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let mut rig = RigSpec::quick();
-    rig.g = 0.8;
-    let m = by_name("wood-tile").unwrap();
+    rig.g = g;
+    let m = by_name(name).unwrap();
     let s = synthesize(
         m.name,
         m.sigma_s_prime,
         m.sigma_a,
-        m.eta,
+        eta.unwrap_or(m.eta),
         &rig,
-        7,
+        seed,
         None,
         &|_, _, _| {},
     )
     .unwrap();
     let folder = dir.path().join(m.name);
-    let fit = FitSection {
+    write_twin_folder(&folder, &s, fit, "g_term test").unwrap();
+    (dir, folder)
+}
+
+/// The `[fit]` section of the exact model with the `mc` α′.
+fn exact() -> FitSection {
+    FitSection {
         model: Some(ModelName::Mc),
         albedo_model: Some(AlbedoModel::Mc),
         ..Default::default()
-    };
-    write_twin_folder(&folder, &s, fit, "g_term test").unwrap();
+    }
+}
+
+#[test]
+fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
+    let m = by_name("wood-tile").unwrap();
+    let (_dir, folder) = twin(m.name, None, 0.8, 7, exact());
     let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
     let r = measured.to_result(None);
     let g = r.g_uncertainty.as_ref().unwrap();
@@ -108,21 +127,7 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
 #[test]
 fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
     use scatterfit_io::quality::{ReasonKind, Verdict};
-    let dir = tempfile::tempdir().unwrap();
-    let m = by_name("wood-tile").unwrap();
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        2.6,
-        &RigSpec::quick(),
-        3,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap();
-    let folder = dir.path().join(m.name);
-    write_twin_folder(&folder, &s, FitSection::default(), "g_term test").unwrap();
+    let (_dir, folder) = twin("wood-tile", Some(2.6), 0.0, 3, FitSection::default());
     let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
     let q = measured.quality();
     let r = measured.to_result(None);
@@ -178,26 +183,7 @@ fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
 #[test]
 fn a_reading_below_the_g_tables_says_so() {
     use scatterfit_io::quality::{ReasonKind, Verdict};
-    let dir = tempfile::tempdir().unwrap();
-    let m = by_name("ketchup").unwrap();
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        &RigSpec::quick(),
-        5,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap();
-    let folder = dir.path().join(m.name);
-    let fit = FitSection {
-        model: Some(ModelName::Mc),
-        albedo_model: Some(AlbedoModel::Mc),
-        ..Default::default()
-    };
-    write_twin_folder(&folder, &s, fit, "g_term test").unwrap();
+    let (_dir, folder) = twin("ketchup", None, 0.0, 5, exact());
     let unknown = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
     let q = unknown.quality();
     assert_eq!(q[Channel::R].verdict, Verdict::Ok, "{:?}", q[Channel::R]);
