@@ -66,7 +66,7 @@ macro_rules! g_table {
 /// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)).
 /// About 45 KB each, 3.9 MB in all (the g = 0 set: 0.75 MB).
 #[rustfmt::skip]
-pub const BUNDLED_G: [(f64, f64, &str); 92] = [
+pub const BUNDLED_G: [(f64, f64, &str); 93] = [
     g_table!(1.0, 0.15, "1.00", "0.15"),
     g_table!(1.05, 0.15, "1.05", "0.15"),
     g_table!(1.1, 0.15, "1.10", "0.15"),
@@ -157,6 +157,7 @@ pub const BUNDLED_G: [(f64, f64, &str); 92] = [
     g_table!(1.4, 0.95, "1.40", "0.95"),
     g_table!(1.6, 0.95, "1.60", "0.95"),
     g_table!(1.8, 0.95, "1.80", "0.95"),
+    g_table!(2.0, 0.95, "2.00", "0.95"),
     g_table!(2.4, 0.95, "2.40", "0.95"),
     g_table!(2.5, 0.95, "2.50", "0.95"),
 ];
@@ -246,7 +247,7 @@ mod tests {
             (4, 14, 2.5),
             (5, 12, 2.5),
             (6, 14, 2.5),
-            (7, 10, 2.5),
+            (7, 11, 2.5),
         ] {
             let set = &grid.nodes()[set];
             assert_eq!(set.tables().len(), n);
