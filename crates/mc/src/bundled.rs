@@ -58,15 +58,14 @@ macro_rules! g_table {
 
 /// The anisotropic tables shipped with the crate (`crates/mc/tables-g/`, README there): (η, g,
 /// compact JSON). g = 0.15, 0.3, 0.5, 0.7 and 0.9 at η 1.0, 1.05, 1.1–1.8 (0.1 apart), 2.0–2.4 (0.2
-/// apart) and 2.5, g = 0.8 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4, 1.6–2.4 (0.2 apart) and 2.5, g = 0.95
-/// at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4, 1.8, 2.4, 2.5 (a coarser set, issue 15: Catmull-Rom over 0.4–0.6 in η costs
-/// 0.4–2 % in shape above η 1.4, BENCHMARKS.md "The `mc` model over g"; 1.05–1.3 added where 1.0–1.4 was
-/// 0.5–3.5 % off and the total up to 4.5·10⁻³);
+/// apart) and 2.5; g = 0.8 and 0.95 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4, 1.6–2.4 (0.2 apart) and 2.5
+/// (g 0.95 had η 1.0, 1.4, 1.8, 2.4 until 2026-11-27: Catmull-Rom over 0.4–0.6 in η was up to 4.6 %
+/// off in shape and 6.7·10⁻³ in the total, BENCHMARKS.md "The g 0.95 node's η layout filled in");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
 /// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)).
-/// About 45 KB each, 3.9 MB in all (the g = 0 set: 0.75 MB).
+/// About 45 KB each, 4.2 MB in all (the g = 0 set: 0.75 MB).
 #[rustfmt::skip]
-pub const BUNDLED_G: [(f64, f64, &str); 93] = [
+pub const BUNDLED_G: [(f64, f64, &str); 94] = [
     g_table!(1.0, 0.15, "1.00", "0.15"),
     g_table!(1.05, 0.15, "1.05", "0.15"),
     g_table!(1.1, 0.15, "1.10", "0.15"),
@@ -158,6 +157,7 @@ pub const BUNDLED_G: [(f64, f64, &str); 93] = [
     g_table!(1.6, 0.95, "1.60", "0.95"),
     g_table!(1.8, 0.95, "1.80", "0.95"),
     g_table!(2.0, 0.95, "2.00", "0.95"),
+    g_table!(2.2, 0.95, "2.20", "0.95"),
     g_table!(2.4, 0.95, "2.40", "0.95"),
     g_table!(2.5, 0.95, "2.50", "0.95"),
 ];
@@ -247,7 +247,7 @@ mod tests {
             (4, 14, 2.5),
             (5, 12, 2.5),
             (6, 14, 2.5),
-            (7, 11, 2.5),
+            (7, 12, 2.5),
         ] {
             let set = &grid.nodes()[set];
             assert_eq!(set.tables().len(), n);

@@ -201,7 +201,7 @@ fn eta_2_5_tables_match_adding_doubling() {
 #[test]
 fn g_0_95_between_its_first_eta_nodes_matches_adding_doubling() {
     let mc = family(ModelName::Mc).unwrap();
-    for eta in [1.05, 1.1, 1.2, 1.3, 1.6, 2.0] {
+    for eta in [1.05, 1.1, 1.2, 1.3, 1.6, 2.0, 2.2] {
         for ap in [0.5, 0.9, 0.99] {
             let (want, q) = adding_doubling(0.95, eta, ap);
             let got = mc.rd_total(ap, eta, 0.95).unwrap();
