@@ -280,11 +280,7 @@ impl McGridSet {
     /// As [`McGridSet::profile`].
     pub fn rd_total(&self, albedo_prime: f64, eta: f64, g: f64) -> Result<f64> {
         self.check_eta(eta, g)?;
-        let mut sum = 0.0;
-        for (set, w) in self.weights(g)? {
-            sum += w * set.rd_total(albedo_from_reduced(albedo_prime, set.g()), eta)?;
-        }
-        Ok(sum)
+        total_of(&self.weights(g)?, albedo_prime, eta)
     }
 
     /// The α′ range a g is tabulated over (the intersection of the bracketing nodes').
@@ -317,7 +313,10 @@ impl McGridSet {
             return Ok(reduced_from_albedo(a, set.g()));
         }
         let (lo, hi) = self.albedo_prime_range(g)?;
-        let (r_lo, r_hi) = (self.rd_total(lo, eta, g)?, self.rd_total(hi, eta, g)?);
+        // The nodes and weights once, not per bisection step (η is checked above).
+        let weights = self.weights(g)?;
+        let total = |ap: f64| total_of(&weights, ap, eta);
+        let (r_lo, r_hi) = (total(lo)?, total(hi)?);
         if !(rd >= r_lo && rd <= r_hi) {
             return Err(McError::OutOfTable {
                 name: "rd_total",
@@ -332,7 +331,7 @@ impl McGridSet {
             if u <= u_lo || u >= u_hi || u_hi - u_lo < 1e-14 {
                 break;
             }
-            if self.rd_total(1.0 - u * u, eta, g)? >= rd {
+            if total(1.0 - u * u)? >= rd {
                 u_lo = u;
             } else {
                 u_hi = u;
@@ -341,6 +340,15 @@ impl McGridSet {
         let u = 0.5 * (u_lo + u_hi);
         Ok((1.0 - u * u).clamp(lo, hi))
     }
+}
+
+/// The total at α′ and η of the nodes `weights` (linear in g between them; [`McGridSet::rd_total`]).
+fn total_of(weights: &[(&McTableSet, f64)], albedo_prime: f64, eta: f64) -> Result<f64> {
+    let mut sum = 0.0;
+    for &(set, w) in weights {
+        sum += w * set.rd_total(albedo_from_reduced(albedo_prime, set.g()), eta)?;
+    }
+    Ok(sum)
 }
 
 /// The grid's model for one parameter set: a node's [`McProfile`], or two interpolated in g.
