@@ -51,6 +51,27 @@ fn twin(
     (dir, folder)
 }
 
+/// The sample in `folder` measured with g given (`Some`) or as its manifest says (`None`).
+fn measured_at(folder: &std::path::Path, g: Option<f64>) -> scatterfit_pipeline::Measurement {
+    let overrides = Overrides {
+        g,
+        ..Overrides::default()
+    };
+    measure_sample(folder, &overrides, &|_| {}).unwrap()
+}
+
+/// Channel `ch`'s `g_term_incomplete` reason (panics, showing the verdict, when there is none).
+fn g_term_reason(
+    q: &scatterfit_optics::Rgb<scatterfit_io::quality::Quality>,
+    ch: Channel,
+) -> &scatterfit_io::quality::Reason {
+    q[ch]
+        .reasons
+        .iter()
+        .find(|r| r.kind == scatterfit_io::quality::ReasonKind::GTermIncomplete)
+        .unwrap_or_else(|| panic!("{}: {:?}", ch.name(), q[ch]))
+}
+
 /// The `[fit]` section of the exact model with the `mc` α′.
 fn exact() -> FitSection {
     FitSection {
@@ -64,7 +85,7 @@ fn exact() -> FitSection {
 fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
     let m = by_name("wood-tile").unwrap();
     let (_dir, folder) = twin(m.name, None, 0.8, 7, exact());
-    let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
+    let measured = measured_at(&folder, None);
     let r = measured.to_result(None);
     let g = r.g_uncertainty.as_ref().unwrap();
     assert_eq!(g.source, GSource::DefaultRange);
@@ -102,16 +123,7 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
     assert!(outside_without_g >= 2);
 
     // Told g = 0.8 (known), the term is 0.
-    let known = measure_sample(
-        &folder,
-        &Overrides {
-            g: Some(0.8),
-            ..Overrides::default()
-        },
-        &|_| {},
-    )
-    .unwrap()
-    .to_result(None);
+    let known = measured_at(&folder, Some(0.8)).to_result(None);
     assert_eq!(known.g_uncertainty.unwrap().source, GSource::Given);
     for ch in Channel::ALL {
         assert_eq!(known.channels[ch].sigma_a_stderr_g, Some(0.0));
@@ -128,7 +140,7 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
 fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
     use scatterfit_io::quality::{ReasonKind, Verdict};
     let (_dir, folder) = twin("wood-tile", Some(2.6), 0.0, 3, FitSection::default());
-    let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
+    let measured = measured_at(&folder, None);
     let q = measured.quality();
     let r = measured.to_result(None);
     for ch in Channel::ALL {
@@ -142,11 +154,7 @@ fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
             ch.name(),
             q[ch]
         );
-        let reason = q[ch]
-            .reasons
-            .iter()
-            .find(|r| r.kind == ReasonKind::GTermIncomplete)
-            .unwrap_or_else(|| panic!("{}: {:?}", ch.name(), q[ch]));
+        let reason = g_term_reason(&q, ch);
         for want in ["g is not known", "2.6", "--g"] {
             assert!(
                 reason.message.contains(want),
@@ -155,15 +163,7 @@ fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
             );
         }
     }
-    let known = measure_sample(
-        &folder,
-        &Overrides {
-            g: Some(0.0),
-            ..Overrides::default()
-        },
-        &|_| {},
-    )
-    .unwrap();
+    let known = measured_at(&folder, Some(0.0));
     for (ch, q) in Channel::ALL.iter().zip(known.quality().into_array()) {
         assert!(
             q.reasons
@@ -182,33 +182,20 @@ fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
 /// to do, not a bare table bound. R (α′ 0.75) is measured and `ok` both ways.
 #[test]
 fn a_reading_below_the_g_tables_says_so() {
-    use scatterfit_io::quality::{ReasonKind, Verdict};
+    use scatterfit_io::quality::Verdict;
     let (_dir, folder) = twin("ketchup", None, 0.0, 5, exact());
-    let unknown = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
+    let unknown = measured_at(&folder, None);
     let q = unknown.quality();
     assert_eq!(q[Channel::R].verdict, Verdict::Ok, "{:?}", q[Channel::R]);
     for ch in [Channel::G, Channel::B] {
-        let r = q[ch]
-            .reasons
-            .iter()
-            .find(|r| r.kind == ReasonKind::GTermIncomplete)
-            .unwrap_or_else(|| panic!("{}: {:?}", ch.name(), q[ch]));
+        let r = g_term_reason(&q, ch);
         assert!(
             r.message.contains("below the totals") && r.message.contains("lowest α′, 0.200"),
             "{}",
             r.message
         );
     }
-    let given = measure_sample(
-        &folder,
-        &Overrides {
-            g: Some(0.8),
-            ..Overrides::default()
-        },
-        &|_| {},
-    )
-    .unwrap()
-    .to_result(None);
+    let given = measured_at(&folder, Some(0.8)).to_result(None);
     assert!(given.channels[Channel::R].sigma_a.is_some());
     for ch in [Channel::G, Channel::B] {
         let p = given.channels[ch].problem.as_deref().unwrap();
