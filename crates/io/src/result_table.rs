@@ -177,7 +177,8 @@ pub fn port_note(results: &[MeasurementResult]) -> String {
                 .join(" / ");
             t.push_str(&format!(
                 "Spectrophotometer port ({}): {} mm aperture lit over {} mm read {pct} % of Rd (R / G \
-                 / B); Rd and α′ corrected from the fitted profile.\n",
+                 / B); Rd and α′ corrected from the fitted profile, so the fit's error reaches α′ \
+                 and σa through the port's reading fraction (α′ ± fit ± spectro).\n",
                 crate::escape::one_line(&r.name),
                 diameter(p.aperture_mm),
                 diameter(p.illuminated_mm)
@@ -224,7 +225,7 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
          albedo_prime,rd_total,eta,method,model,fit_time_s,iterations,mse_mm-4,rms_log_residual,\
          chi2_reduced,rings_used,rings_inside_spot,rings_below_detection,problem,\
          sigma_s_prime_stderr_spectro,sigma_a_stderr_spectro,albedo_prime_stderr,eta_stderr,\
-         sigma_s_prime_stderr_g,sigma_a_stderr_g,albedo_prime_stderr_g\n",
+         sigma_s_prime_stderr_g,sigma_a_stderr_g,albedo_prime_stderr_g,albedo_prime_stderr_fit\n",
     );
     for r in results {
         for (ch, c) in r.channels.iter_channels() {
@@ -236,7 +237,7 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
             };
             let _ = writeln!(
                 t,
-                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 csv_text(&r.name),
                 num(c.sigma_s_prime, 6),
                 num(c.sigma_s_prime_stderr, 6),
@@ -263,6 +264,7 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 num(c.sigma_s_prime_stderr_g, 6),
                 num(c.sigma_a_stderr_g, 8),
                 num(c.albedo_prime_stderr_g, 6),
+                num(c.albedo_prime_stderr_fit, 6),
             );
         }
     }
@@ -305,9 +307,16 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
             let _ = writeln!(
                 t,
                 "| {material} | {name} | {sp} | {sa} | {eta} | {} | {time} | {} |",
-                match (c.albedo_prime, c.albedo_prime_stderr) {
-                    (Some(a), Some(e)) => format!("{a:.5} ± {}", sig4(e)),
-                    (Some(a), None) => format!("{a:.5}"),
+                // Behind a spectrophotometer port α′ has a fit term too, first as in the σ
+                // columns (value ± fit ± spectro).
+                match (
+                    c.albedo_prime,
+                    c.albedo_prime_stderr_fit,
+                    c.albedo_prime_stderr
+                ) {
+                    (Some(a), Some(f), Some(e)) => format!("{a:.5} ± {} ± {}", sig4(f), sig4(e)),
+                    (Some(a), None, Some(e)) => format!("{a:.5} ± {}", sig4(e)),
+                    (Some(a), _, None) => format!("{a:.5}"),
                     _ => "—".into(),
                 } + &c
                     .albedo_prime_stderr_g
@@ -499,7 +508,7 @@ mod tests {
             let mut rows = csv::Reader::from_reader(csv.as_bytes());
             for row in rows.records() {
                 let row = row.unwrap();
-                assert_eq!(row.len(), 28, "{csv}");
+                assert_eq!(row.len(), 29, "{csv}");
                 assert!(!row[0].starts_with(['=', '+', '-', '@']), "{csv}");
             }
             let md = table1_markdown(std::slice::from_ref(&r));

@@ -106,6 +106,22 @@ fn main() {
     }
     let a_fix = 1.0 - u1.exp();
     let sa_fix = sp * (1.0 / a_fix - 1.0);
+    // How F moves with σ′s at fixed α′ (Rd does not: a half-space's total depends on α′ and η
+    // only), and so what a fit whose σ′s is 1 % off does to the corrected σa through F:
+    // d ln(1 − α′) = −(d ln F/d ln σ′s)·δ/slope, d ln σa = δ + d ln(1 − α′).
+    let f_at = |s: f64| {
+        let p = OpticalProperties::new(s, s * (1.0 / a_true - 1.0), eta)
+            .and_then(|p| p.with_g(g))
+            .expect("props");
+        port.reading_of(&grid.profile(&p).expect("model"))
+            .reading_fraction
+    };
+    let dlnf_dlns = (f_at(sp * (1.0 + h)).ln() - f_at(sp * (1.0 - h)).ln()) / (2.0 * h);
+    println!(
+        "  d ln F/d ln σ′s (α′ fixed) = {dlnf_dlns:+.4}: a fitted σ′s 1 % high moves the \
+         corrected σa by {:+.1} %",
+        100.0 * (0.01 - dlnf_dlns * 0.01 / slope),
+    );
     println!(
         "  d ln(Rd·F)/d ln(1 − α′) = {slope:+.4}, d ln Rd/d ln(1 − α′) = {loss_free:+.4} \
          (A = {:.2}); σ′s at the truth, the reading inverted: α′ {a_fix:.6} \

@@ -9,7 +9,8 @@
 //! 4. [`port::correct_port`] — the spectrophotometer port's edge loss, when the manifest gives the
 //!    port (`spectro.aperture_mm`): Rd and α′ corrected from the fitted profile;
 //! 5. [`fit::fit_stage`] — σ′s and σa per channel, and [`fit::propagate_spectro`], the
-//!    spectrophotometer's part of their uncertainty.
+//!    spectrophotometer's part of their uncertainty; behind a port,
+//!    [`port::propagate_fit_through_port`] carries the fit's error through the port's F.
 //!
 //! [`measure_sample`] runs them on a sample folder (its `sample.toml`) and returns a
 //! [`Measurement`]: per channel ([`Rgb`], by [`Channel`]) σ′s, σa and α′ as [`Estimate`]s — the

@@ -447,6 +447,12 @@ fn measure_from(
         None => (spectro, None),
     };
     let fits = fit_and_propagate(&data, &spectro, &settings, model);
+    let fits = match &port {
+        Some(c) => crate::port::propagate_fit_through_port(
+            &data, &spectro, &settings, model, albedo, c, fits,
+        ),
+        None => fits,
+    };
     let fit_s = t_fit.elapsed().as_secs_f64();
     let timings = Timings {
         spectro_s,
@@ -524,7 +530,13 @@ impl Measurement {
             None => (self.spectro.with_albedo_model(albedo), None),
         };
         let fits = if propagate {
-            fit_and_propagate(&data, &spectro, &settings, model)
+            let fits = fit_and_propagate(&data, &spectro, &settings, model);
+            match &port {
+                Some(c) => crate::port::propagate_fit_through_port(
+                    &data, &spectro, &settings, model, albedo, c, fits,
+                ),
+                None => fits,
+            }
         } else {
             fit_stage(&data, &spectro, &settings, model)
         };

@@ -43,6 +43,21 @@ pub struct PortCorrection {
     pub rounds: Rgb<usize>,
     /// Why a channel was left uncorrected.
     pub problems: Rgb<Option<String>>,
+    /// Per corrected channel, the fixed point again with F taken from the fitted σ′s × (1 ∓ s),
+    /// s its relative standard error from the profile's noise: how the fit's error moves the
+    /// corrected Rd ([`propagate_fit_through_port`] turns it into the fit terms).
+    #[serde(skip)]
+    pub fit_pm: Rgb<Option<FitThroughPort>>,
+}
+
+/// A channel's corrected Rd when the fit's σ′s is one standard error low and high (see
+/// [`PortCorrection::fit_pm`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitThroughPort {
+    /// The factors on the fitted σ′s (and σa, α′ fixed) that F was taken at: 1 ∓ s.
+    pub scale: [f64; 2],
+    /// The corrected Rd of the reading at each.
+    pub rd: [f64; 2],
 }
 
 /// The port of the manifest's `spectro.aperture_mm` / `spectro.illuminated_mm` (`None` when no
@@ -87,6 +102,7 @@ pub fn correct_port(
     let mut problems: Rgb<Option<String>> = Rgb::from_fn(|_| None);
     let mut rd = read.rd;
     let mut rd_pm: Rgb<Option<[f64; 2]>> = Rgb::default();
+    let mut fit_pm: Rgb<Option<FitThroughPort>> = Rgb::default();
     let mut warnings = Vec::new();
     let u = &read.uncertainty;
     for ch in Channel::ALL {
@@ -101,14 +117,36 @@ pub fn correct_port(
             albedo,
             port,
         };
-        match point.solve(read.rd[ch], read.eta) {
+        match point.solve(read.rd[ch], read.eta, 1.0) {
             Ok(solved) => {
                 rd[ch] = solved.rd;
                 fraction[ch] = Some(solved.reading_fraction);
                 rounds[ch] = solved.rounds;
+                let s = solved.sigma_s_prime_rel_stderr;
+                if s.is_finite() && s > 0.0 && s < 0.5 {
+                    let scale = [1.0 - s, 1.0 + s];
+                    let pm: Result<Vec<f64>, (usize, String)> = scale
+                        .iter()
+                        .map(|&k| point.solve(read.rd[ch], read.eta, k).map(|s| s.rd))
+                        .collect();
+                    match pm {
+                        Ok(pm) => {
+                            fit_pm[ch] = Some(FitThroughPort {
+                                scale,
+                                rd: [pm[0], pm[1]],
+                            });
+                        }
+                        Err((_, e)) => warnings.push(format!(
+                            "channel {}: the port correction with the fitted σ′s ± its standard \
+                             error failed ({e}), so the fit's error is not carried through the \
+                             port's F and the fit terms understate it",
+                            ch.name()
+                        )),
+                    }
+                }
                 if u.repeatability > 0.0 {
                     let pm: Result<Vec<f64>, (usize, String)> = (0..2)
-                        .map(|k| point.solve(u.rd_pm[ch][k], u.eta_pm[k]).map(|s| s.rd))
+                        .map(|k| point.solve(u.rd_pm[ch][k], u.eta_pm[k], 1.0).map(|s| s.rd))
                         .collect();
                     // Without the perturbed fixed points the stage keeps ε on the corrected Rd,
                     // which understates the bar (see above); the warning says so.
@@ -138,6 +176,7 @@ pub fn correct_port(
         reading_fraction: fraction,
         rounds,
         problems,
+        fit_pm,
     };
     (corrected, correction)
 }
@@ -159,12 +198,15 @@ struct Solved {
     reading_fraction: f64,
     /// Rounds taken.
     rounds: usize,
+    /// The last round's fit: σ′s's standard error over its value (the profile's noise).
+    sigma_s_prime_rel_stderr: f64,
 }
 
 impl FixedPoint<'_> {
-    /// The corrected Rd of a reading `rd_read` at η = `eta`; on failure the round it stopped in
-    /// and why.
-    fn solve(&self, rd_read: f64, eta: f64) -> Result<Solved, (usize, String)> {
+    /// The corrected Rd of a reading `rd_read` at η = `eta`, F taken at the fitted σ′s and σa ×
+    /// `scale` (1: the fit as it is; 1 ∓ s: a fit one standard error off, α′ unchanged); on
+    /// failure the round it stopped in and why.
+    fn solve(&self, rd_read: f64, eta: f64, scale: f64) -> Result<Solved, (usize, String)> {
         let (model, albedo) = (self.model, self.albedo);
         let mut rd_c = rd_read;
         let mut target = rd_read;
@@ -183,10 +225,14 @@ impl FixedPoint<'_> {
                 Ok(_) => return Err(fail("the fit did not converge".into())),
                 Err(e) => return Err(fail(e.to_string())),
             };
-            let f = OpticalProperties::new(report.sigma_s_prime.value, report.sigma_a.value, eta)
-                .and_then(|p| model.profile(&p))
-                .map(|m| self.port.reading_of(&*m).reading_fraction)
-                .map_err(|e| fail(e.to_string()))?;
+            let f = OpticalProperties::new(
+                scale * report.sigma_s_prime.value,
+                scale * report.sigma_a.value,
+                eta,
+            )
+            .and_then(|p| model.profile(&p))
+            .map(|m| self.port.reading_of(&*m).reading_fraction)
+            .map_err(|e| fail(e.to_string()))?;
             if !(f.is_finite() && f > 0.0 && f <= 1.0 + 1e-9) {
                 return Err(fail(format!(
                     "the port's reading fraction {f} is not in (0, 1]"
@@ -199,6 +245,8 @@ impl FixedPoint<'_> {
                     rd: rd_c,
                     reading_fraction: f,
                     rounds: round,
+                    sigma_s_prime_rel_stderr: report.sigma_s_prime.stderr
+                        / report.sigma_s_prime.value,
                 });
             }
             // Step towards the target, halving the step while its Rd lies beyond what the albedo
@@ -231,6 +279,81 @@ impl FixedPoint<'_> {
             ),
         ))
     }
+}
+
+/// The fit's error carried through the port's F into σ′s's, σa's and α′'s fit terms (proposed
+/// method).
+///
+/// Behind a port the corrected Rd depends on the fit: F is the port's reading of the *fitted*
+/// material, and F grows with σ′t (the light leaves the aperture less), so a fitted σ′s one
+/// standard error high gives a larger F, a smaller corrected Rd, a smaller α′ and a larger σa. At
+/// α′ → 1 the reading hardly moves with α′ (d ln(Rd·F)/d ln(1 − α′) is −0.011 for pink plastic's
+/// red behind an 8 mm port lit over 8 mm, against d ln F/d ln σ′s = +0.37), so σa moves 30 times
+/// the fit's relative error (docs/physics.md §12): a fit term of s·σa, the loss-free one,
+/// understates it by that much. Here each term is half the spread of the whole measurement in the
+/// two worlds of [`PortCorrection::fit_pm`] — the fit's σ′s × (1 ∓ s) at every α′: the corrected
+/// Rd of that world, its α′, the refit there (σ′s, σa) and the factor 1 ∓ s on both — first-order
+/// propagation by central differences at ±1 standard error, as the spectrophotometer's term
+/// (`fit::propagate_spectro`). Without a port the two worlds share α′ and the terms reduce to the
+/// loss-free s·σ′s and s·σa. α′ gets a fit term (it had none: without a port it comes from the
+/// reading alone). A channel whose perturbed correction, inversion or refit fails keeps its terms;
+/// with g fitted (`g = "fit"`, determined) the values are ĝ's and the terms are left as they are.
+pub fn propagate_fit_through_port(
+    data: &Rgb<ProfileData>,
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    model: &dyn ModelFamily,
+    albedo: &dyn ModelFamily,
+    correction: &PortCorrection,
+    fits: Rgb<crate::fit::ChannelOutcome>,
+) -> Rgb<crate::fit::ChannelOutcome> {
+    use crate::fit::ChannelOutcome;
+    use scatterfit_fit::{FitOptions, PreparedFit, Start};
+    if settings.method != scatterfit_optics::Method::Proposed {
+        return fits;
+    }
+    let Ok(opts) = settings.options() else {
+        return fits;
+    };
+    fits.map_with_channel(|c, mut outcome| {
+        let ChannelOutcome::Fitted(f) = &mut outcome else {
+            return outcome;
+        };
+        let (Some(pm), true) = (correction.fit_pm[c], f.report.converged) else {
+            return outcome;
+        };
+        if f.g_fit.as_ref().is_some_and(|g| g.determined) {
+            return outcome;
+        }
+        let start = Some(Start {
+            sigma_s_prime: f.report.sigma_s_prime.value,
+            sigma_a: Some(f.report.sigma_a.value),
+            scale: None,
+        });
+        let world = |k: usize| -> Option<[f64; 3]> {
+            let a = albedo.albedo_from_rd(pm.rd[k], spectro.eta, 0.0).ok()?;
+            let input = ChannelInput {
+                eta: spectro.eta,
+                albedo_prime: Some(a),
+                rd_total: Some(pm.rd[k]),
+            };
+            let r = PreparedFit::new(&data[c], &input, model, &FitOptions { start, ..opts })
+                .ok()?
+                .solve();
+            r.converged.then_some([
+                pm.scale[k] * r.sigma_s_prime.value,
+                pm.scale[k] * r.sigma_a.value,
+                a,
+            ])
+        };
+        if let (Some(lo), Some(hi)) = (world(0), world(1)) {
+            let half = |i: usize| Some(0.5 * (hi[i] - lo[i]).abs()).filter(|v| v.is_finite());
+            f.sigma_s_prime.fit = half(0).or(f.sigma_s_prime.fit);
+            f.sigma_a.fit = half(1).or(f.sigma_a.fit);
+            f.albedo_prime.fit = half(2);
+        }
+        outcome
+    })
 }
 
 /// The measured reflectance spectrum corrected for the port's edge loss: Rd(λ) / F(λ), with F

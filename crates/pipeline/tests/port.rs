@@ -385,6 +385,104 @@ fn the_port_corrected_albedo_error_follows_the_reading() {
     }
 }
 
+/// The fit's error reaches the port-corrected values through F (`pipeline::port::
+/// propagate_fit_through_port`): F is the port's reading of the *fitted* material, so a σ′s one
+/// standard error off moves the corrected Rd, α′ and σa. Checked end to end against the world the
+/// propagation imagines, made exactly: the same frames with every length scaled by 1/k (pixel
+/// size and spot; the profile of σ′s, σa at r/k is that of kσ′s, kσa at r, η fixed), so the fit
+/// returns k times its σ′s at every α′ while the port keeps its size. The pink-plastic quick twin
+/// behind an 8 mm port lit over 8 mm, its red channel (α′ 0.9996: the reading hardly moves with
+/// α′, so F's dependence on σ′s dominates): measured at k = 1 ∓ s, s the fit's relative standard
+/// error of σ′s, half the spread of the corrected σa and α′ is the reported fit term within 2 %
+/// (measured: the same to four digits), and σa's fit term is more than three times the loss-free
+/// one, s·σa (measured 5×; the term before this propagation).
+#[test]
+fn the_fit_error_reaches_the_port_corrected_values_through_f() {
+    use scatterfit_optics::Channel;
+    let m = by_name("pink-plastic").unwrap();
+    let rig = RigSpec::quick();
+    let s = synthesize(
+        m.name,
+        m.sigma_s_prime,
+        m.sigma_a,
+        m.eta,
+        &rig,
+        9,
+        None,
+        &|_, _, _| {},
+    )
+    .unwrap();
+    let port = Port::new(8.0, 8.0).unwrap();
+    let read: [f64; 3] = std::array::from_fn(|c| {
+        let layer =
+            Layer::new(m.sigma_a[c], m.sigma_s_prime[c], 0.0, m.eta, f64::INFINITY).unwrap();
+        let sample = Sample::new(vec![layer], 1.0, 1.0).unwrap();
+        simulate_port_reading(sample, &port, 100_000, 70 + c as u64)
+            .unwrap()
+            .rd_read
+            .value
+    });
+    let reading = reading_for(read, m.eta).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let measure = |k: usize, length_scale: f64| {
+        let mut scaled = rig.clone();
+        scaled.mm_per_pixel *= length_scale;
+        scaled.spot_radius_mm *= length_scale;
+        let folder = dir.path().join(format!("s{k}"));
+        write_twin(
+            &folder,
+            &s,
+            &scaled,
+            &reading,
+            Some(scatterfit_io::manifest::GSetting::Value(0.0)),
+            Some([8.0, 8.0]),
+        );
+        measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap()
+    };
+    let mid = measure(0, 1.0);
+    let c = Channel::R;
+    let report = mid.fits[c].report().expect("R fitted");
+    let rel = report.sigma_s_prime.stderr / report.sigma_s_prime.value;
+    // The world whose fit reads σ′s × k has its lengths × 1/k.
+    let [lo, hi] = [(1, 1.0 - rel), (2, 1.0 + rel)].map(|(k, f)| measure(k, 1.0 / f));
+    let value = |m: &scatterfit_pipeline::Measurement| {
+        let r = m.to_result(None);
+        let ch = &r.channels[c];
+        (ch.sigma_a.expect("σa"), ch.albedo_prime.expect("α′"))
+    };
+    let (sa_lo, a_lo) = value(&lo);
+    let (sa_hi, a_hi) = value(&hi);
+    let result = mid.to_result(None);
+    let ch = &result.channels[c];
+    let (reported_sa, reported_a) = (
+        ch.sigma_a_stderr.expect("σa's fit term"),
+        ch.albedo_prime_stderr_fit
+            .expect("α′'s fit term behind a port"),
+    );
+    let (spread_sa, spread_a) = (0.5 * (sa_hi - sa_lo).abs(), 0.5 * (a_hi - a_lo).abs());
+    let loss_free = rel * ch.sigma_a.unwrap();
+    eprintln!(
+        "R: s = {:.3} %, σa {:.4e}: fit term {reported_sa:.3e} (loss-free {loss_free:.3e}), \
+         spread of the scaled worlds {spread_sa:.3e}; α′ fit term {reported_a:.3e}, spread \
+         {spread_a:.3e}",
+        100.0 * rel,
+        ch.sigma_a.unwrap()
+    );
+    assert!(
+        (reported_sa / spread_sa - 1.0).abs() < 0.02,
+        "σa: reported {reported_sa:.3e} vs the scaled worlds' {spread_sa:.3e}"
+    );
+    assert!(
+        (reported_a / spread_a - 1.0).abs() < 0.02,
+        "α′: reported {reported_a:.3e} vs the scaled worlds' {spread_a:.3e}"
+    );
+    assert!(
+        reported_sa > 3.0 * loss_free,
+        "σa's fit term {reported_sa:.3e} vs the loss-free s·σa {loss_free:.3e}: the test no \
+         longer shows what F adds"
+    );
+}
+
 /// The port study behind BENCHMARKS.md "The spectrophotometer port: the correction on the twin":
 /// materials from α′ 0.35 to 0.9995, an 8 mm aperture lit over 14 mm and over 8 mm; per channel
 /// σ′s and σa as read (loss-free), corrected, and the twin's baseline (the loss-free reading).

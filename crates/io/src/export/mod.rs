@@ -402,6 +402,7 @@ mod fixtures {
             sigma_a_stderr_g: None,
             albedo_prime_stderr_g: None,
             albedo_prime_stderr: None,
+            albedo_prime_stderr_fit: None,
             albedo_prime: Some(sp / (sp + sa)),
             rd_total: Some(rd),
             scale: Some(1.0),

@@ -128,6 +128,12 @@ pub struct ChannelResult {
     /// Standard error of α′ from the reading's repeatability (its Rd and η).
     #[serde(default)]
     pub albedo_prime_stderr: Option<f64>,
+    /// The part of α′'s uncertainty that comes from the profile's fit: behind a spectrophotometer
+    /// port (`spectro_port`) the corrected Rd, hence α′, depends on the fitted σ′s through the
+    /// port's reading fraction F (issue 15); add it in quadrature to `albedo_prime_stderr`.
+    /// Absent without a port (α′ is then the reading's alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub albedo_prime_stderr_fit: Option<f64>,
     /// The part of σ′s's uncertainty that comes from the anisotropy g (issue 15): how far the
     /// g-aware estimate moves over the stated range of g ([`MeasurementResult::g_uncertainty`]
     /// says which range and which g were evaluated) \[mm⁻¹\]; `Some(0)` when g was given, `None`
@@ -217,13 +223,12 @@ impl ChannelResult {
         })
     }
 
-    /// α′ with the spectrophotometer's standard error (the proposed method's α′ is the reading's)
-    /// and g's;
-    /// `None` without a value.
+    /// α′ with the spectrophotometer's standard error (the proposed method's α′ is the reading's),
+    /// the fit's (behind a port) and g's; `None` without a value.
     pub fn albedo_prime_estimate(&self) -> Option<Estimate> {
         self.albedo_prime.map(|value| Estimate {
             value,
-            fit: None,
+            fit: self.albedo_prime_stderr_fit,
             spectro: self.albedo_prime_stderr,
             g: self.albedo_prime_stderr_g,
         })
@@ -593,6 +598,7 @@ mod tests {
             sigma_a_stderr_g: None,
             albedo_prime_stderr_g: None,
             albedo_prime_stderr: None,
+            albedo_prime_stderr_fit: None,
             albedo_prime: Some(sp / (sp + sa)),
             rd_total: Some(0.5),
             scale: Some(2.0),

@@ -72,7 +72,7 @@ pub(crate) struct ChannelView {
     pub sigma_s_prime: Valued,
     /// σa \[mm⁻¹\].
     pub sigma_a: Valued,
-    /// α′ (its spectro term only).
+    /// α′ (the reading's term; the fit's too behind a spectrophotometer port).
     pub albedo_prime: Valued,
     /// Total diffuse reflectance of the channel from the spectrophotometer (linear sRGB).
     pub rd_total: Option<f64>,
@@ -183,7 +183,7 @@ fn channel(name: &'static str, c: &ChannelResult) -> ChannelView {
         },
         albedo_prime: Valued {
             value: c.albedo_prime,
-            fit: None,
+            fit: c.albedo_prime_stderr_fit,
             spectro: c.albedo_prime_stderr,
             g: c.albedo_prime_stderr_g,
         },
