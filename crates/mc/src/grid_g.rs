@@ -257,10 +257,10 @@ impl McGridSet {
     pub fn profile(&self, props: &OpticalProperties) -> Result<McGridProfile> {
         self.check_eta(props.eta(), props.g())?;
         Ok(match self.place(props.g())? {
-            Place::Node(k) => McGridProfile::Node(McProfile::new(&self.nodes[k], props)?),
+            Place::Node(k) => McGridProfile::Node(self.node_profile(k, props)?),
             Place::Between(k, t) => {
-                let lo = McProfile::new(&self.nodes[k], props)?;
-                let hi = McProfile::new(&self.nodes[k + 1], props)?;
+                let lo = self.node_profile(k, props)?;
+                let hi = self.node_profile(k + 1, props)?;
                 let rd_total = (1.0 - t) * lo.rd_total() + t * hi.rd_total();
                 McGridProfile::Between {
                     lo,
@@ -269,6 +269,21 @@ impl McGridSet {
                     rd_total,
                 }
             }
+        })
+    }
+
+    /// Node `k`'s model for `props`, continued beyond the node's radial range by the g = 0 node's
+    /// shape when the node's g is not 0 and the g = 0 node answers at these σ′s, σa and η
+    /// ([`McProfile::with_far_field`]).
+    fn node_profile(&self, k: usize, props: &OpticalProperties) -> Result<McProfile> {
+        let own = McProfile::new(&self.nodes[k], props)?;
+        let isotropic = &self.nodes[0];
+        if k == 0 || isotropic.g().abs() > G_NODE_TOLERANCE {
+            return Ok(own);
+        }
+        Ok(match McProfile::far_field_donor(isotropic, props) {
+            Ok(donor) => own.with_far_field(donor),
+            Err(_) => own,
         })
     }
 
@@ -352,6 +367,9 @@ fn total_of(weights: &[(&McTableSet, f64)], albedo_prime: f64, eta: f64) -> Resu
 }
 
 /// The grid's model for one parameter set: a node's [`McProfile`], or two interpolated in g.
+// Made once per residual evaluation of a fit and dropped after it: the variants differ by a
+// McProfile (about 200 bytes on the stack); boxing one would add a heap allocation per evaluation.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum McGridProfile {
     /// At a node of the grid.
@@ -462,8 +480,69 @@ mod tests {
             .with_g(0.8)
             .unwrap();
         let k = grid.g_nodes().iter().position(|&g| g == 0.8).unwrap();
-        let node = McProfile::new(&grid.nodes()[k], &p).unwrap();
+        let node = McProfile::new(&grid.nodes()[k], &p)
+            .unwrap()
+            .with_far_field(McProfile::far_field_donor(&grid.nodes()[0], &p).unwrap());
         assert_eq!(grid.profile(&p).unwrap(), McGridProfile::Node(node));
+    }
+
+    /// Beyond a g ≠ 0 node's radial range the profile is the g = 0 node's shape
+    /// ([`McProfile::with_far_field`]): continuous at the join (the two sides within 10⁻⁹), its
+    /// derivatives those of the continued model (central differences, also across the join's
+    /// dependence on σt), and equal there to a constant times the g = 0 model. At g = 0.95 and
+    /// σ′s = 3 mm⁻¹ the node's tables end at 8.3 mm (500/σt), the join at 6.7 mm. Also above the
+    /// g = 0 tables' last albedo (α′ 0.9999), where the donor holds its shape and decays at the true
+    /// albedo: continuous in α′ across that node.
+    #[test]
+    fn the_far_field_beyond_a_g_node_follows_the_isotropic_shape() {
+        let grid = McGridSet::bundled().unwrap();
+        let (sp, eta, g) = (3.0, 1.4, 0.95);
+        let model = |sp: f64, sa: f64, g: f64| {
+            let p = OpticalProperties::new(sp, sa, eta)
+                .unwrap()
+                .with_g(g)
+                .unwrap();
+            grid.profile(&p).unwrap()
+        };
+        for albedo in [0.9998, 0.99993] {
+            let sa = sp * (1.0 / albedo - 1.0);
+            let m = model(sp, sa, g);
+            let sigma_t = sa + sp / (1.0 - g);
+            let join = crate::model::FAR_FIELD_JOIN * 500.0 / sigma_t;
+            let (below, above) = (m.rd(join * (1.0 - 1e-12)), m.rd(join * (1.0 + 1e-12)));
+            assert!((above / below - 1.0).abs() < 1e-9, "{below} vs {above}");
+            if albedo < 0.9999 {
+                let iso = model(sp, sa, 0.0);
+                let c = m.rd(10.0) / iso.rd(10.0);
+                for r in [8.0, 15.0, 25.0, 40.0] {
+                    assert!((m.rd(r) / iso.rd(r) / c - 1.0).abs() < 1e-12, "r = {r}");
+                }
+            }
+            for r in [3.0, 6.0, 8.0, 20.0] {
+                let got = m.rd_with_derivatives(r);
+                let (h_sp, h_sa) = (1e-6 * sp, 1e-4 * sa);
+                let fd_sp =
+                    (model(sp + h_sp, sa, g).rd(r) - model(sp - h_sp, sa, g).rd(r)) / (2.0 * h_sp);
+                let fd_sa =
+                    (model(sp, sa + h_sa, g).rd(r) - model(sp, sa - h_sa, g).rd(r)) / (2.0 * h_sa);
+                // (σa is 10⁻⁴σ′s here: its step is relatively larger, the tolerance too.)
+                let tol = |fd: f64| 1e-4 * fd.abs() + 1e-7 * got.rd;
+                assert!(
+                    (got.d_sigma_s_prime - fd_sp).abs() <= tol(fd_sp),
+                    "α′ {albedo} ∂/∂σ′s r = {r}: {} vs {fd_sp}",
+                    got.d_sigma_s_prime
+                );
+                assert!(
+                    (got.d_sigma_a - fd_sa).abs() <= tol(fd_sa),
+                    "α′ {albedo} ∂/∂σa r = {r}: {} vs {fd_sa}",
+                    got.d_sigma_a
+                );
+            }
+        }
+        // Across the g = 0 tables' last albedo node (α′ 0.9999) the continued profile is continuous.
+        let at = |albedo: f64| model(sp, sp * (1.0 / albedo - 1.0), g).rd(20.0);
+        let (lo, hi) = (at(0.9999 - 1e-10), at(0.9999 + 1e-10));
+        assert!((hi / lo - 1.0).abs() < 1e-6, "{lo} vs {hi}");
     }
 
     /// A node whose tables stop short of η is refused by name: on a grid of the shipped g = 0 set

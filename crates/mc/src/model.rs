@@ -919,7 +919,29 @@ pub struct McProfile {
     rho_floor: f64,
     /// Outer radius of the Monte Carlo data at this albedo [mm].
     r_data_max: f64,
+    /// The tables' outer radial edge [mean free paths 1/σt of the set's g].
+    rho_max: f64,
     rd_total: f64,
+    /// Beyond a g ≠ 0 set's radial range, the g = 0 model's shape ([`McProfile::with_far_field`]).
+    far: Option<Box<FarField>>,
+}
+
+/// Where a g ≠ 0 set's profile hands over to the g = 0 model's shape, as a fraction of the set's
+/// outer radial edge (`McTableSpec::rho_max`, in its own mean free paths 1/σt): inside the data,
+/// clear of the last bins the smoother's end condition shapes.
+pub const FAR_FIELD_JOIN: f64 = 0.8;
+
+/// The continuation of a [`McProfile`] beyond its set's radial range (see
+/// [`McProfile::with_far_field`]): Rd(r) = c·Rd₀(r) for r > r_join, with c = Rd(r_join)/Rd₀(r_join).
+#[derive(Debug, Clone, PartialEq)]
+struct FarField {
+    /// The g = 0 model at the same σ′s, σa and η.
+    donor: McProfile,
+    /// The join radius [mm].
+    r_join: f64,
+    /// ln c and its derivatives in σ′s and σa (the join radius moves with σt: included).
+    ln_c: f64,
+    d_ln_c: [f64; 2],
 }
 
 impl McProfile {
@@ -928,6 +950,15 @@ impl McProfile {
     /// # Errors
     /// `OutOfTable` when η or the albedo a = σs/σt is outside the tables.
     pub fn new(set: &McTableSet, props: &OpticalProperties) -> Result<Self> {
+        Self::build(set, props, false)
+    }
+
+    /// [`McProfile::new`], or with `beyond_top` for an albedo above the set's last node: the
+    /// smoothed shape S (module docs) held at that node and the exact decay e^{−κ₀(a)ρ} at the true
+    /// albedo — the far-field donor of [`McProfile::with_far_field`], where the g = 0 set (nodes
+    /// to α′ 0.9999) must answer for g ≠ 0 sets that reach α′ 0.99995. Continuous at the node;
+    /// above it the shape's own change with a (which the decay dominates there) is left out.
+    fn build(set: &McTableSet, props: &OpticalProperties, beyond_top: bool) -> Result<Self> {
         let g = set.g();
         let sigma_s = props.sigma_s_prime() / (1.0 - g);
         let sigma_t = props.sigma_a() + sigma_s;
@@ -935,7 +966,13 @@ impl McProfile {
         let eta = props.eta();
         let (j, we) = set.eta_weights(eta)?;
         let t0 = &set.tables[0];
-        let (i, wa, dwa) = t0.albedo_weights(a)?;
+        let top = t0.albedos[t0.albedos.len() - 1];
+        let (i, wa, dwa) = if beyond_top && a > top {
+            let (i, wa, _) = t0.albedo_weights(top)?;
+            (i, wa, [0.0; 4])
+        } else {
+            t0.albedo_weights(a)?
+        };
         let m = t0.knots.len();
         let (mut coefs, mut dcoefs) = (vec![0.0; m], vec![0.0; m]);
         let mut rho_data = 0.0;
@@ -972,8 +1009,69 @@ impl McProfile {
             da_dsa: -sigma_s / st2,
             rho_floor: t0.spec.rho_min,
             r_data_max: rho_data / sigma_t,
-            rd_total: set.rd_total(a, eta)?,
+            rho_max: t0.spec.rho_max,
+            rd_total: set.rd_total(a.min(top), eta)?,
+            far: None,
         })
+    }
+
+    /// The far-field donor for [`McProfile::with_far_field`]: the g = 0 set's model at `props`,
+    /// answering above the set's last albedo node too (its shape held there, the decay exact).
+    ///
+    /// # Errors
+    /// As [`McProfile::new`] below the set's albedo range or outside its η range.
+    pub fn far_field_donor(set: &McTableSet, props: &OpticalProperties) -> Result<Self> {
+        Self::build(set, props, true)
+    }
+
+    /// The same model continued beyond its set's radial range by `donor`'s shape — the g = 0 set's
+    /// model at the same σ′s, σa and η: Rd(r) = c·Rd₀(r) for r beyond r_join =
+    /// [`FAR_FIELD_JOIN`]·ρ_max/σt, c making Rd continuous there.
+    ///
+    /// Why: every table spans ρ = σt·r up to ρ_max = 500 of its *own* mean free paths, which at
+    /// g = 0.9 and 0.95 is only 50 and 25 reduced ones (σ′t r) — 8 mm at σ′s = 3 mm⁻¹ for g 0.95,
+    /// inside the paper rig's 25 mm field, where at α′ → 1 the light still travels tens of
+    /// millimetres. Beyond, the smoother's extrapolation (a power law times e^{−κ₀ρ}) was 10–50 %
+    /// off (BENCHMARKS.md, "The far field beyond the g tables' radius"). The far field follows
+    /// similarity (in reduced units it is the same at every g: Wyman, Patterson & Wilson 1989;
+    /// d'Eon 2012 §4 for the diffusion asymptote), and the g = 0 set's tables reach 500 reduced mean
+    /// free paths, so its shape carries the profile on; the join's factor c keeps the g ≠ 0 set's
+    /// own amplitude (which the near field sets). Measured at nodes whose data reach past the join:
+    /// the continuation joined at 25–50 reduced mean free paths is within 2–5 % of g 0.5–0.8's own
+    /// data out to 100 (same section). The total is the set's own (tallied, not the profile's
+    /// integral). Unchanged where the donor does not answer.
+    #[must_use]
+    pub fn with_far_field(mut self, donor: McProfile) -> Self {
+        let r_join = FAR_FIELD_JOIN * self.rho_max / self.sigma_t;
+        if !(r_join.is_finite() && r_join > 0.0) || donor.sigma_t <= 0.0 {
+            return self;
+        }
+        let (own, d) = (
+            self.rd_with_derivatives(r_join),
+            donor.rd_with_derivatives(r_join),
+        );
+        if !(own.rd > 0.0 && d.rd > 0.0) {
+            return self;
+        }
+        // ∂ln Rd/∂r at the join, of each (σt ∂ln R̂/∂ρ − nothing else: Rd = σt² R̂(σt r)).
+        let slope = |m: &McProfile| m.sigma_t * m.ln_rhat(m.sigma_t * r_join).1;
+        let dr = slope(&self) - slope(&donor);
+        // r_join = J ρ_max/σt: ∂r_join/∂σ′s = −r_join ∂σt/∂σ′s / σt, ∂r_join/∂σa = −r_join/σt.
+        let dr_join = [
+            -r_join * self.dst_dsp / self.sigma_t,
+            -r_join / self.sigma_t,
+        ];
+        let d_ln_c = [
+            own.d_sigma_s_prime / own.rd - d.d_sigma_s_prime / d.rd + dr * dr_join[0],
+            own.d_sigma_a / own.rd - d.d_sigma_a / d.rd + dr * dr_join[1],
+        ];
+        self.far = Some(Box::new(FarField {
+            ln_c: own.rd.ln() - d.rd.ln(),
+            d_ln_c,
+            r_join,
+            donor,
+        }));
+        self
     }
 
     /// The optical properties of this model.
@@ -1013,6 +1111,16 @@ impl McProfile {
     /// Rd(r) with its derivatives in σ′s and σa.
     #[inline]
     pub fn rd_with_derivatives(&self, r_mm: f64) -> ProfileSample {
+        if let Some(f) = self.far.as_deref().filter(|f| r_mm > f.r_join) {
+            let d = f.donor.rd_with_derivatives(r_mm);
+            let c = f.ln_c.exp();
+            let rd = c * d.rd;
+            return ProfileSample {
+                rd,
+                d_sigma_s_prime: c * d.d_sigma_s_prime + rd * f.d_ln_c[0],
+                d_sigma_a: c * d.d_sigma_a + rd * f.d_ln_c[1],
+            };
+        }
         let st = self.sigma_t;
         let (l, l_rho, l_a) = self.ln_rhat(st * r_mm);
         let rd = st * st * l.exp();
@@ -1029,6 +1137,9 @@ impl McProfile {
 
 impl ProfileModel for McProfile {
     fn rd(&self, r_mm: f64) -> f64 {
+        if let Some(f) = self.far.as_deref().filter(|f| r_mm > f.r_join) {
+            return f.ln_c.exp() * f.donor.rd(r_mm);
+        }
         let st = self.sigma_t;
         st * st * self.ln_rhat(st * r_mm).0.exp()
     }

@@ -41,6 +41,9 @@ struct PortErrors {
     /// the port, [`reading_slope`]): how close to the truth any correction can come with this
     /// reading.
     reading_noise_sigma_a: [f64; 3],
+    /// Per channel, the corrected σa's reported total uncertainty (`Estimate::total`: fit ⊕
+    /// spectro, + g) over its value.
+    corrected_sigma_a_bar: [f64; 3],
 }
 
 /// σ′s's and σa's relative errors per channel, as [`errors`], on `rig` (its Monte Carlo profiles
@@ -119,6 +122,7 @@ fn errors_both(
     let reading = reading_for(read, m.eta).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let mut out = [[(0.0, 0.0); 3]; 3];
+    let mut corrected_sigma_a_bar = [f64::NAN; 3];
     for (k, with_port) in [false, true, false].into_iter().enumerate() {
         let folder = dir.path().join(format!("{name}-{k}"));
         write_twin(
@@ -140,6 +144,14 @@ fn errors_both(
                 ch.sigma_a.map_or(f64::NAN, |v| v / m.sigma_a[c] - 1.0),
             )
         });
+        if k == 1 {
+            corrected_sigma_a_bar = std::array::from_fn(|c| {
+                result.channels[scatterfit_optics::Channel::ALL[c]]
+                    .sigma_a_estimate()
+                    .and_then(|e| Some(e.total()? / e.value))
+                    .unwrap_or(f64::NAN)
+            });
+        }
         if let Some(p) = &meas.port {
             // The reflectance spectrum is corrected with the channels: R's F beyond 611 nm (held
             // there), never below the reading (F ≤ 1).
@@ -183,6 +195,7 @@ fn errors_both(
     PortErrors {
         errors: out,
         reading_noise_sigma_a,
+        corrected_sigma_a_bar,
     }
 }
 
@@ -541,13 +554,14 @@ fn port_study_paper() {
 /// material order, so a material has the same seed in both studies).
 fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Path>) {
     println!(
-        "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline | σa from the reading's noise (1 s.e.) |"
+        "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline | σa from the reading's noise (1 s.e.) | corrected σa's reported bar (total) |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     let pct = |x: f64| format!("{:+.1} %", 100.0 * x);
     for (ill, ap) in [(14.0, 8.0), (8.0, 8.0)] {
         let mut left = Vec::new();
         let mut truth = Vec::new();
+        let mut covered = Vec::new();
         for name in materials {
             let m = by_name(name).unwrap();
             let k = QUICK_STUDY_MATERIALS
@@ -558,7 +572,7 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
             let [raw, cor, base] = run.errors;
             for c in 0..3 {
                 println!(
-                    "| {ill} / {ap} mm | {name} | {} | {:.4} | {} / {} / {} | {} / {} / {} | ±{:.1} % |",
+                    "| {ill} / {ap} mm | {name} | {} | {:.4} | {} / {} / {} | {} / {} / {} | ±{:.1} % | ±{:.1} % |",
                     ["R", "G", "B"][c],
                     m.albedo_prime()[c],
                     pct(raw[c].0),
@@ -567,9 +581,14 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
                     pct(raw[c].1),
                     pct(cor[c].1),
                     pct(base[c].1),
-                    100.0 * run.reading_noise_sigma_a[c]
+                    100.0 * run.reading_noise_sigma_a[c],
+                    100.0 * run.corrected_sigma_a_bar[c]
                 );
                 truth.push((m.albedo_prime()[c], cor[c].0.abs(), cor[c].1.abs()));
+                covered.push((
+                    m.albedo_prime()[c],
+                    cor[c].1.abs() <= run.corrected_sigma_a_bar[c],
+                ));
                 left.push(((cor[c].0 - base[c].0).abs(), (cor[c].1 - base[c].1).abs()));
             }
         }
@@ -609,6 +628,17 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
             100.0 * sa[sa.len() / 2],
             100.0 * sa[sa.len() - 1],
             sa.len(),
+            in_range.len()
+        );
+        let in_range: Vec<bool> = covered
+            .iter()
+            .filter(|c| (0.3..=0.9999).contains(&c.0))
+            .map(|c| c.1)
+            .collect();
+        println!(
+            "port {ill}/{ap} mm: corrected σa within its reported total bar: {} of {} channels \
+             (α′ 0.3–0.9999)",
+            in_range.iter().filter(|&&c| c).count(),
             in_range.len()
         );
     }

@@ -4,7 +4,7 @@
 use scatterfit_mc::SimulationResult;
 use scatterfit_optics::ProfileModel;
 
-pub const WINDOWS: [(f64, f64); 7] = [
+pub const WINDOWS: [(f64, f64); 9] = [
     (0.1, 0.5),
     (0.5, 1.0),
     (1.0, 2.0),
@@ -12,6 +12,8 @@ pub const WINDOWS: [(f64, f64); 7] = [
     (5.0, 10.0),
     (10.0, 20.0),
     (20.0, 50.0),
+    (50.0, 100.0),
+    (100.0, 200.0),
 ];
 
 /// The model averaged over the annulus [a, b] (8-point Gauss–Legendre in ln r).
