@@ -41,8 +41,8 @@ struct PortErrors {
     /// the port, [`reading_slope`]): how close to the truth any correction can come with this
     /// reading.
     reading_noise_sigma_a: [f64; 3],
-    /// Per channel, the corrected σa's reported total uncertainty (`Estimate::total`: fit ⊕
-    /// spectro, + g) over its value.
+    /// Per channel, the corrected σa's reported statistical uncertainty (fit ⊕ spectro, without
+    /// the g term: the twin is isotropic, the manifest states no g) over its value.
     corrected_sigma_a_bar: [f64; 3],
 }
 
@@ -148,7 +148,9 @@ fn errors_both(
             corrected_sigma_a_bar = std::array::from_fn(|c| {
                 result.channels[scatterfit_optics::Channel::ALL[c]]
                     .sigma_a_estimate()
-                    .and_then(|e| Some(e.total()? / e.value))
+                    .and_then(|e| {
+                        Some(scatterfit_optics::Estimate { g: None, ..e }.total()? / e.value)
+                    })
                     .unwrap_or(f64::NAN)
             });
         }
@@ -554,7 +556,7 @@ fn port_study_paper() {
 /// material order, so a material has the same seed in both studies).
 fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Path>) {
     println!(
-        "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline | σa from the reading's noise (1 s.e.) | corrected σa's reported bar (total) |"
+        "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline | σa from the reading's noise (1 s.e.) | corrected σa's reported bar (fit ⊕ spectro) |"
     );
     println!("|---|---|---|---|---|---|---|---|");
     let pct = |x: f64| format!("{:+.1} %", 100.0 * x);
@@ -636,8 +638,8 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
             .map(|c| c.1)
             .collect();
         println!(
-            "port {ill}/{ap} mm: corrected σa within its reported total bar: {} of {} channels \
-             (α′ 0.3–0.9999)",
+            "port {ill}/{ap} mm: corrected σa within its reported bar (fit ⊕ spectro): {} of {} \
+             channels (α′ 0.3–0.9999)",
             in_range.iter().filter(|&&c| c).count(),
             in_range.len()
         );
