@@ -288,9 +288,10 @@ impl FixedPoint<'_> {
 /// material, and F grows with σ′t (the light leaves the aperture less), so a fitted σ′s one
 /// standard error high gives a larger F, a smaller corrected Rd, a smaller α′ and a larger σa. At
 /// α′ → 1 the reading hardly moves with α′ (d ln(Rd·F)/d ln(1 − α′) is −0.011 for pink plastic's
-/// red behind an 8 mm port lit over 8 mm, against d ln F/d ln σ′s = +0.37), so σa moves 30 times
-/// the fit's relative error (docs/physics.md §12): a fit term of s·σa, the loss-free one,
-/// understates it by that much. Here each term is half the spread of the whole measurement in the
+/// red behind an 8 mm port lit over 8 mm, against d ln F/d ln σ′s = +0.37), so with σ′s held σa
+/// would move 33 times the fit's relative error; the refit softens it (at fixed data a lower α′
+/// is fitted with a lower σ′s), and on the twins σa's term comes out 5–6 times the loss-free s·σa
+/// (docs/physics.md §12, BENCHMARKS.md). Here each term is half the spread of the whole measurement in the
 /// two worlds of [`PortCorrection::fit_pm`] — the fit's σ′s × (1 ∓ s) at every α′: the corrected
 /// Rd of that world, its α′, the refit there (σ′s, σa) and the factor 1 ∓ s on both — first-order
 /// propagation by central differences at ±1 standard error, as the spectrophotometer's term
