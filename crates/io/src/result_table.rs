@@ -150,10 +150,15 @@ fn spectro_errors_note(results: &[MeasurementResult]) -> String {
         return String::new();
     };
     let all_same = eps.iter().all(|&x| x == e);
+    let port = if results.iter().any(|r| r.spectro_port.is_some()) {
+        "; behind a spectrophotometer port carried through its reading fraction"
+    } else {
+        ""
+    };
     format!(
-        "Errors: value ± fit (the profile's noise, from the fit's Jacobian) ± spectrophotometer (η \
-         and α′ at the reading's repeatability of {}, propagated by refits); add them in \
-         quadrature for the total.\n",
+        "Errors: value ± fit (the profile's noise, from the fit's Jacobian{port}) ± \
+         spectrophotometer (η and α′ at the reading's repeatability of {}, propagated by refits); \
+         add them in quadrature for the total.\n",
         if all_same {
             format!("{:.2} %", 100.0 * e)
         } else {
