@@ -438,6 +438,35 @@ impl ProfileModel for McGridProfile {
 mod tests {
     use super::*;
 
+    /// `model`'s analytic ∂Rd/∂σ′s and ∂Rd/∂σa at (`sp`, `sa`) and radius `r` against central
+    /// differences with relative steps `h` (σ′s, σa), within `rel` of the difference (+ 10⁻⁷ Rd);
+    /// `what` prefixes the failure message.
+    fn assert_derivatives(
+        model: &dyn Fn(f64, f64) -> McGridProfile,
+        sp: f64,
+        sa: f64,
+        r: f64,
+        h: [f64; 2],
+        rel: f64,
+        what: &str,
+    ) {
+        let got = model(sp, sa).rd_with_derivatives(r);
+        let (h_sp, h_sa) = (h[0] * sp, h[1] * sa);
+        let fd_sp = (model(sp + h_sp, sa).rd(r) - model(sp - h_sp, sa).rd(r)) / (2.0 * h_sp);
+        let fd_sa = (model(sp, sa + h_sa).rd(r) - model(sp, sa - h_sa).rd(r)) / (2.0 * h_sa);
+        let tol = |fd: f64| rel * fd.abs() + 1e-7 * got.rd;
+        assert!(
+            (got.d_sigma_s_prime - fd_sp).abs() <= tol(fd_sp),
+            "{what}∂/∂σ′s r = {r}: {} vs {fd_sp}",
+            got.d_sigma_s_prime
+        );
+        assert!(
+            (got.d_sigma_a - fd_sa).abs() <= tol(fd_sa),
+            "{what}∂/∂σa r = {r}: {} vs {fd_sa}",
+            got.d_sigma_a
+        );
+    }
+
     /// Between g nodes the derivatives are those of the interpolant: they agree with central
     /// differences of the model itself (g = 0.85, between the shipped 0.8 and 0.9 sets, at η between
     /// tables); at a node the model is that node's `McProfile`, unchanged.
@@ -455,23 +484,8 @@ mod tests {
             let m = model(sp, sa);
             assert!(matches!(m, McGridProfile::Between { .. }));
             for r in [0.02, 0.3, 1.0, 4.0, 12.0] {
+                assert_derivatives(&model, sp, sa, r, [1e-6, 1e-6], 1e-5, "");
                 let got = m.rd_with_derivatives(r);
-                let (h_sp, h_sa) = (1e-6 * sp, 1e-6 * sa);
-                let fd_sp =
-                    (model(sp + h_sp, sa).rd(r) - model(sp - h_sp, sa).rd(r)) / (2.0 * h_sp);
-                let fd_sa =
-                    (model(sp, sa + h_sa).rd(r) - model(sp, sa - h_sa).rd(r)) / (2.0 * h_sa);
-                let tol = |fd: f64| 1e-5 * fd.abs() + 1e-7 * got.rd;
-                assert!(
-                    (got.d_sigma_s_prime - fd_sp).abs() <= tol(fd_sp),
-                    "∂/∂σ′s r = {r}: {} vs {fd_sp}",
-                    got.d_sigma_s_prime
-                );
-                assert!(
-                    (got.d_sigma_a - fd_sa).abs() <= tol(fd_sa),
-                    "∂/∂σa r = {r}: {} vs {fd_sa}",
-                    got.d_sigma_a
-                );
                 assert!((got.rd / m.rd(r) - 1.0).abs() < 1e-14);
             }
         }
@@ -519,24 +533,10 @@ mod tests {
                 }
             }
             for r in [3.0, 6.0, 8.0, 20.0] {
-                let got = m.rd_with_derivatives(r);
-                let (h_sp, h_sa) = (1e-6 * sp, 1e-4 * sa);
-                let fd_sp =
-                    (model(sp + h_sp, sa, g).rd(r) - model(sp - h_sp, sa, g).rd(r)) / (2.0 * h_sp);
-                let fd_sa =
-                    (model(sp, sa + h_sa, g).rd(r) - model(sp, sa - h_sa, g).rd(r)) / (2.0 * h_sa);
                 // (σa is 10⁻⁴σ′s here: its step is relatively larger, the tolerance too.)
-                let tol = |fd: f64| 1e-4 * fd.abs() + 1e-7 * got.rd;
-                assert!(
-                    (got.d_sigma_s_prime - fd_sp).abs() <= tol(fd_sp),
-                    "α′ {albedo} ∂/∂σ′s r = {r}: {} vs {fd_sp}",
-                    got.d_sigma_s_prime
-                );
-                assert!(
-                    (got.d_sigma_a - fd_sa).abs() <= tol(fd_sa),
-                    "α′ {albedo} ∂/∂σa r = {r}: {} vs {fd_sa}",
-                    got.d_sigma_a
-                );
+                let at_g = |sp: f64, sa: f64| model(sp, sa, g);
+                let what = format!("α′ {albedo} ");
+                assert_derivatives(&at_g, sp, sa, r, [1e-6, 1e-4], 1e-4, &what);
             }
         }
         // Across the g = 0 tables' last albedo node (α′ 0.9999) the continued profile is continuous.

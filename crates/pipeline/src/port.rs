@@ -331,23 +331,29 @@ pub fn propagate_fit_through_port(
             sigma_a: Some(f.report.sigma_a.value),
             scale: None,
         });
-        let world = |k: usize| -> Option<[f64; 3]> {
-            let a = albedo.albedo_from_rd(pm.rd[k], spectro.eta, 0.0).ok()?;
-            let input = ChannelInput {
+        let input = |k: usize| -> Option<ChannelInput> {
+            Some(ChannelInput {
                 eta: spectro.eta,
-                albedo_prime: Some(a),
+                albedo_prime: Some(albedo.albedo_from_rd(pm.rd[k], spectro.eta, 0.0).ok()?),
                 rd_total: Some(pm.rd[k]),
-            };
-            let r = PreparedFit::new(&data[c], &input, model, &FitOptions { start, ..opts })
-                .ok()?
-                .solve();
+            })
+        };
+        let values = |k: usize, r: scatterfit_fit::FitReport| {
             r.converged.then_some([
                 pm.scale[k] * r.sigma_s_prime.value,
                 pm.scale[k] * r.sigma_a.value,
-                a,
+                r.albedo_prime,
             ])
         };
-        if let (Some(lo), Some(hi)) = (world(0), world(1)) {
+        // One preparation (rings, spot kernel) for both refits, as `fit::propagate_spectro`.
+        let worlds = || -> Option<[[f64; 3]; 2]> {
+            let lo_fit =
+                PreparedFit::new(&data[c], &input(0)?, model, &FitOptions { start, ..opts })
+                    .ok()?;
+            let hi = values(1, lo_fit.with_input(&input(1)?, start).ok()?.solve())?;
+            Some([values(0, lo_fit.solve())?, hi])
+        };
+        if let Some([lo, hi]) = worlds() {
             let half = |i: usize| Some(0.5 * (hi[i] - lo[i]).abs()).filter(|v| v.is_finite());
             f.sigma_s_prime.fit = half(0).or(f.sigma_s_prime.fit);
             f.sigma_a.fit = half(1).or(f.sigma_a.fit);

@@ -303,6 +303,40 @@ fn an_8_mm_port_lit_over_14_mm_is_corrected() {
     }
 }
 
+/// The quick-rig twin of `m` (seed `seed`) and its spectrophotometer reading through an 8 mm port
+/// lit over 8 mm, traced by the engine with 10⁵ photons per channel (seeds `port_seed` + channel).
+fn quick_twin_behind_8_mm_port(
+    m: &scatterfit_synth::materials::PublishedMaterial,
+    seed: u64,
+    port_seed: u64,
+) -> (
+    scatterfit_synth::SyntheticSample,
+    scatterfit_optics::spectro::SpectroReading,
+) {
+    let s = synthesize(
+        m.name,
+        m.sigma_s_prime,
+        m.sigma_a,
+        m.eta,
+        &RigSpec::quick(),
+        seed,
+        None,
+        &|_, _, _| {},
+    )
+    .unwrap();
+    let port = Port::new(8.0, 8.0).unwrap();
+    let read: [f64; 3] = std::array::from_fn(|c| {
+        let layer =
+            Layer::new(m.sigma_a[c], m.sigma_s_prime[c], 0.0, m.eta, f64::INFINITY).unwrap();
+        let sample = Sample::new(vec![layer], 1.0, 1.0).unwrap();
+        simulate_port_reading(sample, &port, 100_000, port_seed + c as u64)
+            .unwrap()
+            .rd_read
+            .value
+    });
+    (s, reading_for(read, m.eta).unwrap())
+}
+
 /// The port-corrected α′'s uncertainty follows the reading through the correction
 /// (`pipeline::port::correct_port`): the readings × (1 ∓ ε) at η∓ go through the same fit ↔ F
 /// fixed point, so the bar is the corrected α′'s, not the loss-free inversion's of the corrected
@@ -318,28 +352,7 @@ fn an_8_mm_port_lit_over_14_mm_is_corrected() {
 fn the_port_corrected_albedo_error_follows_the_reading() {
     let m = by_name("wood-tile").unwrap();
     let rig = RigSpec::quick();
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        &rig,
-        5,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap();
-    let port = Port::new(8.0, 8.0).unwrap();
-    let read: [f64; 3] = std::array::from_fn(|c| {
-        let layer =
-            Layer::new(m.sigma_a[c], m.sigma_s_prime[c], 0.0, m.eta, f64::INFINITY).unwrap();
-        let sample = Sample::new(vec![layer], 1.0, 1.0).unwrap();
-        simulate_port_reading(sample, &port, 100_000, 50 + c as u64)
-            .unwrap()
-            .rd_read
-            .value
-    });
-    let reading = reading_for(read, m.eta).unwrap();
+    let (s, reading) = quick_twin_behind_8_mm_port(m, 5, 50);
     let eps = 0.005;
     let dir = tempfile::tempdir().unwrap();
     let measure = |k: usize, scale: f64| {
@@ -416,28 +429,7 @@ fn the_fit_error_reaches_the_port_corrected_values_through_f() {
     use scatterfit_optics::Channel;
     let m = by_name("pink-plastic").unwrap();
     let rig = RigSpec::quick();
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        &rig,
-        9,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap();
-    let port = Port::new(8.0, 8.0).unwrap();
-    let read: [f64; 3] = std::array::from_fn(|c| {
-        let layer =
-            Layer::new(m.sigma_a[c], m.sigma_s_prime[c], 0.0, m.eta, f64::INFINITY).unwrap();
-        let sample = Sample::new(vec![layer], 1.0, 1.0).unwrap();
-        simulate_port_reading(sample, &port, 100_000, 70 + c as u64)
-            .unwrap()
-            .rd_read
-            .value
-    });
-    let reading = reading_for(read, m.eta).unwrap();
+    let (s, reading) = quick_twin_behind_8_mm_port(m, 9, 70);
     let dir = tempfile::tempdir().unwrap();
     let measure = |k: usize, length_scale: f64| {
         let mut scaled = rig.clone();
