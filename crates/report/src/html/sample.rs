@@ -99,19 +99,23 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
          failed: no value to trust.</p></section>\n",
     );
 
-    // Table 1.
+    // Table 1. α′ has a fit term only behind a spectrophotometer port (the fit's error reaches
+    // the corrected α′ through the port's F); its column is shown when a channel has one.
+    let albedo_fit = view.channels.iter().any(|c| c.albedo_prime.fit.is_some());
     let _ = writeln!(
         p,
         "<section id=\"table1\"><h2>Table 1: parameters</h2><p>η = {} <span class=\"err\">{}</span> \
          (from {})</p><div class=\"scroll\"><table><thead><tr><th rowspan=\"2\">channel</th>\
-         <th colspan=\"4\">σ′s [mm⁻¹]</th><th colspan=\"4\">σa [mm⁻¹]</th><th colspan=\"3\">α′</th>\
+         <th colspan=\"4\">σ′s [mm⁻¹]</th><th colspan=\"4\">σa [mm⁻¹]</th><th colspan=\"{}\">α′</th>\
          <th rowspan=\"2\">Rd (spectro)</th></tr><tr><th>value</th><th>± fit</th><th>± spectro</th>\
          <th>± g</th><th>value</th><th>± fit</th><th>± spectro</th><th>± g</th><th>value</th>\
-         <th>± spectro</th><th>± g</th></tr>\
+         {}<th>± spectro</th><th>± g</th></tr>\
          </thead><tbody>",
         view.eta.value_text(),
         view.eta.error_text(),
-        name(&view.eta_source)
+        name(&view.eta_source),
+        if albedo_fit { 4 } else { 3 },
+        if albedo_fit { "<th>± fit</th>" } else { "" },
     );
     for c in &view.channels {
         let _ = writeln!(
@@ -120,13 +124,14 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
             c.name,
             valued_cells(&c.sigma_s_prime, true),
             valued_cells(&c.sigma_a, true),
-            valued_cells(&c.albedo_prime, false),
+            valued_cells(&c.albedo_prime, albedo_fit),
             opt(c.rd_total),
         );
     }
     p.push_str(
         "</tbody></table></div><p class=\"muted\">± terms are one standard error: fit, from the \
-         fit's Jacobian at the solution; spectro, the spectrophotometer's part (its η and α′ at the \
+         fit's Jacobian at the solution (behind a spectrophotometer port carried through its \
+         reading fraction, which also gives α′ a fit term); spectro, the spectrophotometer's part (its η and α′ at the \
          reading's repeatability, propagated through refits); g, the anisotropy's part (how far \
          the estimate moves over the range of g; 0 where g was given). The total is fit and spectro \
          in quadrature plus g (a bound, not a standard error).</p><h3>The fits</h3><div class=\"scroll\"><table><thead><tr><th>channel</th>\

@@ -251,3 +251,29 @@ fn the_sample_page_is_a_result_file_the_outputs_check_protects() {
     // pipeline::outputs guards (links, inputs, other samples' results) the files it lists.
     assert!(scatterfit_pipeline::outputs::RESULT_FILES.contains(&super::SAMPLE_PAGE));
 }
+
+/// Table 1 shows α′'s fit term (behind a spectrophotometer port, `albedo_prime_stderr_fit`) in a
+/// column of its own, and every row keeps as many cells as the header; without it, no column.
+#[test]
+fn table_1_shows_the_albedo_fit_term_when_there_is_one() {
+    let table = |page: &str| -> String {
+        let start = page.find("<section id=\"table1\"").expect("Table 1");
+        let end = start + page[start..].find("</table>").expect("its end");
+        page[start..end].to_string()
+    };
+    let mut r = hostile_result();
+    let without = table(&sample_html(&r, &SampleExtras::default()));
+    assert_eq!(without.matches("<th>± fit</th>").count(), 2, "{without}");
+    r.channels.r.albedo_prime_stderr_fit = Some(1.2345e-5);
+    let with = table(&sample_html(&r, &SampleExtras::default()));
+    assert_eq!(with.matches("<th>± fit</th>").count(), 3, "{with}");
+    assert!(
+        with.contains("1.234e-5") || with.contains("1.235e-5"),
+        "{with}"
+    );
+    // Header: channel, 4 + 4 + 4 value/term columns, Rd; each row the same 14 cells.
+    for row in with.split("<tr><th>").skip(1).filter(|r| r.contains("num")) {
+        let cells = row.matches("<td").count() + 1;
+        assert_eq!(cells, 14, "{row}");
+    }
+}
