@@ -9,7 +9,10 @@
 //! ```
 //! Reduced units: σ′t = 1 mm⁻¹, so r is in reduced mean free paths. With `G_TABLE=FILE` (a table
 //! built by `build_g_tables`, at this η and g), that table's profile and total are printed too, for
-//! a table not yet in the shipped grid (e.g. one with another albedo spacing).
+//! a table not yet in the shipped grid (e.g. one with another albedo spacing). With `FINE=1`, narrower
+//! windows over the far field (5–100 reduced mean free paths) too; with `ENGINE_CACHE=FILE`, the
+//! engine's run is kept in FILE (JSON) and read back on the next call, so that versions of the model
+//! can be compared with one costly run.
 
 #[path = "common/windows.rs"]
 mod windows;
@@ -28,7 +31,7 @@ fn main() {
     };
     let seed = args.get(4).map_or(1, |&s| s as u64);
     let edges: Vec<f64> = std::iter::once(0.0)
-        .chain((0..=60).map(|i| 0.1 * 500f64.powf(i as f64 / 60.0)))
+        .chain((0..=72).map(|i| 0.1 * 2000f64.powf(i as f64 / 72.0)))
         .collect();
     let grid = RadialGrid::from_edges(edges.clone()).expect("grid");
     let t0 = std::time::Instant::now();
@@ -37,9 +40,24 @@ fn main() {
         1.0,
     )
     .expect("sample");
-    let d = Simulation::new(half, Beam::pencil(), grid, photons as u64, seed)
-        .expect("simulation")
-        .run();
+    // `ENGINE_CACHE=FILE`: the engine's run is read from FILE when it exists, else written there
+    // (to compare several versions of the model with one costly run).
+    let cache = std::env::var_os("ENGINE_CACHE").map(std::path::PathBuf::from);
+    let cached = cache
+        .as_ref()
+        .and_then(|f| std::fs::read_to_string(f).ok())
+        .map(|s| {
+            serde_json::from_str::<scatterfit_mc::SimulationResult>(&s).expect("ENGINE_CACHE")
+        });
+    let d = cached.unwrap_or_else(|| {
+        let d = Simulation::new(half, Beam::pencil(), grid, photons as u64, seed)
+            .expect("simulation")
+            .run();
+        if let Some(f) = &cache {
+            std::fs::write(f, serde_json::to_string(&d).expect("json")).expect("ENGINE_CACHE");
+        }
+        d
+    });
     let bins = windows::engine_bins(&d, &edges);
     let p = OpticalProperties::new(a, 1.0 - a, eta)
         .and_then(|p| p.with_g(g))
@@ -54,6 +72,19 @@ fn main() {
         t0.elapsed().as_secs_f64(),
         windows(&m, &bins).replace(" [", "\n  [")
     );
+    if std::env::var_os("FINE").is_some() {
+        // Narrower windows over the far field (where a fit with α′ given finds σ′s at α′ → 1).
+        let fine: Vec<(f64, f64)> = [
+            5.0, 7.5, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0, 65.0, 80.0, 100.0,
+        ]
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .collect();
+        println!(
+            "fine:{}",
+            windows::windows_in(&m, &bins, &fine).replace(" [", "\n  [")
+        );
+    }
     if let Some(file) = std::env::var_os("G_TABLE") {
         let table = scatterfit_mc::McTable::load(std::path::Path::new(&file)).expect("G_TABLE");
         let set = scatterfit_mc::McTableSet::new(vec![table]).expect("a set of one table");

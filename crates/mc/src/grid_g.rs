@@ -504,13 +504,15 @@ mod tests {
     /// ([`McProfile::with_far_field`]): continuous at the join (the two sides within 10⁻⁹), its
     /// derivatives those of the continued model (central differences, also across the join's
     /// dependence on σt), and equal there to a constant times the g = 0 model. At g = 0.95 and
-    /// σ′s = 3 mm⁻¹ the node's tables end at 8.3 mm (500/σt), the join at 6.7 mm. Also above the
+    /// σ′s = 3 mm⁻¹ the node's tables end at 8.3 mm (500/σt), the join at 6.7 mm (0.8 of that);
+    /// at g = 0.8 they end at 33 mm and the join is at 20 reduced mean free paths, 6.7 mm, moving
+    /// with σ′t instead of σt (the derivatives check both). Also above the
     /// g = 0 tables' last albedo (α′ 0.9999), where the donor holds its shape and decays at the true
     /// albedo: continuous in α′ across that node.
     #[test]
     fn the_far_field_beyond_a_g_node_follows_the_isotropic_shape() {
         let grid = McGridSet::bundled().unwrap();
-        let (sp, eta, g) = (3.0, 1.4, 0.95);
+        let (sp, eta) = (3.0, 1.4);
         let model = |sp: f64, sa: f64, g: f64| {
             let p = OpticalProperties::new(sp, sa, eta)
                 .unwrap()
@@ -518,11 +520,14 @@ mod tests {
                 .unwrap();
             grid.profile(&p).unwrap()
         };
-        for albedo in [0.9998, 0.99993] {
+        for (g, albedo) in [(0.95, 0.9998), (0.95, 0.99993), (0.8, 0.9998)] {
             let sa = sp * (1.0 / albedo - 1.0);
             let m = model(sp, sa, g);
-            let sigma_t = sa + sp / (1.0 - g);
-            let join = crate::model::FAR_FIELD_JOIN * 500.0 / sigma_t;
+            // The nearer of the two joins, written out (`McProfile::far_field_join`).
+            let join = f64::min(
+                crate::model::FAR_FIELD_JOIN * 500.0 / (sa + sp / (1.0 - g)),
+                crate::model::FAR_FIELD_JOIN_REDUCED / (sp + sa),
+            );
             let (below, above) = (m.rd(join * (1.0 - 1e-12)), m.rd(join * (1.0 + 1e-12)));
             assert!((above / below - 1.0).abs() < 1e-9, "{below} vs {above}");
             if albedo < 0.9999 {
@@ -540,7 +545,7 @@ mod tests {
             }
         }
         // Across the g = 0 tables' last albedo node (α′ 0.9999) the continued profile is continuous.
-        let at = |albedo: f64| model(sp, sp * (1.0 / albedo - 1.0), g).rd(20.0);
+        let at = |albedo: f64| model(sp, sp * (1.0 / albedo - 1.0), 0.95).rd(20.0);
         let (lo, hi) = (at(0.9999 - 1e-10), at(0.9999 + 1e-10));
         assert!((hi / lo - 1.0).abs() < 1e-6, "{lo} vs {hi}");
     }

@@ -931,6 +931,15 @@ pub struct McProfile {
 /// clear of the last bins the smoother's end condition shapes.
 pub const FAR_FIELD_JOIN: f64 = 0.8;
 
+/// Where a g ≠ 0 set's profile hands over to the g = 0 model's shape at the latest, in reduced mean
+/// free paths 1/σ′t: the g ≠ 0 tables' own far field is reliable only to about there at α′ → 1
+/// (their photons need 1/(1 − g) times the interactions of g = 0 to get as far, and the smoother
+/// bends the noisy rows: at g 0.8, η 1.0, α′ 0.9999 within 0.1 % of a direct engine run to 20
+/// reduced mean free paths, then +0.7 … −1.9 % to 50 and −2 … −4 % beyond), while the shape of
+/// the g ≠ 0 profile differs from the g = 0 one by less than 0.2 % beyond it (BENCHMARKS.md, "The
+/// far field's join at 20 reduced mean free paths").
+pub const FAR_FIELD_JOIN_REDUCED: f64 = 20.0;
+
 /// The continuation of a [`McProfile`] beyond its set's radial range (see
 /// [`McProfile::with_far_field`]): Rd(r) = c·Rd₀(r) for r > r_join, with c = Rd(r_join)/Rd₀(r_join).
 #[derive(Debug, Clone, PartialEq)]
@@ -1025,8 +1034,9 @@ impl McProfile {
     }
 
     /// The same model continued beyond its set's radial range by `donor`'s shape — the g = 0 set's
-    /// model at the same σ′s, σa and η: Rd(r) = c·Rd₀(r) for r beyond r_join =
-    /// [`FAR_FIELD_JOIN`]·ρ_max/σt, c making Rd continuous there.
+    /// model at the same σ′s, σa and η: Rd(r) = c·Rd₀(r) for r beyond r_join — the nearer of
+    /// [`FAR_FIELD_JOIN`]·ρ_max/σt and [`FAR_FIELD_JOIN_REDUCED`]/σ′t
+    /// ([`McProfile::far_field_join`]) — c making Rd continuous there.
     ///
     /// Why: every table spans ρ = σt·r up to ρ_max = 500 of its *own* mean free paths, which at
     /// g = 0.9 and 0.95 is only 50 and 25 reduced ones (σ′t r) — 8 mm at σ′s = 3 mm⁻¹ for g 0.95,
@@ -1036,13 +1046,16 @@ impl McProfile {
     /// similarity (in reduced units it is the same at every g: Wyman, Patterson & Wilson 1989;
     /// d'Eon 2012 §4 for the diffusion asymptote), and the g = 0 set's tables reach 500 reduced mean
     /// free paths, so its shape carries the profile on; the join's factor c keeps the g ≠ 0 set's
-    /// own amplitude (which the near field sets). Measured at nodes whose data reach past the join:
-    /// the continuation joined at 25–50 reduced mean free paths is within 2–5 % of g 0.5–0.8's own
-    /// data out to 100 (same section). The total is the set's own (tallied, not the profile's
-    /// integral). Unchanged where the donor does not answer.
+    /// own amplitude (which the near field sets). And where a g ≠ 0 set's data do reach, they are
+    /// reliable only to about 20 reduced mean free paths at α′ → 1 ([`FAR_FIELD_JOIN_REDUCED`]): a
+    /// fit that weights the far field read σ′s 2–2.5 % low at g 0.8, α′ 0.9999 from the set's own
+    /// far field (BENCHMARKS.md, "The far field's join at 20 reduced mean free paths"). The total
+    /// is the set's own (tallied, not the profile's integral). Unchanged where the donor does not
+    /// answer.
     #[must_use]
     pub fn with_far_field(mut self, donor: McProfile) -> Self {
-        let r_join = FAR_FIELD_JOIN * self.rho_max / self.sigma_t;
+        let (r_join, reduced) = self.far_field_join();
+        let sigma_t_reduced = self.props.sigma_s_prime() + self.props.sigma_a();
         if !(r_join.is_finite() && r_join > 0.0) || donor.sigma_t <= 0.0 {
             return self;
         }
@@ -1057,10 +1070,15 @@ impl McProfile {
         let slope = |m: &McProfile| m.sigma_t * m.ln_rhat(m.sigma_t * r_join).1;
         let dr = slope(&self) - slope(&donor);
         // r_join = J ρ_max/σt: ∂r_join/∂σ′s = −r_join ∂σt/∂σ′s / σt, ∂r_join/∂σa = −r_join/σt.
-        let dr_join = [
-            -r_join * self.dst_dsp / self.sigma_t,
-            -r_join / self.sigma_t,
-        ];
+        // r_join = J′/σ′t (reduced) or J ρ_max/σt (the set's own range), moving with σ′s and σa.
+        let dr_join = if reduced {
+            [-r_join / sigma_t_reduced, -r_join / sigma_t_reduced]
+        } else {
+            [
+                -r_join * self.dst_dsp / self.sigma_t,
+                -r_join / self.sigma_t,
+            ]
+        };
         let d_ln_c = [
             own.d_sigma_s_prime / own.rd - d.d_sigma_s_prime / d.rd + dr * dr_join[0],
             own.d_sigma_a / own.rd - d.d_sigma_a / d.rd + dr * dr_join[1],
@@ -1072,6 +1090,19 @@ impl McProfile {
             donor,
         }));
         self
+    }
+
+    /// Where [`McProfile::with_far_field`] joins \[mm\], and whether it is the reduced radius
+    /// [`FAR_FIELD_JOIN_REDUCED`]/σ′t (else [`FAR_FIELD_JOIN`]·ρ_max/σt, the set's own range):
+    /// the nearer of the two.
+    pub fn far_field_join(&self) -> (f64, bool) {
+        let own_range = FAR_FIELD_JOIN * self.rho_max / self.sigma_t;
+        let reduced = FAR_FIELD_JOIN_REDUCED / (self.props.sigma_s_prime() + self.props.sigma_a());
+        if reduced < own_range {
+            (reduced, true)
+        } else {
+            (own_range, false)
+        }
     }
 
     /// The optical properties of this model.

@@ -38,8 +38,17 @@ fn annulus_average(m: &dyn ProfileModel, a: f64, b: f64) -> f64 {
 
 /// Prints windowed comparisons: per bin (r_lo, r_hi, reference value, its relative s.e.).
 pub fn windows(model: &dyn ProfileModel, bins: &[(f64, f64, f64, f64)]) -> String {
+    windows_in(model, bins, &WINDOWS)
+}
+
+/// [`windows`] over the given windows (r_lo, r_hi).
+pub fn windows_in(
+    model: &dyn ProfileModel,
+    bins: &[(f64, f64, f64, f64)],
+    list: &[(f64, f64)],
+) -> String {
     let mut line = String::new();
-    for (lo, hi) in WINDOWS {
+    for &(lo, hi) in list {
         let (mut sw, mut swd, mut chi2, mut n) = (0.0, 0.0, 0.0, 0);
         for &(a, b, v, rel) in bins {
             let c = 0.5 * (a + b);
