@@ -505,7 +505,7 @@ mod tests {
     /// derivatives those of the continued model (central differences, also across the join's
     /// dependence on σt), and equal there to a constant times the g = 0 model. At g = 0.95 and
     /// σ′s = 3 mm⁻¹ the node's tables end at 8.3 mm (500/σt), the join at 6.7 mm (0.8 of that);
-    /// at g = 0.8 they end at 33 mm and the join is at 20 reduced mean free paths, 6.7 mm, moving
+    /// at g = 0.8 they end at 33 mm and the join is at 25 reduced mean free paths, 8.3 mm, moving
     /// with σ′t instead of σt (the derivatives check both). Also above the
     /// g = 0 tables' last albedo (α′ 0.9999), where the donor holds its shape and decays at the true
     /// albedo: continuous in α′ across that node.
@@ -533,7 +533,7 @@ mod tests {
             if albedo < 0.9999 {
                 let iso = model(sp, sa, 0.0);
                 let c = m.rd(10.0) / iso.rd(10.0);
-                for r in [8.0, 15.0, 25.0, 40.0] {
+                for r in [9.0, 15.0, 25.0, 40.0] {
                     assert!((m.rd(r) / iso.rd(r) / c - 1.0).abs() < 1e-12, "r = {r}");
                 }
             }

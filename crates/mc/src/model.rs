@@ -934,11 +934,12 @@ pub const FAR_FIELD_JOIN: f64 = 0.8;
 /// Where a g ≠ 0 set's profile hands over to the g = 0 model's shape at the latest, in reduced mean
 /// free paths 1/σ′t: the g ≠ 0 tables' own far field is reliable only to about there at α′ → 1
 /// (their photons need 1/(1 − g) times the interactions of g = 0 to get as far, and the smoother
-/// bends the noisy rows: at g 0.8, η 1.0, α′ 0.9999 within 0.1 % of a direct engine run to 20
-/// reduced mean free paths, then +0.7 … −1.9 % to 50 and −2 … −4 % beyond), while the shape of
-/// the g ≠ 0 profile differs from the g = 0 one by less than 0.2 % beyond it (BENCHMARKS.md, "The
-/// far field's join at 20 reduced mean free paths").
-pub const FAR_FIELD_JOIN_REDUCED: f64 = 20.0;
+/// bends the noisy rows). Measured at g 0.8, η 1.0, α′ 0.9999 against a direct engine run
+/// (`g_point_check`, 2·10⁷ photons): the set's own profile is within 0.1 % to 20 reduced mean free
+/// paths, then +0.7 … −1.9 % to 50 and −2 … −4 % beyond; continued from 25 it is within 0.7 % to
+/// 100 (from 20: +0.9 … +1.5 %, the g = 0 shape not yet the g = 0.8 one there; from 30: within
+/// 1.0 %). BENCHMARKS.md, "The far field's join at 25 reduced mean free paths".
+pub const FAR_FIELD_JOIN_REDUCED: f64 = 25.0;
 
 /// The continuation of a [`McProfile`] beyond its set's radial range (see
 /// [`McProfile::with_far_field`]): Rd(r) = c·Rd₀(r) for r > r_join, with c = Rd(r_join)/Rd₀(r_join).
@@ -1047,9 +1048,9 @@ impl McProfile {
     /// d'Eon 2012 §4 for the diffusion asymptote), and the g = 0 set's tables reach 500 reduced mean
     /// free paths, so its shape carries the profile on; the join's factor c keeps the g ≠ 0 set's
     /// own amplitude (which the near field sets). And where a g ≠ 0 set's data do reach, they are
-    /// reliable only to about 20 reduced mean free paths at α′ → 1 ([`FAR_FIELD_JOIN_REDUCED`]): a
+    /// reliable only to about 25 reduced mean free paths at α′ → 1 ([`FAR_FIELD_JOIN_REDUCED`]): a
     /// fit that weights the far field read σ′s 2–2.5 % low at g 0.8, α′ 0.9999 from the set's own
-    /// far field (BENCHMARKS.md, "The far field's join at 20 reduced mean free paths"). The total
+    /// far field (BENCHMARKS.md, "The far field's join at 25 reduced mean free paths"). The total
     /// is the set's own (tallied, not the profile's integral). Unchanged where the donor does not
     /// answer.
     #[must_use]
