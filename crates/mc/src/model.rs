@@ -1057,8 +1057,7 @@ impl McProfile {
     /// answer.
     #[must_use]
     pub fn with_far_field(mut self, donor: McProfile) -> Self {
-        let (r_join, reduced) = self.far_field_join();
-        let sigma_t_reduced = self.props.sigma_s_prime() + self.props.sigma_a();
+        let (r_join, dr_join) = self.far_field_join();
         if !(r_join.is_finite() && r_join > 0.0) || donor.sigma_t <= 0.0 {
             return self;
         }
@@ -1072,16 +1071,6 @@ impl McProfile {
         // ∂ln Rd/∂r at the join, of each (σt ∂ln R̂/∂ρ − nothing else: Rd = σt² R̂(σt r)).
         let slope = |m: &McProfile| m.sigma_t * m.ln_rhat(m.sigma_t * r_join).1;
         let dr = slope(&self) - slope(&donor);
-        // r_join = J ρ_max/σt: ∂r_join/∂σ′s = −r_join ∂σt/∂σ′s / σt, ∂r_join/∂σa = −r_join/σt.
-        // r_join = J′/σ′t (reduced) or J ρ_max/σt (the set's own range), moving with σ′s and σa.
-        let dr_join = if reduced {
-            [-r_join / sigma_t_reduced, -r_join / sigma_t_reduced]
-        } else {
-            [
-                -r_join * self.dst_dsp / self.sigma_t,
-                -r_join / self.sigma_t,
-            ]
-        };
         let d_ln_c = [
             own.d_sigma_s_prime / own.rd - d.d_sigma_s_prime / d.rd + dr * dr_join[0],
             own.d_sigma_a / own.rd - d.d_sigma_a / d.rd + dr * dr_join[1],
@@ -1095,16 +1084,20 @@ impl McProfile {
         self
     }
 
-    /// Where [`McProfile::with_far_field`] joins \[mm\], and whether it is the reduced radius
-    /// [`FAR_FIELD_JOIN_REDUCED`]/σ′t (else [`FAR_FIELD_JOIN`]·ρ_max/σt, the set's own range):
-    /// the nearer of the two.
-    pub fn far_field_join(&self) -> (f64, bool) {
+    /// Where [`McProfile::with_far_field`] joins \[mm\] — the nearer of the reduced radius
+    /// [`FAR_FIELD_JOIN_REDUCED`]/σ′t and [`FAR_FIELD_JOIN`]·ρ_max/σt (the set's own range) — with
+    /// its derivatives in σ′s and σa (the join moves with the coefficients).
+    pub fn far_field_join(&self) -> (f64, [f64; 2]) {
         let own_range = FAR_FIELD_JOIN * self.rho_max / self.sigma_t;
-        let reduced = FAR_FIELD_JOIN_REDUCED / (self.props.sigma_s_prime() + self.props.sigma_a());
+        let sigma_t_reduced = self.props.sigma_s_prime() + self.props.sigma_a();
+        let reduced = FAR_FIELD_JOIN_REDUCED / sigma_t_reduced;
         if reduced < own_range {
-            (reduced, true)
+            // r = J′/σ′t with σ′t = σ′s + σa.
+            (reduced, [-reduced / sigma_t_reduced; 2])
         } else {
-            (own_range, false)
+            // r = J ρ_max/σt with ∂σt/∂σ′s = 1/(1 − g), ∂σt/∂σa = 1.
+            let per_sigma_t = -own_range / self.sigma_t;
+            (own_range, [per_sigma_t * self.dst_dsp, per_sigma_t])
         }
     }
 

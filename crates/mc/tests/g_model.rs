@@ -73,9 +73,21 @@ fn engine_in(
 
 /// MCML's reflected fraction per window and its photon count.
 fn mcml(g: f64, eta: f64, ap: f64) -> (Vec<f64>, f64) {
-    let mut w = vec![0.0; WINDOWS.len() - 1];
+    mcml_in(
+        include_str!("../../../data/reference/mcml_profiles_g.csv"),
+        &WINDOWS,
+        g,
+        eta,
+        ap,
+    )
+}
+
+/// MCML's reflected fraction per window between `edges` for the case (g, η, α′) of the reference
+/// table `csv` (`mcml_profiles_g.csv`'s columns), and its photon count.
+fn mcml_in(csv: &str, edges: &[f64], g: f64, eta: f64, ap: f64) -> (Vec<f64>, f64) {
+    let mut w = vec![0.0; edges.len() - 1];
     let mut photons = 0.0;
-    for line in include_str!("../../../data/reference/mcml_profiles_g.csv").lines() {
+    for line in csv.lines() {
         if line.starts_with('#') || line.starts_with('g') {
             continue;
         }
@@ -85,8 +97,7 @@ fn mcml(g: f64, eta: f64, ap: f64) -> (Vec<f64>, f64) {
         }
         photons = v[3];
         let (lo, hi, rd) = (v[6], v[7], v[8]);
-        if let Some(k) =
-            (0..w.len()).find(|&k| lo >= WINDOWS[k] - 1e-9 && hi <= WINDOWS[k + 1] + 1e-9)
+        if let Some(k) = (0..w.len()).find(|&k| lo >= edges[k] - 1e-9 && hi <= edges[k + 1] + 1e-9)
         {
             w[k] += rd * std::f64::consts::PI * (hi * hi - lo * lo);
         }
@@ -354,22 +365,15 @@ fn between_g_nodes_matches_a_fresh_engine_run() {
 fn the_far_field_at_weak_absorption_matches_mcml() {
     let (g, eta, ap) = (0.8, 1.0, 0.9999);
     let edges = [0.0, 10.0, 25.0, 40.0, 60.0, 97.5];
-    let mut reference = vec![0.0; edges.len() - 1];
-    let mut n_mcml = 0.0;
-    for line in include_str!("../../../data/reference/mcml_far_field_g.csv").lines() {
-        if line.starts_with('#') || line.starts_with('g') {
-            continue;
-        }
-        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
-        assert_eq!((v[0], v[1], v[2]), (g, eta, ap), "one case in the file");
-        n_mcml = v[3];
-        let (lo, hi, rd) = (v[6], v[7], v[8]);
-        if let Some(k) =
-            (0..reference.len()).find(|&k| lo >= edges[k] - 1e-9 && hi <= edges[k + 1] + 1e-9)
-        {
-            reference[k] += rd * std::f64::consts::PI * (hi * hi - lo * lo);
-        }
-    }
+    let csv = include_str!("../../../data/reference/mcml_far_field_g.csv");
+    let rows = csv
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('g'));
+    assert!(
+        rows.clone().count() == 39 && rows.clone().all(|l| l.starts_with("0.8,1.0,0.9999,")),
+        "one case in the file, 39 bins"
+    );
+    let (reference, n_mcml) = mcml_in(csv, &edges, g, eta, ap);
     let n = 100_000;
     let (short, _) = engine_in(&edges, g, eta, ap, n, 7);
     let m = family(ModelName::Mc)
