@@ -473,6 +473,23 @@ fn study_and_the_mc_model() {
         assert_eq!(out.code, 2, "--g {g}: {}", out.stderr);
         assert!(out.stderr.contains(says), "--g {g}: {}", out.stderr);
     }
+    // So is a photon scale that is no count of photons, in `study` and in `synth`.
+    for scale in ["0", "-2", "5000"] {
+        for cmd in ["study", "synth"] {
+            let mut args = vec![cmd, "--photon-scale", scale, "-o", "bad-scale", "--quiet"];
+            if cmd == "synth" {
+                args.extend(["--material", "nephrite"]);
+            }
+            let out = run_cached(d, &args);
+            assert_eq!(out.code, 2, "{cmd} --photon-scale {scale}: {}", out.stderr);
+            assert!(
+                out.stderr.contains("--photon-scale") && out.stderr.contains("[0.01, 1000]"),
+                "{cmd} --photon-scale {scale}: {}",
+                out.stderr
+            );
+            assert!(!d.join("bad-scale").exists(), "{cmd}: made its folder");
+        }
+    }
 
     synth_quick(d, "wood-tile", "w");
     let out = run_cached(d, &["measure", "w", "--model", "mc", "--json", "--quiet"]);

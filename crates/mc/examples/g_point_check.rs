@@ -72,14 +72,15 @@ fn main() {
         t0.elapsed().as_secs_f64(),
         windows(&m, &bins).replace(" [", "\n  [")
     );
-    if std::env::var_os("FINE").is_some() {
-        // Narrower windows over the far field (where a fit with α′ given finds σ′s at α′ → 1).
-        let fine: Vec<(f64, f64)> = [
-            5.0, 7.5, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0, 65.0, 80.0, 100.0,
-        ]
-        .windows(2)
-        .map(|w| (w[0], w[1]))
-        .collect();
+    // Narrower windows over the far field (where a fit with α′ given finds σ′s at α′ → 1).
+    let fine: Vec<(f64, f64)> = [
+        5.0, 7.5, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0, 65.0, 80.0, 100.0,
+    ]
+    .windows(2)
+    .map(|w| (w[0], w[1]))
+    .collect();
+    let fine_wanted = std::env::var_os("FINE").is_some();
+    if fine_wanted {
         println!(
             "fine:{}",
             windows::windows_in(&m, &bins, &fine).replace(" [", "\n  [")
@@ -96,5 +97,11 @@ fn main() {
             (t.rd_total() - d.rd_total.value) / d.rd_total.stderr,
             windows(&t, &bins).replace(" [", "\n  [")
         );
+        if fine_wanted {
+            println!(
+                "fine:{}",
+                windows::windows_in(&t, &bins, &fine).replace(" [", "\n  [")
+            );
+        }
     }
 }

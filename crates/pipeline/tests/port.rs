@@ -518,7 +518,8 @@ const QUICK_STUDY_MATERIALS: [&str; 10] = [
 /// and ten times its photons), for the materials whose light travels farthest — where the quick
 /// rig's own baseline is off because its 12.8 mm field is too small. Materials from
 /// `$PORT_MATERIALS` (comma-separated; default: those with a channel at α′ ≥ 0.97), profiles cached
-/// in `$PORT_CACHE` when set (so the second port reuses the twins). Prints the same table as
+/// in `$PORT_CACHE` when set (so the second port reuses the twins), the twins' photons × `$PORT_TWIN_SCALE`
+/// (default 1). Prints the same table as
 /// [`port_study`]; about 2–4 min per material on a shared 2-core machine.
 #[test]
 #[ignore = "study: the paper-rig table (PORT_MATERIALS=a,b cargo test --release -p scatterfit-pipeline --test port port_study_paper -- --ignored --nocapture)"]
@@ -541,7 +542,15 @@ fn port_study_paper() {
     );
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
     let cache = std::env::var_os("PORT_CACHE").map(std::path::PathBuf::from);
-    port_study_on(&names, &RigSpec::paper(), cache.as_deref());
+    // `$PORT_TWIN_SCALE`: the twins' Monte Carlo photons × that (their own noise ∝ 1/√scale).
+    let scale = std::env::var("PORT_TWIN_SCALE").map_or(1.0, |v| {
+        v.parse::<f64>()
+            .unwrap_or_else(|_| panic!("PORT_TWIN_SCALE={v}: not a number"))
+    });
+    let rig = RigSpec::paper()
+        .with_photon_scale(scale)
+        .expect("PORT_TWIN_SCALE in [0.01, 1000]");
+    port_study_on(&names, &rig, cache.as_deref());
 }
 
 /// Prints the port study's table for `materials` on `rig` (seeds 20, 21, … in the quick study's
