@@ -1,6 +1,6 @@
 //! `scatterfit table`: builds (or shows) a cached Monte Carlo table for one η and g — the table the
 //! `mc` forward model uses (`scatterfit_mc::McTable`: a white Monte Carlo run smoothed per albedo;
-//! the tables shipped with scatterfit for g = 0 are such tables, with the default photons) — and can
+//! the tables shipped with scatterfit for g = 0 are such tables, `McTableSpec::shipped`) — and can
 //! write it to a file.
 
 use std::path::PathBuf;
@@ -24,14 +24,15 @@ pub struct Args {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
     pub g: f64,
     /// Number of albedo nodes (equally spaced in √(1 − a) from a = 0.02 to 0.9999): a count, 4 to
-    /// 1000.
-    #[arg(long, default_value = "64", value_parser = crate::numeric::parse_size)]
-    pub albedos: usize,
+    /// 1000 (default 64; without --albedos and --photons a g = 0 table is built exactly as the
+    /// shipped ones: 128 albedos, 4·10⁶ full-length photons, 4× and 8× as many in the shorter
+    /// strata, a seed per η — 2–8 min on two cores).
+    #[arg(long, value_parser = crate::numeric::parse_size)]
+    pub albedos: Option<usize>,
     /// Full-length photons: a count ≥ 1; 4× and 16× as many photons trace the paths shorter than
-    /// 1024 and 64 interactions. The default is the shipped tables' (1–2 min on two cores at g = 0);
-    /// the expected work must fit --max-interactions.
-    #[arg(long, default_value = "2e6", value_parser = crate::numeric::parse_count)]
-    pub photons: u64,
+    /// 1024 and 64 interactions (default 2e6); the expected work must fit --max-interactions.
+    #[arg(long, value_parser = crate::numeric::parse_count)]
+    pub photons: Option<u64>,
     /// A coarse table that builds in seconds (20 000 full-length photons, the default albedos);
     /// overrides --photons and --albedos. Enough for g = 0 and 0.5; at g ≳ 0.7 the lowest albedos
     /// then reflect too little light to smooth: use --photons 2e5 or more.
@@ -59,8 +60,13 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Most albedo nodes of a table: far more than interpolation needs (the default is 64).
+/// Most albedo nodes of a table: far more than interpolation needs.
 const MAX_ALBEDOS: usize = 1000;
+
+/// Albedo nodes and full-length photons of a table built with other settings than the shipped
+/// g = 0 ones (`McTableSpec::new`'s layout).
+const DEFAULT_ALBEDOS: usize = 64;
+const DEFAULT_PHOTONS: u64 = 2_000_000;
 
 /// Checks the flags' ranges, then the spec's expected work and memory, before anything is built.
 fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
@@ -77,21 +83,22 @@ fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
         );
     }
     if !args.coarse {
-        if !(4..=MAX_ALBEDOS).contains(&args.albedos) {
-            bail!(
-                "--albedos {}: a table has 4 to {MAX_ALBEDOS} albedos",
-                args.albedos
-            );
+        if let Some(n) = args.albedos
+            && !(4..=MAX_ALBEDOS).contains(&n)
+        {
+            bail!("--albedos {n}: a table has 4 to {MAX_ALBEDOS} albedos");
         }
-        if args.photons == 0 {
+        if args.photons == Some(0) {
             bail!("--photons 0: trace at least one photon");
         }
     }
     let spec = if args.coarse {
         McTableSpec::coarse(args.eta, args.g)
+    } else if args.g == 0.0 && args.albedos.is_none() && args.photons.is_none() {
+        McTableSpec::shipped(args.eta)
     } else {
-        McTableSpec::new(args.eta, args.g, args.photons).map(|mut s| {
-            s.albedo_count = args.albedos;
+        McTableSpec::new(args.eta, args.g, args.photons.unwrap_or(DEFAULT_PHOTONS)).map(|mut s| {
+            s.albedo_count = args.albedos.unwrap_or(DEFAULT_ALBEDOS);
             s
         })
     }

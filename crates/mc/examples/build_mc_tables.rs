@@ -1,20 +1,24 @@
-//! Builds the `mc` model's tables for a list of η (g = 0, the default layout) and writes each in
-//! compact form (no raw profiles) as `OUT_DIR/mc-white-eta<η>.json`, the files `McTableSet::bundled`
-//! embeds. Prints build time, interactions and the smoothing χ² per table.
+//! Builds the `mc` model's g = 0 tables for a list of η with the shipped layout
+//! ([`McTableSpec::shipped`]: 128 albedos, 4·10⁶ full-length photons, a seed per η) and writes each
+//! in compact form (no raw profiles) as `OUT_DIR/mc-white-eta<η>.json`, the files
+//! `McTableSet::bundled` embeds. Prints build time, interactions and the smoothing χ² per table.
 //!
-//! Run: `cargo run --release -p scatterfit-mc --example build_mc_tables -- OUT_DIR PHOTONS ETA...`
-//! (PHOTONS is the full-length stratum; the shorter strata get 4× and 16× as many).
+//! Run: `cargo run --release -p scatterfit-mc --example build_mc_tables -- OUT_DIR ETA...`
+//! (the shipped set: η 1.0, 1.05, 1.1, 1.2, …, 2.5; 2–8 min per table on two cores).
 
 use scatterfit_mc::model::{McTable, McTableSpec};
 use scatterfit_mc::white::simulate;
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let out = std::path::PathBuf::from(&args[1]);
-    let photons: u64 = args[2].parse::<f64>().expect("photons") as u64;
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some((out, etas)) = args.split_first() else {
+        eprintln!("usage: build_mc_tables OUT_DIR ETA...");
+        std::process::exit(2);
+    };
+    let out = std::path::PathBuf::from(out);
     std::fs::create_dir_all(&out).expect("output folder");
-    for eta in args[3..].iter().map(|s| s.parse::<f64>().expect("η")) {
-        let spec = McTableSpec::new(eta, 0.0, photons).expect("spec");
+    for eta in etas.iter().map(|s| s.parse::<f64>().expect("η")) {
+        let spec = McTableSpec::shipped(eta).expect("spec");
         let t0 = std::time::Instant::now();
         let tally = simulate(&spec.white().expect("white spec"), &|_| {}).expect("simulate");
         let secs = t0.elapsed().as_secs_f64();

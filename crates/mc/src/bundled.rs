@@ -1,13 +1,13 @@
 //! The `mc` model's tables shipped inside the crate, so that a measurement never waits for a
 //! simulation: g = 0, η ∈ {1.0, 1.05, 1.1, 1.2, 1.3, …, 2.4, 2.5} (17 tables, 0.1 apart and 0.05 near 1,
 //! where total internal reflection sets in; with 0.2 spacing Catmull-Rom in η was measured up to
-//! 0.7 % off a table built at η = 1.33 itself, BENCHMARKS.md), each the default layout of
-//! [`McTableSpec::new`] with
-//! 2·10⁶ full-length photons (and 8·10⁶ / 3.2·10⁷ in the shorter strata), in compact form
-//! ([`McTable::compact`]). Made by
-//! `cargo run --release -p scatterfit-mc --example build_mc_tables -- crates/mc/tables 2e6 <η…>`.
+//! 0.7 % off a table built at η = 1.33 itself, BENCHMARKS.md), each with the layout of
+//! [`McTableSpec::shipped`] (128 albedo nodes, 4·10⁶ full-length photons and 1.6·10⁷ / 3.2·10⁷ in
+//! the shorter strata, a seed per η), in compact form ([`McTable::compact`]). Made by
+//! `cargo run --release -p scatterfit-mc --example build_mc_tables -- crates/mc/tables <η…>`
+//! (rebuilt 2026-11-27 from 64 nodes and 2·10⁶ photons: BENCHMARKS.md, "The g = 0 tables rebuilt").
 //!
-//! [`McTableSpec::new`]: crate::model::McTableSpec::new
+//! [`McTableSpec::shipped`]: crate::model::McTableSpec::shipped
 
 use crate::error::{McError, Result};
 use crate::grid_g::McGridSet;

@@ -110,6 +110,31 @@ impl McTableSpec {
         )
     }
 
+    /// The layout of the g = 0 tables shipped with the crate (`crates/mc/tables/`, rebuilt
+    /// 2026-11-27): the default one with 128 albedo nodes instead of 64 (√(1 − a) spacing 0.0078),
+    /// 4·10⁶ full-length photons, 1.6·10⁷ stopped at 1024 interactions and 3.2·10⁷ at 64, and the
+    /// seed 1000 + round(100 η), so that the tables' Monte Carlo noise is independent from one η to
+    /// the next. Why (BENCHMARKS.md, "The g = 0 tables rebuilt"): between the 64 nodes' last two
+    /// (α′ 0.99935–0.9999) Catmull-Rom put the far field 1–2 % low beyond 30 mean free paths — the
+    /// light a spectrophotometer's port loses, and the g ≠ 0 model's continuation past its join
+    /// ([`crate::model::McProfile::far_field_join`]) — and the full-length stratum's 2·10⁶ photons,
+    /// one seed for every η, left the totals near α′ = 1 a few 10⁻⁴ off together.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for η < 1.
+    pub fn shipped(eta: f64) -> Result<Self> {
+        let mut spec = Self::with_strata(
+            eta,
+            0.0,
+            vec![32_000_000, 16_000_000, 4_000_000],
+            vec![64, 1024],
+        )?;
+        spec.albedo_count = 128;
+        spec.seed = 1000 + (100.0 * eta).round() as u64;
+        spec.white()?;
+        Ok(spec)
+    }
+
     /// The default layout with explicit strata (`photons[k]` photons, separated at `bounds`).
     ///
     /// # Errors

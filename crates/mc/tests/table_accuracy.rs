@@ -1,6 +1,6 @@
 //! Accuracy of Monte Carlo table lookups between the tabulated albedos and radii: the table that
-//! `scatterfit table --eta 1.4` builds and `--model mc` uses (the shipped η = 1.4 table, the default
-//! layout of `McTableSpec::new`: 64 albedos, 216 radial bins, 2·10⁶ full-length photons), looked up
+//! `scatterfit table --eta 1.4` builds and `--model mc` uses (the shipped η = 1.4 table,
+//! `McTableSpec::shipped`: 128 albedos, 216 radial bins, 4·10⁶ full-length photons), looked up
 //! through `McProfile`, against direct simulations of the MCML engine (an independent tracer: implicit
 //! capture and roulette instead of the white run's albedo weights) at off-node α′ and on radial grids
 //! whose bins fall between the table's; and its total Rd and α′ inversion against adding-doubling
@@ -26,10 +26,7 @@ fn table() -> &'static McTable {
     T.get_or_init(|| {
         let set = scatterfit_mc::bundled_tables().unwrap();
         let t = set.tables().iter().find(|t| t.spec().eta == ETA).unwrap();
-        assert_eq!(
-            t.spec(),
-            &scatterfit_mc::McTableSpec::new(ETA, 0.0, 2_000_000).unwrap()
-        );
+        assert_eq!(t.spec(), &scatterfit_mc::McTableSpec::shipped(ETA).unwrap());
         t.clone()
     })
 }
