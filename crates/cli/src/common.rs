@@ -283,6 +283,51 @@ pub struct SamplesArgs {
     pub jobs: JobsArgs,
 }
 
+/// The twins' Monte Carlo photons × a factor (`synth`, `study`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct PhotonScaleArgs {
+    /// Monte Carlo photons of every twin channel × this factor, 0.01–1000 (default 1): a twin's
+    /// own noise (its profile's and its reading's) falls as 1/√factor at factor times its Monte
+    /// Carlo time. At α′ ≥ 0.999 the paper rig's twins carry noise that reaches σ′s and σa at
+    /// 1–2.5 %, so a study that is to resolve the method's error there needs 10–20.
+    #[arg(
+        long,
+        value_name = "FACTOR",
+        default_value_t = 1.0,
+        allow_negative_numbers = true,
+        value_parser = parse_photon_scale
+    )]
+    pub photon_scale: f64,
+}
+
+impl PhotonScaleArgs {
+    /// `rig` with the photons scaled (the factor was checked when parsed).
+    pub fn apply(
+        &self,
+        rig: scatterfit_synth::RigSpec,
+    ) -> anyhow::Result<scatterfit_synth::RigSpec> {
+        Ok(rig.with_photon_scale(self.photon_scale)?)
+    }
+}
+
+/// Parses `--photon-scale`: a finite number in [`scatterfit_synth::rig::PHOTON_SCALE_RANGE`].
+///
+/// # Errors
+/// A message for clap.
+fn parse_photon_scale(text: &str) -> Result<f64, String> {
+    let v = crate::numeric::parse_finite(text)?;
+    let range = scatterfit_synth::rig::PHOTON_SCALE_RANGE;
+    if range.contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "must lie in [{}, {}] (1 is the rig's own photon count)",
+            range.start(),
+            range.end()
+        ))
+    }
+}
+
 /// How many samples are measured at once (`batch`, `compare`, `demo`, `study`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct JobsArgs {

@@ -22,7 +22,7 @@ use scatterfit_pipeline::study::{
     study_sample, summary_markdown,
 };
 
-use crate::common::{JobsArgs, cache_dir};
+use crate::common::{JobsArgs, PhotonScaleArgs, cache_dir};
 use crate::output::{errln, out, outln};
 use crate::twin::{Material, synthesize_on, write_sample};
 
@@ -60,18 +60,8 @@ pub struct Args {
     /// Seed of the rig twin.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Monte Carlo photons of every twin × this factor, 0.01–1000 (default 1). A twin's own noise
-    /// falls as 1/√factor at factor times its Monte Carlo time: at α′ ≥ 0.999 the paper rig's
-    /// twins carry noise that reaches σ′s and σa at 1–2.5 %, so a study that is to resolve the
-    /// method's error there needs 10–20.
-    #[arg(
-        long,
-        value_name = "FACTOR",
-        default_value_t = 1.0,
-        allow_negative_numbers = true,
-        value_parser = crate::numeric::parse_finite
-    )]
-    pub photon_scale: f64,
+    #[command(flatten)]
+    pub photons: PhotonScaleArgs,
     #[command(flatten)]
     pub jobs: JobsArgs,
     /// Leave out photon beam diffusion (its fits take milliseconds, not microseconds).
@@ -120,12 +110,6 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
         bail!(
             "--g: {} is given twice; give each g once",
             crate::numeric::show(args.g[k])
-        );
-    }
-    if !(0.01..=1000.0).contains(&args.photon_scale) {
-        bail!(
-            "--photon-scale {}: must lie in [0.01, 1000] (1 is the rig's own photon count)",
-            crate::numeric::show(args.photon_scale)
         );
     }
     if !(0.2..=20.0).contains(&args.sigma_t_prime) {
@@ -195,9 +179,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             scatterfit_synth::RigSpec::paper()
         };
         rig.g = sample.twin_g();
-        let rig = rig
-            .with_photon_scale(args.photon_scale)
-            .context("--photon-scale")?;
+        let rig = args.photons.apply(rig)?;
         let s = synthesize_on(&m, &rig, args.seed, cache.as_deref(), quiet)?;
         write_sample(&sample.dir, &s)?;
     }
@@ -259,16 +241,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // A padded triple repeats its last albedo: keep one row per grid point and configuration.
     dedup(&mut rows);
     let twins = format!(
-        "Twins: the {} rig, seed {}, {} the default Monte Carlo photons (a twin's own noise goes as \
+        "Twins: the {} rig, seed {}, {}× the default Monte Carlo photons (a twin's own noise goes as \
          1/√ of that; at α′ ≥ 0.999 it reaches σ′s and σa at 1–2.5 % with the default, \
          `--photon-scale` raises it).\n\n",
         if args.quick { "quick" } else { "paper's" },
         args.seed,
-        if args.photon_scale == 1.0 {
-            "1×".to_owned()
-        } else {
-            format!("{}×", args.photon_scale)
-        }
+        args.photons.photon_scale
     );
     let summary = if g_axis {
         let mut t = format!(

@@ -53,16 +53,8 @@ pub struct Args {
     /// and for tests; not for accuracy studies.
     #[arg(long)]
     pub quick: bool,
-    /// Monte Carlo photons per channel × this factor, 0.01–1000 (default 1): the twin's own noise
-    /// (its profile's and its reading's) falls as 1/√factor at factor times the Monte Carlo time.
-    #[arg(
-        long,
-        value_name = "FACTOR",
-        default_value_t = 1.0,
-        allow_negative_numbers = true,
-        value_parser = crate::numeric::parse_finite
-    )]
-    pub photon_scale: f64,
+    #[command(flatten)]
+    pub photons: crate::common::PhotonScaleArgs,
     /// The material's Henyey–Greenstein anisotropy g, in [0, 0.95] (default 0, isotropic): the
     /// profile and the spectrophotometer's reading are traced with it (σs = σ′s/(1 − g)). It goes
     /// into truth.json, never into the manifest: the twin plays a user who does not know g. A g of
@@ -195,15 +187,7 @@ fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
         "the twin's Henyey–Greenstein g must lie in [0, 0.95]",
     )?;
     rig.g = args.g;
-    crate::numeric::ensure(
-        (0.01..=1000.0).contains(&args.photon_scale),
-        "--photon-scale",
-        args.photon_scale,
-        "must lie in [0.01, 1000] (1 is the rig's own photon count)",
-    )?;
-    let mut rig = rig
-        .with_photon_scale(args.photon_scale)
-        .context("--photon-scale")?;
+    let mut rig = args.photons.apply(rig)?;
     rig.camera = scatterfit_synth::CameraModel::named(&args.camera)
         .with_context(|| format!("--camera {}: unknown", args.camera))?;
     if let Some(e) = args.read_noise {

@@ -46,9 +46,14 @@ pub fn study_figure(rows: &[Row], combos: &[Combo]) -> Figure {
                     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
                     Series {
                         label: format!("η = {e}"),
-                        points: pts,
                         errors: None,
-                        style: SeriesStyle::Line,
+                        // A line needs two points: a one-albedo study shows its points as markers.
+                        style: if pts.len() > 1 {
+                            SeriesStyle::Line
+                        } else {
+                            SeriesStyle::Measured
+                        },
+                        points: pts,
                         colour: Some((shade(base.0), shade(base.1), shade(base.2))),
                     }
                 })

@@ -38,6 +38,9 @@ mod camera;
 
 pub use camera::{CameraModel, SensorOutput, ToneCurve};
 
+/// The photon scales [`RigSpec::with_photon_scale`] takes.
+pub const PHOTON_SCALE_RANGE: std::ops::RangeInclusive<f64> = 0.01..=1000.0;
+
 /// The geometry, exposures and camera of the twin.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RigSpec {
@@ -146,9 +149,9 @@ impl RigSpec {
     /// the method's error there needs a larger scale, not a better model.
     ///
     /// # Errors
-    /// [`SynthError::InvalidParameter`] unless `scale` lies in [0.01, 1000].
+    /// [`SynthError::InvalidParameter`] unless `scale` lies in [`PHOTON_SCALE_RANGE`].
     pub fn with_photon_scale(mut self, scale: f64) -> Result<Self, SynthError> {
-        if !(0.01..=1000.0).contains(&scale) {
+        if !PHOTON_SCALE_RANGE.contains(&scale) {
             return Err(SynthError::InvalidParameter {
                 name: "photon scale",
                 value: scale,
