@@ -130,15 +130,15 @@ impl From<MethodArg> for Method {
 /// The forward model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum ModelArg {
-    /// The classical dipole, Jensen et al. 2001 (the paper's).
+    /// The classical dipole, Jensen et al. 2001 (the paper's; approximate).
     Dipole,
     /// d'Eon 2012, "A better dipole".
     BetterDipole,
     /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (slow: ~2 ms per
     /// evaluation).
     Pbd,
-    /// Monte Carlo tables shipped with scatterfit (exact transport, Henyey–Greenstein g 0–0.95
-    /// with --g or `[fit] g`; η 1.0–2.5; α′ up to 0.9999, and from 0.2 at g ≠ 0).
+    /// Monte Carlo tables shipped with scatterfit (exact transport; the default). Henyey–Greenstein
+    /// g 0–0.95 with --g or `[fit] g`; η 1.0–2.5; α′ up to 0.9999, and from 0.2 at g ≠ 0.
     Mc,
 }
 
@@ -177,7 +177,9 @@ pub struct FitArgs {
     /// The fitting method (default: the manifest's `fit.method`, else proposed).
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
-    /// The forward model (default: the manifest's `fit.model`, else dipole).
+    /// The forward model (default: the manifest's `fit.model`, else mc — exact transport; `dipole`
+    /// is the paper's, whose bias reaches tens of percent: its error then joins the bars as the
+    /// ± model term).
     #[arg(long, value_enum)]
     pub model: Option<ModelArg>,
     /// How α′ comes from the spectrophotometer's Rd (default: the manifest's `fit.albedo_model`,

@@ -118,7 +118,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let crate::runner::Comparison {
         pairs,
         dirs: pair_dirs,
-        exacts,
+        papers,
         failed,
     } = crate::runner::compare_dirs(
         &dirs,
@@ -129,7 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         true,
     )?;
     let measure_s = t1.elapsed().as_secs_f64();
-    let rows = scatterfit_pipeline::accuracy::accuracy_rows(&pairs, &exacts, &truths);
+    let rows = scatterfit_pipeline::accuracy::accuracy_rows(&pairs, &papers, &truths);
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
     let out = &args.output_dir;
     let accuracy = scatterfit_report::accuracy_markdown(&rows);
@@ -143,7 +143,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         out,
         "scatterfit demo: the seven materials of Choi, Lee & Chin (2014)",
         "Monte Carlo rig-twin samples of the paper's seven materials, measured with the proposed \
-         method (dipole); the truth is in each sample's truth.json, the errors against it in \
+         method and the exact forward model (Monte Carlo tables); the paper's dipole fits are in \
+         accuracy.md beside them; the truth is in each sample's truth.json, the errors against it in \
          accuracy.md. The sample's name opens its report: verdict, Table 1, Figures 4 and 6, the \
          evidence and the inputs.",
         &proposed,

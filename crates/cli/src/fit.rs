@@ -34,8 +34,8 @@ pub struct Args {
     /// The fitting method.
     #[arg(long, value_enum, default_value_t = MethodArg::Proposed)]
     pub method: MethodArg,
-    /// The forward model.
-    #[arg(long, value_enum, default_value_t = ModelArg::Dipole)]
+    /// The forward model (mc, exact transport, by default; dipole is the paper's).
+    #[arg(long, value_enum, default_value_t = ModelArg::Mc)]
     pub model: ModelArg,
     /// Diameter of the light spot \[mm\], in (0, 20]; the model is convolved with it.
     #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]

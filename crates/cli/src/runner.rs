@@ -102,18 +102,18 @@ pub struct Comparison {
     pub pairs: Vec<Pair>,
     /// Each pair's folder.
     pub dirs: Vec<PathBuf>,
-    /// Per pair, the exact fit (empty without `exact`).
-    pub exacts: Vec<Option<MeasurementResult>>,
+    /// Per pair, the paper's fit (the dipole, α′ from its total; empty without `paper`).
+    pub papers: Vec<Option<MeasurementResult>>,
     /// The samples that failed, with why.
     pub failed: Failures,
 }
 
 /// Measures `dirs` once and fits each both ways ([`scatterfit_pipeline::compare`]); writes
 /// compare.svg/png into each sample folder (and, with `write_results`, the proposed measurement's
-/// result files as `measure` does, its report.html with Figure 6); with `exact` each sample is also
-/// fitted beyond the paper (the Monte Carlo forward model with α′ from the Monte Carlo total; `None`
-/// where that fit cannot run). Returns the pairs with their folders, the exact fits (empty without
-/// `exact`) and the samples that failed.
+/// result files as `measure` does, its report.html with Figure 6); with `paper` each sample is also
+/// fitted with the paper's own model ([`scatterfit_pipeline::compare::paper_settings`]; `None` where
+/// that fit cannot run). Returns the pairs with their folders, the paper's fits (empty without
+/// `paper`) and the samples that failed.
 ///
 /// # Errors
 /// Only when the worker threads cannot start.
@@ -123,42 +123,42 @@ pub fn compare_dirs(
     jobs: usize,
     quiet: bool,
     write_results: bool,
-    exact: bool,
+    paper: bool,
 ) -> anyhow::Result<Comparison> {
     let bar = progress(dirs.len(), quiet);
     let request = BatchRequest::new(dirs.iter().cloned(), *overrides).jobs(jobs);
     let batch = compare_batch_with(
         request,
-        exact,
+        paper,
         &|dir, compared| -> Compared {
             let c = compared.map_err(|e| {
                 let e = anyhow::Error::from(e).context(format!("measuring {}", dir.display()));
                 crate::common::error_text(&e)
             })?;
             let problems = scatterfit_report::write_comparison(dir, &c, write_results);
-            let exact = c
-                .exact
+            let paper = c
+                .paper
                 .and_then(Result::ok)
                 .map(|m| m.to_result(Some("profile.csv")));
             let pair = (
                 c.existing.to_result(Some("profile.csv")),
                 c.proposed.to_result(Some("profile.csv")),
             );
-            Ok((pair, exact, problems))
+            Ok((pair, paper, problems))
         },
         &|e| on_event(e, &bar, quiet),
     )?;
     bar.finish_and_clear();
-    let (mut pairs, mut exacts, mut failed) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut pairs, mut papers, mut failed) = (Vec::new(), Vec::new(), Vec::new());
     let mut pair_dirs = Vec::new();
     for s in batch.samples {
         match s.outcome {
-            Ok((pair, exact_fit, problems)) => {
+            Ok((pair, paper_fit, problems)) => {
                 failed.extend(problems.into_iter().map(|p| (s.dir.clone(), p)));
                 pairs.push(pair);
                 pair_dirs.push(s.dir);
-                if exact {
-                    exacts.push(exact_fit);
+                if paper {
+                    papers.push(paper_fit);
                 }
             }
             Err(e) => failed.push((s.dir, e)),
@@ -167,7 +167,7 @@ pub fn compare_dirs(
     Ok(Comparison {
         pairs,
         dirs: pair_dirs,
-        exacts,
+        papers,
         failed,
     })
 }

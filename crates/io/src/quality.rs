@@ -76,6 +76,21 @@ pub enum ReasonKind {
     FitFailed,
     /// The data do not constrain a parameter.
     Unconstrained,
+    /// The spectrophotometer port's edge-loss correction could not be made for the channel: its
+    /// α′ (and so σa) would be the uncorrected reading's.
+    PortNotCorrected,
+    /// The profile's own reduced albedo (its shape under exact transport) disagrees with the
+    /// spectrophotometer's beyond both their errors: another sample's reading, a wrong port, a
+    /// profile from elsewhere.
+    AlbedoDisagrees,
+    /// The manifest's L*a*b* disagrees with the colour of the spectrum beside it.
+    LabDisagrees,
+    /// An approximate forward model does not describe the profile (its χ²/dof against exact
+    /// transport's), or its error could not be evaluated.
+    ModelError,
+    /// A frame of the bracket that the merged radiance does not predict (a frame from elsewhere,
+    /// a gain or light changed during the bracket).
+    FrameDisagrees,
 }
 
 /// One finding of a check.

@@ -56,7 +56,12 @@ pub fn value_with_errors(c: &ChannelResult, v: Option<Estimate>, name: &str) -> 
     if c.unconstrained.iter().any(|u| u == name) {
         return "unconstrained".into();
     }
-    let g = |e: &Estimate| e.g.map_or(String::new(), |g| format!(" ± {} g", sig4(g)));
+    // The systematic terms, each named: the anisotropy's and an approximate model's.
+    let g = |e: &Estimate| {
+        e.g.map_or(String::new(), |g| format!(" ± {} g", sig4(g)))
+            + &e.model
+                .map_or(String::new(), |m| format!(" ± {} model", sig4(m)))
+    };
     match v {
         Some(
             e @ Estimate {
@@ -96,6 +101,17 @@ pub fn sigma_cells(c: &ChannelResult) -> [String; 2] {
 /// spectrophotometer's part or the g term), with how g entered each result (issue 15).
 pub fn errors_note(results: &[MeasurementResult]) -> String {
     let mut t = spectro_errors_note(results);
+    if results.iter().any(|r| {
+        r.channels
+            .iter()
+            .any(|c| c.sigma_s_prime_stderr_model.is_some())
+    }) {
+        t.push_str(
+            "± … model: an approximate forward model's part — how far the estimate moves to exact \
+             transport's (the Monte Carlo tables) on the same data; a bound, not a standard error: \
+             add it to the quadrature sum of the others for the total.\n",
+        );
+    }
     let with_g: Vec<&MeasurementResult> = results
         .iter()
         .filter(|r| r.g_uncertainty.is_some())
@@ -230,7 +246,8 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
          albedo_prime,rd_total,eta,method,model,fit_time_s,iterations,mse_mm-4,rms_log_residual,\
          chi2_reduced,rings_used,rings_inside_spot,rings_below_detection,problem,\
          sigma_s_prime_stderr_spectro,sigma_a_stderr_spectro,albedo_prime_stderr,eta_stderr,\
-         sigma_s_prime_stderr_g,sigma_a_stderr_g,albedo_prime_stderr_g,albedo_prime_stderr_fit\n",
+         sigma_s_prime_stderr_g,sigma_a_stderr_g,albedo_prime_stderr_g,albedo_prime_stderr_fit,\
+         sigma_s_prime_stderr_model,sigma_a_stderr_model,albedo_prime_stderr_model\n",
     );
     for r in results {
         for (ch, c) in r.channels.iter_channels() {
@@ -242,7 +259,7 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
             };
             let _ = writeln!(
                 t,
-                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 csv_text(&r.name),
                 num(c.sigma_s_prime, 6),
                 num(c.sigma_s_prime_stderr, 6),
@@ -270,6 +287,9 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 num(c.sigma_a_stderr_g, 8),
                 num(c.albedo_prime_stderr_g, 6),
                 num(c.albedo_prime_stderr_fit, 6),
+                num(c.sigma_s_prime_stderr_model, 6),
+                num(c.sigma_a_stderr_model, 8),
+                num(c.albedo_prime_stderr_model, 6),
             );
         }
     }

@@ -41,6 +41,13 @@ pub struct Estimate {
     /// given (known); `None` when it could not be evaluated (the tables do not reach the data)
     /// or was not asked for.
     pub g: Option<f64>,
+    /// The part from an approximate forward model (a diffusion dipole, photon beam diffusion):
+    /// how far the estimate moves to exact transport's (the `mc` tables' profile and α′) on the
+    /// same data, |approximate − exact| (`scatterfit_pipeline::model_term`). Like the g term a
+    /// bounded systematic, added linearly. `None` with the exact model itself, or where exact
+    /// transport could not be evaluated (the channel is then suspect).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<f64>,
 }
 
 impl Estimate {
@@ -80,9 +87,20 @@ impl Estimate {
         }
     }
 
-    /// The known terms, in the order fit, spectro, g.
+    /// The same value with an approximate model's term ([`Estimate::model`]).
+    #[must_use]
+    pub fn with_model(self, term: f64) -> Self {
+        Self {
+            model: Some(term),
+            ..self
+        }
+    }
+
+    /// The known terms, in the order fit, spectro, g, model.
     pub fn terms(&self) -> impl Iterator<Item = f64> {
-        [self.fit, self.spectro, self.g].into_iter().flatten()
+        [self.fit, self.spectro, self.g, self.model]
+            .into_iter()
+            .flatten()
     }
 
     /// The total uncertainty: the standard errors added in quadrature, then the g term added
@@ -102,10 +120,12 @@ impl Estimate {
     /// systematic and a random error; a quadrature sum lets the bar fall short of the end of the
     /// range it claims to cover). Measured on rig twins over g ∈ {0, 0.5, 0.8, 0.9, 0.95}: the
     /// linear sum covers 89 % of 180 values (81–100 % per g), the quadrature sum 81 % (BENCHMARKS.md,
-    /// "The g term: coverage when g is not known"). `None` when no term is known: the uncertainty is
-    /// then unknown, not zero.
+    /// "The g term: coverage when g is not known"). An approximate model's term
+    /// ([`Estimate::model`]) is a systematic of the same kind and is added linearly too. `None`
+    /// when no term is known: the uncertainty is then unknown, not zero.
     pub fn total(&self) -> Option<f64> {
-        if self.fit.is_none() && self.spectro.is_none() && self.g.is_none() {
+        if self.fit.is_none() && self.spectro.is_none() && self.g.is_none() && self.model.is_none()
+        {
             return None;
         }
         let statistical = [self.fit, self.spectro]
@@ -114,7 +134,7 @@ impl Estimate {
             .map(|t| t * t)
             .sum::<f64>()
             .sqrt();
-        Some(statistical + self.g.unwrap_or(0.0))
+        Some(statistical + self.g.unwrap_or(0.0) + self.model.unwrap_or(0.0))
     }
 }
 
@@ -131,8 +151,12 @@ mod tests {
             fit: Some(3.0),
             spectro: Some(4.0),
             g: Some(12.0),
+            model: None,
         };
         assert_eq!(e.total(), Some(17.0));
+        // An approximate model's term is a bounded systematic like g's: added linearly.
+        assert_eq!(e.with_model(2.0).total(), Some(19.0));
+        assert_eq!(Estimate::new(7.0).with_model(0.25).total(), Some(0.25));
         assert_eq!(Estimate::new(7.0).with_g(0.5).total(), Some(0.5));
         assert_eq!(
             Estimate::new(7.0).with_fit(3.0).with_spectro(4.0).total(),

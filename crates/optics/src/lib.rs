@@ -44,7 +44,7 @@ mod diffusion;
 mod dual;
 mod error;
 mod properties;
-mod roots;
+pub mod roots;
 
 pub use error::{OpticsError, Result};
 pub use estimate::Estimate;

@@ -8,7 +8,7 @@
 /// Finds x in [lo, hi] with f(x) = 0 by the Illinois variant of regula falsi (Dowell & Jarratt 1971,
 /// "A modified regula falsi method", BIT 11), which keeps the bracket and converges superlinearly.
 /// Returns `None` when f(lo) and f(hi) have the same sign or are not finite.
-pub(crate) fn bracketed_root<F: Fn(f64) -> f64>(f: F, lo: f64, hi: f64, x_tol: f64) -> Option<f64> {
+pub fn bracketed_root<F: Fn(f64) -> f64>(f: F, lo: f64, hi: f64, x_tol: f64) -> Option<f64> {
     let (mut a, mut b) = (lo, hi);
     let (mut fa, mut fb) = (f(a), f(b));
     if !(fa.is_finite() && fb.is_finite()) || fa * fb > 0.0 {

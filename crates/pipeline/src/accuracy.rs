@@ -1,6 +1,7 @@
 //! The demo's accuracy table: rig-twin samples measured by the proposed and the existing method
-//! (and, beyond the paper, exactly: the Monte Carlo model with α′ from the Monte Carlo total),
-//! each value beside the truth the twin was made with (`truth.json`, [`Truth`]).
+//! (with the measurement's forward model, exact transport by default) and by the paper's own fit
+//! (the dipole, α′ from its total), each value beside the truth the twin was made with
+//! (`truth.json`, [`Truth`]).
 
 use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_optics::Channel;
@@ -37,14 +38,15 @@ pub struct ChannelRow {
     pub existing_sigma_s_prime_error: Option<f64>,
     /// Relative error of the existing σa.
     pub existing_sigma_a_error: Option<f64>,
-    /// Beyond the paper: the Monte Carlo forward model, α′ from the Monte Carlo total.
-    pub exact_sigma_s_prime: Option<f64>,
-    /// σa of the exact fit \[mm⁻¹\].
-    pub exact_sigma_a: Option<f64>,
-    /// Relative error of the exact σ′s.
-    pub exact_sigma_s_prime_error: Option<f64>,
-    /// Relative error of the exact σa.
-    pub exact_sigma_a_error: Option<f64>,
+    /// The paper's own fit (the dipole, α′ from the dipole's total, proposed method): σ′s
+    /// \[mm⁻¹\].
+    pub paper_sigma_s_prime: Option<f64>,
+    /// σa of the paper's fit \[mm⁻¹\].
+    pub paper_sigma_a: Option<f64>,
+    /// Relative error of the paper's σ′s.
+    pub paper_sigma_s_prime_error: Option<f64>,
+    /// Relative error of the paper's σa.
+    pub paper_sigma_a_error: Option<f64>,
 }
 
 /// One material of the demo's accuracy table.
@@ -52,6 +54,8 @@ pub struct ChannelRow {
 pub struct MaterialRow {
     /// The material.
     pub name: String,
+    /// The forward model of the measurement (the proposed and existing columns).
+    pub model: String,
     /// The twin's η.
     pub eta_true: f64,
     /// η from the spectrophotometer.
@@ -64,12 +68,12 @@ fn rel(found: Option<f64>, truth: f64) -> Option<f64> {
     found.map(|f| f / truth - 1.0)
 }
 
-/// The accuracy table's rows: each compared sample ((existing, proposed) results, and the exact
+/// The accuracy table's rows: each compared sample ((existing, proposed) results, and the paper's
 /// fit where it ran) beside its rig twin's truth, matched by name; samples without a truth are
 /// left out.
 pub fn accuracy_rows(
     pairs: &[(MeasurementResult, MeasurementResult)],
-    exacts: &[Option<MeasurementResult>],
+    papers: &[Option<MeasurementResult>],
     truths: &[Truth],
 ) -> Vec<MaterialRow> {
     pairs
@@ -77,9 +81,10 @@ pub fn accuracy_rows(
         .enumerate()
         .filter_map(|(i, (e, p))| {
             let t = truths.iter().find(|t| t.name == p.name)?;
-            let x = exacts.get(i).and_then(Option::as_ref);
+            let x = papers.get(i).and_then(Option::as_ref);
             Some(MaterialRow {
                 name: p.name.clone(),
+                model: p.model.name().to_owned(),
                 eta_true: t.eta,
                 eta_found: p.eta,
                 channels: Channel::ALL
@@ -100,11 +105,11 @@ pub fn accuracy_rows(
                             proposed_sigma_a_error: rel(pc.sigma_a, tc.sigma_a),
                             existing_sigma_s_prime_error: rel(ec.sigma_s_prime, tc.sigma_s_prime),
                             existing_sigma_a_error: rel(ec.sigma_a, tc.sigma_a),
-                            exact_sigma_s_prime: x.and_then(|x| x.channels[c].sigma_s_prime),
-                            exact_sigma_a: x.and_then(|x| x.channels[c].sigma_a),
-                            exact_sigma_s_prime_error: x
+                            paper_sigma_s_prime: x.and_then(|x| x.channels[c].sigma_s_prime),
+                            paper_sigma_a: x.and_then(|x| x.channels[c].sigma_a),
+                            paper_sigma_s_prime_error: x
                                 .and_then(|x| rel(x.channels[c].sigma_s_prime, tc.sigma_s_prime)),
-                            exact_sigma_a_error: x
+                            paper_sigma_a_error: x
                                 .and_then(|x| rel(x.channels[c].sigma_a, tc.sigma_a)),
                         }
                     })

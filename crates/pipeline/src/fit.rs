@@ -102,6 +102,12 @@ pub struct ChannelFit {
     pub g_term_gap: Option<String>,
     /// With `g = "fit"`: the fit of g ([`crate::anisotropy_fit`]), determined or not.
     pub g_fit: Option<crate::anisotropy_fit::GFit>,
+    /// With an approximate forward model: exact transport's fit of the same data
+    /// ([`crate::model_term`]), whose distance from this one is each estimate's `model` term.
+    pub exact: Option<crate::model_term::ExactFit>,
+    /// With an approximate forward model: why exact transport could not be evaluated (the
+    /// estimates then have no `model` term and the channel is suspect).
+    pub model_note: Option<String>,
 }
 
 impl ChannelFit {
@@ -113,6 +119,7 @@ impl ChannelFit {
             fit: finite(e.stderr),
             spectro: None,
             g: None,
+            model: None,
         };
         Self {
             sigma_s_prime: estimate(report.sigma_s_prime),
@@ -123,10 +130,13 @@ impl ChannelFit {
                 // The existing method's α′ comes from its fitted coefficients, not the reading.
                 spectro: albedo_prime_stderr.filter(|_| report.method == Method::Proposed),
                 g: None,
+                model: None,
             },
             g_note: None,
             g_term_gap: None,
             g_fit: None,
+            exact: None,
+            model_note: None,
             report,
         }
     }
@@ -467,6 +477,9 @@ pub fn channel_result(
             sigma_s_prime_stderr_g: None,
             sigma_a_stderr_g: None,
             albedo_prime_stderr_g: None,
+            sigma_s_prime_stderr_model: None,
+            sigma_a_stderr_model: None,
+            albedo_prime_stderr_model: None,
             albedo_prime_stderr: spectro.uncertainty.albedo_prime_stderr[c],
             albedo_prime_stderr_fit: None,
             albedo_prime: spectro.albedo_prime[c],
@@ -524,6 +537,9 @@ pub fn channel_result(
                 sigma_s_prime_stderr_g: f.sigma_s_prime.g,
                 sigma_a_stderr_g: f.sigma_a.g,
                 albedo_prime_stderr_g: f.albedo_prime.g,
+                sigma_s_prime_stderr_model: f.sigma_s_prime.model,
+                sigma_a_stderr_model: f.sigma_a.model,
+                albedo_prime_stderr_model: f.albedo_prime.model,
                 albedo_prime_stderr: f.albedo_prime.spectro,
                 albedo_prime_stderr_fit: f.albedo_prime.fit,
                 albedo_prime: finite(f.albedo_prime.value),

@@ -52,6 +52,7 @@ pub mod export;
 pub mod fit;
 pub mod hdr;
 pub mod measure;
+pub mod model_term;
 pub mod outputs;
 pub mod port;
 pub mod profile;

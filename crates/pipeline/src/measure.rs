@@ -150,6 +150,8 @@ pub struct Measurement {
     pub port: Option<crate::port::PortCorrection>,
     /// Wall times per stage \[s\].
     pub timings: Timings,
+    /// What the data's redundancy says (the profile's own α′; [`crate::checks::evidence`]).
+    pub evidence: crate::checks::evidence::Evidence,
 }
 
 /// Wall times per stage \[s\].
@@ -292,7 +294,7 @@ pub fn values_g_on(grid: &scatterfit_mc::McGridSet, prior: &GPrior) -> Result<f6
 ///
 /// # Errors
 /// [`PipelineError::Input`] for a g the Monte Carlo tables do not cover when either model is `mc`.
-fn families(settings: &FitSettings) -> Result<(AtG<'static>, AtG<'static>)> {
+pub(crate) fn families(settings: &FitSettings) -> Result<(AtG<'static>, AtG<'static>)> {
     let at = |f| AtG::new(f, settings.g).map_err(|e| PipelineError::Input(format!("fit.g: {e}")));
     let (model, albedo) = (
         at(family(settings.model)?)?,
@@ -453,16 +455,22 @@ fn measure_from(
         ),
         None => fits,
     };
-    let fit_s = t_fit.elapsed().as_secs_f64();
+    // With an approximate model the evidence comes from exact transport's fits
+    // (`Measurement::with_model_term`): the model's own error would confound it.
+    let evidence = if crate::model_term::is_approximate(&settings) {
+        crate::checks::evidence::Evidence::default()
+    } else {
+        crate::checks::evidence::gather(&data, &spectro, &settings, model, &fits)
+    };
     let timings = Timings {
         spectro_s,
         read_s: hdr.read_s,
         merge_s: hdr.merge_s,
         profile_s,
-        fit_s,
-        total_s: t0.elapsed().as_secs_f64(),
+        ..Timings::default()
     };
-    Ok(Measurement {
+    // An approximate model's error joins the bars (crate::model_term).
+    let mut m = Measurement {
         manifest,
         settings,
         spectro,
@@ -471,7 +479,12 @@ fn measure_from(
         fits,
         port,
         timings,
-    })
+        evidence,
+    }
+    .with_model_term();
+    m.timings.fit_s = t_fit.elapsed().as_secs_f64();
+    m.timings.total_s = t0.elapsed().as_secs_f64();
+    Ok(m)
 }
 
 impl Measurement {
@@ -540,9 +553,12 @@ impl Measurement {
         } else {
             fit_stage(&data, &spectro, &settings, model)
         };
-        let mut timings = self.timings;
-        timings.fit_s = t.elapsed().as_secs_f64();
-        Ok(Measurement {
+        let evidence = if propagate && !crate::model_term::is_approximate(&settings) {
+            crate::checks::evidence::gather(&data, &spectro, &settings, model, &fits)
+        } else {
+            crate::checks::evidence::Evidence::default()
+        };
+        let mut m = Measurement {
             manifest: self.manifest.clone(),
             settings,
             spectro,
@@ -550,8 +566,14 @@ impl Measurement {
             profile: self.profile.clone(),
             fits,
             port,
-            timings,
-        })
+            timings: self.timings,
+            evidence,
+        };
+        if propagate {
+            m = m.with_model_term();
+        }
+        m.timings.fit_s = t.elapsed().as_secs_f64();
+        Ok(m)
     }
 
     /// True when every channel gave constrained parameters.

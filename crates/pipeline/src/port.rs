@@ -39,7 +39,8 @@ pub struct PortCorrection {
     /// F per channel: the fraction of the true Rd the instrument read (`None` where the channel
     /// could not be fitted, and its Rd was left as read).
     pub reading_fraction: Rgb<Option<f64>>,
-    /// Rounds of fit → F → α′ per channel.
+    /// Rounds of fit → F → α′ per channel (beyond `MAX_ROUNDS` = 60 the iteration did not settle
+    /// and the rest are the bracketed solve's fits).
     pub rounds: Rgb<usize>,
     /// Why a channel was left uncorrected.
     pub problems: Rgb<Option<String>>,
@@ -206,7 +207,130 @@ impl FixedPoint<'_> {
     /// The corrected Rd of a reading `rd_read` at η = `eta`, F taken at the fitted σ′s and σa ×
     /// `scale` (1: the fit as it is; 1 ∓ s: a fit one standard error off, α′ unchanged); on
     /// failure the round it stopped in and why.
+    ///
+    /// The fixed point first (fast: 3–10 fits); where it does not settle — at α′ → 1 behind a
+    /// port much smaller than the lit disc, F changes faster with Rd than Rd itself and the
+    /// iteration cycles, or a round's step leaves the albedo model's range — the same equation
+    /// Rd(α′)·F(α′) = reading is solved on a bracket ([`FixedPoint::bracketed`]).
     fn solve(&self, rd_read: f64, eta: f64, scale: f64) -> Result<Solved, (usize, String)> {
+        self.iterate(rd_read, eta, scale)
+            .or_else(|_| self.bracketed(rd_read, eta, scale))
+    }
+
+    /// The port's reading of the material that the profile gives at α′: the fit at α′ (with the
+    /// albedo model's Rd(α′) as the total), its σ′s and σa × `scale`, and F of that material
+    /// through the port. Returns (Rd(α′), F, the fit's relative σ′s standard error).
+    fn reading_at(
+        &self,
+        albedo_prime: f64,
+        eta: f64,
+        scale: f64,
+    ) -> Result<(f64, f64, f64), String> {
+        let rd = self
+            .albedo
+            .rd_total(albedo_prime, eta, 0.0)
+            .map_err(|e| e.to_string())?;
+        let input = ChannelInput {
+            eta,
+            albedo_prime: Some(albedo_prime),
+            rd_total: Some(rd),
+        };
+        let report = match scatterfit_fit::fit_channel(self.data, &input, self.model, self.opts) {
+            Ok(r) if r.converged => r,
+            Ok(_) => {
+                return Err(format!(
+                    "the fit at α′ = {albedo_prime:.6} did not converge"
+                ));
+            }
+            Err(e) => return Err(e.to_string()),
+        };
+        let f = OpticalProperties::new(
+            scale * report.sigma_s_prime.value,
+            scale * report.sigma_a.value,
+            eta,
+        )
+        .and_then(|p| self.model.profile(&p))
+        .map(|m| self.port.reading_of(&*m).reading_fraction)
+        .map_err(|e| e.to_string())?;
+        if !(f.is_finite() && f > 0.0 && f <= 1.0 + 1e-9) {
+            return Err(format!("the port's reading fraction {f} is not in (0, 1]"));
+        }
+        Ok((
+            rd,
+            f.min(1.0),
+            report.sigma_s_prime.stderr / report.sigma_s_prime.value,
+        ))
+    }
+
+    /// The port equation Rd(α′)·F(α′) = reading solved for α′ on a bracket, by the Illinois
+    /// method (`scatterfit_optics::roots`) in x = ln(1 − α′), where Rd and F are smooth up to the
+    /// albedo model's last α′. The bracket: the α′ of the reading taken as loss-free (F ≤ 1, so the
+    /// port reads at most the reading there) and the largest α′ the albedo model inverts (a
+    /// bound of the search, not a failure). Where even that α′ reads less than the reading there
+    /// is no solution in the model's range, and the error says so with the numbers.
+    fn bracketed(&self, rd_read: f64, eta: f64, scale: f64) -> Result<Solved, (usize, String)> {
+        let fail = |e: String| (MAX_ROUNDS, e);
+        let a_lo = self
+            .albedo
+            .albedo_from_rd(rd_read, eta, 0.0)
+            .map_err(|e| fail(format!("α′ from Rd = {rd_read:.4}: {e}")))?;
+        // The largest α′ the albedo model evaluates (the tables end at 0.9999, the diffusion
+        // models go on).
+        let a_hi = (3..=7)
+            .rev()
+            .map(|k| 1.0 - 10f64.powi(-k))
+            .find(|&a| a > a_lo && self.albedo.rd_total(a, eta, 0.0).is_ok())
+            .ok_or_else(|| {
+                fail(format!(
+                    "the reading's α′ ({a_lo:.6}) is already at the end of the {} albedo \
+                     model's range",
+                    self.albedo.name()
+                ))
+            })?;
+        let evaluations = std::cell::Cell::new(0usize);
+        let residual = |x: f64| -> f64 {
+            evaluations.set(evaluations.get() + 1);
+            self.reading_at(1.0 - x.exp(), eta, scale)
+                .map_or(f64::NAN, |(rd, f, _)| rd * f - rd_read)
+        };
+        let (x_lo, x_hi) = ((1.0 - a_lo).ln(), (1.0 - a_hi).ln());
+        let h_hi = residual(x_hi);
+        if !h_hi.is_finite() {
+            return Err(fail(format!(
+                "the port correction could not be evaluated at α′ = {a_hi} (the fit or the \
+                 port's F failed there)"
+            )));
+        }
+        if h_hi < 0.0 {
+            return Err(fail(format!(
+                "no material the {} model describes reads Rd = {rd_read:.4} through this port: \
+                 at α′ up to {a_hi} (the albedo model's range) the port reads at most {:.4}; \
+                 check spectro.aperture_mm and spectro.illuminated_mm against the instrument, \
+                 and the reading",
+                self.model.name(),
+                h_hi + rd_read
+            )));
+        }
+        let x = scatterfit_optics::roots::bracketed_root(residual, x_lo, x_hi, 1e-10).ok_or_else(
+            || {
+                fail(format!(
+                    "the port correction found no root between α′ {a_lo:.6} and {a_hi} (the \
+                     port's reading is not continuous in α′ there)"
+                ))
+            },
+        )?;
+        let albedo_prime = 1.0 - x.exp();
+        let (rd, f, s) = self.reading_at(albedo_prime, eta, scale).map_err(fail)?;
+        Ok(Solved {
+            rd,
+            reading_fraction: f,
+            rounds: MAX_ROUNDS + evaluations.get(),
+            sigma_s_prime_rel_stderr: s,
+        })
+    }
+
+    /// The fixed-point iteration of [`FixedPoint::solve`].
+    fn iterate(&self, rd_read: f64, eta: f64, scale: f64) -> Result<Solved, (usize, String)> {
         let (model, albedo) = (self.model, self.albedo);
         let mut rd_c = rd_read;
         let mut target = rd_read;

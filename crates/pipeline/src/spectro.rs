@@ -97,6 +97,7 @@ impl SpectroStage {
             fit: None,
             spectro: self.uncertainty.eta_stderr,
             g: None,
+            model: None,
         }
     }
 
@@ -107,6 +108,7 @@ impl SpectroStage {
             fit: None,
             spectro: self.uncertainty.albedo_prime_stderr[c],
             g: None,
+            model: None,
         })
     }
 

@@ -146,6 +146,66 @@ pub fn scaled_to_u16(frames: &[ImageBuf<u8>]) -> Vec<ImageBuf<u16>> {
         .collect()
 }
 
+/// The camera's gain changed before frame `from` (frames in time order): from there on every
+/// pixel's electrons are multiplied by `factor` (an ISO step, a gain set to auto), toned and
+/// quantised again through `camera`.
+pub fn gain(
+    frames: &[ImageBuf<u8>],
+    camera: &CameraModel,
+    from: usize,
+    factor: f64,
+) -> Vec<ImageBuf<u8>> {
+    relight(frames, camera, from, |e| e * factor)
+}
+
+/// Room light switched on before frame `from`: every pixel of the frames from there on gains
+/// `electrons_per_s` × the frame's exposure time `times_s[j]` (a uniform glow over the sample, as
+/// a lamp adds it), toned and quantised again through `camera`.
+pub fn room_light(
+    frames: &[ImageBuf<u8>],
+    camera: &CameraModel,
+    times_s: &[f64],
+    from: usize,
+    electrons_per_s: f64,
+) -> Vec<ImageBuf<u8>> {
+    let mut out = frames[..from.min(frames.len())].to_vec();
+    for (j, f) in frames.iter().enumerate().skip(from) {
+        let add = electrons_per_s * times_s[j];
+        out.extend(relight(std::slice::from_ref(f), camera, 0, |e| e + add));
+    }
+    out
+}
+
+fn relight(
+    frames: &[ImageBuf<u8>],
+    camera: &CameraModel,
+    from: usize,
+    change: impl Fn(f64) -> f64,
+) -> Vec<ImageBuf<u8>> {
+    frames
+        .iter()
+        .enumerate()
+        .map(|(j, f)| {
+            if j < from {
+                return f.clone();
+            }
+            // Clipped codes stay clipped: the light behind them is unknown (and only grows).
+            let data = f
+                .data()
+                .iter()
+                .map(|&z| {
+                    if z == u8::MAX {
+                        z
+                    } else {
+                        camera.code(change(electrons(camera, z)))
+                    }
+                })
+                .collect();
+            ImageBuf::new(f.width(), f.height(), f.channels(), data).expect("same shape")
+        })
+        .collect()
+}
+
 /// Electrons behind an 8-bit code: the inverse of the camera's tone curve
 /// T(s) = (1 + b)s/(s + b), s = bT/(1 + b − T), at T = z/255, times the full well.
 pub fn electrons(camera: &CameraModel, z: u8) -> f64 {

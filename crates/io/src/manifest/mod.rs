@@ -33,7 +33,7 @@
 //!
 //! [fit]                         # every key optional, defaults shown
 //! method = "proposed"           # proposed | existing
-//! model = "dipole"              # dipole | better-dipole | pbd | mc
+//! model = "mc"                  # mc (exact transport) | dipole (the paper's) | better-dipole | pbd
 //! # albedo_model = "diffusion"  # diffusion | mc (default: mc for the mc model, else diffusion)
 //! r_max_px = 300                # the paper's cut-off
 //! # g = 0.85                    # Henyey–Greenstein g of the material, known or assumed (default 0),
@@ -312,7 +312,7 @@ impl<'de> Deserialize<'de> for GSetting {
 pub struct FitSection {
     /// proposed | existing.
     pub method: Option<Method>,
-    /// dipole | better-dipole | pbd | mc.
+    /// mc (the default: exact transport) | dipole (the paper's) | better-dipole | pbd.
     pub model: Option<ModelName>,
     /// diffusion | mc: how α′ is obtained from the spectrophotometer's Rd (default: the physics of
     /// `model`: mc for the mc model, else diffusion).

@@ -146,6 +146,19 @@ pub struct ChannelResult {
     /// The same for α′.
     #[serde(default)]
     pub albedo_prime_stderr_g: Option<f64>,
+    /// The part of σ′s's uncertainty from an approximate forward model (a diffusion dipole, photon
+    /// beam diffusion): |its estimate − exact transport's (the `mc` tables) on the same data|
+    /// \[mm⁻¹\], added linearly to the total like the g term. Absent with the exact model (and in
+    /// files written before the term) and where exact transport could not be evaluated (the
+    /// channel is then suspect).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma_s_prime_stderr_model: Option<f64>,
+    /// The same for σa \[mm⁻¹\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma_a_stderr_model: Option<f64>,
+    /// The same for α′.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub albedo_prime_stderr_model: Option<f64>,
     /// Reduced albedo α′ = σ′s/(σ′s + σa): from the spectrophotometer (proposed method) or from the
     /// fitted coefficients (existing method).
     pub albedo_prime: Option<f64>,
@@ -210,6 +223,7 @@ impl ChannelResult {
             fit: self.sigma_s_prime_stderr,
             spectro: self.sigma_s_prime_stderr_spectro,
             g: self.sigma_s_prime_stderr_g,
+            model: self.sigma_s_prime_stderr_model,
         })
     }
 
@@ -220,6 +234,7 @@ impl ChannelResult {
             fit: self.sigma_a_stderr,
             spectro: self.sigma_a_stderr_spectro,
             g: self.sigma_a_stderr_g,
+            model: self.sigma_a_stderr_model,
         })
     }
 
@@ -231,6 +246,7 @@ impl ChannelResult {
             fit: self.albedo_prime_stderr_fit,
             spectro: self.albedo_prime_stderr,
             g: self.albedo_prime_stderr_g,
+            model: self.albedo_prime_stderr_model,
         })
     }
 }
@@ -407,6 +423,7 @@ impl MeasurementResult {
             fit: None,
             spectro: self.eta_stderr,
             g: None,
+            model: None,
         }
     }
 }
@@ -597,6 +614,9 @@ mod tests {
             sigma_s_prime_stderr_g: None,
             sigma_a_stderr_g: None,
             albedo_prime_stderr_g: None,
+            sigma_s_prime_stderr_model: None,
+            sigma_a_stderr_model: None,
+            albedo_prime_stderr_model: None,
             albedo_prime_stderr: None,
             albedo_prime_stderr_fit: None,
             albedo_prime: Some(sp / (sp + sa)),

@@ -242,7 +242,11 @@ pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
         reasons.push(suspect(
             ReasonKind::ResponseSteps,
             format!(
-                "the camera response was recovered from exposures {median:.1}× apart ({:.1}                  stops): beyond {MAX_STEP_RECOVERED}× a recovered response can carry a ripple                  the bracket cannot see (up to 13 % in the profile's shape at 3.5× on a filmic                  tone curve) — shoot steps of 2× (1 stop) or less, give the camera's response                  (camera.response), or use linear 16-bit or RAW frames",
+                "the camera response was recovered from exposures {median:.1}× apart ({:.1} \
+                 stops): beyond {MAX_STEP_RECOVERED}× a recovered response can carry a ripple \
+                 the bracket cannot see (up to 13 % in the profile's shape at 3.5× on a filmic \
+                 tone curve) — shoot steps of 2× (1 stop) or less, give the camera's response \
+                 (camera.response), or use linear 16-bit or RAW frames",
                 median.log2()
             ),
         ));
@@ -276,4 +280,164 @@ pub(super) fn short(t: f64) -> String {
         .trim_end_matches('0')
         .trim_end_matches('.')
         .to_string()
+}
+
+/// How one frame of an 8-bit bracket agrees with the merged radiance ([`frame_agreement`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FrameAgreement {
+    /// The frame's index (shortest first).
+    pub frame: usize,
+    /// Well-exposed samples compared.
+    pub samples: usize,
+    /// The median of g(z) − ln(E·Δt): the frame's exposure against the merge's (0 when it holds
+    /// the light its time says), in natural log units.
+    pub offset_ln: f64,
+    /// The robust spread of g(z) − ln(E·Δt) about that median (1.4826 × the median absolute
+    /// deviation): how far the frame's picture differs from the merged one in shape.
+    pub spread_ln: f64,
+}
+
+/// Codes a frame's sample must lie within to be compared: away from the tone curve's toe, where
+/// the response is least certain and one code is a large step in log exposure, and from clipping.
+pub const AGREEMENT_CODES: (u8, u8) = (40, 230);
+
+/// Well-exposed samples a frame needs for its agreement to be judged.
+pub const AGREEMENT_MIN_SAMPLES: usize = 50;
+
+/// A frame whose spread about the merge is larger than this (natural log units: 10 %) and four
+/// times the bracket's median spread disagrees with the others in shape: a frame from elsewhere,
+/// room light, a change in the scene. The quick twins' frames lie at 0.006–0.03.
+pub const MAX_FRAME_SPREAD_LN: f64 = 0.10;
+
+/// A frame whose median exposure is off the merge's by more than this (natural log units: a
+/// factor 1.22 either way) after the bracket's own exposure estimate holds a different light: a
+/// gain changed, a light switched on or off, a frame from another session.
+pub const MAX_FRAME_OFFSET_LN: f64 = 0.20;
+
+/// The merged radiance predicts every frame: per frame, g(z) − ln(E·Δt) over its well-exposed
+/// samples (Debevec & Malik 1997, eq. 2, g(Z_ij) = ln E_i + ln Δt_j, read the other way: the
+/// merge's E and the frame's time predict its codes). Computed on the frames' thumbnails (one
+/// sample per block of the image, the block's centre: up to 96 × 96 per frame), against the
+/// radiance at the same pixels. Only 8-bit brackets with their response, and without a dark or
+/// flat frame (whose corrections the prediction would have to repeat); `None` otherwise.
+pub fn frame_agreement(m: &Measurement) -> Option<Vec<FrameAgreement>> {
+    let response = m.hdr.response.as_ref()?;
+    if m.hdr.thumbnails.len() != m.hdr.frames.len()
+        || m.hdr.corrections.flat.is_some()
+        || m.manifest.camera.dark.is_some()
+    {
+        return None;
+    }
+    let radiance = &m.hdr.hdr.radiance;
+    let clipped = &m.hdr.hdr.clipped;
+    let (w, h) = (radiance.width(), radiance.height());
+    let step = w.max(h).div_ceil(crate::hdr::THUMBNAIL_SIDE).max(1);
+    let ch = radiance.channels().min(3);
+    let tables = response.tables();
+    let factors = m
+        .hdr
+        .corrections
+        .exposure
+        .as_ref()
+        .filter(|_| m.hdr.corrections.exposure_applied)
+        .map(|e| e.factor.clone());
+    let mut out = Vec::new();
+    for (j, (thumb, info)) in m.hdr.thumbnails.iter().zip(&m.hdr.frames).enumerate() {
+        let t = info.time_s
+            * factors
+                .as_ref()
+                .and_then(|f| f.get(j))
+                .copied()
+                .unwrap_or(1.0);
+        if !(t > 0.0) {
+            continue;
+        }
+        let mut d = Vec::new();
+        for ty in 0..thumb.height() {
+            let y = (ty * step + step / 2).min(h - 1);
+            for tx in 0..thumb.width() {
+                let x = (tx * step + step / 2).min(w - 1);
+                let (Some(z), Some(e), Some(cl)) = (
+                    thumb.pixel(tx, ty),
+                    radiance.pixel(x, y),
+                    clipped.pixel(x, y),
+                ) else {
+                    continue;
+                };
+                for c in 0..ch {
+                    let zc = z[c.min(z.len() - 1)];
+                    let ec = f64::from(e[c]);
+                    if zc < AGREEMENT_CODES.0 || zc > AGREEMENT_CODES.1 || cl[c] != 0 || !(ec > 0.0)
+                    {
+                        continue;
+                    }
+                    let g = &tables[c.min(tables.len() - 1)];
+                    d.push(g[usize::from(zc)] - (ec * t).ln());
+                }
+            }
+        }
+        if d.len() < AGREEMENT_MIN_SAMPLES {
+            continue;
+        }
+        let mid = d.len() / 2;
+        let offset = *d.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let mut dev: Vec<f64> = d.iter().map(|v| (v - offset).abs()).collect();
+        let mad = *dev.select_nth_unstable_by(mid, f64::total_cmp).1;
+        out.push(FrameAgreement {
+            frame: j,
+            samples: d.len(),
+            offset_ln: offset,
+            spread_ln: 1.4826 * mad,
+        });
+    }
+    Some(out)
+}
+
+/// Frames that the merged radiance does not predict ([`frame_agreement`],
+/// [`MAX_FRAME_SPREAD_LN`], [`MAX_FRAME_OFFSET_LN`]): one reason naming them, for every channel.
+pub fn frame_agreement_reasons(m: &Measurement) -> Vec<Reason> {
+    let Some(frames) = frame_agreement(m) else {
+        return Vec::new();
+    };
+    let mut spreads: Vec<f64> = frames.iter().map(|f| f.spread_ln).collect();
+    if spreads.is_empty() {
+        return Vec::new();
+    }
+    spreads.sort_by(f64::total_cmp);
+    let typical = spreads[spreads.len() / 2];
+    let bad: Vec<String> = frames
+        .iter()
+        .filter(|f| {
+            (f.spread_ln > MAX_FRAME_SPREAD_LN && f.spread_ln > 4.0 * typical)
+                || f.offset_ln.abs() > MAX_FRAME_OFFSET_LN
+        })
+        .map(|f| {
+            let name = m.hdr.frames[f.frame]
+                .file
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            format!(
+                "frame {} ({}, {} s) holds {:.2}× the light the merge predicts, spread {:.0} % \
+                 about it",
+                f.frame,
+                scatterfit_io::escape::one_line(&name),
+                short(m.hdr.frames[f.frame].time_s),
+                f.offset_ln.exp(),
+                100.0 * f.spread_ln
+            )
+        })
+        .collect();
+    if bad.is_empty() {
+        return Vec::new();
+    }
+    vec![suspect(
+        ReasonKind::FrameDisagrees,
+        format!(
+            "the merged radiance does not predict every frame (the others agree within {:.0} %): \
+             {} — a frame from another sample or session, a gain or light changed during the \
+             bracket, or a frame repeated with the wrong time; remove or retake it",
+            100.0 * typical,
+            bad.join("; ")
+        ),
+    )]
 }

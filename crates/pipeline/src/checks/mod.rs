@@ -22,12 +22,14 @@ use scatterfit_optics::Rgb;
 use crate::fit::ChannelOutcome;
 use crate::measure::Measurement;
 
+pub mod evidence;
 mod frames;
 
 pub use frames::{
-    CodeRange, MAX_FRAME_SHIFT_PX, MAX_STEP_8BIT, MAX_STEP_LINEAR, MAX_STEP_RECOVERED,
+    AGREEMENT_CODES, AGREEMENT_MIN_SAMPLES, CodeRange, FrameAgreement, MAX_FRAME_OFFSET_LN,
+    MAX_FRAME_SHIFT_PX, MAX_FRAME_SPREAD_LN, MAX_STEP_8BIT, MAX_STEP_LINEAR, MAX_STEP_RECOVERED,
     PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS, Registration, bracket_reasons, code_range,
-    code_reasons, registration, registration_reasons,
+    code_reasons, frame_agreement, frame_agreement_reasons, registration, registration_reasons,
 };
 
 /// A fit whose rms log residual exceeds this is suspect: the profile differs from the model by
@@ -52,6 +54,36 @@ pub const SECOND_SPOT_RATIO: f64 = 1.25;
 
 /// See [`SECOND_SPOT_RATIO`].
 pub const SECOND_SPOT_Z: f64 = 8.0;
+
+/// An approximate model whose χ²/dof on the profile exceeds this many times exact transport's on
+/// the same rings (floored at 1, what the noise allows) does not describe the profile: its
+/// channel is suspect even with its `model` term. On the demo's twins the dipole's ratio is
+/// 2–1000 (red aluminium, blue coating and pink plastic well beyond); noise alone gives ≈ 1.
+pub const MAX_MODEL_CHI2_RATIO: f64 = 3.0;
+
+/// A manifest L\*a\*b\* further than this CIE 1976 ΔE\*ab from the colour of the spectrum beside
+/// it (its SCE or, where the instrument reported specular-included colour, its SCI; D65, the
+/// same observer) makes every channel suspect. ΔE\*ab ≈ 1 is a just-noticeable difference and
+/// d/8 instruments of one model agree within about 0.5; at 3 the two cannot be readings of one
+/// sample by one instrument (a copied row, another sample's file). Rd, hence α′ and σa, follows
+/// the L\*a\*b\*: an L\* off by 3 moves Rd by about 7 %.
+pub const MAX_LAB_DELTA_E: f64 = 3.0;
+
+/// The image's spot half width over the one the fitted model predicts at the stated scale and
+/// spot ([`evidence::spot_scale`]) outside this range makes every channel suspect: a scale (or a
+/// spot diameter) 10 % off gives 0.91 or 1.10. The demo's twins give 0.99–1.01, the quick twins
+/// and the camera sweep 0.97–1.03 (RELIABILITY.md, "The evidence behind ok").
+pub const SPOT_FACTOR_RANGE: (f64, f64) = (0.94, 1.06);
+
+/// The profile's own α′ and the spectrophotometer's further apart than this many standard
+/// errors (in ln(1 − α′), [`evidence::AlbedoCheck`]) …
+pub const ALBEDO_Z: f64 = 5.0;
+
+/// … with the proposed fit's χ²/dof more than this many times the two-parameter fit's (floored
+/// at 1) make the channel suspect: the reading does not describe this profile. Both are needed:
+/// a model's small near-field error can move the free fit's α′ by several of its (tiny) errors
+/// without the reading being wrong, and then the proposed fit is nearly as good.
+pub const ALBEDO_CHI2_RATIO: f64 = 3.0;
 
 /// The documented ranges a value must lie in before it is called a measurement [mm⁻¹]
 /// (ARCHITECTURE.md, "The measurement, as files").
@@ -117,6 +149,28 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
     reasons.extend(code_reasons(m));
     reasons.extend(registration_reasons(m));
     reasons.extend(bracket_reasons(m));
+    reasons.extend(frame_agreement_reasons(m));
+    if let Some(factor) = evidence::spot_scale(m)
+        && !(SPOT_FACTOR_RANGE.0..=SPOT_FACTOR_RANGE.1).contains(&factor)
+    {
+        reasons.push(suspect(
+            ReasonKind::SpotSize,
+            format!(
+                "the spot in the image is {factor:.3}× the size the fitted model predicts for a \
+                 {:.3} mm spot at {mmpp} mm per pixel (expected {}–{}): camera.mm_per_pixel or \
+                 camera.spot_diameter_mm is about {:.0} % off (the true scale is near {:.4} mm \
+                 per pixel if the diameter is right); σ′s and σa scale with it",
+                2.0 * m.settings.spot_radius_mm,
+                SPOT_FACTOR_RANGE.0,
+                SPOT_FACTOR_RANGE.1,
+                100.0 * (1.0 / factor - 1.0),
+                mmpp / factor,
+            ),
+        ));
+    }
+    if let Some(msg) = lab_disagreement(m) {
+        reasons.push(suspect(ReasonKind::LabDisagrees, msg));
+    }
     // (d) Exactly one spot.
     if let Some(msg) = second_spot(m, a_px) {
         reasons.push(suspect(ReasonKind::SecondSpot, msg));
@@ -144,6 +198,45 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
         }
     }
     SampleChecks { reasons }
+}
+
+/// The manifest's L\*a\*b\* against the spectrum beside it ([`MAX_LAB_DELTA_E`]): the message
+/// when they disagree, `None` when they agree or only one of them is given.
+pub fn lab_disagreement(m: &Measurement) -> Option<String> {
+    use scatterfit_optics::colour::{Lab, Observer, spectrum_to_xyz, xyz_to_lab};
+    let [l, a, b] = m.manifest.spectro.lab?;
+    let analysis = m.spectro.analysis.as_ref()?;
+    let observer = match m.manifest.spectro.lab_observer {
+        Some(2) => Observer::TwoDegree,
+        _ => Observer::TenDegree,
+    };
+    let wl: Vec<f64> = analysis.spectral.iter().map(|p| p.wavelength_nm).collect();
+    let lab_of = |values: Vec<f64>| -> Option<Lab> {
+        spectrum_to_xyz(&wl, &values, observer)
+            .ok()
+            .map(|xyz| xyz_to_lab(xyz, observer.d65_white()))
+    };
+    let sce = lab_of(analysis.spectral.iter().map(|p| p.sce).collect())?;
+    let sci = lab_of(analysis.spectral.iter().map(|p| p.sci).collect());
+    // CIE 1976 colour difference ΔE*ab: the Euclidean distance in L*a*b*.
+    let delta = |x: &Lab| ((x.l - l).powi(2) + (x.a - a).powi(2) + (x.b - b).powi(2)).sqrt();
+    let (d_sce, d_sci) = (delta(&sce), sci.as_ref().map_or(f64::INFINITY, delta));
+    let d = d_sce.min(d_sci);
+    (d > MAX_LAB_DELTA_E).then(|| {
+        format!(
+            "spectro.lab = [{l}, {a}, {b}] is ΔE*ab {d:.1} from the colour of the spectrum in \
+             the spectro file (SCE L*a*b* [{:.1}, {:.1}, {:.1}]{}; more than {MAX_LAB_DELTA_E}): \
+             they are not one reading of one sample — α′ and σa follow the L*a*b*; check that \
+             both are this sample's, or drop spectro.lab to use the spectrum",
+            sce.l,
+            sce.a,
+            sce.b,
+            sci.map_or(String::new(), |s| format!(
+                ", SCI [{:.1}, {:.1}, {:.1}]",
+                s.l, s.a, s.b
+            )),
+        )
+    })
 }
 
 /// Whether rings to `r_fit_px` around `c` in a `w × h` frame are cut by its edges on one side
@@ -176,27 +269,12 @@ pub fn incomplete_rings(w: usize, h: usize, c: [f64; 2], r_fit_px: f64) -> Optio
 /// sum falls below half the maximum of the first rings, linearly interpolated).
 pub fn spot_hwhm_px(m: &Measurement) -> Option<f64> {
     let rings = &m.profile.profile.rings;
-    let sum = |k: usize| -> f64 { rings[k].channels.iter().map(|c| c.mean).sum() };
-    let peak = (0..rings.len().min(4))
-        .map(sum)
-        .filter(|v| v.is_finite())
-        .fold(f64::NAN, f64::max);
-    if peak.is_nan() || peak <= 0.0 {
-        return None;
-    }
-    for k in 1..rings.len() {
-        let (u, v) = (sum(k - 1), sum(k));
-        if v.is_finite() && v < 0.5 * peak {
-            let (r0, r1) = (rings[k - 1].r_px, rings[k].r_px);
-            let t = if u.is_finite() && u > v {
-                ((u - 0.5 * peak) / (u - v)).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            return Some(r0 + t * (r1 - r0));
-        }
-    }
-    None
+    let sum: Vec<f64> = rings
+        .iter()
+        .map(|r| r.channels.iter().map(|c| c.mean).sum())
+        .collect();
+    let radii: Vec<f64> = rings.iter().map(|r| r.r_px).collect();
+    evidence::hwhm_of(&sum, &radii)
 }
 
 /// A second spot: pixels (channel sum) well above their ring's median (a spot on a ring leaves its
@@ -388,11 +466,105 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
     reasons
 }
 
-/// The verdict on each channel (R, G, B): the fit's checks and the sample's.
+/// What the stages recorded about one channel, as reasons: a port correction that could not be
+/// made fails the channel (its α′ and σa would be the uncorrected reading's, biased by the port's
+/// edge loss, and reported as if corrected).
+pub fn stage_reasons(m: &Measurement, c: scatterfit_optics::Channel) -> Vec<Reason> {
+    let mut reasons = Vec::new();
+    if let Some(p) = &m.port
+        && let Some(problem) = &p.problems[c]
+    {
+        reasons.push(Reason {
+            kind: ReasonKind::PortNotCorrected,
+            severity: Verdict::Failed,
+            message: format!(
+                "the spectrophotometer port's edge-loss correction ({} mm aperture lit over {} \
+                 mm) could not be made: {problem}; α′ and σa would be the uncorrected reading's, \
+                 not a measurement",
+                p.aperture_mm, p.illuminated_mm
+            ),
+        });
+    }
+    reasons
+}
+
+/// An approximate forward model's checks on one channel ([`crate::model_term`]): its error
+/// measured against exact transport (else the channel is suspect: the bar lacks it), and its
+/// χ²/dof against exact transport's on the same rings ([`MAX_MODEL_CHI2_RATIO`]).
+pub fn model_reasons(outcome: &ChannelOutcome, model: scatterfit_optics::ModelName) -> Vec<Reason> {
+    let Some(f) = outcome.fit() else {
+        return Vec::new();
+    };
+    let mut reasons = Vec::new();
+    if let Some(note) = &f.model_note {
+        reasons.push(suspect(
+            ReasonKind::ModelError,
+            format!("{note}: the error bars leave out the model's error; use --model mc"),
+        ));
+    }
+    if let Some(x) = &f.exact {
+        let allowed = MAX_MODEL_CHI2_RATIO * x.chi2_reduced.max(1.0);
+        let chi2 = f.report.chi2_reduced;
+        if chi2.is_finite() && chi2 > allowed {
+            let pct = |a: f64, b: f64| 100.0 * (a / b - 1.0);
+            reasons.push(suspect(
+                ReasonKind::ModelError,
+                format!(
+                    "the {model} model does not describe this profile: χ²/dof {chi2:.1} against \
+                     {:.1} for exact transport on the same rings (more than {MAX_MODEL_CHI2_RATIO}×); \
+                     its σ′s and σa differ from exact transport's by {:+.1} % and {:+.1} % (the \
+                     ± model term) — measure with --model mc",
+                    x.chi2_reduced,
+                    pct(f.sigma_s_prime.value, x.sigma_s_prime),
+                    pct(f.sigma_a.value, x.sigma_a),
+                ),
+            ));
+        }
+    }
+    reasons
+}
+
+/// The profile's own α′ against the spectrophotometer's, per channel ([`ALBEDO_Z`],
+/// [`ALBEDO_CHI2_RATIO`]); when two channels disagree the reading is likely not this sample's,
+/// and the third is suspect too.
+pub fn albedo_reasons(m: &Measurement) -> Rgb<Vec<Reason>> {
+    let flagged = m.evidence.albedo.as_ref().map(|check| {
+        check.filter(|a| {
+            a.z > ALBEDO_Z && a.chi2_proposed > ALBEDO_CHI2_RATIO * a.chi2_profile.max(1.0)
+        })
+    });
+    let count = flagged.iter().filter(|f| f.is_some()).count();
+    flagged.as_ref().map(|f| match f {
+        Some(a) => vec![suspect(
+            ReasonKind::AlbedoDisagrees,
+            format!(
+                "the profile's own shape gives α′ {:.4} (σ′s and σa both fitted), the \
+                 spectrophotometer α′ {:.4}: {:.0} standard errors apart, and the fit with the \
+                 reading's α′ has χ²/dof {:.1} against {:.1} — check that the spectro file is \
+                 this sample's (and the port, spectro.aperture_mm), or measure with \
+                 --method existing",
+                a.profile, a.spectro, a.z, a.chi2_proposed, a.chi2_profile
+            ),
+        )],
+        None if count >= 2 => vec![suspect(
+            ReasonKind::AlbedoDisagrees,
+            "two other channels' α′ from the profile disagree with the spectrophotometer's: \
+             the reading is likely not this sample's, so this channel's α′ is in doubt too"
+                .into(),
+        )],
+        None => Vec::new(),
+    })
+}
+
+/// The verdict on each channel (R, G, B): the fit's checks, the stages' and the sample's.
 pub fn quality(m: &Measurement) -> Rgb<Quality> {
     let sample = sample_checks(m);
-    m.fits.as_ref().map(|o| {
+    let albedo = albedo_reasons(m);
+    m.fits.as_ref().map_with_channel(|c, o| {
         let mut reasons = fit_reasons(o, m.spectro.eta);
+        reasons.extend(stage_reasons(m, c));
+        reasons.extend(model_reasons(o, m.settings.model));
+        reasons.extend(albedo[c].iter().cloned());
         // A failed channel has no value the sample's findings could qualify.
         if !reasons.iter().any(|r| r.severity == Verdict::Failed) {
             reasons.extend(sample.reasons.iter().cloned());

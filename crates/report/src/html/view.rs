@@ -18,8 +18,10 @@ pub(crate) struct Valued {
     pub fit: Option<f64>,
     /// The spectrophotometer's part (its η and α′ at the reading's repeatability, propagated).
     pub spectro: Option<f64>,
-    /// The anisotropy g's part (issue 15: how far the estimate moves over the range of g).
+    /// The anisotropy g's part (how far the estimate moves over the range of g).
     pub g: Option<f64>,
+    /// An approximate forward model's part (how far the estimate moves to exact transport's).
+    pub model: Option<f64>,
 }
 
 impl Valued {
@@ -30,11 +32,16 @@ impl Valued {
 
     /// `± fit (fit) ± spectro (spectro) ± g (g)`, the known terms only, or empty.
     pub fn error_text(&self) -> String {
-        [(self.fit, "fit"), (self.spectro, "spectro"), (self.g, "g")]
-            .into_iter()
-            .filter_map(|(v, name)| v.map(|v| format!("± {} ({name})", sig4(v))))
-            .collect::<Vec<_>>()
-            .join(" ")
+        [
+            (self.fit, "fit"),
+            (self.spectro, "spectro"),
+            (self.g, "g"),
+            (self.model, "model"),
+        ]
+        .into_iter()
+        .filter_map(|(v, name)| v.map(|v| format!("± {} ({name})", sig4(v))))
+        .collect::<Vec<_>>()
+        .join(" ")
     }
 
     /// The total uncertainty: fit and spectro in quadrature plus the g term
@@ -45,6 +52,7 @@ impl Valued {
             fit: self.fit,
             spectro: self.spectro,
             g: self.g,
+            model: self.model,
         }
         .total()
     }
@@ -174,18 +182,21 @@ fn channel(name: &'static str, c: &ChannelResult) -> ChannelView {
             fit: c.sigma_s_prime_stderr,
             spectro: c.sigma_s_prime_stderr_spectro,
             g: c.sigma_s_prime_stderr_g,
+            model: c.sigma_s_prime_stderr_model,
         },
         sigma_a: Valued {
             value: c.sigma_a,
             fit: c.sigma_a_stderr,
             spectro: c.sigma_a_stderr_spectro,
             g: c.sigma_a_stderr_g,
+            model: c.sigma_a_stderr_model,
         },
         albedo_prime: Valued {
             value: c.albedo_prime,
             fit: c.albedo_prime_stderr_fit,
             spectro: c.albedo_prime_stderr,
             g: c.albedo_prime_stderr_g,
+            model: c.albedo_prime_stderr_model,
         },
         rd_total: c.rd_total,
         mse: c.mse,
@@ -256,6 +267,7 @@ impl ResultView {
                 fit: None,
                 spectro: r.eta_stderr,
                 g: None,
+                model: None,
             },
             eta_source: r.eta_source.map_or_else(|| "—".into(), |e| e.name().into()),
             method: r.method.to_string(),

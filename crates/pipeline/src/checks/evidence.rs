@@ -1,0 +1,195 @@
+//! Cross-checks from the data's own redundancy: what one part of a measurement says that another
+//! part can confirm.
+//!
+//! - **The profile's own α′.** Under exact transport the shape of Rd(r) determines σ′s and σa
+//!   both (the existing method of Jensen et al. 2001 fits them), so the profile carries its own
+//!   reduced albedo beside the spectrophotometer's. Another sample's spectrophotometer file, a
+//!   reading through a wrong port or a profile from elsewhere make the two disagree far beyond
+//!   their errors, and the proposed fit (α′ held at the reading's) then misses the profile's shape
+//!   that the two-parameter fit follows ([`AlbedoCheck`]).
+//! - **The spot's size in pixels.** The fitted model convolved with the stated spot, at the
+//!   stated scale, predicts the profile inside the spot too, where the fit did not look: its half
+//!   width in pixels is the spot's radius over `mm_per_pixel`, widened by the light's spread in
+//!   the material. The image's half width against it ([`spot_scale`]) measures the scale (or the
+//!   spot's diameter) to a few percent.
+
+use scatterfit_optics::{Channel, Method, ModelFamily, OpticalProperties, Rgb};
+use serde::Serialize;
+
+use crate::fit::{ChannelOutcome, FitSettings};
+use crate::measure::Measurement;
+use crate::spectro::SpectroStage;
+
+/// One channel's α′ from the profile's shape against the spectrophotometer's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AlbedoCheck {
+    /// α′ of the two-parameter fit (σ′s and σa both from the profile).
+    pub profile: f64,
+    /// Its standard error in ln(1 − α′) (from the fit's σ′s and σa errors and their
+    /// correlation).
+    pub profile_se_ln: f64,
+    /// α′ of the spectrophotometer's reading.
+    pub spectro: f64,
+    /// Its standard error in ln(1 − α′) (the reading's repeatability; 0 when unknown).
+    pub spectro_se_ln: f64,
+    /// |ln(1 − α′ profile) − ln(1 − α′ spectro)| over the two errors in quadrature.
+    pub z: f64,
+    /// χ²/dof of the proposed fit (α′ held at the reading's).
+    pub chi2_proposed: f64,
+    /// χ²/dof of the two-parameter fit on the same rings.
+    pub chi2_profile: f64,
+}
+
+/// What the measurement's redundancy gave, kept with it ([`Measurement::evidence`]).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Evidence {
+    /// Per channel, the profile's α′ against the reading's (proposed method only; `None` where
+    /// either fit is missing).
+    pub albedo: Rgb<Option<AlbedoCheck>>,
+}
+
+/// Gathers the evidence of a measurement made with the proposed method: the two-parameter fit
+/// of every channel on the same rings with the same model (one more fit per channel).
+pub fn gather(
+    data: &Rgb<scatterfit_fit::ProfileData>,
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    model: &dyn ModelFamily,
+    fits: &Rgb<ChannelOutcome>,
+) -> Evidence {
+    if settings.method != Method::Proposed {
+        return Evidence::default();
+    }
+    let free = FitSettings {
+        method: Method::Existing,
+        normalise_with_spectro: false,
+        ..*settings
+    };
+    let profile_fits = crate::fit::fit_stage(data, spectro, &free, model);
+    let albedo = Rgb::from_fn(|c: Channel| {
+        let proposed = fits[c].report().filter(|r| r.converged)?;
+        let free = profile_fits[c].report().filter(|r| r.converged)?;
+        albedo_check(proposed, free, spectro.uncertainty.albedo_prime_stderr[c])
+    });
+    Evidence { albedo }
+}
+
+/// The comparison of one channel's two fits ([`AlbedoCheck`]); `None` when the two-parameter fit
+/// left a parameter unconstrained or its α′ is not in (0, 1).
+fn albedo_check(
+    proposed: &scatterfit_fit::FitReport,
+    free: &scatterfit_fit::FitReport,
+    spectro_stderr: Option<f64>,
+) -> Option<AlbedoCheck> {
+    if !free.unconstrained.is_empty() {
+        return None;
+    }
+    let (s, a) = (free.sigma_s_prime, free.sigma_a);
+    let alpha = s.value / (s.value + a.value);
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return None;
+    }
+    // ln(1 − α′) = ln σa − ln(σ′s + σa), so d ln(1 − α′) = α′ (dσa/σa − dσ′s/σ′s): its variance
+    // from the relative errors and their correlation (delta method).
+    let (rs, ra) = (s.stderr / s.value, a.stderr / a.value);
+    let index = |name: &str| free.parameters.iter().position(|p| p == name);
+    let rho = match (index("sigma_s_prime"), index("sigma_a")) {
+        (Some(i), Some(j)) => free
+            .correlation
+            .get(i)
+            .and_then(|row| row.get(j))
+            .copied()
+            .unwrap_or(0.0),
+        _ => 0.0,
+    };
+    let var = alpha * alpha * (ra * ra + rs * rs - 2.0 * rho * ra * rs);
+    let profile_se_ln = var.max(0.0).sqrt();
+    let spectro = proposed.albedo_prime;
+    let spectro_se_ln = spectro_stderr.map_or(0.0, |e| e / (1.0 - spectro));
+    let gap = ((1.0 - alpha).ln() - (1.0 - spectro).ln()).abs();
+    let se = profile_se_ln.hypot(spectro_se_ln);
+    let z = if se > 0.0 { gap / se } else { f64::INFINITY };
+    profile_se_ln.is_finite().then_some(AlbedoCheck {
+        profile: alpha,
+        profile_se_ln,
+        spectro,
+        spectro_se_ln,
+        z,
+        chi2_proposed: proposed.chi2_reduced,
+        chi2_profile: free.chi2_reduced,
+    })
+}
+
+/// The ratio of the image's spot half width to the one the fitted model predicts at the stated
+/// scale and spot ([`crate::checks::SPOT_FACTOR_RANGE`]): each fitted channel's model (convolved
+/// with the spot, × its fitted scale) averaged over the same rings as the image (8 radii per
+/// ring, equal areas), the channels summed as the image's half width is measured
+/// ([`crate::checks::spot_hwhm_px`]). About mm_per_pixel(stated) / mm_per_pixel(true): 0.91 for
+/// a scale stated 10 % too large. With an approximate model the exact fit of the same data
+/// ([`crate::model_term::ExactFit`]) predicts the spot instead: a diffusion model's near field,
+/// inside the spot, is its least accurate part (the dipole's spot on red aluminium is 2.6× too
+/// wide). `None` without three fitted channels or a half width.
+pub fn spot_scale(m: &Measurement) -> Option<f64> {
+    let data_hwhm = crate::checks::spot_hwhm_px(m)?;
+    let rings = &m.profile.profile.rings;
+    let mmpp = m.profile.profile.mm_per_pixel;
+    if !(mmpp.is_finite() && mmpp > 0.0) {
+        return None;
+    }
+    let spot = m.settings.options().ok()?.spot;
+    let exact = m.settings.model == scatterfit_optics::ModelName::Mc;
+    let family = scatterfit_mc::family(scatterfit_optics::ModelName::Mc).ok()?;
+    let model = scatterfit_optics::AtG::new(family, m.settings.g).ok()?;
+    const SUB: usize = 8;
+    let radii: Vec<f64> = rings
+        .iter()
+        .flat_map(|ring| {
+            let (a2, b2) = (ring.r_inner_px.powi(2), ring.r_outer_px.powi(2));
+            (0..SUB).map(move |j| mmpp * (a2 + (j as f64 + 0.5) / SUB as f64 * (b2 - a2)).sqrt())
+        })
+        .collect();
+    let mut sum = vec![0.0; rings.len()];
+    for c in Channel::ALL {
+        let f = m.fits[c].fit().filter(|f| f.report.converged)?;
+        let (s, a, scale) = if exact {
+            let r = &f.report;
+            (r.sigma_s_prime.value, r.sigma_a.value, r.scale.value)
+        } else {
+            let x = f.exact?;
+            (x.sigma_s_prime, x.sigma_a, x.scale)
+        };
+        let props = OpticalProperties::new(s, a, m.spectro.eta).ok()?;
+        let values = scatterfit_fit::model_profile(&model, &props, spot, &radii).ok()?;
+        for (k, chunk) in values.chunks(SUB).enumerate() {
+            sum[k] += scale * chunk.iter().sum::<f64>() / SUB as f64;
+        }
+    }
+    let model_hwhm = hwhm_of(&sum, &rings.iter().map(|r| r.r_px).collect::<Vec<_>>())?;
+    Some(data_hwhm / model_hwhm)
+}
+
+/// The half width at half maximum of ring values `v` at radii `r` \[px\], as
+/// [`crate::checks::spot_hwhm_px`] measures the image's.
+pub(crate) fn hwhm_of(v: &[f64], r: &[f64]) -> Option<f64> {
+    let peak = v
+        .iter()
+        .take(4)
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::NAN, f64::max);
+    if peak.is_nan() || peak <= 0.0 {
+        return None;
+    }
+    for k in 1..v.len() {
+        let (u, w) = (v[k - 1], v[k]);
+        if w.is_finite() && w < 0.5 * peak {
+            let t = if u.is_finite() && u > w {
+                ((u - 0.5 * peak) / (u - w)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            return Some(r[k - 1] + t * (r[k] - r[k - 1]));
+        }
+    }
+    None
+}
