@@ -468,9 +468,26 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
 
 /// What the stages recorded about one channel, as reasons: a port correction that could not be
 /// made fails the channel (its α′ and σa would be the uncorrected reading's, biased by the port's
-/// edge loss, and reported as if corrected).
+/// edge loss, and reported as if corrected); behind a port with g not known the ± g term keeps
+/// the port's F at one g, so it understates (F changes by 2–9 % between g = 0 and 0.8 at
+/// α′ ≥ 0.99 behind an 8 mm port; BENCHMARKS.md, "The port's conditioning") and the channel is
+/// suspect.
 pub fn stage_reasons(m: &Measurement, c: scatterfit_optics::Channel) -> Vec<Reason> {
     let mut reasons = Vec::new();
+    if let Some(p) = &m.port
+        && p.problems[c].is_none()
+        && let Some([lo, hi]) = m.settings.g_prior.propagated_range()
+    {
+        reasons.push(suspect(
+            ReasonKind::GTermIncomplete,
+            format!(
+                "behind the spectrophotometer port the ± g term (g in {lo}–{hi}) keeps the port's \
+                 correction at g = {}, but the port's loss itself changes with g, so the term \
+                 understates: give [fit] g (or --g) if it is known",
+                m.settings.g
+            ),
+        ));
+    }
     if let Some(p) = &m.port
         && let Some(problem) = &p.problems[c]
     {
