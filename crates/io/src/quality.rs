@@ -88,6 +88,8 @@ pub enum ReasonKind {
     /// An approximate forward model does not describe the profile (its χ²/dof against exact
     /// transport's), or its error could not be evaluated.
     ModelError,
+    /// JPEG frames compressed so far that the quantisation changes the profile.
+    Compression,
     /// A frame of the bracket that the merged radiance does not predict (a frame from elsewhere,
     /// a gain or light changed during the bracket).
     FrameDisagrees,

@@ -347,3 +347,31 @@ fn frames_the_merge_does_not_predict_are_suspect() {
     let e = measure_sample(&d, &Overrides::default(), &|_| {}).expect_err("refused");
     assert!(e.to_string().contains("frame_0"), "{e}");
 }
+
+/// The bracket saved as JPEG at quality 50 is suspect for its compression; at 95 it is not.
+#[test]
+fn a_heavily_compressed_jpeg_bracket_is_suspect() {
+    let root = tempfile::tempdir().unwrap();
+    let s = twin();
+    for (label, quality, caught) in [("JPEG q50", 50u8, true), ("JPEG q95", 95, false)] {
+        let d = root.path().join(label.replace(' ', "_"));
+        write_frames(&d, &s.bracket.frames);
+        for (j, f) in s.bracket.frames.iter().enumerate() {
+            let png = d.join(format!("frame_{j:02}.png"));
+            scatterfit_io::image_files::write_jpeg(&png.with_extension("jpg"), f, quality).unwrap();
+            std::fs::remove_file(png).unwrap();
+        }
+        for name in ["exposures.csv", "sample.toml"] {
+            let p = d.join(name);
+            if let Ok(text) = std::fs::read_to_string(&p) {
+                std::fs::write(&p, text.replace(".png", ".jpg")).unwrap();
+            }
+        }
+        let (_, q) = measure(label, &d, &Overrides::default());
+        if caught {
+            assert!(all_have(&q, ReasonKind::Compression), "{label}: {q:?}");
+        } else {
+            assert!(none_has(&q, ReasonKind::Compression), "{label}: {q:?}");
+        }
+    }
+}

@@ -28,8 +28,9 @@ mod frames;
 pub use frames::{
     AGREEMENT_CODES, AGREEMENT_MIN_SAMPLES, CodeRange, FrameAgreement, MAX_FRAME_OFFSET_LN,
     MAX_FRAME_SHIFT_PX, MAX_FRAME_SPREAD_LN, MAX_STEP_8BIT, MAX_STEP_LINEAR, MAX_STEP_RECOVERED,
-    PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS, Registration, bracket_reasons, code_range,
-    code_reasons, frame_agreement, frame_agreement_reasons, registration, registration_reasons,
+    MIN_JPEG_QUALITY, PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS, Registration, bracket_reasons,
+    code_range, code_reasons, compression_reasons, frame_agreement, frame_agreement_reasons,
+    jpeg_quality, registration, registration_reasons,
 };
 
 /// A fit whose rms log residual exceeds this is suspect: the profile differs from the model by
@@ -150,6 +151,7 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
     reasons.extend(registration_reasons(m));
     reasons.extend(bracket_reasons(m));
     reasons.extend(frame_agreement_reasons(m));
+    reasons.extend(compression_reasons(m));
     if let Some(factor) = evidence::spot_scale(m)
         && !(SPOT_FACTOR_RANGE.0..=SPOT_FACTOR_RANGE.1).contains(&factor)
     {
