@@ -22,7 +22,8 @@ pub struct Compared {
     /// The existing method (σ′s and σa fitted) on the same profile.
     pub existing: Measurement,
     /// When asked: the proposed method with the paper's model — the dipole, α′ from the dipole's
-    /// total (Choi et al. 2014 eq. 1) — or why that fit could not run.
+    /// total (Choi et al. 2014 eq. 1) — or why that fit could not run; its values only (no
+    /// uncertainty terms).
     pub paper: Option<Result<Measurement>>,
 }
 
@@ -46,7 +47,9 @@ pub fn paper_settings(settings: &FitSettings) -> FitSettings {
 /// loaded).
 pub fn compare_measurement(proposed: Measurement, paper: bool) -> Result<Compared> {
     let existing = proposed.refit(Method::Existing)?;
-    let paper = paper.then(|| proposed.refit_with(paper_settings(&proposed.settings)));
+    // Values only: the paper's column is printed beside the measurement, not measured again
+    // with its bars and cross-checks.
+    let paper = paper.then(|| proposed.refit_values_only(paper_settings(&proposed.settings)));
     Ok(Compared {
         proposed,
         existing,
