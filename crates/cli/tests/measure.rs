@@ -40,7 +40,8 @@ fn synth_then_measure() {
     let r: serde_json::Value = read_json(&dir.path().join("wood/result.json"));
     let truth: serde_json::Value = read_json(&dir.path().join("wood/truth.json"));
     assert_eq!(r["method"], "proposed");
-    assert_eq!(r["model"], "dipole");
+    // Exact transport by default.
+    assert_eq!(r["model"], "mc");
     let got = r["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
     let want = truth["channels"][0]["sigma_s_prime"].as_f64().unwrap();
     assert!((got / want - 1.0).abs() < 0.05, "{got} vs {want}");

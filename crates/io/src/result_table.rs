@@ -533,7 +533,7 @@ mod tests {
             let mut rows = csv::Reader::from_reader(csv.as_bytes());
             for row in rows.records() {
                 let row = row.unwrap();
-                assert_eq!(row.len(), 29, "{csv}");
+                assert_eq!(row.len(), 32, "{csv}");
                 assert!(!row[0].starts_with(['=', '+', '-', '@']), "{csv}");
             }
             let md = table1_markdown(std::slice::from_ref(&r));

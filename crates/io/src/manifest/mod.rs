@@ -759,8 +759,8 @@ r_max_px = 300
         m.camera.saturation = Some(4095);
         m.fit = FitSection {
             method: Some(Method::Existing),
-            model: Some(ModelName::Mc),
-            albedo_model: Some(AlbedoModel::Diffusion),
+            model: Some(ModelName::Pbd),
+            albedo_model: Some(AlbedoModel::Mc),
             r_max_px: Some(250.0),
             r_min_mm: Some(1.5),
             normalise_with_spectro: Some(false),
