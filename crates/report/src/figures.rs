@@ -136,7 +136,11 @@ pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
         title: format!(
             "{} — radial profile and {} fit ({} method, η = {:.4}{})",
             result.name,
-            result.model,
+            // The default, `mc`, in words: a reader of the figure need not know the flag.
+            match result.model {
+                scatterfit_optics::ModelName::Mc => "exact-transport (mc)".to_string(),
+                m => m.to_string(),
+            },
             result.method,
             result.eta,
             g_in_title(result.g_uncertainty.as_ref())

@@ -141,7 +141,7 @@ fn a_measured_sample_gets_its_report_files() {
     }
     let svg = std::fs::read_to_string(out.join("fit.svg")).unwrap();
     assert!(
-        svg.contains("wood-tile — radial profile and dipole fit"),
+        svg.contains("wood-tile — radial profile and exact-transport (mc) fit"),
         "SVG title"
     );
 
