@@ -150,7 +150,7 @@ fn a_measured_sample_gets_its_report_files() {
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(page.contains("<h1>wood-tile</h1>"));
     assert!(
-        page.contains("wood-tile — radial profile and dipole fit"),
+        page.contains("wood-tile — radial profile and exact-transport (mc) fit"),
         "Figure 4"
     );
     assert!(!page.contains("src=\"http") && !page.contains("href=\"http"));
