@@ -21,7 +21,7 @@ use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_fil
 mod exposures;
 
 pub use exposures::{
-    ExposureEntry, exif_exposure_time, parse_exposures_bytes, parse_exposures_csv,
+    ExposureEntry, MAX_FRAMES, exif_exposure_time, parse_exposures_bytes, parse_exposures_csv,
     read_exposures_csv,
 };
 
@@ -136,8 +136,8 @@ pub enum BracketError {
     },
     /// A frame's size, channel count or bit depth differs from the first frame's.
     #[error(
-        "{} is {found} but {} is {expected}; all frames of a bracket (and the dark frame) must have \
-         the same size, channels and bit depth",
+        "{} is {found} but {} is {expected}; all frames of a bracket (and its dark and flat frames) \
+         must have the same size, channels and bit depth",
         path.display(),
         first.display()
     )]
