@@ -150,6 +150,16 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
                 time_s,
             });
         }
+        if !is_shutter_time(time_s) {
+            return Err(BracketError::ImplausibleTime {
+                where_: format!(
+                    "{}, line {line} ({})",
+                    path.display(),
+                    crate::escape::token(file)
+                ),
+                time_s,
+            });
+        }
         entries.push(ExposureEntry {
             path: base.join(file),
             named: PathBuf::from(file),
@@ -206,6 +216,12 @@ pub fn exif_exposure_time(bytes: &[u8], path: &Path) -> Result<f64, BracketError
     };
     if !(time_s > 0.0 && time_s.is_finite()) {
         return Err(BracketError::NonPositiveTime {
+            where_: format!("{} (EXIF ExposureTime)", path.display()),
+            time_s,
+        });
+    }
+    if !is_shutter_time(time_s) {
+        return Err(BracketError::ImplausibleTime {
             where_: format!("{} (EXIF ExposureTime)", path.display()),
             time_s,
         });
