@@ -573,7 +573,9 @@ fn chromatic_media_render_their_reflectance_with_the_advised_integrator() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(512);
-    let materials: [(&str, f64, [(f64, f64); 3]); 2] = [
+    // (name, η, (σ′s, σa) per channel [mm⁻¹])
+    type Material<'a> = (&'a str, f64, [(f64, f64); 3]);
+    let materials: [Material; 2] = [
         ("skin1", 1.3, [(0.74, 0.032), (0.88, 0.17), (1.01, 0.48)]),
         (
             "marble",
