@@ -23,10 +23,11 @@ pub struct SampleInputs {
 }
 
 impl SampleInputs {
-    /// The measurement's peak memory \[bytes\], estimated from the frames' headers (not their
+    /// The measurement's peak memory \[bytes\], estimated from the images' headers (not their
     /// pixels): the decoded bracket, and as much again for the radiance map, its mask and the
-    /// decoders' copies; for a radiance map file, 6 × its size (a float map decodes to ≈ 3 × the
-    /// file, plus the copy made on reading). 0 when unknown (the measurement reports what is wrong).
+    /// decoders' copies, plus the dark frame, flat frame and spot image; for a radiance map file,
+    /// 6 × its size (a float map decodes to ≈ 3 × the file, plus the copy made on reading). 0 when
+    /// unknown (the measurement reports what is wrong).
     pub fn peak_memory_bytes(&self) -> u64 {
         let m = &self.manifest;
         if let Some(hdr) = &m.camera.hdr {
@@ -34,7 +35,16 @@ impl SampleInputs {
         }
         let (total, _, _) =
             scatterfit_io::bracket::decoded_size(self.frames.iter().map(PathBuf::as_path));
-        total.saturating_mul(2)
+        // The other images read whole (dark, flat, spot image), from their headers too.
+        let others = self
+            .files
+            .iter()
+            .filter(|(key, _)| {
+                ["`camera.dark`", "`camera.flat`", "`camera.spot_image`"].contains(&key.as_str())
+            })
+            .map(|(_, p)| p.as_path());
+        let (extra, _, _) = scatterfit_io::bracket::decoded_size(others);
+        total.saturating_mul(2).saturating_add(extra)
     }
 }
 
