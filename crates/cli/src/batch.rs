@@ -52,6 +52,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &args.samples.dirs,
         &crate::common::RESULT_FILES,
         &shared,
+        &args.output_dir,
+        args.samples.force,
         overrides.allow_outside_paths,
         args.quiet || args.json,
     )?;

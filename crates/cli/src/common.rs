@@ -74,6 +74,51 @@ pub fn bar(len: u64, template: &str, quiet: bool) -> indicatif::ProgressBar {
     bar
 }
 
+/// Progress for a log: when stderr is not a terminal (piped, redirected, a batch job) a progress
+/// bar is hidden, so a long run would say nothing for minutes; then a status line is printed at
+/// the first update and at most once per [`StatusLines::EVERY`] after. Nothing when `quiet` or on
+/// a terminal (the bar shows there).
+#[derive(Debug)]
+pub struct StatusLines {
+    on: bool,
+    start: std::time::Instant,
+    last: std::sync::Mutex<Option<std::time::Instant>>,
+}
+
+impl StatusLines {
+    /// Seconds between status lines.
+    pub const EVERY: std::time::Duration = std::time::Duration::from_secs(5);
+
+    /// Status lines unless `quiet` or stderr is a terminal.
+    pub fn new(quiet: bool) -> Self {
+        Self {
+            on: !quiet && !std::io::stderr().is_terminal(),
+            start: std::time::Instant::now(),
+            last: std::sync::Mutex::new(None),
+        }
+    }
+
+    /// Prints `line()` with the elapsed time when the last line is at least [`Self::EVERY`] old.
+    pub fn update(&self, line: impl FnOnce() -> String) {
+        if !self.on {
+            return;
+        }
+        let Ok(mut last) = self.last.lock() else {
+            return;
+        };
+        let now = std::time::Instant::now();
+        if last.is_some_and(|t| now.duration_since(t) < Self::EVERY) {
+            return;
+        }
+        *last = Some(now);
+        crate::output::errln!(
+            "{} ({:.0} s)",
+            line(),
+            now.duration_since(self.start).as_secs_f64()
+        );
+    }
+}
+
 /// The progress bar of a Monte Carlo run (`simulate`, `table`).
 pub const PHOTONS_BAR: &str = "{bar:40} {human_pos}/{human_len} photons  {per_sec}  ETA {eta}";
 
@@ -283,6 +328,10 @@ pub struct SamplesArgs {
     pub dirs: Vec<PathBuf>,
     #[command(flatten)]
     pub jobs: JobsArgs,
+    /// Write -o into another sample's folder, and replace files there or in the sample folders
+    /// that scatterfit did not write (its ledger, .scatterfit-written.json, does not list them).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The twins' Monte Carlo photons × a factor (`synth`, `study`).
@@ -348,7 +397,7 @@ impl JobsArgs {
 /// `study`.
 pub const JOBS_HELP: &str = "Samples measured at the same time: a count, 1 to 256 (default: one \
      per core). Fewer are run at once when that many would not fit the memory budget \
-     ($SCATTERFIT_MAX_MEMORY_MIB, default 8192 MiB; each sample holds its decoded bracket and \
+     ($SCATTERFIT_MAX_MEMORY_MIB, default half of this machine's memory; each sample holds its decoded bracket and \
      radiance map); a note on stderr says so";
 
 /// Parses `-j`: a count in 1..=256.
@@ -383,7 +432,8 @@ pub use scatterfit_io::inputs::{identity, same_file};
 
 pub use scatterfit_pipeline::outputs::{
     Failures, Format, RESULT_FILES, check_destination, check_output_dir, check_output_file,
-    check_output_folder, refuse_foreign_results, refuse_outputs_that_are_inputs, refuse_overwrite,
+    check_output_folder, refuse_foreign_folder, refuse_foreign_results,
+    refuse_outputs_that_are_inputs, refuse_overwrite,
 };
 
 /// The sample folders of a command over many samples (`batch`, `compare`), found and checked before
@@ -392,12 +442,16 @@ pub use scatterfit_pipeline::outputs::{
 /// misspelt returned as failures to report.
 ///
 /// # Errors
-/// An output that is an input, or a link at an output's name.
+/// An output that is an input, or a link at an output's name; `out_dir` being another sample's
+/// folder (unless `force`).
+#[allow(clippy::too_many_arguments)]
 pub fn samples_for(
     command: &str,
     dirs: &[PathBuf],
     per_sample: &[&str],
     shared: &[PathBuf],
+    out_dir: &Path,
+    force: bool,
     allow_outside: bool,
     quiet: bool,
 ) -> anyhow::Result<(Vec<PathBuf>, Failures)> {
@@ -408,6 +462,7 @@ pub fn samples_for(
         shared,
         allow_outside,
     )?;
+    refuse_foreign_folder(out_dir, &found.dirs, force)?;
     if !quiet {
         for (path, kept) in &found.duplicates {
             crate::output::errln!(
@@ -431,4 +486,32 @@ pub fn list_failures(what: &str, failed: &[(PathBuf, String)]) -> std::process::
         crate::output::errln!("  {}: {why}", dir.display());
     }
     std::process::ExitCode::from(1)
+}
+
+/// Downstream honesty: for a result whose data checks did not pass every channel, a warning on
+/// stderr (always: `--quiet` silences progress, not this) and exit 1, unless `allow_suspect` (then
+/// the warning and exit 0). Exit 0 for a trusted result.
+pub fn suspect_exit(
+    file: &Path,
+    result: &scatterfit_io::result_json::MeasurementResult,
+    allow_suspect: bool,
+) -> std::process::ExitCode {
+    let Some(why) = result.untrusted() else {
+        return std::process::ExitCode::SUCCESS;
+    };
+    crate::output::errln!(
+        "warning: {}: not every channel passed the measurement's data checks ({why}); the numbers \
+         are not trusted{}",
+        file.display(),
+        if allow_suspect {
+            ""
+        } else {
+            " — exit 1; pass --allow-suspect to use them anyway"
+        }
+    );
+    if allow_suspect {
+        std::process::ExitCode::SUCCESS
+    } else {
+        std::process::ExitCode::from(1)
+    }
 }

@@ -35,6 +35,10 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Exit 0 when a sample's data checks found a channel suspect (the warning is still printed
+    /// and written above compare.md's table).
+    #[arg(long)]
+    pub allow_suspect: bool,
 }
 
 /// Runs `scatterfit compare`.
@@ -51,6 +55,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &args.samples.dirs,
         &["compare.svg", "compare.png"],
         &shared,
+        &args.output_dir,
+        args.samples.force,
         overrides.allow_outside_paths,
         args.quiet || args.json,
     )?;
@@ -92,5 +98,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
         outln!("index: {}", index.display())?;
     }
-    Ok(crate::common::list_failures("failed", &failed))
+    let code = crate::common::list_failures("failed", &failed);
+    let mut honest = std::process::ExitCode::SUCCESS;
+    for ((existing, proposed), dir) in pairs.iter().zip(&pair_dirs) {
+        for r in [existing, proposed] {
+            let c = crate::common::suspect_exit(dir, r, args.allow_suspect);
+            if c != std::process::ExitCode::SUCCESS {
+                honest = c;
+            }
+        }
+    }
+    Ok(if code == std::process::ExitCode::SUCCESS {
+        honest
+    } else {
+        code
+    })
 }

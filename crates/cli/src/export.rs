@@ -43,6 +43,10 @@ pub struct Args {
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
+    /// Exit 0 for a result whose data checks found a channel suspect (the warning is still printed
+    /// and written into the file's header).
+    #[arg(long)]
+    pub allow_suspect: bool,
     /// No warnings or confirmation on stderr/stdout (errors are still printed).
     #[arg(short, long)]
     pub quiet: bool,
@@ -147,7 +151,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         // A closed stdout (`| head`) ends the output quietly (crate::output).
         None => crate::output::write_stdout_bytes(exported.text.as_bytes())?,
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(crate::common::suspect_exit(
+        &args.result,
+        &result,
+        args.allow_suspect,
+    ))
 }
 
 /// Refuses an output whose extension does not match the format, an existing file without `--force`,

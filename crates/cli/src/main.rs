@@ -123,7 +123,31 @@ fn main() -> ExitCode {
     }
 }
 
+/// The user's `--force`: besides each command's own meaning, files scatterfit did not write may be
+/// replaced (`scatterfit_safefs::ledger`).
+fn force(command: &Command) -> bool {
+    match command {
+        Command::Demo(a) => a.force,
+        Command::Measure(a) => a.force,
+        Command::Fit(a) => a.force,
+        Command::Batch(a) => a.samples.force,
+        Command::Compare(a) => a.samples.force,
+        Command::Spectro(a) => a.force,
+        Command::Simulate(a) => a.force,
+        Command::Table(a) => a.force,
+        Command::Merge(a) => a.force,
+        Command::Profile(a) => a.force,
+        Command::Synth(a) => a.force,
+        Command::Study(a) => a.force,
+        Command::Export(a) => a.force,
+        Command::Render(a) => a.force,
+        Command::Bench(_) => false,
+    }
+}
+
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    // One output policy for every command: a file is replaced only if scatterfit wrote it.
+    scatterfit_io::atomic::guard_outputs(force(&cli.command));
     match cli.command {
         Command::Demo(args) => demo::run(args),
         Command::Measure(args) => measure::run(args),

@@ -2,12 +2,12 @@
 //! budgets (memory, Monte Carlo work) that sizes derived from the flags are checked against before
 //! anything is allocated or traced.
 
-use scatterfit_io::budget::{DEFAULT_MEMORY_BUDGET_MIB, MEMORY_BUDGET_ENV, describe_bytes};
+use scatterfit_io::budget::{MEMORY_BUDGET_ENV, default_memory_budget_mib, describe_bytes};
 
 /// Help text of `--max-memory-mib`.
 pub const MAX_MEMORY_HELP: &str = "Memory budget [MiB, ≥ 1] for what the other flags and the \
      inputs size (tallies, tables, rings, images); checked before anything is allocated. Default: \
-     $SCATTERFIT_MAX_MEMORY_MIB, else 8192 (8 GiB). Raise it if this machine has the memory";
+     $SCATTERFIT_MAX_MEMORY_MIB, else half of this machine's memory (MemTotal of /proc/meminfo)";
 
 /// Help text of `--max-interactions`.
 pub const MAX_INTERACTIONS_HELP: &str = "Work budget: the most photon interactions (scattering \
@@ -130,7 +130,7 @@ pub fn parse_finite(text: &str) -> Result<f64, String> {
 }
 
 /// The memory budget \[bytes\]: the flag's MiB, else [`MEMORY_BUDGET_ENV`], else
-/// [`DEFAULT_MEMORY_BUDGET_MIB`].
+/// half of the machine's memory (`scatterfit_io::budget::default_memory_budget_mib`).
 pub fn memory_budget(flag_mib: Option<u64>) -> u64 {
     flag_mib.map_or_else(scatterfit_io::budget::memory_budget_bytes, |m| {
         m.saturating_mul(1 << 20)
@@ -145,10 +145,11 @@ pub fn check_memory(what: &str, needed: u64, budget: u64) -> anyhow::Result<()> 
     if needed > budget {
         anyhow::bail!(
             "{what} needs {} of memory, more than the budget of {}; use fewer, or raise the budget \
-             with --max-memory-mib (or {MEMORY_BUDGET_ENV}; default {DEFAULT_MEMORY_BUDGET_MIB} MiB) \
-             if this machine has the memory",
+             with --max-memory-mib (or {MEMORY_BUDGET_ENV}; default {} MiB, half of this \
+             machine's memory) if this machine has the memory",
             describe_bytes(needed),
-            describe_bytes(budget)
+            describe_bytes(budget),
+            default_memory_budget_mib()
         );
     }
     Ok(())

@@ -188,6 +188,9 @@ pub struct Args {
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
+    /// Exit 0 when a result's data checks found a channel suspect (the warning is still printed).
+    #[arg(long)]
+    pub allow_suspect: bool,
     #[command(flatten)]
     pub memory: crate::numeric::MemoryArgs,
     /// Print the summary as JSON.
@@ -343,6 +346,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|s| ParameterSet::load(s, model).map_err(cli_error))
         .collect::<anyhow::Result<_>>()?;
+    // Downstream honesty: a result the data checks did not trust is said so before the work, and
+    // the exit code says it after.
+    let mut code = ExitCode::SUCCESS;
+    for (result, json, _) in params.iter().filter_map(ParameterSet::result) {
+        let c = crate::common::suspect_exit(json, result, args.allow_suspect);
+        if c != ExitCode::SUCCESS {
+            code = c;
+        }
+    }
     let options = RenderOptions {
         width: args.size.0,
         height: args.size.1,
@@ -379,7 +391,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         white: args.white,
     };
     if args.profile {
-        return run_profile(&args, params.remove(0), model, options, &tone);
+        return run_profile(&args, params.remove(0), model, options, &tone)
+            .map(|c| if c == ExitCode::SUCCESS { code } else { c });
     }
 
     // The scene: the object read or built, then lit (mesh warnings in between).
@@ -438,7 +451,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         threads: rayon::current_num_threads(),
     };
     print_summary(&args, &summary)?;
-    Ok(ExitCode::SUCCESS)
+    Ok(code)
 }
 
 fn light_rig(light: LightArg) -> LightRig {

@@ -161,11 +161,13 @@ fn configure(args: &Args) -> anyhow::Result<Simulation> {
         args.incidence_deg,
         "the angle of incidence must lie in [0, 90) degrees",
     )?;
+    // Below a micrometre the bins' areas (π r², down to 1e-600 mm² for 1e-300) underflow to 0 and
+    // the tallies divide by them: NaN. No measurement resolves less than a micrometre.
     range(
-        args.r_max_mm > 0.0 && args.r_max_mm <= 1e6,
+        (1e-3..=1e6).contains(&args.r_max_mm),
         "--r-max-mm",
         args.r_max_mm,
-        "the outer radius must lie in (0, 1e6] mm",
+        "the outer radius must lie in [1e-3, 1e6] mm (a micrometre to a kilometre)",
     )?;
     if args.photons == 0 {
         bail!("--photons 0: trace at least one photon");

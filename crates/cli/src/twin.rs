@@ -54,6 +54,7 @@ pub fn synthesize_on(
         quiet,
     );
     let done = Mutex::new([0.0f64; 3]);
+    let status = crate::common::StatusLines::new(quiet);
     let sample = scatterfit_synth::synthesize(
         &m.name,
         m.sigma_s_prime,
@@ -68,6 +69,8 @@ pub fn synthesize_on(
                 bar.set_length(300);
                 bar.set_position((100.0 * f.iter().sum::<f64>()) as u64);
                 bar.set_message("Monte Carlo");
+                let percent = 100.0 * f.iter().sum::<f64>() / 3.0;
+                status.update(|| format!("{}: Monte Carlo {percent:.0} %", m.name));
             }
         },
     )

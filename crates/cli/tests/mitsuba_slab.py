@@ -37,6 +37,7 @@ spread / sqrt(pixels)), the pixel count, spp, seconds, and the Mitsuba version.
 """
 
 import argparse
+import re
 import json
 import math
 import os
@@ -57,6 +58,10 @@ def main():
     ap.add_argument("--light", choices=["constant", "directional"], default="constant")
     ap.add_argument("--extra", help="a second fragment, given to a box out of view")
     ap.add_argument("--variant", default="scalar_rgb")
+    ap.add_argument(
+        "--integrator",
+        help="the integrator type (default: the one the fragment's header recommends, else volpath)",
+    )
     args = ap.parse_args()
 
     import mitsuba as mi
@@ -75,6 +80,10 @@ def main():
 
     fragment = os.path.abspath(args.fragment)
     bsdf_id, medium_id, medium = ids(fragment)
+    # The integrator the fragment's header recommends: the test renders at the export's own advice.
+    with open(fragment, encoding="utf-8") as f:
+        advised = re.search(r'<integrator type=\\?"(\w+)\\?"', f.read())
+    integrator = args.integrator or (advised.group(1) if advised else "volpath")
     albedo = [e for e in medium if e.tag in ("rgb", "spectrum") and e.get("name") == "albedo"]
     # "a, b, c" (rgb) or "λ:a, λ:b, …" (spectrum): the largest value.
     alpha = (
@@ -124,7 +133,7 @@ def main():
     </shape>"""
     scene_xml = f"""<scene version="3.0.0">
     <include filename="{os.path.basename(fragment)}"/>
-    <integrator type="volpath">
+    <integrator type="{integrator}">
         <integer name="max_depth" value="-1"/>
         <integer name="rr_depth" value="{rr_depth}"/>
     </integrator>

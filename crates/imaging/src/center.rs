@@ -159,6 +159,18 @@ pub fn find_spot_center(img: &ImageBuf<f32>, opts: &CenterOptions) -> Result<Spo
     let nth = finite.len() - k;
     finite.select_nth_unstable_by(nth, |a, b| a.total_cmp(b));
     let robust_max = finite[nth];
+    // A spot is brighter than most of the frame: the profile falls by orders of magnitude from it.
+    // A frame whose median is half its maximum or more (a uniform grey, a flat frame, a white
+    // wall) has no spot, and "its centre" would be the middle of the frame.
+    let mid = finite.len() / 2;
+    let (_, median, _) = finite.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
+    if *median >= UNIFORM_MEDIAN_FRACTION * robust_max {
+        return Err(ImagingError::NoSpot {
+            reason: "the image is nearly uniform (its median is at least half its brightest \
+                     part): a spot image has a bright spot fading into a dark surround — is \
+                     this a flat frame, or a frame of the wrong scene?",
+        });
+    }
     // 2. Largest bright region (twice: the second time with the spot's own maximum).
     let mut t = frac * robust_max;
     let mut region = largest_region(&smooth, bw, bh, t);
@@ -249,6 +261,10 @@ pub fn find_spot_center(img: &ImageBuf<f32>, opts: &CenterOptions) -> Result<Spo
         threshold: t,
     })
 }
+
+/// A frame whose median (binned, smoothed) radiance is at least this fraction of its maximum has
+/// no light spot ([`find_spot_center`]).
+const UNIFORM_MEDIAN_FRACTION: f64 = 0.5;
 
 /// Mean of the finite samples, NaN if none.
 fn channel_mean(p: &[f32]) -> f64 {

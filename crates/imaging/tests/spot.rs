@@ -255,3 +255,22 @@ fn profile_refuses_bad_input() {
         Err(ImagingError::ShapeMismatch { .. })
     ));
 }
+
+/// A uniform frame (or a gently vignetted one, a flat frame's look) has no spot: it is refused as
+/// such, not given "a centre" in the middle of the frame. The noisy spot of the tests above still
+/// has one.
+#[test]
+fn a_uniform_image_has_no_spot() {
+    let grey = ImageBuf::filled(64, 48, 3, 0.4f32).unwrap();
+    let vignetted = render(640, 480, 320.0, 240.0, &[1.0, 0.9, 0.8], |r| {
+        1.0 - 0.4 * (r / 400.0).powi(2)
+    });
+    for img in [&grey, &vignetted] {
+        let e = find_spot_center(img, &CenterOptions::default()).unwrap_err();
+        assert!(
+            matches!(e, ImagingError::NoSpot { .. }) && e.to_string().contains("uniform"),
+            "{e}"
+        );
+    }
+    find_spot_center(&noisy_spot(300.2, 240.7, 9), &CenterOptions::default()).unwrap();
+}

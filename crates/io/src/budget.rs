@@ -2,24 +2,45 @@
 //!
 //! Sizes that follow from the input (an image's width × height, a bracket's frames) are checked
 //! against it *before* anything is allocated, so that a corrupt header or a typo in a flag is a clear
-//! error instead of an abort or a machine that starts to swap. The default,
-//! [`DEFAULT_MEMORY_BUDGET_MIB`], holds a 13-frame bracket of 100-MP 16-bit RGB frames; raise it with
-//! the environment variable [`MEMORY_BUDGET_ENV`] (MiB), or with a command's `--max-memory-mib`.
+//! error instead of an abort or a machine that starts to swap. The default is half of this
+//! machine's memory ([`default_memory_budget_mib`], `MemTotal` of `/proc/meminfo`; where that
+//! cannot be read, [`DEFAULT_MEMORY_BUDGET_MIB`]); set it with the environment variable
+//! [`MEMORY_BUDGET_ENV`] (MiB), or with a command's `--max-memory-mib`.
 
-/// The default budget \[MiB\]: 8 GiB, a third of the project's 24-GiB standard machine.
+/// The budget \[MiB\] where the machine's memory cannot be read: 8 GiB, a third of the project's
+/// 24-GiB standard machine.
 pub const DEFAULT_MEMORY_BUDGET_MIB: u64 = 8192;
+
+/// The default budget \[MiB\]: half of the machine's memory (`MemTotal` in `/proc/meminfo`, the
+/// kernel's figure for usable RAM), else [`DEFAULT_MEMORY_BUDGET_MIB`]. Half, because the decoded
+/// data is not the only thing in memory (the OS, other users of a shared machine, the page cache
+/// of the inputs).
+pub fn default_memory_budget_mib() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| mem_total_kib(&t))
+        .map_or(DEFAULT_MEMORY_BUDGET_MIB, |kib| (kib / 1024 / 2).max(1))
+}
+
+/// `MemTotal` \[KiB\] of the text of `/proc/meminfo`.
+fn mem_total_kib(meminfo: &str) -> Option<u64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let mut words = line["MemTotal:".len()..].split_whitespace();
+    let kib: u64 = words.next()?.parse().ok()?;
+    (words.next() == Some("kB") && kib > 0).then_some(kib)
+}
 
 /// Environment variable that sets the budget in MiB, e.g. `SCATTERFIT_MAX_MEMORY_MIB=32768`.
 pub const MEMORY_BUDGET_ENV: &str = "SCATTERFIT_MAX_MEMORY_MIB";
 
 /// The budget in bytes: [`MEMORY_BUDGET_ENV`] when it holds a positive whole number of MiB, else
-/// [`DEFAULT_MEMORY_BUDGET_MIB`].
+/// [`default_memory_budget_mib`].
 pub fn memory_budget_bytes() -> u64 {
     std::env::var(MEMORY_BUDGET_ENV)
         .ok()
         .and_then(|v| v.trim().parse::<u64>().ok())
         .filter(|&mib| mib > 0)
-        .unwrap_or(DEFAULT_MEMORY_BUDGET_MIB)
+        .unwrap_or_else(default_memory_budget_mib)
         .saturating_mul(1 << 20)
 }
 
@@ -61,8 +82,9 @@ pub fn describe_seconds(s: f64) -> String {
 /// How to raise the budget, for messages.
 pub fn how_to_raise() -> String {
     format!(
-        "raise the memory budget with {MEMORY_BUDGET_ENV}=<MiB> (default {DEFAULT_MEMORY_BUDGET_MIB}) \
-         if this machine has the memory"
+        "raise the memory budget with {MEMORY_BUDGET_ENV}=<MiB> (default {} MiB, half of this \
+         machine's memory) if this machine has the memory",
+        default_memory_budget_mib()
     )
 }
 
@@ -75,6 +97,22 @@ mod tests {
         assert_eq!(describe_bytes(512), "512 bytes");
         assert_eq!(describe_bytes(3 << 29), "1.5 GiB");
         assert_eq!(describe_bytes(144 << 20), "144 MiB");
+    }
+
+    /// The default is half of `MemTotal`; a text without it (or in other units) gives none.
+    #[test]
+    fn the_default_budget_is_half_the_machines_memory() {
+        let meminfo = "MemTotal:       24684084 kB\nMemFree:         1000 kB\n";
+        assert_eq!(mem_total_kib(meminfo), Some(24_684_084));
+        assert_eq!(mem_total_kib("MemFree: 5 kB\n"), None);
+        assert_eq!(mem_total_kib("MemTotal: 5 MB\n"), None);
+        if let Some(kib) = std::fs::read_to_string("/proc/meminfo")
+            .ok()
+            .and_then(|t| mem_total_kib(&t))
+        {
+            assert_eq!(default_memory_budget_mib(), kib / 2048);
+            assert_ne!(default_memory_budget_mib(), DEFAULT_MEMORY_BUDGET_MIB);
+        }
     }
 
     #[test]

@@ -17,21 +17,44 @@
 //! between the check and the read — by someone writing into the folder during the run — is not
 //! caught: that would need every reader to open beneath the folder, `openat2(RESOLVE_BENEATH)`.)
 
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
+
+/// Why a named path is refused (the same words for every key).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum OutsideReason {
+    /// The path is absolute.
+    Absolute,
+    /// The path goes up with `..` (or names a drive or root).
+    GoesUp,
+    /// A symbolic link on the way leads out of the folder (or cannot be followed).
+    Link,
+}
+
+impl std::fmt::Display for OutsideReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Absolute => "it is an absolute path",
+            Self::GoesUp => "it goes up with `..`",
+            Self::Link => "a symbolic link on its way leads outside the folder",
+        })
+    }
+}
 
 /// An input that resolves outside its folder, or a folder that cannot be resolved.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum InputPathError {
-    /// The path resolves outside the folder.
+    /// The path is not a relative path beneath the folder. The message is decided from the path's
+    /// text and the links inside the folder only, never from whether a file outside exists.
     #[error(
-        "{}: {key} = {} resolves outside {} (to {}); files named by a manifest or result stay \
-         inside its folder — symbolic links that leave it count as outside. Move or copy the file \
-         into the folder, or pass --allow-outside-paths if you trust this file",
+        "{}: {key} = {} is refused: {reason}. Files named by a manifest, an exposures list or a \
+         result are relative paths inside its folder {} (no absolute path, no `..`, no symbolic \
+         link that leads outside). Move or copy the file into the folder, or pass \
+         --allow-outside-paths if you trust this file",
         named_in.display(),
-        crate::escape::one_line(&path.to_string_lossy()),
-        root.display(),
-        resolved.display()
+        crate::escape::token(&path.to_string_lossy()),
+        root.display()
     )]
     Outside {
         /// The file that names the path (the manifest, the exposures CSV, the result).
@@ -41,8 +64,8 @@ pub enum InputPathError {
         key: String,
         /// The path as named.
         path: PathBuf,
-        /// Where it leads.
-        resolved: PathBuf,
+        /// Why it is refused.
+        reason: OutsideReason,
         /// The folder it must stay in (resolved).
         root: PathBuf,
     },
@@ -94,9 +117,51 @@ impl InputPolicy {
         self.allow_outside
     }
 
-    /// Checks `path` (already joined to the folder if it was relative), named in `named_in` under
-    /// `key`. A path that does not exist is left to its reader to report, unless the folder it
-    /// would be in already lies outside.
+    /// The one resolver of every path a file names: `named` (as written in `named_in` under
+    /// `key`) joined to `base` (the folder of the file that names it, itself inside the policy's
+    /// folder). Refused unless `named` is relative, has no `..`, and no symbolic link on its way
+    /// leads out of the folder — decided from the text and the links only, so the refusal is the
+    /// same whether or not a file outside exists (no existence oracle). A missing file inside is
+    /// left to its reader to report.
+    ///
+    /// # Errors
+    /// [`InputPathError::Outside`].
+    pub fn resolve(
+        &self,
+        named_in: &Path,
+        key: &str,
+        base: &Path,
+        named: &Path,
+    ) -> Result<PathBuf, InputPathError> {
+        let joined = base.join(named);
+        if self.allow_outside {
+            return Ok(joined);
+        }
+        let refuse = |reason| InputPathError::Outside {
+            named_in: named_in.to_path_buf(),
+            key: key.to_string(),
+            path: named.to_path_buf(),
+            reason,
+            root: self.root.clone(),
+        };
+        if named.is_absolute() || named.has_root() {
+            return Err(refuse(OutsideReason::Absolute));
+        }
+        if named
+            .components()
+            .any(|c| !matches!(c, Component::Normal(_) | Component::CurDir))
+        {
+            return Err(refuse(OutsideReason::GoesUp));
+        }
+        match self.check(named_in, key, &joined) {
+            Err(InputPathError::Outside { reason, .. }) => Err(refuse(reason)),
+            other => other.map(|()| joined),
+        }
+    }
+
+    /// Checks `path` (already joined to its folder; given on the command line or built by
+    /// scatterfit, so `..` and absolute spellings are allowed) for symbolic links that lead out of
+    /// the folder, named in `named_in` under `key`.
     ///
     /// # Errors
     /// [`InputPathError::Outside`].
@@ -104,39 +169,80 @@ impl InputPolicy {
         if self.allow_outside {
             return Ok(());
         }
-        let Some(resolved) = resolve(path) else {
-            return Ok(());
-        };
-        if resolved.starts_with(&self.root) {
+        if resolve(path, 0).is_some_and(|r| r.starts_with(&self.root)) {
             return Ok(());
         }
+        let reason = if path.is_absolute() && !path.starts_with(&self.root) && !is_link_on_way(path)
+        {
+            OutsideReason::Absolute
+        } else {
+            OutsideReason::Link
+        };
         Err(InputPathError::Outside {
             named_in: named_in.to_path_buf(),
             key: key.to_string(),
             path: path.to_path_buf(),
-            resolved,
+            reason,
             root: self.root.clone(),
         })
     }
 }
 
-/// `path` with every link followed: the file itself when it exists, else its folder joined with
-/// its name (a dangling link resolves as far as its folder), else `None`.
-fn resolve(path: &Path) -> Option<PathBuf> {
+/// True when some prefix of `path` is a symbolic link.
+fn is_link_on_way(path: &Path) -> bool {
+    path.ancestors()
+        .any(|p| std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_symlink()))
+}
+
+/// Links followed before giving up (Linux's own limit).
+const MAX_LINKS: u32 = 40;
+
+/// Where `path` leads with every symbolic link followed, whether or not it exists: the longest
+/// prefix that exists is resolved (a dangling link by reading it), the rest appended as named.
+/// `None` when it cannot be followed (a loop of links, a link's target that goes up from a
+/// folder that does not exist).
+fn resolve(path: &Path, links: u32) -> Option<PathBuf> {
+    if links > MAX_LINKS {
+        return None;
+    }
     if let Ok(p) = std::fs::canonicalize(path) {
         return Some(p);
     }
-    // A dangling symbolic link: where it points.
-    if let Ok(target) = std::fs::read_link(path) {
-        let base = path.parent().unwrap_or(Path::new("."));
-        return resolve(&base.join(target));
+    let mut existing = path.to_path_buf();
+    let mut rest: Vec<std::ffi::OsString> = Vec::new();
+    loop {
+        if existing.as_os_str().is_empty() {
+            existing = PathBuf::from(".");
+        }
+        match std::fs::symlink_metadata(&existing) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                // A dangling link (or one leading into a folder that lacks the rest): follow it
+                // by hand.
+                let target = std::fs::read_link(&existing).ok()?;
+                let base = existing.parent().unwrap_or(Path::new("."));
+                let mut next = base.join(target);
+                next.extend(rest.iter().rev());
+                return resolve(&next, links + 1);
+            }
+            Ok(_) => {
+                let mut p = std::fs::canonicalize(&existing).ok()?;
+                p.extend(rest.iter().rev());
+                return Some(p);
+            }
+            Err(_) => {
+                // Only plain names are carried over; a missing folder followed by `..` is
+                // refused (where it leads cannot be told).
+                match existing.components().next_back()? {
+                    Component::Normal(name) => rest.push(name.to_os_string()),
+                    Component::CurDir => {}
+                    _ => return None,
+                }
+                if !existing.pop() {
+                    return None;
+                }
+            }
+        }
     }
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let dir = std::fs::canonicalize(parent).ok()?;
-    Some(dir.join(path.file_name()?))
 }
 
 /// A path's identity for "is this one of the inputs?": the canonical path when it exists, else its
@@ -189,22 +295,73 @@ mod tests {
         for inside in [
             "spectro.csv",
             "frames/a.png",
-            "frames/../spectro.csv",
+            "./frames/a.png",
             "missing.csv",
         ] {
-            p.check(&m, "k", &sample.join(inside)).unwrap();
+            let r = p.resolve(&m, "k", &sample, Path::new(inside)).unwrap();
+            assert_eq!(r, sample.join(inside));
         }
-        for outside in ["../secret", "frames/../../secret", "/etc/passwd"] {
+        let secret = top.path().join("secret");
+        let inside_abs = sample.join("spectro.csv");
+        for (outside, reason) in [
+            ("../secret", OutsideReason::GoesUp),
+            ("frames/../../secret", OutsideReason::GoesUp),
+            ("frames/../spectro.csv", OutsideReason::GoesUp),
+            ("/etc/passwd", OutsideReason::Absolute),
+            (secret.to_str().unwrap(), OutsideReason::Absolute),
+            (inside_abs.to_str().unwrap(), OutsideReason::Absolute),
+        ] {
             let e = p
-                .check(&m, "spectro.file", &sample.join(outside))
+                .resolve(&m, "`spectro.file`", &sample, Path::new(outside))
                 .unwrap_err();
             let text = e.to_string();
-            assert!(text.contains("--allow-outside-paths") && text.contains("spectro.file"));
+            assert!(
+                text.contains("--allow-outside-paths") && text.contains("spectro.file"),
+                "{text}"
+            );
+            assert!(matches!(e, InputPathError::Outside { reason: r, .. } if r == reason));
         }
-        // A missing file in a folder outside.
-        assert!(p.check(&m, "k", &top.path().join("nowhere.csv")).is_err());
         let allowed = InputPolicy::new(&sample, true).unwrap();
-        allowed.check(&m, "k", &sample.join("../secret")).unwrap();
+        let r = allowed
+            .resolve(&m, "k", &sample, Path::new("../secret"))
+            .unwrap();
+        assert_eq!(r, sample.join("../secret"));
+    }
+
+    /// The refusal of a path outside is the same text whether or not the file (or its folder)
+    /// exists: no existence oracle.
+    #[cfg(unix)]
+    #[test]
+    fn a_refusal_does_not_tell_whether_a_file_exists() {
+        use std::os::unix::fs::symlink;
+        let top = tempfile::tempdir().unwrap();
+        let sample = top.path().join("sample");
+        fs::create_dir(&sample).unwrap();
+        fs::create_dir(top.path().join("there")).unwrap();
+        fs::write(top.path().join("there/secret"), b"x").unwrap();
+        symlink(top.path(), sample.join("up")).unwrap();
+        let m = sample.join("sample.toml");
+        let p = InputPolicy::new(&sample, false).unwrap();
+        let message = |named: &str| {
+            p.resolve(&m, "`camera.flat`", &sample, Path::new(named))
+                .unwrap_err()
+                .to_string()
+                .replace(named, "NAMED")
+        };
+        for (exists, missing) in [
+            ("../there/secret", "../there/missing"),
+            ("../there/secret", "../nowhere/missing"),
+            ("up/there/secret", "up/there/missing"),
+            ("up/there/secret", "up/nowhere/missing"),
+        ] {
+            assert_eq!(message(exists), message(missing), "{exists} / {missing}");
+        }
+        let abs = top.path().join("there/secret");
+        let abs_missing = top.path().join("nowhere/missing");
+        assert_eq!(
+            message(abs.to_str().unwrap()),
+            message(abs_missing.to_str().unwrap())
+        );
     }
 
     /// Links that leave the folder count as outside — to a file, to a folder, dangling, chained;
@@ -228,12 +385,24 @@ mod tests {
         for bad in [
             "file-link.csv",
             "dir-link/secret",
+            "dir-link/missing/deeper",
             "dangling.csv",
             "chain.csv",
         ] {
-            assert!(p.check(&m, "k", &sample.join(bad)).is_err(), "{bad}");
+            let e = p.resolve(&m, "k", &sample, Path::new(bad)).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    InputPathError::Outside {
+                        reason: OutsideReason::Link,
+                        ..
+                    }
+                ),
+                "{bad}"
+            );
         }
-        p.check(&m, "k", &sample.join("inner-link.csv")).unwrap();
+        p.resolve(&m, "k", &sample, Path::new("inner-link.csv"))
+            .unwrap();
         // A sample folder that is itself a link: its files are inside its target.
         let alias = top.path().join("alias");
         symlink(&sample, &alias).unwrap();

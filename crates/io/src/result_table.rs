@@ -386,7 +386,21 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
 /// Table 2 as Markdown: per material, MSE of the existing and the proposed method per channel, with
 /// fit times and parameters beside (pairs of results of the same sample).
 pub fn table2_markdown(pairs: &[(MeasurementResult, MeasurementResult)]) -> String {
-    let mut t = String::from(
+    // Downstream honesty: a sample whose data checks did not pass is said so above the table.
+    let mut t = String::new();
+    for (existing, proposed) in pairs {
+        for (method, r) in [("existing", existing), ("proposed", proposed)] {
+            if let Some(why) = r.untrusted() {
+                let _ = writeln!(
+                    t,
+                    "> **Warning — not trusted:** {} ({method} method): {}\n",
+                    crate::escape::markdown_cell(&r.name),
+                    crate::escape::markdown_cell(&why)
+                );
+            }
+        }
+    }
+    t.push_str(
         "| Material | Color | σ′s existing | σa existing | MSE existing | fit µs | σ′s proposed | σa proposed | MSE proposed | fit µs |\n\
          |---|---|---|---|---|---|---|---|---|---|\n",
     );

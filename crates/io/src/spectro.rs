@@ -151,6 +151,10 @@ pub enum SpectroCsvError {
     },
 }
 
+/// The most data rows a spectrophotometer CSV may have: one per wavelength, 1 nm apart over
+/// 100–2500 nm is 2401; 10 000 leaves room and bounds the work a crafted file can ask for.
+pub const MAX_SPECTRUM_ROWS: usize = 10_000;
+
 /// Reads a spectrophotometer CSV.
 ///
 /// # Errors
@@ -246,6 +250,16 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
             message: csv_message(&e, &dialect),
         })?;
         let line = lines.line(record.position());
+        if wavelengths.len() >= MAX_SPECTRUM_ROWS {
+            return Err(SpectroCsvError::Malformed {
+                path: p(),
+                line,
+                message: format!(
+                    "more than {MAX_SPECTRUM_ROWS} rows; a reflectance spectrum has one row per \
+                     wavelength (31 from 400 to 700 nm every 10 nm) — is this the right file?"
+                ),
+            });
+        }
         let cell = |col: usize, name: &str| -> Result<f64, SpectroCsvError> {
             let text = record.get(col).unwrap_or("");
             let bad = |reason: String| SpectroCsvError::BadValue {
@@ -426,6 +440,18 @@ mod tests {
 
     fn err(text: &str) -> String {
         parse(text).unwrap_err().to_string()
+    }
+
+    /// A spectrum longer than any instrument writes (rows 0.01 nm apart) is refused at the row
+    /// past the bound, not read and inverted whole.
+    #[test]
+    fn an_overlong_spectrum_is_refused() {
+        let mut text = String::from("wavelength_nm,sci,sce\n");
+        for i in 0..=MAX_SPECTRUM_ROWS {
+            text.push_str(&format!("{},0.55,0.51\n", 400.0 + 0.01 * i as f64));
+        }
+        let e = err(&text);
+        assert!(e.contains("more than 10000 rows"), "{e}");
     }
 
     #[test]

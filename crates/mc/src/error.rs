@@ -7,7 +7,7 @@ use std::path::PathBuf;
 #[non_exhaustive]
 pub enum McError {
     /// A physical or numerical parameter is outside its domain.
-    #[error("invalid parameter {name} = {value}: {reason}")]
+    #[error("invalid parameter {name} = {}: {reason}", short_number(*value))]
     InvalidParameter {
         /// The parameter's name as the API spells it, e.g. `sigma_a`.
         name: &'static str,
@@ -131,5 +131,15 @@ pub(crate) fn check(ok: bool, name: &'static str, value: f64, reason: &'static s
             value,
             reason,
         })
+    }
+}
+
+/// A number for messages: as written for ordinary magnitudes, in scientific notation beyond them
+/// (Display writes 1e300 as 301 digits).
+fn short_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:.4e}")
     }
 }

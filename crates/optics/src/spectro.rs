@@ -80,7 +80,7 @@ impl SpectroReading {
         for (name, values) in [("SCI", &sci), ("SCE", &sce)] {
             if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
                 return Err(OpticsError::Spectrum(format!(
-                    "{name} reflectance {v} is not a fraction in [0, 1]"
+                    "{name} reflectance {v:.4e} is not a fraction in [0, 1]"
                 )));
             }
         }

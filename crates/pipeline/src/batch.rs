@@ -76,7 +76,7 @@ pub struct BatchRequest {
     /// `memory_budget` ([`JobPlan`]).
     pub jobs: usize,
     /// The memory the samples measured at once may take \[bytes\] (default:
-    /// `scatterfit_io::budget::memory_budget_bytes`, 8 GiB or `$SCATTERFIT_MAX_MEMORY_MIB`).
+    /// `scatterfit_io::budget::memory_budget_bytes`: half the machine's memory, or `$SCATTERFIT_MAX_MEMORY_MIB`).
     pub memory_budget: u64,
 }
 

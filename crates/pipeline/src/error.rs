@@ -39,6 +39,12 @@ pub enum PipelineError {
     /// The dark frame's size, channels or bit depth differ from the bracket's frames.
     #[error(transparent)]
     DarkFrameShape(BracketError),
+    /// The flat frame (`camera.flat`) is unreadable.
+    #[error("reading the flat frame (camera.flat): {0}")]
+    FlatFrame(#[source] ImageFileError),
+    /// The flat frame's size, channels or bit depth differ from the bracket's frames.
+    #[error("the flat frame (camera.flat) does not match the bracket: {0}")]
+    FlatFrameShape(#[source] BracketError),
     /// An image file is unreadable.
     #[error(transparent)]
     Image(#[from] ImageFileError),

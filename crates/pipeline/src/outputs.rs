@@ -299,7 +299,7 @@ pub fn check_samples(
     allow_outside: bool,
 ) -> Result<CheckedSamples, OutputError> {
     let found = crate::sample_dirs(dirs);
-    let misspelt = found
+    let mut misspelt: Failures = found
         .misspelt
         .iter()
         .map(|(dir, file)| {
@@ -313,6 +313,17 @@ pub fn check_samples(
             )
         })
         .collect();
+    misspelt.extend(found.links_out.iter().map(|(link, top)| {
+        (
+            link.clone(),
+            format!(
+                "a symbolic link that leads out of {}; not measured — a folder of samples is \
+                 never left through a link (its results would be written where the link points); \
+                 give the sample folder itself if you mean it",
+                top.display()
+            ),
+        )
+    }));
     for o in shared {
         check_destination(o, "-o")?;
     }
@@ -336,6 +347,32 @@ pub fn check_samples(
         dirs: found.dirs,
         duplicates: found.duplicates,
         misspelt,
+    })
+}
+
+/// `batch`/`compare -o DIR`: refuses, unless `force`, a `DIR` that is the folder of a sample not
+/// being measured (it holds a `sample.toml`): its files are that sample's.
+///
+/// # Errors
+/// [`OutputError::AnotherSampleFolder`].
+pub fn refuse_foreign_folder(
+    out: &Path,
+    measured: &[PathBuf],
+    force: bool,
+) -> Result<(), OutputError> {
+    let out = if out.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        out
+    };
+    if force
+        || std::fs::symlink_metadata(out.join(manifest::MANIFEST_NAME)).is_err()
+        || measured.iter().any(|d| same_file(d, out))
+    {
+        return Ok(());
+    }
+    Err(OutputError::AnotherSampleFolder {
+        out: out.to_path_buf(),
     })
 }
 

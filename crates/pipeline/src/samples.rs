@@ -23,10 +23,11 @@ pub struct SampleInputs {
 }
 
 impl SampleInputs {
-    /// The measurement's peak memory \[bytes\], estimated from the frames' headers (not their
+    /// The measurement's peak memory \[bytes\], estimated from the images' headers (not their
     /// pixels): the decoded bracket, and as much again for the radiance map, its mask and the
-    /// decoders' copies; for a radiance map file, 6 × its size (a float map decodes to ≈ 3 × the
-    /// file, plus the copy made on reading). 0 when unknown (the measurement reports what is wrong).
+    /// decoders' copies, plus the dark frame, flat frame and spot image; for a radiance map file,
+    /// 6 × its size (a float map decodes to ≈ 3 × the file, plus the copy made on reading). 0 when
+    /// unknown (the measurement reports what is wrong).
     pub fn peak_memory_bytes(&self) -> u64 {
         let m = &self.manifest;
         if let Some(hdr) = &m.camera.hdr {
@@ -34,7 +35,16 @@ impl SampleInputs {
         }
         let (total, _, _) =
             scatterfit_io::bracket::decoded_size(self.frames.iter().map(PathBuf::as_path));
-        total.saturating_mul(2)
+        // The other images read whole (dark, flat, spot image), from their headers too.
+        let others = self
+            .files
+            .iter()
+            .filter(|(key, _)| {
+                ["`camera.dark`", "`camera.flat`", "`camera.spot_image`"].contains(&key.as_str())
+            })
+            .map(|(_, p)| p.as_path());
+        let (extra, _, _) = scatterfit_io::bracket::decoded_size(others);
+        total.saturating_mul(2).saturating_add(extra)
     }
 }
 
@@ -63,31 +73,22 @@ pub fn sample_inputs(dir: &Path, allow_outside: bool) -> Result<SampleInputs> {
     let manifest = read_manifest(dir)?;
     let mut files = vec![("the manifest".to_string(), manifest_path.clone())];
     let m = &manifest;
-    let named = [
-        ("spectro.file", m.spectro.file.as_ref()),
-        ("camera.exposures", m.camera.exposures.as_ref()),
-        ("camera.hdr", m.camera.hdr.as_ref()),
-        ("camera.response", m.camera.response.as_ref()),
-        ("camera.dark", m.camera.dark.as_ref()),
-    ];
-    for (key, p) in named {
-        if let Some(p) = p {
-            files.push((format!("`{key}`"), m.resolve(p)));
-        }
-    }
     let mut frames = Vec::new();
-    for p in m.camera.images.iter().flatten() {
-        files.push(("`camera.images`".to_string(), m.resolve(p)));
-        frames.push(m.resolve(p));
-    }
-    for (key, path) in &files {
-        policy.check(&manifest_path, key, path)?;
+    // One resolver for every key: relative paths beneath the sample folder only.
+    for (key, named) in m.named_paths() {
+        let key = format!("`{key}`");
+        let path = policy.resolve(&manifest_path, &key, &m.dir, named)?;
+        if key == "`camera.images`" {
+            frames.push(path.clone());
+        }
+        files.push((key, path));
     }
     if m.camera.hdr.is_none()
         && m.camera.images.as_ref().is_none_or(Vec::is_empty)
         && let Some(csv) = &m.camera.exposures
     {
         let csv = m.resolve(csv);
+        let csv_dir = csv.parent().unwrap_or(Path::new("."));
         // An exposures CSV that cannot be read names no frame that could be read; the bracket
         // stage reports it in its turn (after the spectrophotometer's errors, as before).
         let listed = scatterfit_io::bracket::read_exposures_csv(&csv).unwrap_or_default();
@@ -97,9 +98,9 @@ pub fn sample_inputs(dir: &Path, allow_outside: bool) -> Result<SampleInputs> {
                 e.line,
                 csv.file_name().unwrap_or_default().to_string_lossy()
             );
-            policy.check(&csv, &key, &e.path)?;
-            frames.push(e.path.clone());
-            files.push((key, e.path));
+            let path = policy.resolve(&csv, &key, csv_dir, &e.named)?;
+            frames.push(path.clone());
+            files.push((key, path));
         }
     }
     Ok(SampleInputs {
@@ -122,6 +123,10 @@ pub struct SampleDirs {
     /// (`Sample.toml`, `sample.TOML`, `sample.toml.txt`): `(folder, the file)`. Not measured;
     /// to be reported.
     pub misspelt: Vec<(PathBuf, PathBuf)>,
+    /// Sub-folders of a folder of samples that are symbolic links leading out of it: `(the link,
+    /// the folder given)`. Never followed (results would be written where the link points); to be
+    /// reported.
+    pub links_out: Vec<(PathBuf, PathBuf)>,
 }
 
 /// A file in `dir` whose name looks like a misspelt `sample.toml`.
@@ -150,6 +155,7 @@ pub fn sample_dirs(paths: &[PathBuf]) -> SampleDirs {
     let manifest = scatterfit_io::manifest::MANIFEST_NAME;
     let mut candidates: Vec<PathBuf> = Vec::new();
     let mut misspelt = Vec::new();
+    let mut links_out = Vec::new();
     for p in paths {
         if p.join(manifest).is_file() || !p.is_dir() {
             candidates.push(p.clone());
@@ -163,13 +169,27 @@ pub fn sample_dirs(paths: &[PathBuf]) -> SampleDirs {
             .filter(|d| d.is_dir())
             .collect();
         subs.sort();
+        let top = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
         let mut found = Vec::new();
+        let links_before = links_out.len();
         for d in subs {
+            let leaves = std::fs::canonicalize(&d).map_or(true, |c| !c.starts_with(&top));
+            if leaves {
+                if d.join(manifest).is_file() || misspelt_manifest(&d).is_some() {
+                    links_out.push((d, p.clone()));
+                }
+                continue;
+            }
             if d.join(manifest).is_file() {
                 found.push(d);
             } else if let Some(f) = misspelt_manifest(&d) {
                 misspelt.push((d, f));
             }
+        }
+        if found.is_empty() && links_out.len() > links_before {
+            // A folder of samples whose samples are all links that leave it: reported, not
+            // measured as a sample itself.
+            continue;
         }
         if found.is_empty() {
             // Not a folder of samples: measured as given (and its error reported), unless its
@@ -184,6 +204,7 @@ pub fn sample_dirs(paths: &[PathBuf]) -> SampleDirs {
     }
     let mut out = SampleDirs {
         misspelt,
+        links_out,
         ..SampleDirs::default()
     };
     let mut seen: Vec<(PathBuf, PathBuf)> = Vec::new();

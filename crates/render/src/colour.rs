@@ -78,6 +78,9 @@ impl Default for ColourParams {
     }
 }
 
+/// The largest coefficient of eq. (5) accepted (ρd, ρts, ρs, α, β, γ).
+const MAX_COEFFICIENT: f64 = 1000.0;
+
 impl ColourParams {
     /// Checks the domains.
     ///
@@ -95,9 +98,19 @@ impl ColourParams {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(invalid(name, v, "must be finite and ≥ 0"));
             }
+            // Eq. (5) multiplies these into radiance: beyond MAX_COEFFICIENT every lit pixel is
+            // white (or the product overflows to ∞ and NaN, which renders black).
+            if v > MAX_COEFFICIENT {
+                return Err(invalid(
+                    name,
+                    v,
+                    "must be at most 1000 (eq. 5's coefficients are of order 1; larger ones \
+                     overflow the radiance — set the brightness with --exposure)",
+                ));
+            }
         }
-        if !(self.beta.is_finite() && self.beta > 0.0) {
-            return Err(invalid("beta", self.beta, "must be > 0"));
+        if !(self.beta.is_finite() && self.beta > 0.0 && self.beta <= MAX_COEFFICIENT) {
+            return Err(invalid("beta", self.beta, "must lie in (0, 1000]"));
         }
         for (name, v) in [("alpha_x", self.alpha_x), ("alpha_y", self.alpha_y)] {
             if !(v.is_finite() && v > 0.0) {

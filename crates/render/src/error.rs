@@ -176,9 +176,15 @@ pub(crate) fn invalid(
     value: impl ToString,
     reason: &'static str,
 ) -> RenderError {
+    let text = value.to_string();
+    // A huge or tiny float prints in full (1e300 as 301 digits): shown in scientific notation.
+    let value = match text.parse::<f64>() {
+        Ok(v) if text.len() > 16 && v.is_finite() => format!("{v:.4e}"),
+        _ => text,
+    };
     RenderError::InvalidOption {
         name,
-        value: value.to_string(),
+        value,
         reason,
     }
 }

@@ -69,10 +69,14 @@ pub fn profile_path(
                 .into(),
         });
     };
-    let csv = folder.join(rel);
     // A result names files inside its folder (the input path policy), and the result and the
     // profile it names must come from one run (the folder's result set).
-    InputPolicy::new(folder, allow_outside_paths)?.check(json, "`inputs.profile`", &csv)?;
+    let csv = InputPolicy::new(folder, allow_outside_paths)?.resolve(
+        json,
+        "`inputs.profile`",
+        folder,
+        Path::new(rel),
+    )?;
     let unchecked = check_one_run(json, &csv)?;
     Ok((csv, unchecked))
 }

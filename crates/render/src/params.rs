@@ -55,7 +55,8 @@ pub struct ParameterSet {
 }
 
 impl ParameterSet {
-    /// Loads `spec`: a result file when a file of that name exists, else a published set's name
+    /// Loads `spec`: a result file when a file of that name exists (a folder: its `result.json`),
+    /// else a published set's name
     /// (`pink-plastic`, `pink-plastic-existing`, …). `model` is the caller's override of the fitted
     /// model: it also lets a result fitted with a model this version does not know be rendered.
     ///
@@ -64,7 +65,19 @@ impl ParameterSet {
     /// [`RenderError::ResultJson`] (an unreadable result), [`RenderError::UnknownModel`],
     /// [`RenderError::FailedChannel`] (a channel without σ′s or σa: a failed measurement).
     pub fn load(spec: &str, model: Option<ModelName>) -> Result<Self> {
-        let path = Path::new(spec);
+        let given = Path::new(spec);
+        // A folder (a sample folder, e.g. the demo's `pink-plastic/` beside the published set of
+        // that name) stands for its result.json; one without a result is not a result file.
+        let in_folder;
+        let path = if given.is_dir() {
+            in_folder = given.join("result.json");
+            if !in_folder.is_file() {
+                return Self::published(spec);
+            }
+            in_folder.as_path()
+        } else {
+            given
+        };
         if !path.exists() {
             return Self::published(spec);
         }

@@ -17,6 +17,7 @@
 //! Errors are `std::io::Error`s (so every caller's `source: io::Error` keeps working) whose inner
 //! error is one of this crate's types ([`UnsafeFile`]), for callers that want to tell them apart.
 
+pub mod ledger;
 pub mod read;
 pub mod write;
 
@@ -61,6 +62,15 @@ pub enum UnsafeFile {
         /// What it is, e.g. `a folder`.
         kind: &'static str,
     },
+    /// An output path exists and scatterfit did not write it (its folder's ledger does not list
+    /// it, [`ledger`]).
+    #[error(
+        "exists and was not written by scatterfit (it is not in the folder's {ledger}); \
+         scatterfit never replaces a file it did not write — move the file away, choose another \
+         output folder, or pass --force to replace it",
+        ledger = ledger::LEDGER_NAME
+    )]
+    NotWrittenByScatterfit,
     /// Writing stopped: the process is being interrupted (Ctrl-C).
     #[error("interrupted: no more files are written")]
     Interrupted,

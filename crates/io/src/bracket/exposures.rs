@@ -3,11 +3,17 @@
 
 use super::*;
 
+/// The most frames a bracket may have (`exposures.csv` lines, `camera.images`): real brackets
+/// have 3–20, and each frame is decoded whole, so thousands would be refused only after hours.
+pub const MAX_FRAMES: usize = 64;
+
 /// One exposure-time entry of an `exposures.csv`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExposureEntry {
     /// The image, resolved against the CSV's folder.
     pub path: PathBuf,
+    /// The image as the CSV names it (what the input path policy checks).
+    pub named: PathBuf,
     /// Shutter time Δt \[s\].
     pub time_s: f64,
     /// 1-based line in the CSV.
@@ -92,6 +98,15 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
         if record.iter().all(str::is_empty) {
             continue;
         }
+        if entries.len() >= MAX_FRAMES {
+            return Err(line_err(
+                line,
+                format!(
+                    "more than {MAX_FRAMES} frames; a bracket needs a dozen or so (each frame is \
+                     decoded whole) — is this the right file?"
+                ),
+            ));
+        }
         if record.len() > headers.len() {
             return Err(line_err(
                 line,
@@ -135,8 +150,19 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
                 time_s,
             });
         }
+        if !is_shutter_time(time_s) {
+            return Err(BracketError::ImplausibleTime {
+                where_: format!(
+                    "{}, line {line} ({})",
+                    path.display(),
+                    crate::escape::token(file)
+                ),
+                time_s,
+            });
+        }
         entries.push(ExposureEntry {
             path: base.join(file),
+            named: PathBuf::from(file),
             time_s,
             line,
         });
@@ -190,6 +216,12 @@ pub fn exif_exposure_time(bytes: &[u8], path: &Path) -> Result<f64, BracketError
     };
     if !(time_s > 0.0 && time_s.is_finite()) {
         return Err(BracketError::NonPositiveTime {
+            where_: format!("{} (EXIF ExposureTime)", path.display()),
+            time_s,
+        });
+    }
+    if !is_shutter_time(time_s) {
+        return Err(BracketError::ImplausibleTime {
             where_: format!("{} (EXIF ExposureTime)", path.display()),
             time_s,
         });

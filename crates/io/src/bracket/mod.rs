@@ -21,9 +21,18 @@ use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_fil
 mod exposures;
 
 pub use exposures::{
-    ExposureEntry, exif_exposure_time, parse_exposures_bytes, parse_exposures_csv,
+    ExposureEntry, MAX_FRAMES, exif_exposure_time, parse_exposures_bytes, parse_exposures_csv,
     read_exposures_csv,
 };
+
+/// The shutter times accepted \[s\]: 1 µs (beyond the fastest electronic shutters, 1/32000 s) to a
+/// day (beyond any bulb exposure of a lit sample).
+pub const SHUTTER_RANGE_S: (f64, f64) = (1e-6, 86_400.0);
+
+/// True for a time within [`SHUTTER_RANGE_S`].
+pub fn is_shutter_time(t: f64) -> bool {
+    (SHUTTER_RANGE_S.0..=SHUTTER_RANGE_S.1).contains(&t)
+}
 
 /// What can go wrong reading a bracket. Every variant names the file (and line) at fault.
 #[derive(Debug, thiserror::Error)]
@@ -73,6 +82,21 @@ pub enum BracketError {
     )]
     NonPositiveTime {
         /// Where the time came from (`exposures.csv, line 3` or `img.jpg (EXIF ExposureTime)`).
+        where_: String,
+        /// The value found.
+        time_s: f64,
+    },
+    /// An exposure time no shutter takes (outside [`SHUTTER_RANGE_S`]): a unit or typing mistake.
+    #[error(
+        "{where_}: exposure time {} s is not a shutter time (cameras take {} s to {} s); write \
+         each frame's time in seconds, e.g. 1/600 or 0.0016667 — times in milliseconds or \
+         microseconds, or a mangled exponent, would be off by that factor",
+        crate::escape::number(*time_s),
+        crate::escape::number(SHUTTER_RANGE_S.0),
+        crate::escape::number(SHUTTER_RANGE_S.1)
+    )]
+    ImplausibleTime {
+        /// Where the time came from.
         where_: String,
         /// The value found.
         time_s: f64,
@@ -136,8 +160,8 @@ pub enum BracketError {
     },
     /// A frame's size, channel count or bit depth differs from the first frame's.
     #[error(
-        "{} is {found} but {} is {expected}; all frames of a bracket (and the dark frame) must have \
-         the same size, channels and bit depth",
+        "{} is {found} but {} is {expected}; all frames of a bracket (and its dark and flat frames) \
+         must have the same size, channels and bit depth",
         path.display(),
         first.display()
     )]
@@ -194,6 +218,12 @@ impl Bracket {
             .find(|f| !(f.time_s.is_finite() && f.time_s > 0.0))
         {
             return Err(BracketError::NonPositiveTime {
+                where_: f.path.display().to_string(),
+                time_s: f.time_s,
+            });
+        }
+        if let Some(f) = frames.iter().find(|f| !is_shutter_time(f.time_s)) {
+            return Err(BracketError::ImplausibleTime {
                 where_: f.path.display().to_string(),
                 time_s: f.time_s,
             });
@@ -519,6 +549,31 @@ pub fn write_exposures_csv(path: &Path, entries: &[(String, f64)]) -> std::io::R
 mod tests {
     use super::exposures::parse_time;
     use super::*;
+
+    /// Times off by 10^±300 (a mangled exponent, a unit mistake far past milliseconds) are
+    /// refused as no shutter time, naming the line and the unit to use, not merged into an
+    /// all-black or all-white radiance map with advice about the exposures.
+    #[test]
+    fn times_no_shutter_takes_are_refused() {
+        for t in ["1e300", "1e-300", "2e5"] {
+            let text = format!("file,time_s\na.png,{t}\nb.png,0.01\n");
+            let e = parse_exposures_csv(&text, Path::new("s/exposures.csv")).unwrap_err();
+            assert!(
+                matches!(e, BracketError::ImplausibleTime { .. }),
+                "{t}: {e}"
+            );
+            let m = e.to_string();
+            assert!(
+                m.contains("line 2") && m.contains("not a shutter time") && m.len() < 400,
+                "{m}"
+            );
+        }
+        let ok = "file,time_s\na.png,1/32000\nb.png,30\n";
+        assert_eq!(
+            parse_exposures_csv(ok, Path::new("e.csv")).unwrap().len(),
+            2
+        );
+    }
 
     #[test]
     fn times_parse_as_decimals_and_fractions() {

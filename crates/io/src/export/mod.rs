@@ -349,7 +349,7 @@ pub fn export_with(
 /// What a target renders a material with: the light transport its numbers meet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Renderer {
-    /// Mitsuba 3's `volpath` on the `homogeneous` medium: exact transport.
+    /// Mitsuba 3's `volpathmis` (or `volpath`) on the `homogeneous` medium: exact transport.
     MitsubaVolpath,
     /// pbrt-v4's `volpath` on the `homogeneous` medium: exact transport.
     PbrtVolpath,
@@ -364,7 +364,7 @@ impl Renderer {
     /// The renderer and its transport, in words.
     pub fn describe(self) -> &'static str {
         match self {
-            Renderer::MitsubaVolpath => "Mitsuba's volpath (exact volumetric transport)",
+            Renderer::MitsubaVolpath => "Mitsuba's volpathmis (exact volumetric transport)",
             Renderer::PbrtVolpath => "pbrt's volpath on the medium (exact volumetric transport)",
             Renderer::PbrtSubsurface => {
                 "pbrt's subsurface material from sigma_a, sigma_s (its photon beam diffusion BSSRDF, \

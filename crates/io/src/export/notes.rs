@@ -192,14 +192,22 @@ pub(super) fn provenance_line(params: &RendererParameters) -> String {
             one_line(t)
         }
     };
-    format!(
+    let mut line = format!(
         "Measured with scatterfit {} (method {}, profile model {}, albedo model {}, eta from {}).",
         or_unknown(&s.measured_with),
         or_unknown(&s.method),
         or_unknown(&s.model),
         or_unknown(&s.albedo_model),
         or_unknown(&s.eta_source),
-    )
+    );
+    if let Some(why) = &s.not_trusted {
+        line.push_str(&format!(
+            " WARNING: not every channel passed the measurement's data checks, so these numbers \
+             are not trusted: {}.",
+            one_line(why)
+        ));
+    }
+    line
 }
 
 /// The per-channel coefficients as aligned comment lines starting with `prefix`.

@@ -102,6 +102,10 @@ pub struct Provenance {
     pub eta_source: String,
     /// The scatterfit version that measured the result.
     pub measured_with: String,
+    /// The channels the result's data checks did not pass, and why
+    /// (`MeasurementResult::untrusted`): a renderer's user must know the numbers are not trusted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub not_trusted: Option<String>,
 }
 
 /// The measured diffuse reflectance spectrum (the spectrophotometer's SCE) carried into an export:
@@ -339,6 +343,7 @@ impl RendererParameters {
                     .eta_source
                     .map_or_else(String::new, |e| e.to_string()),
                 measured_with: result.version.clone(),
+                not_trusted: result.untrusted(),
             },
             conventions: format!(
                 "linear sRGB channels; coefficients per {u} ({u}^-1), lengths in {u}; sigma_s is the \

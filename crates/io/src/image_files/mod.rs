@@ -323,6 +323,15 @@ pub fn read_image_bytes(path: &Path, budget: u64) -> Result<Vec<u8>, ImageFileEr
     })
 }
 
+/// The most a decoder may allocate while reading an image's header and ancillary chunks \[bytes\]
+/// (64 MiB; a camera's ICC profile is under 1 MiB).
+const HEADER_ALLOC: u64 = 64 << 20;
+
+/// The largest ratio of decoded to file bytes any accepted format reaches: deflate (PNG, TIFF)
+/// stops at 1032:1 (RFC 1951: 258 bytes per 2-bit code at best), LZW (TIFF) near 1365:1, a JPEG
+/// needs at least a few bits per 8 × 8 block per component (≤ 512:1). 4096 leaves room.
+const MAX_COMPRESSION: u64 = 4096;
+
 /// What decoding an image of this header allocates at most [bytes]: the decoded buffer, plus a
 /// copy without alpha (or a float conversion) of at most the same size.
 fn decode_cost(width: u32, height: u32, color: image::ColorType) -> u64 {
@@ -353,12 +362,13 @@ fn decode_any(
     {
         reader.set_format(format);
     }
-    // The `image` crate checks every allocation of the decoders against `max_alloc`; the whole
-    // decode is checked against the budget from the header first.
+    // The `image` crate checks every allocation of the decoders against `max_alloc`. Reading the
+    // header may inflate ancillary chunks (a PNG's compressed ICC profile, zTXt text): bounded by
+    // HEADER_ALLOC, far above any real profile, so a small file cannot make it allocate gigabytes.
     let mut limits = image::Limits::default();
-    limits.max_alloc = Some(budget);
+    limits.max_alloc = Some(budget.min(HEADER_ALLOC));
     reader.limits(limits);
-    let decoder = reader.into_decoder().map_err(decode_err)?;
+    let mut decoder = reader.into_decoder().map_err(decode_err)?;
     let (w, h) = decoder.dimensions();
     let color = decoder.color_type();
     let needed = decode_cost(w, h, color);
@@ -370,6 +380,30 @@ fn decode_any(
             budget,
         });
     }
+    // The header against the file: no image codec packs more than MAX_COMPRESSION decoded bytes
+    // into one byte of file, so a header that claims more is corrupt or crafted (a 10 KB JPEG
+    // announcing 30000 × 30000 pixels) — refused before its pixels are allocated.
+    let pixels_bytes = u64::from(w)
+        .saturating_mul(u64::from(h))
+        .saturating_mul(u64::from(color.bytes_per_pixel()));
+    let plausible = (bytes.len() as u64)
+        .saturating_mul(MAX_COMPRESSION)
+        .saturating_add(1 << 20);
+    if pixels_bytes > plausible {
+        return Err(ImageFileError::Unsupported {
+            path: path.to_path_buf(),
+            detail: format!(
+                "the header announces a {w}×{h} image ({}), but the file has only {} bytes — no \
+                 image format compresses {MAX_COMPRESSION}:1; the file is truncated or its header \
+                 is corrupt. Export the frame again",
+                crate::budget::describe_bytes(pixels_bytes),
+                bytes.len()
+            ),
+        });
+    }
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(budget);
+    decoder.set_limits(limits).map_err(decode_err)?;
     image::DynamicImage::from_decoder(decoder).map_err(decode_err)
 }
 
@@ -503,6 +537,134 @@ mod tests {
             vec![1, 2, 3, 4, 5, 6]
         );
         assert_eq!(drop_alpha(&[7u16, 1, 9, 1], 2), vec![7, 9]);
+    }
+
+    /// CRC-32 (ISO 3309, the PNG chunk checksum), bit by bit: enough for a test's few chunks.
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = 0xffff_ffffu32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xedb8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+
+    fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
+        out.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+    }
+
+    /// A PNG whose header claims `w`×`h` 8-bit RGB and whose data is a few bytes.
+    fn lying_png(w: u32, h: u32) -> Vec<u8> {
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        let mut ihdr = Vec::new();
+        ihdr.extend_from_slice(&w.to_be_bytes());
+        ihdr.extend_from_slice(&h.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+        chunk(&mut png, b"IHDR", &ihdr);
+        // A zlib stream of a few zero bytes (stored block), far short of the image.
+        chunk(
+            &mut png,
+            b"IDAT",
+            &[
+                0x78, 0x01, 0x01, 0x04, 0x00, 0xfb, 0xff, 0, 0, 0, 0, 0, 0x04, 0x00, 0x01,
+            ],
+        );
+        chunk(&mut png, b"IEND", &[]);
+        png
+    }
+
+    /// A header that announces far more pixels than the file could hold (a 100-byte PNG claiming
+    /// 30000 × 30000) is refused from the header, before a buffer is allocated — however large
+    /// the budget. A small image whose header fits its file still decodes.
+    #[test]
+    fn a_header_that_its_file_cannot_hold_is_refused_before_decoding() {
+        let png = lying_png(30_000, 30_000);
+        let e = decode_camera_frame_within(&png, Path::new("frame.png"), 1 << 40).unwrap_err();
+        assert!(e.to_string().contains("header announces"), "{e}");
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("ok.png");
+        let frame = ImageBuf::new(64, 48, 3, vec![9u8; 64 * 48 * 3]).unwrap();
+        write_camera_frame(&p, &CameraFrame::U8(frame)).unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        let d = decode_camera_frame_within(&bytes, &p, 1 << 30).unwrap();
+        assert_eq!((d.frame.width(), d.frame.height()), (64, 48));
+    }
+
+    /// A zlib stream of `1 + 258 k` zero bytes in fixed-Huffman deflate (RFC 1950/1951): a
+    /// literal 0, then `k` copies of (length 258, distance 1) at 13 bits each.
+    fn zlib_zeros(k: usize) -> Vec<u8> {
+        let mut out = vec![0x78, 0x01];
+        let (mut acc, mut n) = (0u64, 0u32);
+        let mut bits = |value: u32, count: u32, out: &mut Vec<u8>| {
+            acc |= u64::from(value) << n;
+            n += count;
+            while n >= 8 {
+                out.push(acc as u8);
+                acc >>= 8;
+                n -= 8;
+            }
+        };
+        // Huffman codes go most significant bit first.
+        let code =
+            |c: u32, len: u32| (0..len).fold(0, |r, i| r | (((c >> i) & 1) << (len - 1 - i)));
+        bits(1, 1, &mut out); // BFINAL
+        bits(1, 2, &mut out); // BTYPE = 01, fixed Huffman
+        bits(code(0x30, 8), 8, &mut out); // literal 0
+        for _ in 0..k {
+            bits(code(0xC5, 8), 8, &mut out); // length 258 (symbol 285)
+            bits(0, 5, &mut out); // distance 1 (code 0)
+        }
+        bits(0, 7, &mut out); // end of block (symbol 256)
+        bits(0, 7, &mut out); // flush
+        let len = 1 + 258 * k as u64;
+        let adler = ((len % 65_521) << 16) | 1;
+        out.extend_from_slice(&(adler as u32).to_be_bytes());
+        out
+    }
+
+    /// The peak resident memory of this process \[KiB\] (`VmHWM`), where /proc has it.
+    fn peak_kib() -> Option<u64> {
+        let status = std::fs::read_to_string("/proc/self/status").ok()?;
+        let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+        line.split_whitespace().nth(1)?.parse().ok()
+    }
+
+    /// An ICC profile chunk that inflates to 1 GiB from a 7 MB file is not inflated past the
+    /// decoder's header bound (64 MiB): the image decodes, the peak memory stays far below a GiB.
+    #[test]
+    fn an_inflating_icc_chunk_is_bounded() {
+        use image::ImageEncoder;
+        let mut plain = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut plain)
+            .write_image(&[7u8; 16 * 16 * 3], 16, 16, image::ExtendedColorType::Rgb8)
+            .unwrap();
+        let mut iccp = b"bomb\0\0".to_vec();
+        iccp.extend(zlib_zeros(4_161_600));
+        // The signature and IHDR (8 + 25 bytes), the iCCP chunk, the rest.
+        let mut png = plain[..33].to_vec();
+        chunk(&mut png, b"iCCP", &iccp);
+        png.extend_from_slice(&plain[33..]);
+        assert!(png.len() < 8 << 20, "{} bytes", png.len());
+        let before = peak_kib();
+        let d = decode_camera_frame_within(&png, Path::new("icc.png"), 1 << 40).unwrap();
+        assert_eq!(d.frame.width(), 16);
+        if let (Some(a), Some(b)) = (before, peak_kib()) {
+            assert!(
+                b - a < 512 << 10,
+                "peak memory rose by {} MiB",
+                (b - a) >> 10
+            );
+        }
     }
 
     #[test]

@@ -112,6 +112,7 @@ pub struct SpectroSection {
     /// The SCI/SCE CSV.
     pub file: Option<PathBuf>,
     /// Measured L\*a\*b\* (D65) for the colour instead of the SCE spectrum.
+    #[serde(default, deserialize_with = "exact_array")]
     pub lab: Option<[f64; 3]>,
     /// Observer of `lab`: 10 (default) or 2.
     pub lab_observer: Option<u32>,
@@ -209,6 +210,7 @@ pub struct CameraSection {
     /// A dark frame.
     pub dark: Option<PathBuf>,
     /// The spot centre [x, y] px.
+    #[serde(default, deserialize_with = "exact_array")]
     pub center_px: Option<[f64; 2]>,
     /// Diameter of the light spot \[mm\].
     pub spot_diameter_mm: Option<f64>,
@@ -346,6 +348,7 @@ pub struct FitSection {
     /// default): the values stay at g = 0 and the term is propagated over 0–0.95** — an unstated g
     /// is not known, and real materials span that range: a σa computed at g = 0 for a
     /// forward-scattering material is 5–25 % high, which the term then shows.
+    #[serde(default, deserialize_with = "exact_array")]
     pub g_range: Option<[f64; 2]>,
 }
 
@@ -379,6 +382,33 @@ impl SampleManifest {
         }
     }
 
+    /// Every file the manifest names, with its key (`spectro.file`, `camera.flat`, …), as
+    /// written: what the input path policy ([`crate::inputs::InputPolicy::resolve`]) checks, one
+    /// list so that no key is forgotten.
+    pub fn named_paths(&self) -> Vec<(&'static str, &Path)> {
+        let c = &self.camera;
+        let single = [
+            ("spectro.file", self.spectro.file.as_deref()),
+            ("camera.exposures", c.exposures.as_deref()),
+            ("camera.hdr", c.hdr.as_deref()),
+            ("camera.response", c.response.as_deref()),
+            ("camera.dark", c.dark.as_deref()),
+            ("camera.spot_image", c.spot_image.as_deref()),
+            ("camera.flat", c.flat.as_deref()),
+        ];
+        let mut out: Vec<(&'static str, &Path)> = single
+            .into_iter()
+            .filter_map(|(k, p)| p.map(|p| (k, p)))
+            .collect();
+        out.extend(
+            c.images
+                .iter()
+                .flatten()
+                .map(|p| ("camera.images", p.as_path())),
+        );
+        out
+    }
+
     /// The sample's name, or the folder's.
     pub fn display_name(&self) -> String {
         self.name.clone().unwrap_or_else(|| {
@@ -388,6 +418,30 @@ impl SampleManifest {
         })
     }
 }
+
+/// An optional array of exactly `N` numbers. serde's fixed-size arrays take the first `N`
+/// elements of a longer TOML array and drop the rest without a word (`center_px = [412, 300, 7]`
+/// would be read as [412, 300]); a number too many or too few is a mistake to name instead.
+fn exact_array<'de, D, const N: usize>(d: D) -> Result<Option<[f64; N]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let v: Option<Vec<f64>> = Option::deserialize(d)?;
+    v.map(|v| {
+        <[f64; N]>::try_from(v.as_slice()).map_err(|_| {
+            serde::de::Error::custom(format!(
+                "must be exactly {N} numbers, but {} are given (none is dropped silently); write \
+                 [{}]",
+                v.len(),
+                vec!["…"; N].join(", ")
+            ))
+        })
+    })
+    .transpose()
+}
+
+/// Longest sample name accepted \[characters\]: a name is shown in tables, plots and exports.
+pub const MAX_NAME_CHARS: usize = 200;
 
 /// The manifest's file name in a sample folder.
 pub const MANIFEST_NAME: &str = "sample.toml";
@@ -572,6 +626,31 @@ pub fn parse_manifest(
         }
         Some(_) => {}
     }
+    if let Some(name) = &m.name
+        && name.chars().count() > MAX_NAME_CHARS
+    {
+        return Err(invalid(
+            "name",
+            format!(
+                "is {} characters long; a sample's name is shown in tables, plots and exports — \
+                 keep it within {MAX_NAME_CHARS}",
+                name.chars().count()
+            ),
+        ));
+    }
+    if let Some(images) = &m.camera.images
+        && images.len() > crate::bracket::MAX_FRAMES
+    {
+        return Err(invalid(
+            "camera.images",
+            format!(
+                "lists {} frames; a bracket needs a dozen or so (each frame is decoded whole), at \
+                 most {}",
+                images.len(),
+                crate::bracket::MAX_FRAMES
+            ),
+        ));
+    }
     if m.camera.hdr.is_none() && m.camera.exposures.is_none() && m.camera.images.is_none() {
         return Err(invalid(
             "camera.exposures",
@@ -610,7 +689,8 @@ pub fn parse_manifest(
             return Err(invalid(
                 "camera.black_level",
                 format!(
-                    "= {v}: a black level is a raw value in [0, 65535) DN, or \"auto\"/\"none\""
+                    "= {}: a black level is a raw value in [0, 65535) DN, or \"auto\"/\"none\"",
+                    num(v)
                 ),
             ));
         }
@@ -739,6 +819,45 @@ method = "existing"
 model = "dipole"
 r_max_px = 300
 "#;
+
+    /// Fixed-size arrays with a number too many or too few are refused (serde alone would drop
+    /// the extra ones); an overlong name and more frames than a bracket has are refused.
+    #[test]
+    fn arrays_names_and_frame_lists_are_bounded() {
+        for (key, line) in [
+            ("center_px", "center_px = [320, 240, 7]"),
+            ("center_px", "center_px = [320]"),
+            ("g_range", "g_range = [0.1, 0.5, 0.9]"),
+        ] {
+            let text = if key == "g_range" {
+                GOOD.replace("[fit]\n", &format!("[fit]\n{line}\n"))
+            } else {
+                GOOD.replace("[camera]\n", &format!("[camera]\n{line}\n"))
+            };
+            let e = parse(&text).unwrap_err().to_string();
+            assert!(e.contains("exactly 2 numbers"), "{line}: {e}");
+        }
+        let lab = GOOD.replace("[spectro]\n", "[spectro]\nlab = [50, 10, 10, 99]\n");
+        let e = parse(&lab).unwrap_err().to_string();
+        assert!(e.contains("exactly 3 numbers"), "{e}");
+        let ok = GOOD.replace("[camera]\n", "[camera]\ncenter_px = [320, 240]\n");
+        assert_eq!(parse(&ok).unwrap().camera.center_px, Some([320.0, 240.0]));
+        let long = GOOD.replace("pink plastic", &"x".repeat(MAX_NAME_CHARS + 1));
+        let e = parse(&long).unwrap_err().to_string();
+        assert!(e.contains("201 characters"), "{e}");
+        let frames: Vec<String> = (0..=crate::bracket::MAX_FRAMES)
+            .map(|i| format!("\"f{i}.png\""))
+            .collect();
+        let many = GOOD.replace(
+            "exposures = \"exposures.csv\"",
+            &format!("images = [{}]", frames.join(", ")),
+        );
+        let e = parse(&many).unwrap_err().to_string();
+        assert!(
+            e.contains("camera.images") && e.contains("65 frames"),
+            "{e}"
+        );
+    }
 
     /// The documented example parses; what is written reads back the same, every `[fit]` key
     /// included — with values that differ from the defaults, so a writer that dropped one (and let

@@ -396,6 +396,28 @@ pub struct MeasurementResult {
 }
 
 impl MeasurementResult {
+    /// The channels whose data checks did not say ok, and why, on one line (`R suspect: …; B
+    /// failed: …`); `None` when every channel is ok (or the result predates the checks). What
+    /// every command that reads a result (`export`, `render`, `compare`) warns with.
+    pub fn untrusted(&self) -> Option<String> {
+        let parts: Vec<String> = self
+            .channels
+            .iter_channels()
+            .filter_map(|(ch, c)| {
+                let q = c.quality.as_ref()?;
+                (q.verdict != crate::quality::Verdict::Ok).then(|| {
+                    format!(
+                        "{} {}: {}",
+                        ch.name(),
+                        q.verdict.name(),
+                        crate::escape::one_line(&q.summary())
+                    )
+                })
+            })
+            .collect();
+        (!parts.is_empty()).then(|| parts.join("; "))
+    }
+
     /// (σ′s, σa) per channel when every channel has both, else the first channel (R, G, B order)
     /// without.
     ///

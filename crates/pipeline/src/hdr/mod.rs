@@ -378,10 +378,10 @@ pub fn read_frames(
     };
     let flat = match &inputs.flat {
         Some(path) => {
-            let d = read_camera_frame(path).map_err(PipelineError::DarkFrame)?;
+            let d = read_camera_frame(path).map_err(PipelineError::FlatFrame)?;
             bracket
                 .check_same_shape(&d.frame, path)
-                .map_err(PipelineError::DarkFrameShape)?;
+                .map_err(PipelineError::FlatFrameShape)?;
             Some((path.clone(), d.frame))
         }
         None => None,

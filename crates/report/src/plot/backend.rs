@@ -22,6 +22,9 @@ use super::layout::{FONT, draw_figure};
 use super::{Figure, figure_size};
 use crate::error::{self, ReportError, draw_error};
 
+/// The most characters of one label drawn into a plot (longer ones end in `…`).
+const MAX_DRAWN_CHARS: usize = 200;
+
 /// The figure as SVG text.
 ///
 /// # Errors
@@ -180,6 +183,18 @@ impl<'a> DrawingBackend for GlyphTextBackend<'a> {
         if colour.alpha == 0.0 {
             return Ok(());
         }
+        // Bounded before layout: a label drawn from a file (a sample's name) could be megabytes,
+        // and laying it out costs memory and time in proportion.
+        let bounded;
+        let text = if text.chars().count() > MAX_DRAWN_CHARS {
+            bounded = format!(
+                "{}…",
+                text.chars().take(MAX_DRAWN_CHARS - 1).collect::<String>()
+            );
+            bounded.as_str()
+        } else {
+            text
+        };
         let ((min_x, min_y), (max_x, max_y)) = style
             .layout_box(text)
             .map_err(|e| DrawingErrorKind::FontError(Box::new(e)))?;
