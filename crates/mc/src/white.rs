@@ -21,16 +21,25 @@
 //! Scores are per photon, so standard errors come from per-photon second moments, as in the engine;
 //! photons run in chunks with one random stream per chunk, so a seed gives the same tally bit for bit
 //! on any number of threads.
+//!
+//! Shards ([`simulate_shard`], [`combine`]): a run split over machines traces, per stratum, a
+//! contiguous range of its chunks ([`Shard::chunk_range`]) and keeps its sums *exactly*
+//! ([`ExactSum`]: each chunk's f64 sums added without rounding), so that the shards' sums added in
+//! any order are the one run's sums, and rounding them once gives the same f64 bit for bit.
+//! [`simulate`] is the one-shard case of the same path: a table built on one machine and one merged
+//! from N shards are the same bytes.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::engine::{CHUNK_PHOTONS, spin_isotropic};
-use crate::error::{Result, check};
+use crate::error::{McError, Result, check};
+use crate::exact::ExactSum;
 use crate::fresnel::fresnel_mcml;
 use crate::grid::RadialGrid;
 use crate::phase::{HgSampler, scatter_hg};
 use crate::rng::{PhotonRng, stream};
+use crate::shard::Shard;
 
 /// Survival probability of the interaction-count roulette.
 pub const ROULETTE_SURVIVAL: f64 = 0.25;
@@ -122,6 +131,19 @@ impl WhiteSpec {
     /// Photons over all strata.
     pub fn photons(&self) -> u64 {
         self.strata.iter().map(|s| s.photons).sum()
+    }
+
+    /// Photons `shard` traces, over all strata ([`simulate_shard`]).
+    pub fn shard_photons(&self, shard: Shard) -> u64 {
+        self.strata
+            .iter()
+            .map(|s| {
+                photons_in(
+                    &shard.chunk_range(s.photons.div_ceil(CHUNK_PHOTONS)),
+                    s.photons,
+                )
+            })
+            .sum()
     }
 
     /// Checks every field.
@@ -223,31 +245,64 @@ impl Accum {
             interactions: 0,
         }
     }
+}
 
-    fn add(&mut self, o: &Accum) {
-        for (a, b) in self.w.iter_mut().zip(&o.w) {
-            *a += b;
-        }
-        for (a, b) in self.w2.iter_mut().zip(&o.w2) {
-            *a += b;
-        }
-        for (a, b) in self.tot.iter_mut().zip(&o.tot) {
-            *a += b;
-        }
-        for (a, b) in self.tot2.iter_mut().zip(&o.tot2) {
-            *a += b;
-        }
-        self.capped += o.capped;
-        self.interactions += o.interactions;
-    }
+/// One stratum's share of a sharded white run: its chunk range and the exact sums of the per-photon
+/// scores over those chunks (row-major as [`WhiteTally`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StratumSums {
+    /// The chunks traced, [first, end) of the stratum's ⌈photons / CHUNK_PHOTONS⌉.
+    pub chunks: [u64; 2],
+    /// Σ score per (albedo, bin).
+    pub w: Vec<ExactSum>,
+    /// Σ score² per (albedo, bin).
+    pub w2: Vec<ExactSum>,
+    /// Σ score per albedo (all radii).
+    pub tot: Vec<ExactSum>,
+    /// Σ score² per albedo.
+    pub tot2: Vec<ExactSum>,
+    /// Photons stopped by the stratum's interaction cap.
+    pub capped: u64,
+    /// Interactions traced.
+    pub interactions: u64,
+}
+
+/// A shard's part of a white run ([`simulate_shard`]): exact sums per stratum, to be added to the
+/// other shards' by [`combine`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WhitePartial {
+    /// The whole run's spec.
+    pub spec: WhiteSpec,
+    /// Which slice of it this is.
+    pub shard: Shard,
+    /// Per stratum of `spec`.
+    pub strata: Vec<StratumSums>,
 }
 
 /// Runs the white simulation on the current rayon pool, stratum after stratum; `progress(done)`
-/// counts photons over all strata.
+/// counts photons over all strata. The one-shard case of [`simulate_shard`] and [`combine`].
 ///
 /// # Errors
 /// `InvalidParameter` for a bad spec.
 pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<WhiteTally> {
+    combine(&[simulate_shard(spec, Shard::WHOLE, progress)?])
+}
+
+/// Photons of a stratum traced by the chunks `range`.
+fn photons_in(range: &std::ops::Range<u64>, photons: u64) -> u64 {
+    (range.end * CHUNK_PHOTONS).min(photons) - (range.start * CHUNK_PHOTONS).min(photons)
+}
+
+/// Runs `shard`'s slice of the white simulation (per stratum, its range of chunks) on the current
+/// rayon pool and keeps the sums exactly; `progress(done)` counts the shard's photons.
+///
+/// # Errors
+/// `InvalidParameter` for a bad spec.
+pub fn simulate_shard(
+    spec: &WhiteSpec,
+    shard: Shard,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<WhitePartial> {
     spec.validate()?;
     let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
     let bins = grid.bins();
@@ -258,13 +313,8 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
     } else {
         0.0
     };
-    // Launch weight 1 − R_sp (MCML `LaunchPhoton`, normal incidence from air).
-    let w0 = 1.0 - ((spec.eta - 1.0) / (spec.eta + 1.0)).powi(2);
-    let mut rd = vec![0.0; k * bins];
-    let mut var = vec![0.0; k * bins];
-    let mut rd_total = vec![0.0; k];
-    let mut var_total = vec![0.0; k];
-    let (mut capped, mut interactions, mut done_before) = (0, 0, 0);
+    let mut strata = Vec::with_capacity(spec.strata.len());
+    let mut done_before = 0;
     let mut min_n = 0;
     for (si, stratum) in spec.strata.iter().enumerate() {
         let tracer = Tracer {
@@ -279,15 +329,22 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
             ln_a: &ln_a,
             bins,
         };
-        let last_stratum = si + 1 == spec.strata.len();
         let photons = stratum.photons;
         // Stratum k's streams: (seed mixed with k, chunk index).
         let seed = spec.seed ^ (si as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        let chunks = photons.div_ceil(CHUNK_PHOTONS);
-        let mut total = Accum::new(k, bins);
-        let mut first = 0;
-        while first < chunks {
-            let last = (first + WAVE_CHUNKS).min(chunks);
+        let range = shard.chunk_range(photons.div_ceil(CHUNK_PHOTONS));
+        let mut sums = StratumSums {
+            chunks: [range.start, range.end],
+            w: vec![ExactSum::new(); k * bins],
+            w2: vec![ExactSum::new(); k * bins],
+            tot: vec![ExactSum::new(); k],
+            tot2: vec![ExactSum::new(); k],
+            capped: 0,
+            interactions: 0,
+        };
+        let mut first = range.start;
+        while first < range.end {
+            let last = (first + WAVE_CHUNKS).min(range.end);
             let wave: Vec<Accum> = (first..last)
                 .into_par_iter()
                 .map(|c| {
@@ -308,12 +365,121 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
                 })
                 .collect();
             for acc in &wave {
-                total.add(acc);
+                sums.add_exactly(acc);
             }
             first = last;
-            progress(done_before + (last * CHUNK_PHOTONS).min(photons));
+            progress(done_before + photons_in(&(range.start..last), photons));
         }
-        done_before += photons;
+        done_before += photons_in(&range, photons);
+        strata.push(sums);
+        min_n = stratum.max_interactions;
+    }
+    Ok(WhitePartial {
+        spec: spec.clone(),
+        shard,
+        strata,
+    })
+}
+
+impl StratumSums {
+    /// Adds a chunk's f64 sums exactly.
+    fn add_exactly(&mut self, acc: &Accum) {
+        for (pairs, xs) in [
+            (&mut self.w, &acc.w),
+            (&mut self.w2, &acc.w2),
+            (&mut self.tot, &acc.tot),
+            (&mut self.tot2, &acc.tot2),
+        ] {
+            for (s, &x) in pairs.iter_mut().zip(xs) {
+                s.add(x);
+            }
+        }
+        self.capped += acc.capped;
+        self.interactions += acc.interactions;
+    }
+}
+
+/// The tally of a whole run from its shards' parts: every shard 1…N of one spec exactly once, in
+/// any order. The sums are added exactly and rounded once, so the result does not depend on N or
+/// on the order of `parts`.
+///
+/// # Errors
+/// [`McError::Shards`] for an empty list, parts of different specs or shard counts, a shard
+/// missing or given twice, or a part whose chunk ranges or sums do not fit its spec;
+/// `InvalidParameter` for a bad spec.
+pub fn combine(parts: &[WhitePartial]) -> Result<WhiteTally> {
+    let bad = |message: String| Err(McError::Shards { message });
+    let Some(first) = parts.first() else {
+        return bad("no parts to combine".into());
+    };
+    let spec = &first.spec;
+    spec.validate()?;
+    let count = first.shard.count();
+    let mut seen = vec![None; count as usize];
+    for (i, p) in parts.iter().enumerate() {
+        if p.spec != *spec {
+            return bad(format!(
+                "part {} (shard {}) was made from another spec than part 1",
+                i + 1,
+                p.shard
+            ));
+        }
+        if p.shard.count() != count {
+            return bad(format!(
+                "part {} is shard {} but part 1 is of {count} shards",
+                i + 1,
+                p.shard
+            ));
+        }
+        let slot = &mut seen[p.shard.index() as usize - 1];
+        if let Some(j) = *slot {
+            return bad(format!(
+                "shard {} is given twice (parts {} and {})",
+                p.shard,
+                j + 1,
+                i + 1
+            ));
+        }
+        *slot = Some(i);
+        check_part(p)?;
+    }
+    let missing: Vec<String> = seen
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_none())
+        .map(|(k, _)| format!("{}/{count}", k + 1))
+        .collect();
+    if !missing.is_empty() {
+        return bad(format!("shard(s) {} missing", missing.join(", ")));
+    }
+    let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
+    let bins = grid.bins();
+    let k = spec.albedos.len();
+    // Launch weight 1 − R_sp (MCML `LaunchPhoton`, normal incidence from air).
+    let w0 = 1.0 - ((spec.eta - 1.0) / (spec.eta + 1.0)).powi(2);
+    let mut rd = vec![0.0; k * bins];
+    let mut var = vec![0.0; k * bins];
+    let mut rd_total = vec![0.0; k];
+    let mut var_total = vec![0.0; k];
+    let (mut capped, mut interactions) = (0, 0);
+    for (si, stratum) in spec.strata.iter().enumerate() {
+        // The exact sums over the shards, rounded once.
+        let exact = |pick: &dyn Fn(&StratumSums) -> &Vec<ExactSum>, len: usize| -> Vec<f64> {
+            (0..len)
+                .map(|i| {
+                    let mut s = ExactSum::new();
+                    for p in parts {
+                        s.add_sum(&pick(&p.strata[si])[i]);
+                    }
+                    s.value()
+                })
+                .collect()
+        };
+        let w = exact(&|s| &s.w, k * bins);
+        let w2 = exact(&|s| &s.w2, k * bins);
+        let tot = exact(&|s| &s.tot, k);
+        let tot2 = exact(&|s| &s.tot2, k);
+        let photons = stratum.photons;
         let n = photons as f64;
         // Mean and variance of the mean of per-photon scores.
         let moments = |s1: f64, s2: f64| {
@@ -329,19 +495,19 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
             for j in 0..bins {
                 let i = kk * bins + j;
                 let scale = w0 / grid.area(j);
-                let (m, v) = moments(total.w[i], total.w2[i]);
+                let (m, v) = moments(w[i], w2[i]);
                 rd[i] += m * scale;
                 var[i] += v * scale * scale;
             }
-            let (m, v) = moments(total.tot[kk], total.tot2[kk]);
+            let (m, v) = moments(tot[kk], tot2[kk]);
             rd_total[kk] += m * w0;
             var_total[kk] += v * w0 * w0;
         }
-        if last_stratum {
-            capped = total.capped;
+        let stratum_capped: u64 = parts.iter().map(|p| p.strata[si].capped).sum();
+        if si + 1 == spec.strata.len() {
+            capped = stratum_capped;
         }
-        interactions += total.interactions;
-        min_n = stratum.max_interactions;
+        interactions += parts.iter().map(|p| p.strata[si].interactions).sum::<u64>();
     }
     Ok(WhiteTally {
         spec: spec.clone(),
@@ -352,6 +518,38 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
         capped,
         interactions,
     })
+}
+
+/// Checks that a part's strata fit its spec and shard: the chunk ranges its shard owns, sums of the
+/// right sizes, valid expansions.
+fn check_part(p: &WhitePartial) -> Result<()> {
+    let bad = |why: &str| {
+        Err(McError::Shards {
+            message: format!("shard {}: {why}", p.shard),
+        })
+    };
+    if p.strata.len() != p.spec.strata.len() {
+        return bad("its strata do not match its spec");
+    }
+    let bins = p.spec.radial_edges.len().saturating_sub(1);
+    let k = p.spec.albedos.len();
+    for (s, spec) in p.strata.iter().zip(&p.spec.strata) {
+        let range = p.shard.chunk_range(spec.photons.div_ceil(CHUNK_PHOTONS));
+        if s.chunks != [range.start, range.end] {
+            return bad("its chunk range is not the one its shard owns");
+        }
+        if s.w.len() != k * bins || s.w2.len() != k * bins || s.tot.len() != k || s.tot2.len() != k
+        {
+            return bad("its sums do not have the spec's size");
+        }
+        if ![&s.w, &s.w2, &s.tot, &s.tot2]
+            .iter()
+            .all(|v| v.iter().all(ExactSum::is_valid))
+        {
+            return bad("a sum is not a valid exact sum (damaged file?)");
+        }
+    }
+    Ok(())
 }
 
 /// What the inner loop reads.
