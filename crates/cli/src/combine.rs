@@ -1,5 +1,5 @@
 //! `scatterfit combine PARTIALS... -o OUT`: adds up the partial files of a sharded run (`--shard
-//! K/N` of `table` or `batch`) into what the run on one machine gives — for a table the same bytes
+//! K/N` of `table`, `batch` or `study`) into what the run on one machine gives — for a table the same bytes
 //! (its tallies are exact sums, rounded once), for a batch the same summary and index.
 //!
 //! The set is checked first, naming the file: every file a partial of one run (same kind,
@@ -20,8 +20,9 @@ pub struct Args {
     /// The partial files of one run (all N shards; e.g. `partials/table-*.json`).
     #[arg(required = true, value_name = "PARTIALS")]
     pub partials: Vec<PathBuf>,
-    /// What to write: a table's `.json` file (the form `scatterfit table -o` writes), or a batch's
-    /// folder for summary.csv, summary.md and index.html.
+    /// What to write: a table's `.json` file (the form `scatterfit table -o` writes), a batch's
+    /// folder for summary.csv, summary.md and index.html, or a study's folder for study.md,
+    /// study.csv and study.png (the shards' -o, where their samples are).
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     pub output: PathBuf,
     /// Replace an existing table file.
@@ -124,6 +125,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let code = match kind {
         Kind::Table => combine_table(&args, parts)?,
         Kind::Batch => crate::batch_set::combine(&args.output, &args.partials, args.json)?,
+        Kind::Study => {
+            crate::study_set::combine(&args.output, &parts[0].inputs, &args.partials, args.json)?
+        }
     };
     if !args.quiet {
         errln!(

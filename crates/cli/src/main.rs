@@ -31,6 +31,7 @@ mod simulate;
 mod slurm;
 mod spectro;
 mod study;
+mod study_set;
 mod synth;
 mod table;
 mod twin;
@@ -78,7 +79,8 @@ enum Command {
     Table(table::Args),
     /// Add up the partial files of a sharded run (`--shard K/N`) into the one-machine result.
     Combine(combine::Args),
-    /// Write a Slurm script: a job array of `table` or `batch` shards and a dependent combine job.
+    /// Write a Slurm script: a job array of `table`, `batch` or `study` shards and a dependent
+    /// combine job.
     Slurm(slurm::Args),
     /// Merge an exposure bracket into an HDR radiance map (Debevec & Malik 1997).
     ///

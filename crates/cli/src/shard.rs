@@ -60,6 +60,8 @@ pub enum Kind {
     Table,
     /// A batch of samples (`scatterfit batch`).
     Batch,
+    /// A bias study (`scatterfit study`).
+    Study,
 }
 
 impl Kind {
@@ -68,6 +70,7 @@ impl Kind {
         match self {
             Kind::Table => "table",
             Kind::Batch => "batch",
+            Kind::Study => "study",
         }
     }
 }

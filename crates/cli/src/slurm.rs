@@ -1,4 +1,4 @@
-//! `scatterfit slurm table|batch ARGS... --array N`: writes a Slurm batch script for the user to
+//! `scatterfit slurm table|batch|study ARGS... --array N`: writes a Slurm batch script for the user to
 //! read and submit — a job array of N shards of the command (`--shard $SLURM_ARRAY_TASK_ID/N`,
 //! each writing its partial file) and a combine job that runs once every shard has succeeded
 //! (`sbatch --dependency=afterok`). No scheduler of our own: the script is plain `sbatch`, and
@@ -53,6 +53,14 @@ pub enum What {
         slurm: SlurmArgs,
         #[command(flatten)]
         args: crate::batch::Args,
+    },
+    /// A bias study (`scatterfit study`'s arguments; the shards write their samples into -o DIR,
+    /// the combine job the tables and the figure).
+    Study {
+        #[command(flatten)]
+        slurm: SlurmArgs,
+        #[command(flatten)]
+        args: crate::study::Args,
     },
 }
 
@@ -180,6 +188,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             vec!["-o", "--output-dir"],
             None,
         ),
+        // The shards need -o (their samples go there): it stays in their command line too.
+        What::Study { slurm, args } => (
+            crate::shard::Kind::Study,
+            slurm,
+            &args.shard,
+            args.shard.partial_dir.clone(),
+            vec![],
+            None,
+        ),
+    };
+    let study_out = match &args.what {
+        What::Study { args, .. } => Some(args.output_dir.to_string_lossy().into_owned()),
+        _ => None,
     };
     if let Some(s) = shard.shard {
         bail!("--shard {s}: the script gives each array task its shard; leave --shard out");
@@ -203,7 +224,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut strip: Vec<&str> = output_flags.clone();
     strip.extend(["--cache-dir"]);
     let (kept, taken) = split_tokens(tokens, &strip, &["--json", "--quiet"]);
-    let output = last(&taken, &output_flags).map(str::to_owned);
+    let output = study_out.or_else(|| last(&taken, &output_flags).map(str::to_owned));
     let cache_dir = last(&taken, &["--cache-dir"]).map(str::to_owned);
     let cwd = std::env::current_dir().context("the current folder")?;
     let abs = |p: &Path| {
@@ -304,10 +325,10 @@ echo "logs: {logs}; squeue -j $array,$combine shows them"
         out_shown = output
             .as_deref()
             .map_or(String::from("-o ."), |o| format!("-o {}", quote(o))),
-        same = if kind == crate::shard::Kind::Table {
-            "byte for byte"
-        } else {
-            "the same summary.csv, summary.md and index.html"
+        same = match kind {
+            crate::shard::Kind::Table => "byte for byte",
+            crate::shard::Kind::Batch => "the same summary.csv, summary.md and index.html",
+            crate::shard::Kind::Study => "the same rows in study.csv and study.md",
         },
         cwd = cwd.display(),
         cache_note = cache.as_deref().map_or(String::new(), |c| format!(
