@@ -159,13 +159,19 @@ fn combine_table(args: &Args, parts: Vec<Partial<IgnoredAny>>) -> anyhow::Result
     )?;
     let spec: scatterfit_mc::McTableSpec = serde_json::from_value(parts[0].inputs.clone())
         .with_context(|| format!("{}: the table spec", args.partials[0].display()))?;
+    let count = parts[0].shard.count();
     drop(parts);
-    let mut data = Vec::with_capacity(args.partials.len());
+    // One part at a time into the running exact sums (memory: the sums and one part).
+    let mut combiner = scatterfit_mc::white::Combiner::new(spec.white()?, count)?;
     for path in &args.partials {
         let p = crate::shard::read::<scatterfit_mc::white::WhitePartial>(path)?;
-        data.push(p.data);
+        combiner
+            .add(&p.data)
+            .with_context(|| format!("{}", path.display()))?;
     }
-    let table = scatterfit_mc::McTable::combine(&spec, &data).context("combining the shards")?;
+    let tally = combiner.finish().context("combining the shards")?;
+    let table = scatterfit_mc::McTable::from_tally(&spec, &tally)
+        .context("smoothing the combined table")?;
     let json = serde_json::to_vec(&table.clone().compact())
         .context("the table does not serialise (a defect)")?;
     scatterfit_io::atomic::write_atomic(&args.output, &json)

@@ -401,123 +401,190 @@ impl StratumSums {
 
 /// The tally of a whole run from its shards' parts: every shard 1…N of one spec exactly once, in
 /// any order. The sums are added exactly and rounded once, so the result does not depend on N or
-/// on the order of `parts`.
+/// on the order of `parts`. ([`Combiner`] does the same one part at a time.)
 ///
 /// # Errors
 /// [`McError::Shards`] for an empty list, parts of different specs or shard counts, a shard
 /// missing or given twice, or a part whose chunk ranges or sums do not fit its spec;
 /// `InvalidParameter` for a bad spec.
 pub fn combine(parts: &[WhitePartial]) -> Result<WhiteTally> {
-    let bad = |message: String| Err(McError::Shards { message });
     let Some(first) = parts.first() else {
-        return bad("no parts to combine".into());
+        return Err(McError::Shards {
+            message: "no parts to combine".into(),
+        });
     };
-    let spec = &first.spec;
-    spec.validate()?;
-    let count = first.shard.count();
-    let mut seen = vec![None; count as usize];
-    for (i, p) in parts.iter().enumerate() {
-        if p.spec != *spec {
+    let mut c = Combiner::new(first.spec.clone(), first.shard.count())?;
+    for p in parts {
+        c.add(p)?;
+    }
+    c.finish()
+}
+
+/// Adds the parts of a sharded white run one at a time, exactly (so that only the running sums and
+/// the part being added need memory: a merge of 64 parts of a shipped table holds two, not 64), and
+/// makes the tally once every shard is in.
+#[derive(Debug, Clone)]
+pub struct Combiner {
+    spec: WhiteSpec,
+    count: u64,
+    seen: Vec<bool>,
+    strata: Vec<StratumSums>,
+}
+
+impl Combiner {
+    /// A combiner for the `count` shards of the run `spec`.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad spec; [`McError::Shards`] for no shards.
+    pub fn new(spec: WhiteSpec, count: u64) -> Result<Self> {
+        spec.validate()?;
+        if count == 0 {
+            return Err(McError::Shards {
+                message: "a run of 0 shards".into(),
+            });
+        }
+        let bins = spec.radial_edges.len() - 1;
+        let k = spec.albedos.len();
+        let strata = spec
+            .strata
+            .iter()
+            .map(|_| StratumSums {
+                chunks: [0, 0],
+                w: vec![ExactSum::new(); k * bins],
+                w2: vec![ExactSum::new(); k * bins],
+                tot: vec![ExactSum::new(); k],
+                tot2: vec![ExactSum::new(); k],
+                capped: 0,
+                interactions: 0,
+            })
+            .collect();
+        Ok(Self {
+            seen: vec![false; count as usize],
+            spec,
+            count,
+            strata,
+        })
+    }
+
+    /// Adds a part's sums exactly.
+    ///
+    /// # Errors
+    /// [`McError::Shards`] for a part of another spec or shard count, a shard given twice, or a
+    /// part whose chunk ranges or sums do not fit its spec (nothing is added then).
+    pub fn add(&mut self, p: &WhitePartial) -> Result<()> {
+        let bad = |message: String| Err(McError::Shards { message });
+        if p.spec != self.spec {
             return bad(format!(
-                "part {} (shard {}) was made from another spec than part 1",
-                i + 1,
+                "shard {} was made from another spec than the others",
                 p.shard
             ));
         }
-        if p.shard.count() != count {
+        if p.shard.count() != self.count {
             return bad(format!(
-                "part {} is shard {} but part 1 is of {count} shards",
-                i + 1,
-                p.shard
+                "shard {} is not one of {} shards",
+                p.shard, self.count
             ));
         }
-        let slot = &mut seen[p.shard.index() as usize - 1];
-        if let Some(j) = *slot {
-            return bad(format!(
-                "shard {} is given twice (parts {} and {})",
-                p.shard,
-                j + 1,
-                i + 1
-            ));
+        let slot = &mut self.seen[p.shard.index() as usize - 1];
+        if *slot {
+            return bad(format!("shard {} is given twice", p.shard));
         }
-        *slot = Some(i);
         check_part(p)?;
-    }
-    let missing: Vec<String> = seen
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.is_none())
-        .map(|(k, _)| format!("{}/{count}", k + 1))
-        .collect();
-    if !missing.is_empty() {
-        return bad(format!("shard(s) {} missing", missing.join(", ")));
-    }
-    let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
-    let bins = grid.bins();
-    let k = spec.albedos.len();
-    // Launch weight 1 − R_sp (MCML `LaunchPhoton`, normal incidence from air).
-    let w0 = 1.0 - ((spec.eta - 1.0) / (spec.eta + 1.0)).powi(2);
-    let mut rd = vec![0.0; k * bins];
-    let mut var = vec![0.0; k * bins];
-    let mut rd_total = vec![0.0; k];
-    let mut var_total = vec![0.0; k];
-    let (mut capped, mut interactions) = (0, 0);
-    for (si, stratum) in spec.strata.iter().enumerate() {
-        // The exact sums over the shards, rounded once.
-        let exact = |pick: &dyn Fn(&StratumSums) -> &Vec<ExactSum>, len: usize| -> Vec<f64> {
-            (0..len)
-                .map(|i| {
-                    let mut s = ExactSum::new();
-                    for p in parts {
-                        s.add_sum(&pick(&p.strata[si])[i]);
-                    }
-                    s.value()
-                })
-                .collect()
-        };
-        let w = exact(&|s| &s.w, k * bins);
-        let w2 = exact(&|s| &s.w2, k * bins);
-        let tot = exact(&|s| &s.tot, k);
-        let tot2 = exact(&|s| &s.tot2, k);
-        let photons = stratum.photons;
-        let n = photons as f64;
-        // Mean and variance of the mean of per-photon scores.
-        let moments = |s1: f64, s2: f64| {
-            let mean = s1 / n;
-            let v = if photons > 1 {
-                (s2 / n - mean * mean).max(0.0) / (n - 1.0)
-            } else {
-                f64::INFINITY
-            };
-            (mean, v)
-        };
-        for kk in 0..k {
-            for j in 0..bins {
-                let i = kk * bins + j;
-                let scale = w0 / grid.area(j);
-                let (m, v) = moments(w[i], w2[i]);
-                rd[i] += m * scale;
-                var[i] += v * scale * scale;
+        *slot = true;
+        for (acc, part) in self.strata.iter_mut().zip(&p.strata) {
+            for (sums, add) in [
+                (&mut acc.w, &part.w),
+                (&mut acc.w2, &part.w2),
+                (&mut acc.tot, &part.tot),
+                (&mut acc.tot2, &part.tot2),
+            ] {
+                for (s, x) in sums.iter_mut().zip(add) {
+                    s.add_sum(x);
+                }
             }
-            let (m, v) = moments(tot[kk], tot2[kk]);
-            rd_total[kk] += m * w0;
-            var_total[kk] += v * w0 * w0;
+            acc.capped += part.capped;
+            acc.interactions += part.interactions;
         }
-        let stratum_capped: u64 = parts.iter().map(|p| p.strata[si].capped).sum();
-        if si + 1 == spec.strata.len() {
-            capped = stratum_capped;
-        }
-        interactions += parts.iter().map(|p| p.strata[si].interactions).sum::<u64>();
+        Ok(())
     }
-    Ok(WhiteTally {
-        spec: spec.clone(),
-        rd,
-        rd_stderr: var.iter().map(|v| v.sqrt()).collect(),
-        rd_total,
-        rd_total_stderr: var_total.iter().map(|v| v.sqrt()).collect(),
-        capped,
-        interactions,
-    })
+
+    /// The tally: every sum rounded once, then the per-stratum means and variances as
+    /// [`simulate`] has always made them.
+    ///
+    /// # Errors
+    /// [`McError::Shards`] naming the shards not added.
+    pub fn finish(self) -> Result<WhiteTally> {
+        let count = self.count;
+        let missing: Vec<String> = self
+            .seen
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| !**s)
+            .map(|(k, _)| format!("{}/{count}", k + 1))
+            .collect();
+        if !missing.is_empty() {
+            return Err(McError::Shards {
+                message: format!("shard(s) {} missing", missing.join(", ")),
+            });
+        }
+        let spec = self.spec;
+        let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
+        let bins = grid.bins();
+        let k = spec.albedos.len();
+        // Launch weight 1 − R_sp (MCML `LaunchPhoton`, normal incidence from air).
+        let w0 = 1.0 - ((spec.eta - 1.0) / (spec.eta + 1.0)).powi(2);
+        let mut rd = vec![0.0; k * bins];
+        let mut var = vec![0.0; k * bins];
+        let mut rd_total = vec![0.0; k];
+        let mut var_total = vec![0.0; k];
+        let (mut capped, mut interactions) = (0, 0);
+        for (si, (stratum, sums)) in spec.strata.iter().zip(&self.strata).enumerate() {
+            let round = |v: &[ExactSum]| -> Vec<f64> { v.iter().map(ExactSum::value).collect() };
+            let (w, w2, tot, tot2) = (
+                round(&sums.w),
+                round(&sums.w2),
+                round(&sums.tot),
+                round(&sums.tot2),
+            );
+            let photons = stratum.photons;
+            let n = photons as f64;
+            // Mean and variance of the mean of per-photon scores.
+            let moments = |s1: f64, s2: f64| {
+                let mean = s1 / n;
+                let v = if photons > 1 {
+                    (s2 / n - mean * mean).max(0.0) / (n - 1.0)
+                } else {
+                    f64::INFINITY
+                };
+                (mean, v)
+            };
+            for kk in 0..k {
+                for j in 0..bins {
+                    let i = kk * bins + j;
+                    let scale = w0 / grid.area(j);
+                    let (m, v) = moments(w[i], w2[i]);
+                    rd[i] += m * scale;
+                    var[i] += v * scale * scale;
+                }
+                let (m, v) = moments(tot[kk], tot2[kk]);
+                rd_total[kk] += m * w0;
+                var_total[kk] += v * w0 * w0;
+            }
+            if si + 1 == spec.strata.len() {
+                capped = sums.capped;
+            }
+            interactions += sums.interactions;
+        }
+        Ok(WhiteTally {
+            rd,
+            rd_stderr: var.iter().map(|v| v.sqrt()).collect(),
+            rd_total,
+            rd_total_stderr: var_total.iter().map(|v| v.sqrt()).collect(),
+            capped,
+            interactions,
+            spec,
+        })
+    }
 }
 
 /// Checks that a part's strata fit its spec and shard: the chunk ranges its shard owns, sums of the

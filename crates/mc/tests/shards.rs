@@ -105,5 +105,9 @@ fn incomplete_duplicated_or_foreign_sets_are_refused() {
     );
     // A shard of a 4-way split among 3-way ones.
     let four = McTable::build_shard(&spec, Shard::new(3, 4).unwrap(), &|_, _| {}).unwrap();
-    refused(&spec, &[p[0].clone(), p[1].clone(), four], "of 3 shards");
+    refused(
+        &spec,
+        &[p[0].clone(), p[1].clone(), four],
+        "not one of 3 shards",
+    );
 }
