@@ -300,7 +300,7 @@ array=$(sbatch --parsable <<'SCATTERFIT_ARRAY'
 #SBATCH --array=1-{n}
 #SBATCH --cpus-per-task={cpus}
 #SBATCH --output={logs_q}/{name}-%A-%a.out
-{header}{env}exec {exe_q} {name} {cmd} --shard "${{SLURM_ARRAY_TASK_ID}}/{n}" --quiet
+{header}{env}exec {exe_q} {name} {cmd} --shard "${{SLURM_ARRAY_TASK_ID}}/{n}"
 SCATTERFIT_ARRAY
 )
 array=${{array%%;*}}

@@ -45,7 +45,8 @@ pub struct Args {
     /// profiles; checked before the build; an existing file only with --force).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<PathBuf>,
-    /// Replace an existing output file.
+    /// Replace an existing output file; with --shard, redo a shard whose partial file is there but
+    /// does not match.
     #[arg(long)]
     pub force: bool,
     #[command(flatten)]
