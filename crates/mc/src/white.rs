@@ -23,9 +23,10 @@
 //! on any number of threads.
 //!
 //! Shards ([`simulate_shard`], [`combine`]): a run split over machines traces, per stratum, a
-//! contiguous range of its chunks ([`Shard::chunk_range`]) and keeps its sums *exactly*
-//! ([`ExactSum`]: each chunk's f64 sums added without rounding), so that the shards' sums added in
-//! any order are the one run's sums, and rounding them once gives the same f64 bit for bit.
+//! contiguous range of its chunks ([`Shard::chunk_range`] over groups of ⌈chunks/1024⌉ chunks) and
+//! keeps its sums *exactly* ([`ExactSum`]: each group's f64 sums — its chunks added in chunk order,
+//! an order the spec fixes — added without rounding), so that the shards' sums added in any order
+//! are the one run's sums, and rounding them once gives the same f64 bit for bit.
 //! [`simulate`] is the one-shard case of the same path: a table built on one machine and one merged
 //! from N shards are the same bytes.
 
@@ -137,12 +138,7 @@ impl WhiteSpec {
     pub fn shard_photons(&self, shard: Shard) -> u64 {
         self.strata
             .iter()
-            .map(|s| {
-                photons_in(
-                    &shard.chunk_range(s.photons.div_ceil(CHUNK_PHOTONS)),
-                    s.photons,
-                )
-            })
+            .map(|s| photons_in(&stratum_chunks(shard, s.photons), s.photons))
             .sum()
     }
 
@@ -245,6 +241,22 @@ impl Accum {
             interactions: 0,
         }
     }
+
+    /// Adds another tally's f64 sums (within a group of chunks, in chunk order).
+    fn add(&mut self, o: &Accum) {
+        for (a, b) in [
+            (&mut self.w, &o.w),
+            (&mut self.w2, &o.w2),
+            (&mut self.tot, &o.tot),
+            (&mut self.tot2, &o.tot2),
+        ] {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
+            }
+        }
+        self.capped += o.capped;
+        self.interactions += o.interactions;
+    }
 }
 
 /// One stratum's share of a sharded white run: its chunk range and the exact sums of the per-photon
@@ -286,6 +298,29 @@ pub struct WhitePartial {
 /// `InvalidParameter` for a bad spec.
 pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<WhiteTally> {
     combine(&[simulate_shard(spec, Shard::WHOLE, progress)?])
+}
+
+/// Most groups of chunks per stratum. A group's chunks are summed in f64 in chunk order (fixed by
+/// the spec, whatever the shards) and each group's sums are then added exactly: exact additions
+/// cost about as much as tracing a chunk of short paths, so grouping keeps them to ≤ 1024 per
+/// stratum (cells × 1024), while a stratum still splits into up to 1024 shards.
+const GROUPS_PER_STRATUM: u64 = 1024;
+
+/// Chunks per group for a stratum of `photons` photons: ⌈chunks / 1024⌉.
+fn group_chunks(photons: u64) -> u64 {
+    photons
+        .div_ceil(CHUNK_PHOTONS)
+        .div_ceil(GROUPS_PER_STRATUM)
+        .max(1)
+}
+
+/// The chunks `shard` traces in a stratum of `photons` photons: its range of the stratum's groups
+/// ([`Shard::chunk_range`] over the groups), in chunks.
+fn stratum_chunks(shard: Shard, photons: u64) -> std::ops::Range<u64> {
+    let chunks = photons.div_ceil(CHUNK_PHOTONS);
+    let per = group_chunks(photons);
+    let groups = shard.chunk_range(chunks.div_ceil(per));
+    (groups.start * per).min(chunks)..(groups.end * per).min(chunks)
 }
 
 /// Photons of a stratum traced by the chunks `range`.
@@ -332,7 +367,9 @@ pub fn simulate_shard(
         let photons = stratum.photons;
         // Stratum k's streams: (seed mixed with k, chunk index).
         let seed = spec.seed ^ (si as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        let range = shard.chunk_range(photons.div_ceil(CHUNK_PHOTONS));
+        let range = stratum_chunks(shard, photons);
+        let per_group = group_chunks(photons);
+        let mut group = Accum::new(k, bins);
         let mut sums = StratumSums {
             chunks: [range.start, range.end],
             w: vec![ExactSum::new(); k * bins],
@@ -364,8 +401,13 @@ pub fn simulate_shard(
                     acc
                 })
                 .collect();
-            for acc in &wave {
-                sums.add_exactly(acc);
+            // In chunk order: f64 sums within a group, each finished group added exactly.
+            for (c, acc) in (first..last).zip(&wave) {
+                group.add(acc);
+                if (c + 1) % per_group == 0 || c + 1 == range.end {
+                    sums.add_exactly(&group);
+                    group = Accum::new(k, bins);
+                }
             }
             first = last;
             progress(done_before + photons_in(&(range.start..last), photons));
@@ -601,7 +643,7 @@ fn check_part(p: &WhitePartial) -> Result<()> {
     let bins = p.spec.radial_edges.len().saturating_sub(1);
     let k = p.spec.albedos.len();
     for (s, spec) in p.strata.iter().zip(&p.spec.strata) {
-        let range = p.shard.chunk_range(spec.photons.div_ceil(CHUNK_PHOTONS));
+        let range = stratum_chunks(p.shard, spec.photons);
         if s.chunks != [range.start, range.end] {
             return bad("its chunk range is not the one its shard owns");
         }
