@@ -2,15 +2,24 @@
 //! are written into its folder as soon as it is done, failures are listed at the end (exit 1 if
 //! any), and summary.csv / summary.md (Table 1's shape) gather the good ones; index.html shows them
 //! all, linked to their report.html, with the failures and their messages.
+//!
+//! A sample whose result files are one complete set (`result-files.json`) and whose `result.json`
+//! records the hashes its input files still have — and the options given here — is not measured
+//! again (its result is reused) unless `--force`. With `--shard K/N` the command measures every Nth
+//! sample (round-robin over the sorted list) and writes their results into a partial file;
+//! `scatterfit combine` makes the summary and the index of all.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Mutex;
 
 use scatterfit_io::result_json::MeasurementResult;
+use scatterfit_pipeline::Overrides;
+use serde::Serialize;
 
+use crate::batch_set::{Entry, failure_of, summarise};
 use crate::common::{FitArgs, SamplesArgs};
-use crate::output::{out, outln};
+use crate::output::errln;
 
 /// Arguments of `scatterfit batch`.
 #[derive(Debug, clap::Args)]
@@ -30,12 +39,63 @@ pub struct Args {
     pub output_dir: PathBuf,
     #[command(flatten)]
     pub fit: FitArgs,
+    #[command(flatten)]
+    pub shard: crate::shard::ShardArgs,
     /// Print the results as a JSON array.
     #[arg(long)]
     pub json: bool,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// What a batch's shards have in common (the partial files' run fingerprint).
+#[derive(Serialize)]
+struct BatchInputs {
+    samples: Vec<PathBuf>,
+    misspelt: Vec<PathBuf>,
+    overrides: String,
+}
+
+/// Whether the result files in `dir` are one complete set whose result.json records the SHA-256
+/// its input files still have, made with the options `overrides` asks for. A g range or a g fit
+/// asked for on the command line is not recorded in a result: such runs measure every sample.
+fn reusable(dir: &Path, o: &Overrides) -> Option<MeasurementResult> {
+    use scatterfit_io::result_set::{SetStatus, verify};
+    if o.g_range.is_some() || o.g_fit {
+        return None;
+    }
+    if !matches!(
+        verify(dir, &["result.json", "profile.csv"]),
+        Ok(SetStatus::Complete(_))
+    ) {
+        return None;
+    }
+    let r = scatterfit_io::result_json::read_result_json(&dir.join("result.json")).ok()?;
+    let inputs = &r.inputs;
+    let manifest = inputs.manifest.as_ref()?;
+    let refs = std::iter::once(manifest)
+        .chain(inputs.spectro.as_ref())
+        .chain(inputs.hdr.as_ref())
+        .chain(&inputs.frames);
+    for f in refs {
+        if scatterfit_pipeline::measure::hash_file(&dir.join(&f.path)).as_deref() != Some(&f.sha256)
+        {
+            return None;
+        }
+    }
+    let opt = &inputs.options;
+    let same = |given: bool, ok: bool| !given || ok;
+    (same(o.method.is_some(), opt.method == o.method)
+        && same(o.model.is_some(), opt.model == o.model)
+        && same(o.albedo_model.is_some(), opt.albedo_model == o.albedo_model)
+        && same(o.g.is_some(), opt.g == o.g)
+        && same(o.eta.is_some(), Some(r.eta) == o.eta)
+        && same(
+            o.normalise_with_spectro.is_some(),
+            opt.normalise_with_spectro == o.normalise_with_spectro,
+        ))
+    .then_some(r)
 }
 
 /// Runs `scatterfit batch`.
@@ -57,9 +117,66 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         overrides.allow_outside_paths,
         args.quiet || args.json,
     )?;
+    let quiet = args.quiet || args.json;
+    let misspelt_dirs: Vec<PathBuf> = misspelt.iter().map(|(d, _)| d.clone()).collect();
+    let job = match args.shard.get()? {
+        Some((shard, dir)) => {
+            let inputs = BatchInputs {
+                samples: dirs.clone(),
+                misspelt: misspelt_dirs.clone(),
+                overrides: format!("{overrides:?}"),
+            };
+            let job = crate::shard::Job::new(dir, crate::shard::Kind::Batch, shard, &inputs);
+            if job.done::<Vec<Entry>>(args.samples.force, |_| true)? {
+                if !quiet {
+                    errln!(
+                        "shard {shard}: {} is there and matches; nothing to do",
+                        job.path.display()
+                    );
+                }
+                return Ok(ExitCode::SUCCESS);
+            }
+            Some((shard, job))
+        }
+        None => None,
+    };
+    let owned = |i: usize| job.as_ref().is_none_or(|(shard, _)| shard.owns(i));
+    let mut entries: Vec<Entry> = Vec::new();
+    let mut todo: Vec<(usize, PathBuf)> = Vec::new();
+    for (i, dir) in dirs.iter().enumerate().filter(|(i, _)| owned(*i)) {
+        match (!args.samples.force).then(|| reusable(dir, &overrides)).flatten() {
+            Some(r) => entries.push(Entry {
+                index: i,
+                dir: dir.clone(),
+                failure: failure_of(&r),
+                result: Some(r),
+                reused: true,
+            }),
+            None => todo.push((i, dir.clone())),
+        }
+    }
+    for (j, (dir, why)) in misspelt.iter().enumerate() {
+        if owned(dirs.len() + j) {
+            entries.push(Entry {
+                index: dirs.len() + j,
+                dir: dir.clone(),
+                result: None,
+                failure: Some(why.clone()),
+                reused: false,
+            });
+        }
+    }
+    let reused = entries.iter().filter(|e| e.reused).count();
+    if reused > 0 && !quiet {
+        errln!(
+            "{reused} sample(s) not measured again: their result files match their inputs (--force \
+             measures them again)"
+        );
+    }
+    let todo_dirs: Vec<PathBuf> = todo.iter().map(|(_, d)| d.clone()).collect();
     let write_errors = Mutex::new(Vec::<(PathBuf, String)>::new());
     let outcomes = crate::runner::measure_many(
-        &dirs,
+        &todo_dirs,
         &overrides,
         args.samples.jobs.count(),
         args.quiet || args.json,
@@ -72,67 +189,49 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
         },
     )?;
-    let mut results: Vec<MeasurementResult> = Vec::new();
-    let mut result_dirs: Vec<PathBuf> = Vec::new();
-    let mut failed: Vec<(PathBuf, String)> = write_errors.into_inner().unwrap_or_default();
-    // The samples without a result (not measured, or their files not written), for the index.
-    let mut not_measured: Vec<(PathBuf, String)> = failed.clone();
-    not_measured.extend(misspelt.iter().cloned());
-    let samples = dirs.len() + misspelt.len();
-    failed.extend(misspelt);
+    let write_errors = write_errors.into_inner().unwrap_or_default();
     for o in &outcomes {
-        match &o.result {
-            Ok(m) => {
+        let dir = &o.dir;
+        let i = todo
+            .iter()
+            .find(|(_, d)| d == dir)
+            .map_or(usize::MAX, |(i, _)| *i);
+        let written = write_errors
+            .iter()
+            .find(|(d, _)| d == dir)
+            .map(|(_, e)| e.clone());
+        let (result, failure) = match (&o.result, written) {
+            (Ok(m), None) => {
                 let r = m.to_result(Some("profile.csv"));
-                if !m.complete() {
-                    let why: Vec<String> = r
-                        .channels
-                        .iter()
-                        .filter_map(|c| c.problem.clone())
-                        .collect();
-                    failed.push((o.dir.clone(), why.join("; ")));
-                } else if !scatterfit_report::trusted(&r) {
-                    failed.push((o.dir.clone(), scatterfit_report::suspect_text(&r)));
-                }
-                results.push(r);
-                result_dirs.push(o.dir.clone());
+                let f = failure_of(&r);
+                (Some(r), f)
             }
-            Err(e) => {
-                let why = crate::common::error_text(e);
-                not_measured.push((o.dir.clone(), why.clone()));
-                failed.push((o.dir.clone(), why));
-            }
-        }
+            (Ok(_), Some(e)) => (None, Some(e)),
+            (Err(e), _) => (None, Some(crate::common::error_text(e))),
+        };
+        entries.push(Entry {
+            index: i,
+            dir: dir.clone(),
+            result,
+            failure,
+            reused: false,
+        });
     }
-    std::fs::create_dir_all(&args.output_dir)?;
-    scatterfit_report::write_table1(&args.output_dir, &results)?;
-    let index = scatterfit_report::html::write_results_index(
-        &args.output_dir,
-        "scatterfit batch",
-        "One row per sample: its verdict (the data checks per channel), η, σ′s and σa per channel; \
-         the sample's name opens its report.",
-        &results,
-        &result_dirs,
-        &not_measured,
-        &scatterfit_report::tables::TABLE1_FILES,
-    )?;
-    if args.json {
-        crate::output::print_json(&results)?;
-    } else {
-        for r in &results {
-            out!("{}", scatterfit_report::summary_text(r))?;
+    entries.sort_by_key(|e| e.index);
+    if let Some((shard, job)) = job {
+        job.write(&entries)?;
+        if !quiet {
+            errln!(
+                "shard {shard}: {} sample(s), {} failed, incomplete or suspect; {} (the summary: \
+                 `scatterfit combine`)",
+                entries.len(),
+                entries.iter().filter(|e| e.failure.is_some()).count(),
+                job.path.display()
+            );
         }
-        outln!(
-            "\n{} of {} samples measured completely with every check ok; summary: {} and {}",
-            samples - failed.len(),
-            samples,
-            args.output_dir.join("summary.csv").display(),
-            args.output_dir.join("summary.md").display()
-        )?;
-        outln!("index: {}", index.display())?;
+        // A failed sample is the combined run's news (exit 1 there): the shard itself succeeded,
+        // so that a job array's dependent combine step runs.
+        return Ok(ExitCode::SUCCESS);
     }
-    Ok(crate::common::list_failures(
-        "failed, are incomplete or suspect",
-        &failed,
-    ))
+    summarise(&args.output_dir, &entries, args.json)
 }

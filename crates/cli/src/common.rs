@@ -329,7 +329,11 @@ pub struct SamplesArgs {
     #[command(flatten)]
     pub jobs: JobsArgs,
     /// Write -o into another sample's folder, and replace files there or in the sample folders
-    /// that scatterfit did not write (its ledger, .scatterfit-written.json, does not list them).
+    /// that scatterfit did not write (its ledger, .scatterfit-written.json, does not list them);
+    /// for `batch`, also measure every sample again, even one whose result files match its inputs
+    /// (by default such a sample's result is reused: its result set complete, its inputs' SHA-256
+    /// and the options given as result.json records them), and with --shard redo a shard whose
+    /// partial file is there.
     #[arg(long)]
     pub force: bool,
 }

@@ -10,7 +10,9 @@
 #![deny(clippy::print_stdout, clippy::print_stderr)]
 
 mod batch;
+mod batch_set;
 mod bench;
+mod combine;
 mod common;
 mod compare;
 mod demo;
@@ -24,9 +26,12 @@ mod output;
 mod profile;
 mod render;
 mod runner;
+mod shard;
 mod simulate;
+mod slurm;
 mod spectro;
 mod study;
+mod study_set;
 mod synth;
 mod table;
 mod twin;
@@ -72,6 +77,11 @@ enum Command {
     Simulate(simulate::Args),
     /// Build (or show) a cached Monte Carlo profile table Rd(α′, r) for one η and g.
     Table(table::Args),
+    /// Add up the partial files of a sharded run (`--shard K/N`) into the one-machine result.
+    Combine(combine::Args),
+    /// Write a Slurm script: a job array of `table`, `batch` or `study` shards and a dependent
+    /// combine job.
+    Slurm(slurm::Args),
     /// Merge an exposure bracket into an HDR radiance map (Debevec & Malik 1997).
     ///
     /// The frames' order is checked first (a longer exposure that is darker than its neighbour is
@@ -135,6 +145,12 @@ fn force(command: &Command) -> bool {
         Command::Spectro(a) => a.force,
         Command::Simulate(a) => a.force,
         Command::Table(a) => a.force,
+        Command::Combine(a) => a.force,
+        Command::Slurm(a) => match &a.what {
+            slurm::What::Table { slurm, .. }
+            | slurm::What::Batch { slurm, .. }
+            | slurm::What::Study { slurm, .. } => slurm.force_script,
+        },
         Command::Merge(a) => a.force,
         Command::Profile(a) => a.force,
         Command::Synth(a) => a.force,
@@ -157,6 +173,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Spectro(args) => spectro::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Table(args) => table::run(args),
+        Command::Combine(args) => combine::run(args),
+        Command::Slurm(args) => slurm::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Profile(args) => profile::run(args),
         Command::Synth(args) => synth::run(args),

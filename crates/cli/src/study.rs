@@ -7,6 +7,9 @@
 //! all (default 2 mm⁻¹, a mean free path of 0.5 mm, like the paper's materials), so σ′s = α′σ′t and
 //! σa = (1 − α′)σ′t. The study owns its output folder (a `.scatterfit-study` marker).
 //!
+//! `--shard K/N` does every Nth sample of the grid (round-robin) and writes its rows into a partial
+//! file; `scatterfit combine` makes the tables and the figure of all (`study_set`).
+//!
 //! `--g` gives the study a g axis (issue 15): the twins are made at each Henyey–Greenstein g, fitted
 //! every way assuming g = 0 and once more with the g-aware `mc` model told the true g
 //! (`scatterfit_pipeline::study::g_given_combo`); `study.md` gains a table per model over g.
@@ -18,12 +21,11 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use rayon::prelude::*;
 use scatterfit_pipeline::study::{
-    Row, StudySample, combos, dedup, g_axis_markdown, g_given_combo, has_g_axis, rows_csv, samples,
-    study_sample, summary_markdown,
+    Row, StudySample, combos, g_given_combo, has_g_axis, samples, study_sample,
 };
 
 use crate::common::{JobsArgs, PhotonScaleArgs, cache_dir};
-use crate::output::{errln, out, outln};
+use crate::output::errln;
 use crate::twin::{Material, synthesize_on, write_sample};
 
 /// Arguments of `scatterfit study`.
@@ -73,6 +75,8 @@ pub struct Args {
     /// Folder for cached Monte Carlo profiles.
     #[arg(long, value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub shard: crate::shard::ShardArgs,
     /// Print the rows as JSON.
     #[arg(long)]
     pub json: bool,
@@ -148,7 +152,40 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let cache = cache_dir(args.cache_dir.as_deref());
     // Samples: three albedos per η each (the last triple padded with its last albedo).
     let g_axis = has_g_axis(&args.g);
-    let samples: Vec<StudySample> = samples(out, &args.etas, &args.albedos, &args.g);
+    let all: Vec<StudySample> = samples(out, &args.etas, &args.albedos, &args.g);
+    let config = crate::study_set::StudyConfig {
+        etas: args.etas.clone(),
+        albedos: args.albedos.clone(),
+        sigma_t_prime: args.sigma_t_prime,
+        quick: args.quick,
+        g: args.g.clone(),
+        seed: args.seed,
+        photon_scale: args.photons.photon_scale,
+        no_pbd: args.no_pbd,
+    };
+    // With --shard, every Nth sample (round-robin over the grid's samples).
+    let job = match args.shard.get()? {
+        Some((shard, dir)) => {
+            let job = crate::shard::Job::new(dir, crate::shard::Kind::Study, shard, &config);
+            if job.done::<crate::study_set::StudyPart>(args.force, |_| true)? {
+                if !quiet {
+                    errln!(
+                        "shard {shard}: {} is there and matches; nothing to do",
+                        job.path.display()
+                    );
+                }
+                return Ok(ExitCode::SUCCESS);
+            }
+            Some((shard, job))
+        }
+        None => None,
+    };
+    let samples: Vec<StudySample> = all
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| job.as_ref().is_none_or(|(shard, _)| shard.owns(*i)))
+        .map(|(_, s)| s)
+        .collect();
     if !quiet {
         errln!(
             "study: {} samples ({} η × {} α′{}) on the {} rig, Monte Carlo cached in {}",
@@ -238,81 +275,34 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )),
         }
     }
-    // A padded triple repeats its last albedo: keep one row per grid point and configuration.
-    dedup(&mut rows);
-    let twins = format!(
-        "Twins: the {} rig, seed {}, {}× the default Monte Carlo photons (a twin's own noise goes as \
-         1/√ of that; at α′ ≥ 0.999 it reaches σ′s and σa at 1–2.5 % with the default, \
-         `--photon-scale` raises it).\n\n",
-        if args.quick { "quick" } else { "paper's" },
-        args.seed,
-        args.photons.photon_scale
-    );
-    let summary = if g_axis {
-        let mut t = format!(
-            "## The g axis (twins at g = {})\n\n{}",
-            args.g
-                .iter()
-                .map(|g| g.to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            g_axis_markdown(&rows, &combos, &args.g)
-        );
-        for &g in &args.g {
-            let at: Vec<Row> = rows.iter().filter(|r| r.g == Some(g)).cloned().collect();
-            t.push_str(&format!(
-                "## Twins at g = {g}: every configuration\n\n{}",
-                summary_markdown(&at, &combos)
-            ));
+    let synth_s_total = synth_s;
+    if let Some((shard, job)) = job {
+        let n = samples.len();
+        job.write(crate::study_set::StudyPart {
+            rows: rows.iter().map(crate::study_set::RowFile::from).collect(),
+            failed: failed.clone(),
+            synth_s,
+            fit_s: t0.elapsed().as_secs_f64() - synth_s,
+        })?;
+        if !quiet {
+            errln!(
+                "shard {shard}: {n} sample(s), {} failed; {} (the tables and the figure: \
+                 `scatterfit combine`)",
+                failed.len(),
+                job.path.display()
+            );
         }
-        t
-    } else {
-        summary_markdown(&rows, &combos)
-    };
-    // The figure: the first g's twins fitted assuming g = 0 (the isotropic study's figure without --g).
-    let first_g: Vec<Row> = rows
-        .iter()
-        .filter(|r| r.g.is_none_or(|g| g == args.g[0]) && r.g_given != Some(true))
-        .cloned()
-        .collect();
-    let csv = rows_csv(&rows);
-    for (name, text) in [
-        ("study.csv", csv),
-        ("study.md", format!("{twins}{summary}")),
-    ] {
-        let p = out.join(name);
-        scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
-            .with_context(|| format!("writing {}", p.display()))?;
+        // A failed sample is the combined study's news: the shard succeeded, so that a job array's
+        // dependent combine step runs.
+        return Ok(ExitCode::SUCCESS);
     }
-    let mut figure = scatterfit_report::study::study_figure(&first_g, &assuming_g_0);
-    if g_axis {
-        // Say which twins the figure shows: study.md has the g axis's tables.
-        figure.title = format!(
-            "{} at g = {}, fitted assuming g = 0 (the g axis: study.md)",
-            figure.title, args.g[0]
-        );
-    }
-    scatterfit_report::write_figure(
-        &figure,
-        Some(&out.join("study.svg")),
-        Some(&out.join("study.png")),
-    )?;
-    if args.json {
-        crate::output::print_json(&rows)?;
-    } else {
-        out!("{summary}")?;
-        outln!(
-            "\ntime: {synth_s:.0} s synthesising, {:.0} s fitting; files: {}/study.md, study.csv, study.png",
-            t0.elapsed().as_secs_f64() - synth_s,
-            out.display()
-        )?;
-    }
-    if !failed.is_empty() {
-        errln!("\n{} sample(s) failed:", failed.len());
-        for f in &failed {
-            errln!("  {f}");
-        }
-        return Ok(ExitCode::from(1));
-    }
-    Ok(ExitCode::SUCCESS)
+    crate::study_set::write(
+        out,
+        &config,
+        rows,
+        &failed,
+        synth_s_total,
+        t0.elapsed().as_secs_f64() - synth_s_total,
+        args.json,
+    )
 }

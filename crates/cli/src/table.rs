@@ -45,13 +45,16 @@ pub struct Args {
     /// profiles; checked before the build; an existing file only with --force).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<PathBuf>,
-    /// Replace an existing output file.
+    /// Replace an existing output file; with --shard, redo a shard whose partial file is there but
+    /// does not match.
     #[arg(long)]
     pub force: bool,
     #[command(flatten)]
     pub work: crate::numeric::WorkArgs,
     #[command(flatten)]
     pub memory: crate::numeric::MemoryArgs,
+    #[command(flatten)]
+    pub shard: crate::shard::ShardArgs,
     /// Print the table summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -68,8 +71,22 @@ const MAX_ALBEDOS: usize = 1000;
 const DEFAULT_ALBEDOS: usize = 64;
 const DEFAULT_PHOTONS: u64 = 2_000_000;
 
+/// The spec of a table split into `shards` shards (`scatterfit slurm table`), checked as
+/// `scatterfit table --shard K/N` checks it.
+///
+/// # Errors
+/// As [`spec_from`].
+pub fn spec_for_shards(args: &Args, shards: u64) -> anyhow::Result<McTableSpec> {
+    spec_with(args, shards)
+}
+
 /// Checks the flags' ranges, then the spec's expected work and memory, before anything is built.
 fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
+    spec_with(args, args.shard.shard.map_or(1, |s| s.count()))
+}
+
+/// [`spec_from`] with the work split into `shards` shards (the work budget is per shard).
+fn spec_with(args: &Args, shards: u64) -> anyhow::Result<McTableSpec> {
     if !(args.eta >= 1.0 && args.eta <= 10.0) {
         bail!(
             "--eta {}: the relative refractive index must lie in [1, 10]",
@@ -103,7 +120,9 @@ fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
         })
     }
     .context("bad table parameters")?;
-    let cost = spec.cost_estimate()?;
+    let mut cost = spec.cost_estimate()?;
+    // A shard does its share of the work.
+    cost.interactions /= shards as f64;
     // The table itself beside the tallies: coefficients and raw profiles, and the JSON text.
     let table_bytes = (spec.albedo_count as u64) * (spec.radial_bins as u64 + 64) * 8 * 6;
     crate::numeric::check_memory(
@@ -131,6 +150,9 @@ fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
 /// Runs `scatterfit table`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let spec = spec_from(&args)?;
+    if let Some((shard, dir)) = args.shard.get()? {
+        return run_shard(&args, &spec, shard, dir);
+    }
     let dir = match crate::common::cache_dir(args.cache_dir.as_deref()) {
         Some(d) => d,
         None => bail!("no cache folder: pass --cache-dir or set SCATTERFIT_CACHE"),
@@ -181,6 +203,55 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         crate::output::print_json(&summary)?;
     } else {
         out!("{}", summary.text())?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `scatterfit table --shard K/N`: the shard's part of the table's white run, written as a partial
+/// file (exact sums, `scatterfit_mc::white::WhitePartial`); `scatterfit combine` makes the table.
+fn run_shard(
+    args: &Args,
+    spec: &McTableSpec,
+    shard: scatterfit_mc::Shard,
+    dir: &std::path::Path,
+) -> anyhow::Result<ExitCode> {
+    if let Some(out) = &args.output {
+        bail!(
+            "-o {}: with --shard the table is written by `scatterfit combine PARTIALS... -o {}` \
+             once every shard is done; leave -o out here",
+            out.display(),
+            out.display()
+        );
+    }
+    let job = crate::shard::Job::new(dir, crate::shard::Kind::Table, shard, spec);
+    let white = spec.white()?;
+    if job.done::<scatterfit_mc::white::WhitePartial>(args.force, |p| {
+        p.spec == white && p.shard == shard
+    })? {
+        if !args.quiet {
+            errln!(
+                "shard {shard}: {} is there and matches; nothing to do",
+                job.path.display()
+            );
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let t0 = std::time::Instant::now();
+    let bar = crate::common::bar(0, crate::common::PHOTONS_BAR, args.quiet);
+    let part = scatterfit_mc::McTable::build_shard(spec, shard, &|done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    })?;
+    bar.finish_and_clear();
+    let photons = white.shard_photons(shard);
+    job.write(&part)?;
+    if !args.quiet {
+        errln!(
+            "shard {shard}: {photons} of {} photons in {:.1} s; {}",
+            white.photons(),
+            t0.elapsed().as_secs_f64(),
+            job.path.display()
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

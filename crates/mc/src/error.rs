@@ -110,6 +110,12 @@ pub enum McError {
         /// What was wrong.
         message: String,
     },
+    /// Shards of a run that do not add up to the run (another spec, a shard missing or twice).
+    #[error("the shards do not make one run: {message}")]
+    Shards {
+        /// What is wrong, naming the shard.
+        message: String,
+    },
     /// The tables compiled into the crate do not load (a build defect, not the user's).
     #[error(
         "the Monte Carlo tables shipped with scatterfit do not load: {0}; this is a defect of the \

@@ -30,8 +30,9 @@ use scatterfit_optics::{OpticalProperties, ProfileModel, ProfileSample};
 
 use crate::cache::CacheStatus;
 use crate::error::{McError, Result, check};
+use crate::shard::Shard;
 use crate::smooth::{Knots, SmoothParams, fit_row, kappa0};
-use crate::white::{WhiteSpec, WhiteTally, simulate};
+use crate::white::{WhitePartial, WhiteSpec, WhiteTally, simulate_shard};
 
 /// Version of the `McTable` file format; files of another version are rebuilt.
 pub const MC_TABLE_VERSION: u32 = 1;
@@ -431,10 +432,43 @@ impl McTable {
     ///
     /// # Errors
     /// `InvalidParameter` for a bad spec; `Smoothing` if a row has too little data to smooth.
+    /// The one-shard case of [`McTable::build_shard`] and [`McTable::combine`]: a table built here
+    /// and one combined from N shards of the same spec are equal, bit for bit.
     pub fn build(spec: &McTableSpec, progress: &(dyn Fn(u64, u64) + Sync)) -> Result<Self> {
+        let part = Self::build_shard(spec, Shard::WHOLE, progress)?;
+        Self::combine(spec, &[part])
+    }
+
+    /// Simulates `shard`'s slice of the table's white run ([`crate::white::simulate_shard`]: per
+    /// path-length stratum, a contiguous range of its chunks of photons, with their own random
+    /// streams) and keeps its sums exactly; `progress(done, total)` counts the shard's photons.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad spec.
+    pub fn build_shard(
+        spec: &McTableSpec,
+        shard: Shard,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<WhitePartial> {
         let white = spec.white()?;
-        let total = white.photons();
-        let tally = simulate(&white, &|done| progress(done, total))?;
+        let total = white.shard_photons(shard);
+        simulate_shard(&white, shard, &|done| progress(done, total))
+    }
+
+    /// The table from the parts of all shards 1…N of `spec`'s run, in any order: their sums added
+    /// exactly and rounded once ([`crate::white::combine`]), then smoothed as [`McTable::build`].
+    ///
+    /// # Errors
+    /// [`McError::Shards`] when the parts are not every shard of this spec's run exactly once;
+    /// `Smoothing` as [`McTable::from_tally`].
+    pub fn combine(spec: &McTableSpec, parts: &[WhitePartial]) -> Result<Self> {
+        let white = spec.white()?;
+        if let Some(p) = parts.iter().find(|p| p.spec != white) {
+            return Err(McError::Shards {
+                message: format!("shard {} was made for another table spec", p.shard),
+            });
+        }
+        let tally = crate::white::combine(parts)?;
         Self::from_tally(spec, &tally)
     }
 
@@ -1212,6 +1246,7 @@ impl ProfileModel for McProfile {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::white::simulate;
 
     /// A table that builds in a fraction of a second: 8 albedos 0.3–0.99, 120 bins to 60 mean free
     /// paths, 30 000 + 6 000 photons.

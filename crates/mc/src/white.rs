@@ -21,16 +21,26 @@
 //! Scores are per photon, so standard errors come from per-photon second moments, as in the engine;
 //! photons run in chunks with one random stream per chunk, so a seed gives the same tally bit for bit
 //! on any number of threads.
+//!
+//! Shards ([`simulate_shard`], [`combine`]): a run split over machines traces, per stratum, a
+//! contiguous range of its chunks ([`Shard::chunk_range`] over groups of ⌈chunks/1024⌉ chunks) and
+//! keeps its sums *exactly* ([`ExactSum`]: each group's f64 sums — its chunks added in chunk order,
+//! an order the spec fixes — added without rounding), so that the shards' sums added in any order
+//! are the one run's sums, and rounding them once gives the same f64 bit for bit.
+//! [`simulate`] is the one-shard case of the same path: a table built on one machine and one merged
+//! from N shards are the same bytes.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::engine::{CHUNK_PHOTONS, spin_isotropic};
-use crate::error::{Result, check};
+use crate::error::{McError, Result, check};
+use crate::exact::ExactSum;
 use crate::fresnel::fresnel_mcml;
 use crate::grid::RadialGrid;
 use crate::phase::{HgSampler, scatter_hg};
 use crate::rng::{PhotonRng, stream};
+use crate::shard::Shard;
 
 /// Survival probability of the interaction-count roulette.
 pub const ROULETTE_SURVIVAL: f64 = 0.25;
@@ -122,6 +132,14 @@ impl WhiteSpec {
     /// Photons over all strata.
     pub fn photons(&self) -> u64 {
         self.strata.iter().map(|s| s.photons).sum()
+    }
+
+    /// Photons `shard` traces, over all strata ([`simulate_shard`]).
+    pub fn shard_photons(&self, shard: Shard) -> u64 {
+        self.strata
+            .iter()
+            .map(|s| photons_in(&stratum_chunks(shard, s.photons), s.photons))
+            .sum()
     }
 
     /// Checks every field.
@@ -224,30 +242,102 @@ impl Accum {
         }
     }
 
+    /// Adds another tally's f64 sums (within a group of chunks, in chunk order).
     fn add(&mut self, o: &Accum) {
-        for (a, b) in self.w.iter_mut().zip(&o.w) {
-            *a += b;
-        }
-        for (a, b) in self.w2.iter_mut().zip(&o.w2) {
-            *a += b;
-        }
-        for (a, b) in self.tot.iter_mut().zip(&o.tot) {
-            *a += b;
-        }
-        for (a, b) in self.tot2.iter_mut().zip(&o.tot2) {
-            *a += b;
+        for (a, b) in [
+            (&mut self.w, &o.w),
+            (&mut self.w2, &o.w2),
+            (&mut self.tot, &o.tot),
+            (&mut self.tot2, &o.tot2),
+        ] {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
+            }
         }
         self.capped += o.capped;
         self.interactions += o.interactions;
     }
 }
 
+/// One stratum's share of a sharded white run: its chunk range and the exact sums of the per-photon
+/// scores over those chunks (row-major as [`WhiteTally`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StratumSums {
+    /// The chunks traced, [first, end) of the stratum's ⌈photons / CHUNK_PHOTONS⌉.
+    pub chunks: [u64; 2],
+    /// Σ score per (albedo, bin).
+    pub w: Vec<ExactSum>,
+    /// Σ score² per (albedo, bin).
+    pub w2: Vec<ExactSum>,
+    /// Σ score per albedo (all radii).
+    pub tot: Vec<ExactSum>,
+    /// Σ score² per albedo.
+    pub tot2: Vec<ExactSum>,
+    /// Photons stopped by the stratum's interaction cap.
+    pub capped: u64,
+    /// Interactions traced.
+    pub interactions: u64,
+}
+
+/// A shard's part of a white run ([`simulate_shard`]): exact sums per stratum, to be added to the
+/// other shards' by [`combine`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WhitePartial {
+    /// The whole run's spec.
+    pub spec: WhiteSpec,
+    /// Which slice of it this is.
+    pub shard: Shard,
+    /// Per stratum of `spec`.
+    pub strata: Vec<StratumSums>,
+}
+
 /// Runs the white simulation on the current rayon pool, stratum after stratum; `progress(done)`
-/// counts photons over all strata.
+/// counts photons over all strata. The one-shard case of [`simulate_shard`] and [`combine`].
 ///
 /// # Errors
 /// `InvalidParameter` for a bad spec.
 pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<WhiteTally> {
+    combine(&[simulate_shard(spec, Shard::WHOLE, progress)?])
+}
+
+/// Most groups of chunks per stratum. A group's chunks are summed in f64 in chunk order (fixed by
+/// the spec, whatever the shards) and each group's sums are then added exactly: exact additions
+/// cost about as much as tracing a chunk of short paths, so grouping keeps them to ≤ 1024 per
+/// stratum (cells × 1024), while a stratum still splits into up to 1024 shards.
+const GROUPS_PER_STRATUM: u64 = 1024;
+
+/// Chunks per group for a stratum of `photons` photons: ⌈chunks / 1024⌉.
+fn group_chunks(photons: u64) -> u64 {
+    photons
+        .div_ceil(CHUNK_PHOTONS)
+        .div_ceil(GROUPS_PER_STRATUM)
+        .max(1)
+}
+
+/// The chunks `shard` traces in a stratum of `photons` photons: its range of the stratum's groups
+/// ([`Shard::chunk_range`] over the groups), in chunks.
+fn stratum_chunks(shard: Shard, photons: u64) -> std::ops::Range<u64> {
+    let chunks = photons.div_ceil(CHUNK_PHOTONS);
+    let per = group_chunks(photons);
+    let groups = shard.chunk_range(chunks.div_ceil(per));
+    (groups.start * per).min(chunks)..(groups.end * per).min(chunks)
+}
+
+/// Photons of a stratum traced by the chunks `range`.
+fn photons_in(range: &std::ops::Range<u64>, photons: u64) -> u64 {
+    (range.end * CHUNK_PHOTONS).min(photons) - (range.start * CHUNK_PHOTONS).min(photons)
+}
+
+/// Runs `shard`'s slice of the white simulation (per stratum, its range of chunks) on the current
+/// rayon pool and keeps the sums exactly; `progress(done)` counts the shard's photons.
+///
+/// # Errors
+/// `InvalidParameter` for a bad spec.
+pub fn simulate_shard(
+    spec: &WhiteSpec,
+    shard: Shard,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<WhitePartial> {
     spec.validate()?;
     let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
     let bins = grid.bins();
@@ -258,13 +348,8 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
     } else {
         0.0
     };
-    // Launch weight 1 − R_sp (MCML `LaunchPhoton`, normal incidence from air).
-    let w0 = 1.0 - ((spec.eta - 1.0) / (spec.eta + 1.0)).powi(2);
-    let mut rd = vec![0.0; k * bins];
-    let mut var = vec![0.0; k * bins];
-    let mut rd_total = vec![0.0; k];
-    let mut var_total = vec![0.0; k];
-    let (mut capped, mut interactions, mut done_before) = (0, 0, 0);
+    let mut strata = Vec::with_capacity(spec.strata.len());
+    let mut done_before = 0;
     let mut min_n = 0;
     for (si, stratum) in spec.strata.iter().enumerate() {
         let tracer = Tracer {
@@ -279,15 +364,24 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
             ln_a: &ln_a,
             bins,
         };
-        let last_stratum = si + 1 == spec.strata.len();
         let photons = stratum.photons;
         // Stratum k's streams: (seed mixed with k, chunk index).
         let seed = spec.seed ^ (si as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        let chunks = photons.div_ceil(CHUNK_PHOTONS);
-        let mut total = Accum::new(k, bins);
-        let mut first = 0;
-        while first < chunks {
-            let last = (first + WAVE_CHUNKS).min(chunks);
+        let range = stratum_chunks(shard, photons);
+        let per_group = group_chunks(photons);
+        let mut group = Accum::new(k, bins);
+        let mut sums = StratumSums {
+            chunks: [range.start, range.end],
+            w: vec![ExactSum::new(); k * bins],
+            w2: vec![ExactSum::new(); k * bins],
+            tot: vec![ExactSum::new(); k],
+            tot2: vec![ExactSum::new(); k],
+            capped: 0,
+            interactions: 0,
+        };
+        let mut first = range.start;
+        while first < range.end {
+            let last = (first + WAVE_CHUNKS).min(range.end);
             let wave: Vec<Accum> = (first..last)
                 .into_par_iter()
                 .map(|c| {
@@ -307,51 +401,264 @@ pub fn simulate(spec: &WhiteSpec, progress: &(dyn Fn(u64) + Sync)) -> Result<Whi
                     acc
                 })
                 .collect();
-            for acc in &wave {
-                total.add(acc);
+            // In chunk order: f64 sums within a group, each finished group added exactly.
+            for (c, acc) in (first..last).zip(&wave) {
+                group.add(acc);
+                if (c + 1) % per_group == 0 || c + 1 == range.end {
+                    sums.add_exactly(&group);
+                    group = Accum::new(k, bins);
+                }
             }
             first = last;
-            progress(done_before + (last * CHUNK_PHOTONS).min(photons));
+            progress(done_before + photons_in(&(range.start..last), photons));
         }
-        done_before += photons;
-        let n = photons as f64;
-        // Mean and variance of the mean of per-photon scores.
-        let moments = |s1: f64, s2: f64| {
-            let mean = s1 / n;
-            let v = if photons > 1 {
-                (s2 / n - mean * mean).max(0.0) / (n - 1.0)
-            } else {
-                f64::INFINITY
-            };
-            (mean, v)
-        };
-        for kk in 0..k {
-            for j in 0..bins {
-                let i = kk * bins + j;
-                let scale = w0 / grid.area(j);
-                let (m, v) = moments(total.w[i], total.w2[i]);
-                rd[i] += m * scale;
-                var[i] += v * scale * scale;
-            }
-            let (m, v) = moments(total.tot[kk], total.tot2[kk]);
-            rd_total[kk] += m * w0;
-            var_total[kk] += v * w0 * w0;
-        }
-        if last_stratum {
-            capped = total.capped;
-        }
-        interactions += total.interactions;
+        done_before += photons_in(&range, photons);
+        strata.push(sums);
         min_n = stratum.max_interactions;
     }
-    Ok(WhiteTally {
+    Ok(WhitePartial {
         spec: spec.clone(),
-        rd,
-        rd_stderr: var.iter().map(|v| v.sqrt()).collect(),
-        rd_total,
-        rd_total_stderr: var_total.iter().map(|v| v.sqrt()).collect(),
-        capped,
-        interactions,
+        shard,
+        strata,
     })
+}
+
+impl StratumSums {
+    /// Adds a chunk's f64 sums exactly.
+    fn add_exactly(&mut self, acc: &Accum) {
+        for (pairs, xs) in [
+            (&mut self.w, &acc.w),
+            (&mut self.w2, &acc.w2),
+            (&mut self.tot, &acc.tot),
+            (&mut self.tot2, &acc.tot2),
+        ] {
+            for (s, &x) in pairs.iter_mut().zip(xs) {
+                s.add(x);
+            }
+        }
+        self.capped += acc.capped;
+        self.interactions += acc.interactions;
+    }
+}
+
+/// The tally of a whole run from its shards' parts: every shard 1…N of one spec exactly once, in
+/// any order. The sums are added exactly and rounded once, so the result does not depend on N or
+/// on the order of `parts`. ([`Combiner`] does the same one part at a time.)
+///
+/// # Errors
+/// [`McError::Shards`] for an empty list, parts of different specs or shard counts, a shard
+/// missing or given twice, or a part whose chunk ranges or sums do not fit its spec;
+/// `InvalidParameter` for a bad spec.
+pub fn combine(parts: &[WhitePartial]) -> Result<WhiteTally> {
+    let Some(first) = parts.first() else {
+        return Err(McError::Shards {
+            message: "no parts to combine".into(),
+        });
+    };
+    let mut c = Combiner::new(first.spec.clone(), first.shard.count())?;
+    for p in parts {
+        c.add(p)?;
+    }
+    c.finish()
+}
+
+/// Adds the parts of a sharded white run one at a time, exactly (so that only the running sums and
+/// the part being added need memory: a merge of 64 parts of a shipped table holds two, not 64), and
+/// makes the tally once every shard is in.
+#[derive(Debug, Clone)]
+pub struct Combiner {
+    spec: WhiteSpec,
+    count: u64,
+    seen: Vec<bool>,
+    strata: Vec<StratumSums>,
+}
+
+impl Combiner {
+    /// A combiner for the `count` shards of the run `spec`.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bad spec; [`McError::Shards`] for no shards.
+    pub fn new(spec: WhiteSpec, count: u64) -> Result<Self> {
+        spec.validate()?;
+        if count == 0 {
+            return Err(McError::Shards {
+                message: "a run of 0 shards".into(),
+            });
+        }
+        let bins = spec.radial_edges.len() - 1;
+        let k = spec.albedos.len();
+        let strata = spec
+            .strata
+            .iter()
+            .map(|_| StratumSums {
+                chunks: [0, 0],
+                w: vec![ExactSum::new(); k * bins],
+                w2: vec![ExactSum::new(); k * bins],
+                tot: vec![ExactSum::new(); k],
+                tot2: vec![ExactSum::new(); k],
+                capped: 0,
+                interactions: 0,
+            })
+            .collect();
+        Ok(Self {
+            seen: vec![false; count as usize],
+            spec,
+            count,
+            strata,
+        })
+    }
+
+    /// Adds a part's sums exactly.
+    ///
+    /// # Errors
+    /// [`McError::Shards`] for a part of another spec or shard count, a shard given twice, or a
+    /// part whose chunk ranges or sums do not fit its spec (nothing is added then).
+    pub fn add(&mut self, p: &WhitePartial) -> Result<()> {
+        let bad = |message: String| Err(McError::Shards { message });
+        if p.spec != self.spec {
+            return bad(format!(
+                "shard {} was made from another spec than the others",
+                p.shard
+            ));
+        }
+        if p.shard.count() != self.count {
+            return bad(format!(
+                "shard {} is not one of {} shards",
+                p.shard, self.count
+            ));
+        }
+        let slot = &mut self.seen[p.shard.index() as usize - 1];
+        if *slot {
+            return bad(format!("shard {} is given twice", p.shard));
+        }
+        check_part(p)?;
+        *slot = true;
+        for (acc, part) in self.strata.iter_mut().zip(&p.strata) {
+            for (sums, add) in [
+                (&mut acc.w, &part.w),
+                (&mut acc.w2, &part.w2),
+                (&mut acc.tot, &part.tot),
+                (&mut acc.tot2, &part.tot2),
+            ] {
+                for (s, x) in sums.iter_mut().zip(add) {
+                    s.add_sum(x);
+                }
+            }
+            acc.capped += part.capped;
+            acc.interactions += part.interactions;
+        }
+        Ok(())
+    }
+
+    /// The tally: every sum rounded once, then the per-stratum means and variances as
+    /// [`simulate`] has always made them.
+    ///
+    /// # Errors
+    /// [`McError::Shards`] naming the shards not added.
+    pub fn finish(self) -> Result<WhiteTally> {
+        let count = self.count;
+        let missing: Vec<String> = self
+            .seen
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| !**s)
+            .map(|(k, _)| format!("{}/{count}", k + 1))
+            .collect();
+        if !missing.is_empty() {
+            return Err(McError::Shards {
+                message: format!("shard(s) {} missing", missing.join(", ")),
+            });
+        }
+        let spec = self.spec;
+        let grid = RadialGrid::from_edges(spec.radial_edges.clone())?;
+        let bins = grid.bins();
+        let k = spec.albedos.len();
+        // Launch weight 1 − R_sp (MCML `LaunchPhoton`, normal incidence from air).
+        let w0 = 1.0 - ((spec.eta - 1.0) / (spec.eta + 1.0)).powi(2);
+        let mut rd = vec![0.0; k * bins];
+        let mut var = vec![0.0; k * bins];
+        let mut rd_total = vec![0.0; k];
+        let mut var_total = vec![0.0; k];
+        let (mut capped, mut interactions) = (0, 0);
+        for (si, (stratum, sums)) in spec.strata.iter().zip(&self.strata).enumerate() {
+            let round = |v: &[ExactSum]| -> Vec<f64> { v.iter().map(ExactSum::value).collect() };
+            let (w, w2, tot, tot2) = (
+                round(&sums.w),
+                round(&sums.w2),
+                round(&sums.tot),
+                round(&sums.tot2),
+            );
+            let photons = stratum.photons;
+            let n = photons as f64;
+            // Mean and variance of the mean of per-photon scores.
+            let moments = |s1: f64, s2: f64| {
+                let mean = s1 / n;
+                let v = if photons > 1 {
+                    (s2 / n - mean * mean).max(0.0) / (n - 1.0)
+                } else {
+                    f64::INFINITY
+                };
+                (mean, v)
+            };
+            for kk in 0..k {
+                for j in 0..bins {
+                    let i = kk * bins + j;
+                    let scale = w0 / grid.area(j);
+                    let (m, v) = moments(w[i], w2[i]);
+                    rd[i] += m * scale;
+                    var[i] += v * scale * scale;
+                }
+                let (m, v) = moments(tot[kk], tot2[kk]);
+                rd_total[kk] += m * w0;
+                var_total[kk] += v * w0 * w0;
+            }
+            if si + 1 == spec.strata.len() {
+                capped = sums.capped;
+            }
+            interactions += sums.interactions;
+        }
+        Ok(WhiteTally {
+            rd,
+            rd_stderr: var.iter().map(|v| v.sqrt()).collect(),
+            rd_total,
+            rd_total_stderr: var_total.iter().map(|v| v.sqrt()).collect(),
+            capped,
+            interactions,
+            spec,
+        })
+    }
+}
+
+/// Checks that a part's strata fit its spec and shard: the chunk ranges its shard owns, sums of the
+/// right sizes, valid expansions.
+fn check_part(p: &WhitePartial) -> Result<()> {
+    let bad = |why: &str| {
+        Err(McError::Shards {
+            message: format!("shard {}: {why}", p.shard),
+        })
+    };
+    if p.strata.len() != p.spec.strata.len() {
+        return bad("its strata do not match its spec");
+    }
+    let bins = p.spec.radial_edges.len().saturating_sub(1);
+    let k = p.spec.albedos.len();
+    for (s, spec) in p.strata.iter().zip(&p.spec.strata) {
+        let range = stratum_chunks(p.shard, spec.photons);
+        if s.chunks != [range.start, range.end] {
+            return bad("its chunk range is not the one its shard owns");
+        }
+        if s.w.len() != k * bins || s.w2.len() != k * bins || s.tot.len() != k || s.tot2.len() != k
+        {
+            return bad("its sums do not have the spec's size");
+        }
+        if ![&s.w, &s.w2, &s.tot, &s.tot2]
+            .iter()
+            .all(|v| v.iter().all(ExactSum::is_valid))
+        {
+            return bad("a sum is not a valid exact sum (damaged file?)");
+        }
+    }
+    Ok(())
 }
 
 /// What the inner loop reads.

@@ -1,0 +1,200 @@
+//! `scatterfit combine PARTIALS... -o OUT`: adds up the partial files of a sharded run (`--shard
+//! K/N` of `table`, `batch` or `study`) into what the run on one machine gives — for a table the same bytes
+//! (its tallies are exact sums, rounded once), for a batch the same summary and index.
+//!
+//! The set is checked first, naming the file: every file a partial of one run (same kind,
+//! fingerprint and scatterfit version), shards 1…N each exactly once.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use serde::de::IgnoredAny;
+
+use crate::output::{errln, out};
+use crate::shard::{Kind, Partial};
+
+/// Arguments of `scatterfit combine`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The partial files of one run (all N shards; e.g. `partials/table-*.json`).
+    #[arg(required = true, value_name = "PARTIALS")]
+    pub partials: Vec<PathBuf>,
+    /// What to write: a table's `.json` file (the form `scatterfit table -o` writes), a batch's
+    /// folder for summary.csv, summary.md and index.html, or a study's folder for study.md,
+    /// study.csv and study.png (the shards' -o, where their samples are).
+    #[arg(short = 'o', long = "output", value_name = "OUT")]
+    pub output: PathBuf,
+    /// Replace an existing table file.
+    #[arg(long)]
+    pub force: bool,
+    /// Cache folder a combined table is also stored in, as `scatterfit table` stores it (default:
+    /// $SCATTERFIT_CACHE, else $XDG_CACHE_HOME/scatterfit, else ~/.cache/scatterfit).
+    #[arg(long)]
+    pub cache_dir: Option<PathBuf>,
+    /// Print the result as JSON (a table's summary; a batch's results).
+    #[arg(long)]
+    pub json: bool,
+    /// Nothing on stderr but errors.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Reads every file's envelope and checks that they are the shards 1…N of one run, once each.
+fn check_set(paths: &[PathBuf]) -> anyhow::Result<Vec<Partial<IgnoredAny>>> {
+    let mut parts = Vec::with_capacity(paths.len());
+    for p in paths {
+        parts.push(crate::shard::read::<IgnoredAny>(p)?);
+    }
+    let first = &parts[0];
+    let this = env!("CARGO_PKG_VERSION");
+    for (p, path) in parts.iter().zip(paths) {
+        if p.version != this {
+            bail!(
+                "{} was written by scatterfit {}, this is {this}: redo its shards with this version",
+                path.display(),
+                p.version
+            );
+        }
+        if p.kind != first.kind || p.run != first.run {
+            bail!(
+                "{} is a shard of another run ({} {}) than {} ({} {}): a foreign shard; give the \
+                 files of one run",
+                path.display(),
+                p.kind.name(),
+                p.run,
+                paths[0].display(),
+                first.kind.name(),
+                first.run
+            );
+        }
+        if p.shard.count() != first.shard.count() {
+            bail!(
+                "{} is shard {} but {} is of {} shards: give the files of one split",
+                path.display(),
+                p.shard,
+                paths[0].display(),
+                first.shard.count()
+            );
+        }
+    }
+    let n = first.shard.count();
+    let mut seen: Vec<Option<&PathBuf>> = vec![None; n as usize];
+    for (p, path) in parts.iter().zip(paths) {
+        let slot = &mut seen[p.shard.index() as usize - 1];
+        if let Some(other) = slot {
+            bail!(
+                "shard {} is given twice: {} and {}",
+                p.shard,
+                other.display(),
+                path.display()
+            );
+        }
+        *slot = Some(path);
+    }
+    let missing: Vec<PathBuf> = seen
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_none())
+        .map(|(k, _)| {
+            let shard = scatterfit_mc::Shard::new(k as u64 + 1, n).expect("1 ≤ k + 1 ≤ n");
+            let dir = paths[0].parent().unwrap_or(Path::new("."));
+            crate::shard::partial_path(dir, first.kind, &first.run, shard)
+        })
+        .collect();
+    if !missing.is_empty() {
+        bail!(
+            "{} of {n} shards missing: {}; run them (a resubmitted job array does only these) and \
+             combine again",
+            missing.len(),
+            missing
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(parts)
+}
+
+/// Runs `scatterfit combine`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let t0 = std::time::Instant::now();
+    let parts = check_set(&args.partials)?;
+    let kind = parts[0].kind;
+    let code = match kind {
+        Kind::Table => combine_table(&args, parts)?,
+        Kind::Batch => crate::batch_set::combine(&args.output, &args.partials, args.json)?,
+        Kind::Study => {
+            crate::study_set::combine(&args.output, &parts[0].inputs, &args.partials, args.json)?
+        }
+    };
+    if !args.quiet {
+        errln!(
+            "combined {} shards of a {} in {:.2} s",
+            args.partials.len(),
+            kind.name(),
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    Ok(code)
+}
+
+/// The table from the checked set: each file's sums read straight into their type (no
+/// intermediate JSON tree: a shipped-size partial is ~10 MB).
+fn combine_table(args: &Args, parts: Vec<Partial<IgnoredAny>>) -> anyhow::Result<ExitCode> {
+    crate::common::check_output_file(
+        &args.output,
+        "-o",
+        crate::common::Format {
+            extensions: &["json"],
+            what: "the table is written as JSON",
+        },
+        &args
+            .partials
+            .iter()
+            .map(PathBuf::as_path)
+            .collect::<Vec<_>>(),
+        args.force,
+    )?;
+    let spec: scatterfit_mc::McTableSpec = serde_json::from_value(parts[0].inputs.clone())
+        .with_context(|| format!("{}: the table spec", args.partials[0].display()))?;
+    let count = parts[0].shard.count();
+    drop(parts);
+    // One part at a time into the running exact sums (memory: the sums and one part).
+    let mut combiner = scatterfit_mc::white::Combiner::new(spec.white()?, count)?;
+    for path in &args.partials {
+        let p = crate::shard::read::<scatterfit_mc::white::WhitePartial>(path)?;
+        combiner
+            .add(&p.data)
+            .with_context(|| format!("{}", path.display()))?;
+    }
+    let tally = combiner.finish().context("combining the shards")?;
+    let table = scatterfit_mc::McTable::from_tally(&spec, &tally)
+        .context("smoothing the combined table")?;
+    let json = serde_json::to_vec(&table.clone().compact())
+        .context("the table does not serialise (a defect)")?;
+    scatterfit_io::atomic::write_atomic(&args.output, &json)
+        .with_context(|| format!("-o {}", args.output.display()))?;
+    // Also where `scatterfit table` keeps it, so that the tool finds it as if built here.
+    let cached =
+        crate::common::cache_dir(args.cache_dir.as_deref()).map(|d| d.join(spec.file_name()));
+    if let Some(path) = &cached {
+        table
+            .save(path)
+            .with_context(|| format!("storing the table in the cache: {}", path.display()))?;
+    }
+    let summary = scatterfit_mc::TableSummary::new(
+        &table,
+        &spec,
+        scatterfit_mc::cache::CacheStatus::Built,
+        cached.unwrap_or_else(|| args.output.clone()),
+        Some(args.output.clone()),
+    );
+    if args.json {
+        crate::output::print_json(&summary)?;
+    } else {
+        out!("{}", summary.text())?;
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,383 @@
+//! `scatterfit slurm table|batch|study ARGS... --array N`: writes a Slurm batch script for the user to
+//! read and submit — a job array of N shards of the command (`--shard $SLURM_ARRAY_TASK_ID/N`,
+//! each writing its partial file) and a combine job that runs once every shard has succeeded
+//! (`sbatch --dependency=afterok`). No scheduler of our own: the script is plain `sbatch`, and
+//! submitting it again redoes only the shards whose partial file is missing.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+
+use crate::output::{errln, outln};
+
+/// Slurm's side of the script.
+#[derive(Debug, clap::Args)]
+pub struct SlurmArgs {
+    /// Shards: the job array's size, 1 to 10 000 (tasks 1…N).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    pub array: u64,
+    /// Where to write the script (a `.sh` file; an existing one only with --force-script).
+    #[arg(long, value_name = "FILE", default_value = "scatterfit-slurm.sh")]
+    pub script: PathBuf,
+    /// Replace an existing script file.
+    #[arg(long)]
+    pub force_script: bool,
+    /// CPUs of each array task (`#SBATCH --cpus-per-task`; the task's threads), 1 to 1024.
+    #[arg(long, value_name = "C", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    pub cpus_per_task: u64,
+    /// Time limit of each task (`#SBATCH --time`, Slurm's format, e.g. 2:00:00).
+    #[arg(long, value_name = "TIME")]
+    pub time: Option<String>,
+    /// Partition (`#SBATCH --partition`).
+    #[arg(long, value_name = "NAME")]
+    pub partition: Option<String>,
+    /// Another `#SBATCH` option for both jobs, verbatim (repeatable; e.g. --sbatch-option=--account=lab).
+    #[arg(long, value_name = "OPTION", allow_hyphen_values = true)]
+    pub sbatch_option: Vec<String>,
+}
+
+/// The commands `slurm` can shard.
+#[derive(Debug, clap::Subcommand)]
+pub enum What {
+    /// A Monte Carlo table (`scatterfit table`'s arguments; -o FILE is written by the combine job).
+    Table {
+        #[command(flatten)]
+        slurm: SlurmArgs,
+        #[command(flatten)]
+        args: crate::table::Args,
+    },
+    /// A batch of samples (`scatterfit batch`'s arguments; -o DIR gets the combine job's summary).
+    Batch {
+        #[command(flatten)]
+        slurm: SlurmArgs,
+        #[command(flatten)]
+        args: crate::batch::Args,
+    },
+    /// A bias study (`scatterfit study`'s arguments; the shards write their samples into -o DIR,
+    /// the combine job the tables and the figure).
+    Study {
+        #[command(flatten)]
+        slurm: SlurmArgs,
+        #[command(flatten)]
+        args: crate::study::Args,
+    },
+}
+
+/// Arguments of `scatterfit slurm`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub what: What,
+}
+
+/// `slurm`'s own flags, taking a value: removed from the command line the array tasks run.
+const OWN_WITH_VALUE: [&str; 6] = [
+    "--array",
+    "--script",
+    "--cpus-per-task",
+    "--time",
+    "--partition",
+    "--sbatch-option",
+];
+const OWN_SWITCHES: [&str; 1] = ["--force-script"];
+
+/// `s` quoted for a POSIX shell.
+fn quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b"-_./=:,+@%".contains(&b))
+    {
+        s.to_owned()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// The command's own tokens (after `slurm <kind>`) without `slurm`'s flags and without the flags
+/// in `strip` (with their values), and the last value of each flag in `take`.
+fn split_tokens(
+    tokens: &[String],
+    strip_with_value: &[&str],
+    strip_switches: &[&str],
+) -> (Vec<String>, Vec<(String, String)>) {
+    let mut kept = Vec::new();
+    let mut taken = Vec::new();
+    let mut i = 0;
+    while i < tokens.len() {
+        let t = &tokens[i];
+        let (name, inline) = match t.split_once('=') {
+            Some((n, v)) if n.starts_with("--") => (n.to_owned(), Some(v.to_owned())),
+            _ if t.starts_with("-o") && t.len() > 2 && !t.starts_with("--") => {
+                ("-o".to_owned(), Some(t[2..].to_owned()))
+            }
+            _ => (t.clone(), None),
+        };
+        if t == "--" {
+            kept.extend(tokens[i..].iter().cloned());
+            break;
+        }
+        let with_value =
+            OWN_WITH_VALUE.contains(&name.as_str()) || strip_with_value.contains(&name.as_str());
+        if with_value {
+            let value = match inline {
+                Some(v) => v,
+                None => {
+                    i += 1;
+                    tokens.get(i).cloned().unwrap_or_default()
+                }
+            };
+            taken.push((name, value));
+        } else if OWN_SWITCHES.contains(&name.as_str()) || strip_switches.contains(&name.as_str()) {
+            taken.push((name, String::new()));
+        } else {
+            kept.push(t.clone());
+        }
+        i += 1;
+    }
+    (kept, taken)
+}
+
+fn last<'a>(taken: &'a [(String, String)], names: &[&str]) -> Option<&'a str> {
+    taken
+        .iter()
+        .rev()
+        .find(|(n, _)| names.contains(&n.as_str()))
+        .map(|(_, v)| v.as_str())
+}
+
+/// Runs `scatterfit slurm`.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    // The command's tokens as given: `scatterfit slurm <kind> TOKENS…`.
+    let argv: Vec<String> = std::env::args().collect();
+    let at = argv
+        .iter()
+        .position(|a| a == "slurm")
+        .context("`slurm` not found on the command line")?;
+    let tokens = &argv[(at + 2).min(argv.len())..];
+    let (kind, slurm, shard, partial_dir, output_flags, fingerprint) = match &args.what {
+        What::Table { slurm, args } => {
+            let Some(out) = &args.output else {
+                bail!("give -o FILE: the table the combine job writes (e.g. -o table.json)");
+            };
+            crate::common::check_output_file(
+                out,
+                "-o",
+                crate::common::Format {
+                    extensions: &["json"],
+                    what: "the table is written as JSON",
+                },
+                &[],
+                args.force,
+            )?;
+            let spec = crate::table::spec_for_shards(args, slurm.array)?;
+            (
+                crate::shard::Kind::Table,
+                slurm,
+                &args.shard,
+                args.shard.partial_dir.clone(),
+                vec!["-o", "--output"],
+                Some(crate::shard::fingerprint(&spec)),
+            )
+        }
+        What::Batch { slurm, args } => (
+            crate::shard::Kind::Batch,
+            slurm,
+            &args.shard,
+            args.shard.partial_dir.clone(),
+            vec!["-o", "--output-dir"],
+            None,
+        ),
+        // The shards need -o (their samples go there): it stays in their command line too.
+        What::Study { slurm, args } => (
+            crate::shard::Kind::Study,
+            slurm,
+            &args.shard,
+            args.shard.partial_dir.clone(),
+            vec![],
+            None,
+        ),
+    };
+    let study_out = match &args.what {
+        What::Study { args, .. } => Some(args.output_dir.to_string_lossy().into_owned()),
+        _ => None,
+    };
+    if let Some(s) = shard.shard {
+        bail!("--shard {s}: the script gives each array task its shard; leave --shard out");
+    }
+    let Some(partial_dir) = partial_dir else {
+        bail!(
+            "give --partial-dir DIR: the folder for the shards' partial files and the logs, on a \
+             file system every node sees"
+        );
+    };
+    crate::common::check_output_file(
+        &slurm.script,
+        "--script",
+        crate::common::Format {
+            extensions: &["sh"],
+            what: "the script is a shell script",
+        },
+        &[],
+        slurm.force_script,
+    )?;
+    let mut strip: Vec<&str> = output_flags.clone();
+    strip.extend(["--cache-dir"]);
+    let (kept, taken) = split_tokens(tokens, &strip, &["--json", "--quiet"]);
+    let output = study_out.or_else(|| last(&taken, &output_flags).map(str::to_owned));
+    let cache_dir = last(&taken, &["--cache-dir"]).map(str::to_owned);
+    let cwd = std::env::current_dir().context("the current folder")?;
+    let abs = |p: &Path| {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            cwd.join(p)
+        }
+    };
+    let exe = std::env::current_exe().context("finding the scatterfit binary")?;
+    let partial_abs = abs(&partial_dir);
+    let logs = partial_abs.join("logs");
+    let n = slurm.array;
+    let name = kind.name();
+    let mut header = String::new();
+    header.push_str(&format!(
+        "#SBATCH --chdir={}\n",
+        quote(&cwd.to_string_lossy())
+    ));
+    if let Some(t) = &slurm.time {
+        header.push_str(&format!("#SBATCH --time={}\n", quote(t)));
+    }
+    if let Some(p) = &slurm.partition {
+        header.push_str(&format!("#SBATCH --partition={}\n", quote(p)));
+    }
+    for o in &slurm.sbatch_option {
+        header.push_str(&format!("#SBATCH {o}\n"));
+    }
+    let mut env = String::from("export RAYON_NUM_THREADS=\"${SLURM_CPUS_PER_TASK:-1}\"\n");
+    let cache = crate::common::cache_dir(cache_dir.as_deref().map(Path::new));
+    if let Some(c) = &cache {
+        env.push_str(&format!(
+            "export SCATTERFIT_CACHE={}\n",
+            quote(&abs(c).to_string_lossy())
+        ));
+    }
+    let exe_q = quote(&exe.to_string_lossy());
+    let cmd: Vec<String> = kept.iter().map(|t| quote(t)).collect();
+    let pattern = format!(
+        "{}/{name}-{}-*-of-{n:04}.json",
+        quote(&partial_abs.to_string_lossy()),
+        fingerprint.as_deref().unwrap_or("*")
+    );
+    let mut combine = format!("{exe_q} combine {pattern}");
+    if let Some(o) = &output {
+        combine.push_str(&format!(" -o {}", quote(o)));
+    } else {
+        combine.push_str(" -o .");
+    }
+    let script = format!(
+        r#"#!/bin/bash
+# Written by `scatterfit slurm` (scatterfit {version}). Read it, then submit it from any login node:
+#
+#     bash {script}
+#
+# It submits two jobs:
+#   1. a job array of {n} tasks: task K runs shard K/{n} of
+#          scatterfit {name} {shown}
+#      and writes its partial file into {partials}
+#   2. a combine job, held until every task has succeeded (--dependency=afterok):
+#          scatterfit combine … {out_shown}
+#      — the same result as the command on one machine ({same}).
+# Submitting it again (a task failed, a node died) redoes only the shards whose partial file is
+# missing: a task whose partial file is there and matches returns at once.
+# Everything below must be on a file system every node sees: the binary, {cwd}, the partial
+# files and logs ({partials}){cache_note}.
+set -euo pipefail
+mkdir -p {logs}
+
+array=$(sbatch --parsable <<'SCATTERFIT_ARRAY'
+#!/bin/bash
+#SBATCH --job-name=scatterfit-{name}
+#SBATCH --array=1-{n}
+#SBATCH --cpus-per-task={cpus}
+#SBATCH --output={logs_q}/{name}-%A-%a.out
+{header}{env}exec {exe_q} {name} {cmd} --shard "${{SLURM_ARRAY_TASK_ID}}/{n}"
+SCATTERFIT_ARRAY
+)
+array=${{array%%;*}}
+
+combine=$(sbatch --parsable --dependency=afterok:"$array" <<'SCATTERFIT_COMBINE'
+#!/bin/bash
+#SBATCH --job-name=scatterfit-{name}-combine
+#SBATCH --cpus-per-task=1
+#SBATCH --output={logs_q}/{name}-combine-%j.out
+{header}{env}exec {combine}
+SCATTERFIT_COMBINE
+)
+combine=${{combine%%;*}}
+
+echo "submitted: job array $array ({n} shards of scatterfit {name}), combine job $combine after it"
+echo "logs: {logs}; squeue -j $array,$combine shows them"
+"#,
+        version = env!("CARGO_PKG_VERSION"),
+        script = quote(&slurm.script.to_string_lossy()),
+        shown = cmd.join(" "),
+        partials = partial_abs.display(),
+        out_shown = output
+            .as_deref()
+            .map_or(String::from("-o ."), |o| format!("-o {}", quote(o))),
+        same = match kind {
+            crate::shard::Kind::Table => "byte for byte",
+            crate::shard::Kind::Batch => "the same summary.csv, summary.md and index.html",
+            crate::shard::Kind::Study => "the same rows in study.csv and study.md",
+        },
+        cwd = cwd.display(),
+        cache_note = cache.as_deref().map_or(String::new(), |c| format!(
+            ", and the table cache ({})",
+            abs(c).display()
+        )),
+        logs = quote(&logs.to_string_lossy()),
+        logs_q = quote(&logs.to_string_lossy()),
+        cpus = slurm.cpus_per_task,
+        cmd = cmd.join(" "),
+    );
+    scatterfit_io::atomic::write_atomic(&slurm.script, script.as_bytes())
+        .with_context(|| format!("--script {}", slurm.script.display()))?;
+    errln!(
+        "wrote {}: {n} shards of `scatterfit {name}` and a combine job; read it, then `bash {}`",
+        slurm.script.display(),
+        slurm.script.display()
+    );
+    outln!("{}", slurm.script.display())?;
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quoting_and_splitting() {
+        assert_eq!(quote("a b"), "'a b'");
+        assert_eq!(quote("it's"), r"'it'\''s'");
+        assert_eq!(quote("--eta=1.3"), "--eta=1.3");
+        let t: Vec<String> = [
+            "--eta",
+            "1.3",
+            "--array",
+            "8",
+            "-o",
+            "t.json",
+            "--time=1:00",
+            "--json",
+            "--g",
+            "0.9",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let (kept, taken) = split_tokens(&t, &["-o"], &["--json"]);
+        assert_eq!(kept, ["--eta", "1.3", "--g", "0.9"]);
+        assert_eq!(last(&taken, &["-o"]), Some("t.json"));
+        assert_eq!(last(&taken, &["--array"]), Some("8"));
+    }
+}
