@@ -168,9 +168,7 @@ mod tests {
         assert_eq!(predicted_code(&g, -3.0), 0.0);
         assert_eq!(predicted_code(&g, 300.0), 255.0);
         // A flat stretch g(5..=7) = 5: u = 5 passes it.
-        for z in 6..=7 {
-            g[z] = 5.0;
-        }
+        g[6..=7].fill(5.0);
         assert_eq!(predicted_code(&g, 5.0), 7.0);
         // Then from g(7) = 5 to g(8) = 8.
         assert!((predicted_code(&g, 7.5) - (7.0 + 2.5 / 3.0)).abs() < 1e-12);

@@ -22,8 +22,9 @@ pub const FLOOR_DARKEST_FRACTION: f64 = 0.02;
 /// noise lifts a value without signal above the floor once in a hundred.
 pub const FLOOR_QUANTILE: f64 = 0.99;
 
-/// The least share of a frame's values above its noise floor and below the clip for the frame to
-/// carry signal: 0.1 % (the merge's [`crate::MIN_VALID_FRACTION`]). A frame with fewer (all black,
+/// The least share of a frame's values above its noise floor and below the clip, beyond the
+/// 1 − [`FLOOR_QUANTILE`] that noise alone puts there, for the frame to carry signal: 0.1 % (the
+/// merge's [`crate::MIN_VALID_FRACTION`]). A frame with fewer (all black,
 /// or all clipped) is left out of the merge with a note, not a reason to refuse the bracket.
 pub const MIN_SIGNAL_FRACTION: f64 = 1e-3;
 
@@ -36,12 +37,14 @@ pub const MIN_ORDER_EVIDENCE: usize = 100;
 pub struct BracketSignal {
     /// Per frame (as given) and channel, the noise floor: the [`FLOOR_QUANTILE`] of the frame's
     /// values over the [`FLOOR_DARKEST_FRACTION`] darkest pixels of the scene (by their codes
-    /// summed over the whole bracket, which rises with radiance whatever the times say). A value at
-    /// or below it may be noise about the black level.
+    /// summed over the bracket's other frames, which rises with radiance whatever the times say
+    /// and is independent of this frame's noise). A value at or below it may be noise about the
+    /// black level.
     pub floor: Vec<Vec<f64>>,
     /// Per frame, the share of its (subsampled) values above the floor and below the clip.
     pub signal_fraction: Vec<f64>,
-    /// Per frame, whether that share reaches [`MIN_SIGNAL_FRACTION`].
+    /// Per frame, whether that share exceeds noise's 1 − [`FLOOR_QUANTILE`] by
+    /// [`MIN_SIGNAL_FRACTION`].
     pub has_signal: Vec<bool>,
 }
 
@@ -66,39 +69,55 @@ where
     let step = subsample(n_px);
     let p = frames.len();
     let zero = T::default();
-    let mut floor = vec![vec![0.0; ch]; p];
-    for c in 0..ch {
-        // (key, pixel index) of the pixels with some value above the low clip.
-        let mut keyed: Vec<(f64, usize)> = (0..n_px)
-            .step_by(step)
-            .filter_map(|i| {
+    // Per channel, per frame.
+    let by_channel: Vec<Vec<f64>> = (0..ch)
+        .map(|c| {
+            // Pixels with some value above the low clip, and their summed codes.
+            let (mut idx, mut total) = (Vec::new(), Vec::new());
+            for i in (0..n_px).step_by(step) {
                 let k = i * ch + c;
-                let mut key = 0.0;
-                let mut any = false;
+                let (mut key, mut any) = (0.0, false);
                 for f in frames {
                     let v = f.data()[k];
                     any |= v > zero;
                     key += v.into();
                 }
-                any.then_some((key, k))
-            })
-            .collect();
-        if keyed.is_empty() {
-            continue;
-        }
-        keyed.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let take =
-            ((FLOOR_DARKEST_FRACTION * keyed.len() as f64).ceil() as usize).clamp(1, keyed.len());
-        for (j, f) in frames.iter().enumerate() {
-            let mut v: Vec<f64> = keyed[..take]
+                if any {
+                    idx.push(k);
+                    total.push(key);
+                }
+            }
+            if idx.is_empty() {
+                return vec![0.0; p];
+            }
+            let take =
+                ((FLOOR_DARKEST_FRACTION * idx.len() as f64).ceil() as usize).clamp(1, idx.len());
+            frames
                 .iter()
-                .map(|&(_, k)| f.data()[k].into())
-                .collect();
-            v.sort_by(f64::total_cmp);
-            let q = ((FLOOR_QUANTILE * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
-            floor[j][c] = v[q];
-        }
-    }
+                .map(|f| {
+                    // The darkest pixels by the *other* frames' codes, so that frame j's own noise does
+                    // not choose them (which would pull its floor low).
+                    let mut keyed: Vec<(f64, usize)> = idx
+                        .iter()
+                        .zip(&total)
+                        .map(|(&k, &t)| (t - f.data()[k].into(), k))
+                        .collect();
+                    keyed.select_nth_unstable_by(take - 1, |a, b| a.0.total_cmp(&b.0));
+                    let mut v: Vec<f64> = keyed[..take]
+                        .iter()
+                        .map(|&(_, k)| f.data()[k].into())
+                        .collect();
+                    v.sort_by(f64::total_cmp);
+                    let q =
+                        ((FLOOR_QUANTILE * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
+                    v[q]
+                })
+                .collect()
+        })
+        .collect();
+    let floor: Vec<Vec<f64>> = (0..p)
+        .map(|j| by_channel.iter().map(|f| f[j]).collect())
+        .collect();
     let mut signal_fraction = vec![0.0; p];
     for (j, f) in frames.iter().enumerate() {
         let (mut above, mut total) = (0usize, 0usize);
@@ -113,9 +132,10 @@ where
         }
         signal_fraction[j] = above as f64 / total.max(1) as f64;
     }
+    // Noise alone puts about 1 − FLOOR_QUANTILE of a dark frame's values above its floor.
     let has_signal = signal_fraction
         .iter()
-        .map(|&s| s >= MIN_SIGNAL_FRACTION)
+        .map(|&s| s - (1.0 - FLOOR_QUANTILE) >= MIN_SIGNAL_FRACTION)
         .collect();
     Ok(BracketSignal {
         floor,
