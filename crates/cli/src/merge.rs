@@ -30,6 +30,9 @@ pub enum Fill {
 /// How 8-bit samples are weighted across the bracket.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum WeightingArg {
+    /// Chosen from the bracket: noise-optimal, unless the paper's hat explains the frames clearly
+    /// better (processed JPEGs, phones, scanned film; BENCHMARKS.md, "Real brackets").
+    Auto,
     /// Noise-aware linear-domain average (Robertson et al. 2003 / Granados et al. 2010): unbiased for
     /// dim pixels (BENCHMARKS.md, "dim pixels").
     NoiseOptimal,
@@ -71,7 +74,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Fill::Nan)]
     pub clipped_fill: Fill,
     /// Sample weighting of 8-bit brackets.
-    #[arg(long, value_enum, default_value_t = WeightingArg::NoiseOptimal)]
+    #[arg(long, value_enum, default_value_t = WeightingArg::Auto)]
     pub weighting: WeightingArg,
     /// The radiance map to write (.exr: 32-bit float, PIZ lossless; .hdr: Radiance RGBE); checked
     /// with --response-out before any work; existing files only with --force.
@@ -107,8 +110,9 @@ fn hdr_inputs(args: &Args, budget: u64) -> HdrInputs {
     inputs.lambda = args.lambda;
     inputs.saturation = args.saturation;
     inputs.clipped_fill = fill(args.clipped_fill);
+    inputs.weighting_auto = args.weighting == WeightingArg::Auto;
     inputs.weighting = match args.weighting {
-        WeightingArg::NoiseOptimal => Weighting::NoiseOptimal,
+        WeightingArg::Auto | WeightingArg::NoiseOptimal => Weighting::NoiseOptimal,
         WeightingArg::DebevecHat => Weighting::DebevecHat,
     };
     inputs.memory_budget = Some(budget);

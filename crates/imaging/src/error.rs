@@ -156,8 +156,8 @@ pub enum ImagingError {
     #[error(
         "the frames do not brighten with their exposure times: {what} (frame {longer} at {t_longer} s \
          against frame {shorter} at {t_shorter} s, counting frames in the order given from 0; of the \
-         {compared} pixel values that are unclipped in either and differ, {darker} got darker and \
-         {brighter} brighter with the longer time) — are the exposure times in the right order, each \
+         {compared} pixel values that differ and carry signal in both (above each frame's noise \
+         floor, below the clip), {darker} got darker and {brighter} brighter with the longer time) — are the exposure times in the right order, each \
          with its own frame? (check the exposures CSV or the files' EXIF times)"
     )]
     BracketOutOfOrder {
@@ -171,7 +171,7 @@ pub enum ImagingError {
         t_shorter: f64,
         /// Its time \[s\].
         t_longer: f64,
-        /// Pixel values compared (not clipped at the same end in both frames).
+        /// Pixel values compared that differ (above both frames' noise floors, below the clip).
         compared: usize,
         /// Of those, how many are lower in the longer exposure.
         darker: usize,
@@ -183,8 +183,9 @@ pub enum ImagingError {
     #[error(
         "frame {frame} (at {time_s} s, counting frames by time from 0) holds {factor:.3} × the \
          light its exposure time says, measured against its neighbours on the pixels well exposed \
-         in both — more than a shutter's error ({limit:.0} %): is it the right file for that time \
-         (one frame listed twice, a frame of another bracket, the light changed)?"
+         in both — more than half a stop off (beyond {limit:.3} × either way, and beyond the \
+         estimate's noise), more than a shutter errs: is it the right file for that time (one \
+         frame listed twice, a frame of another bracket, the light changed)?"
     )]
     ExposureMismatch {
         /// Index of the frame, by time.
@@ -193,7 +194,7 @@ pub enum ImagingError {
         time_s: f64,
         /// Its estimated exposure over the nominal one.
         factor: f64,
-        /// The largest deviation taken for a shutter's [%].
+        /// The largest factor (and its inverse the least) taken for a shutter's error.
         limit: f64,
     },
     /// The dark frame is at or above the signal: fewer than [`crate::MIN_VALID_FRACTION`] of a

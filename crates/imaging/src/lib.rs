@@ -18,6 +18,7 @@
 
 pub mod buffer;
 pub mod center;
+pub mod consistency;
 pub mod error;
 pub mod merge;
 pub mod order;
@@ -27,12 +28,13 @@ pub mod text;
 
 pub use buffer::{ImageBuf, ShapeError};
 pub use center::{CenterOptions, SpotCenter, find_spot_center};
+pub use consistency::{SelfConsistency, WELL_EXPOSED, self_consistency};
 pub use error::{ImagingError, Result};
 pub use merge::{
     CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MIN_VALID_FRACTION,
     MergeOptions, Weighting, merge, merge_linear_black, merge_linear_u16,
 };
-pub use order::check_bracket_order;
+pub use order::{BracketSignal, bracket_signal, check_bracket_order};
 pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{
     CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,

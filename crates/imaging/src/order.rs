@@ -1,26 +1,166 @@
 //! Is the bracket's order right? A camera's output rises with exposure, so in a bracket sorted by
-//! time each frame must be brighter than the one before — pixel by pixel, wherever neither frame
-//! is clipped. A bracket whose times were reversed, shuffled or given to the wrong files, or in
+//! time each frame must be brighter than the one before — pixel by pixel, wherever both frames
+//! carry signal. A bracket whose times were reversed, shuffled or given to the wrong files, or in
 //! which one frame was listed twice, fails this test directly, before any response is recovered
-//! (issue 16: a recovered response that dips is no evidence of a wrong order — noise at low codes
-//! does it too — so the response recovery no longer judges the order; this does).
+//! (a recovered response that dips is no evidence of a wrong order — noise at low codes does it
+//! too — so the response recovery does not judge the order; this does).
+//!
+//! Only values that carry signal are evidence: a value at or below its frame's *noise floor* (the
+//! black pedestal plus its noise, [`BracketSignal::floor`]) or at the clip says nothing about
+//! order — the darkest frames of Debevec's memorial (1/1024 s, 1/512 s) sit at codes 13–20 almost
+//! everywhere, the film's pedestal, which drifts by a code from frame to frame; compared value by
+//! value they look out of order by noise alone.
 
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result, check_bracket};
 
-/// Checks that the frames of a bracket brighten with their exposure times: for each pair of frames
-/// adjacent in time, over the pixel values that are not clipped at the same end in both (`0` and
-/// `max` are the clip codes), the summed change Σ(y − x) from the shorter frame x to the longer y
-/// in units of its noise, z = Σ(y − x)/√Σ(y − x)² (noise moves a value either way, so over values
-/// without signal z stays within a few units of 0, whatever the noise; values with signal add to
-/// it). Refused when z < −3 (the longer frame is clearly darker: times reversed or shuffled), when
-/// the two frames are identical value for value (one frame listed twice). A frame shot twice and
-/// listed under two times differs from its twin by noise only and is not refused here (a pair of
-/// short frames of a dark sample looks the same); the HDR stage's exposure estimate finds it
-/// (`ImagingError::ExposureMismatch`). The message gives how many values got darker and brighter.
+/// The share of a bracket's pixels (the darkest by their summed codes over every frame, pixels at
+/// the low clip in every frame left out) whose codes give each frame's noise floor: 2 %.
+pub const FLOOR_DARKEST_FRACTION: f64 = 0.02;
+
+/// The quantile of the darkest pixels' codes in a frame taken for its noise floor: 0.99, so that
+/// noise lifts a value without signal above the floor once in a hundred.
+pub const FLOOR_QUANTILE: f64 = 0.99;
+
+/// The least share of a frame's values above its noise floor and below the clip for the frame to
+/// carry signal: 0.1 % (the merge's [`crate::MIN_VALID_FRACTION`]). Frames below it are black
+/// (lens capped, far too short) or clipped all over. A frame with fewer (all black,
+/// or all clipped) is left out of the merge with a note, not a reason to refuse the bracket.
+pub const MIN_SIGNAL_FRACTION: f64 = 1e-3;
+
+/// The least number of values carrying signal in both frames of a pair for the pair to be judged
+/// at all (fewer: no evidence either way).
+pub const MIN_ORDER_EVIDENCE: usize = 100;
+
+/// What each frame of a bracket carries above its noise floor ([`bracket_signal`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BracketSignal {
+    /// Per frame (as given) and channel, the noise floor: the [`FLOOR_QUANTILE`] of the frame's
+    /// values over the [`FLOOR_DARKEST_FRACTION`] darkest pixels of the scene (by their codes
+    /// summed over the bracket's other frames, which rises with radiance whatever the times say
+    /// and is independent of this frame's noise). A value at or below it may be noise about the
+    /// black level.
+    pub floor: Vec<Vec<f64>>,
+    /// Per frame, the share of its (subsampled) values above the floor and below the clip.
+    pub signal_fraction: Vec<f64>,
+    /// Per frame, whether that share reaches [`MIN_SIGNAL_FRACTION`].
+    pub has_signal: Vec<bool>,
+}
+
+/// The regular subsample of value indices that the checks read: at most about 200 000 values per
+/// channel.
+fn subsample(n_pixels: usize) -> usize {
+    (n_pixels / 200_000).max(1)
+}
+
+/// Each frame's noise floor per channel and whether it carries signal (see [`BracketSignal`]).
+/// `max` is the clip value (255 for 8-bit, the saturation for linear data).
 ///
-/// `max` is the clip value (255 for 8-bit, the saturation for linear data). At most about 200 000
-/// values per pair are compared (a regular subsample).
+/// # Errors
+/// Bracket errors.
+pub fn bracket_signal<T>(frames: &[ImageBuf<T>], times_s: &[f64], max: T) -> Result<BracketSignal>
+where
+    T: Copy + PartialOrd + Default + Into<f64>,
+{
+    check_bracket(frames, times_s)?;
+    let ch = frames[0].channels();
+    let n_px = frames[0].width() * frames[0].height();
+    let step = subsample(n_px);
+    let p = frames.len();
+    let zero = T::default();
+    // Per channel, per frame.
+    let by_channel: Vec<Vec<f64>> = (0..ch)
+        .map(|c| {
+            // Pixels with some value above the low clip, and their summed codes.
+            let (mut idx, mut total) = (Vec::new(), Vec::new());
+            for i in (0..n_px).step_by(step) {
+                let k = i * ch + c;
+                let (mut key, mut any) = (0.0, false);
+                for f in frames {
+                    let v = f.data()[k];
+                    any |= v > zero;
+                    key += v.into();
+                }
+                if any {
+                    idx.push(k);
+                    total.push(key);
+                }
+            }
+            if idx.is_empty() {
+                return vec![0.0; p];
+            }
+            let take =
+                ((FLOOR_DARKEST_FRACTION * idx.len() as f64).ceil() as usize).clamp(1, idx.len());
+            frames
+                .iter()
+                .map(|f| {
+                    // The darkest pixels by the *other* frames' codes, so that frame j's own noise does
+                    // not choose them (which would pull its floor low).
+                    let mut keyed: Vec<(f64, usize)> = idx
+                        .iter()
+                        .zip(&total)
+                        .map(|(&k, &t)| (t - f.data()[k].into(), k))
+                        .collect();
+                    keyed.select_nth_unstable_by(take - 1, |a, b| a.0.total_cmp(&b.0));
+                    let mut v: Vec<f64> = keyed[..take]
+                        .iter()
+                        .map(|&(_, k)| f.data()[k].into())
+                        .collect();
+                    v.sort_by(f64::total_cmp);
+                    let q =
+                        ((FLOOR_QUANTILE * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
+                    v[q]
+                })
+                .collect()
+        })
+        .collect();
+    let floor: Vec<Vec<f64>> = (0..p)
+        .map(|j| by_channel.iter().map(|f| f[j]).collect())
+        .collect();
+    let mut signal_fraction = vec![0.0; p];
+    for (j, f) in frames.iter().enumerate() {
+        let (mut above, mut total) = (0usize, 0usize);
+        for i in (0..n_px).step_by(step) {
+            for (c, fl) in floor[j].iter().enumerate() {
+                let v = f.data()[i * ch + c];
+                total += 1;
+                if v.into() > *fl && v < max {
+                    above += 1;
+                }
+            }
+        }
+        signal_fraction[j] = above as f64 / total.max(1) as f64;
+    }
+    // Kept generously: noise alone lifts up to 1 − FLOOR_QUANTILE of a dark frame's values above
+    // its floor, so a frame of pure noise counts as one with signal (and is merged, harmlessly);
+    // a short frame whose only signal is a small bright spot — the only unclipped reading of the
+    // spot's peak — must never be dropped (judged against noise's share, the twin's s-curve
+    // camera at 15 e⁻ lost such a frame and its profile by 33 %).
+    let has_signal = signal_fraction
+        .iter()
+        .map(|&s| s >= MIN_SIGNAL_FRACTION)
+        .collect();
+    Ok(BracketSignal {
+        floor,
+        signal_fraction,
+        has_signal,
+    })
+}
+
+/// Checks that the frames of a bracket brighten with their exposure times: for each pair of frames
+/// adjacent in time among those that carry signal ([`bracket_signal`]), over the values above
+/// both frames' noise floors and below the clip `max` in both (the only values that are evidence
+/// of order), the summed change Σ(y − x) from the shorter frame x to the longer y in units of its
+/// noise, z = Σ(y − x)/√Σ(y − x)² (noise moves a value either way, so over values without signal z
+/// stays within a few units of 0; values with signal add to it). Refused when z < −3 over at least
+/// [`MIN_ORDER_EVIDENCE`] such values (the longer frame is clearly darker: times reversed or
+/// shuffled), or when two frames adjacent in time are identical value for value (one frame
+/// listed twice). A pair with less evidence is not judged. A frame shot twice and listed under two
+/// times differs from its twin by noise only and is not refused here; the HDR stage's exposure
+/// estimate finds it (`ImagingError::ExposureMismatch`). The message gives how many values got
+/// darker and brighter.
+///
+/// At most about 200 000 pixels per channel are compared (a regular subsample).
 ///
 /// # Errors
 /// Bracket errors, [`ImagingError::BracketOutOfOrder`].
@@ -29,58 +169,87 @@ where
     T: Copy + PartialOrd + PartialEq + Default + Sync + Into<f64>,
     [T]: PartialEq,
 {
-    check_bracket(frames, times_s)?;
+    let signal = bracket_signal(frames, times_s, max)?;
     let mut order: Vec<usize> = (0..frames.len()).collect();
     order.sort_by(|&a, &b| times_s[a].total_cmp(&times_s[b]));
-    let n = frames[0].data().len();
-    let step = (n / 200_000).max(1);
     let zero = T::default();
+    // One frame listed twice: identical value for value (any two frames adjacent in time).
     for pair in order.windows(2) {
         let (s, l) = (pair[0], pair[1]);
         let (a, b) = (frames[s].data(), frames[l].data());
-        let (mut darker, mut brighter, mut compared, mut unclipped) = (0, 0, 0, 0);
+        if a == b && a.iter().any(|&v| v != zero && v != max) {
+            return Err(out_of_order(
+                "the two frames are identical (one frame listed twice?)",
+                (s, l),
+                times_s,
+                (0, 0, 0),
+            ));
+        }
+    }
+    let ch = frames[0].channels();
+    let n_px = frames[0].width() * frames[0].height();
+    let step = subsample(n_px);
+    let with_signal: Vec<usize> = order
+        .iter()
+        .copied()
+        .filter(|&j| signal.has_signal[j])
+        .collect();
+    for pair in with_signal.windows(2) {
+        let (s, l) = (pair[0], pair[1]);
+        let (a, b) = (frames[s].data(), frames[l].data());
+        let (fa, fb) = (&signal.floor[s], &signal.floor[l]);
+        let (mut darker, mut brighter, mut evidence) = (0usize, 0usize, 0usize);
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
-        let mut k = 0;
-        while k < n {
-            let (x, y) = (a[k], b[k]);
-            let low = x == zero && y == zero;
-            let high = x == max && y == max;
-            if !low && !high {
-                unclipped += 1;
-                let d = y.into() - x.into();
+        for i in (0..n_px).step_by(step) {
+            for c in 0..ch {
+                let k = i * ch + c;
+                let (x, y) = (a[k], b[k]);
+                let (xf, yf): (f64, f64) = (x.into(), y.into());
+                if xf <= fa[c] || yf <= fb[c] || x >= max || y >= max {
+                    continue;
+                }
+                evidence += 1;
+                let d = yf - xf;
                 sum += d;
                 sum2 += d * d;
-                if y < x {
+                if d < 0.0 {
                     darker += 1;
-                    compared += 1;
-                } else if y > x {
+                } else if d > 0.0 {
                     brighter += 1;
-                    compared += 1;
                 }
             }
-            k += step;
+        }
+        if evidence < MIN_ORDER_EVIDENCE {
+            continue;
         }
         // z: the summed change in units of its noise (noise moves each value either way).
         let z = if sum2 > 0.0 { sum / sum2.sqrt() } else { 0.0 };
-        let what = if z < -3.0 {
-            Some("the longer exposure is darker")
-        } else if a == b && unclipped > 0 {
-            Some("the two frames are identical (one frame listed twice?)")
-        } else {
-            None
-        };
-        if let Some(what) = what {
-            return Err(ImagingError::BracketOutOfOrder {
-                what,
-                shorter: s,
-                longer: l,
-                t_shorter: times_s[s],
-                t_longer: times_s[l],
-                compared,
-                darker,
-                brighter,
-            });
+        if z < -3.0 {
+            return Err(out_of_order(
+                "the longer exposure is darker",
+                (s, l),
+                times_s,
+                (darker + brighter, darker, brighter),
+            ));
         }
     }
     Ok(())
+}
+
+fn out_of_order(
+    what: &'static str,
+    (shorter, longer): (usize, usize),
+    times_s: &[f64],
+    (compared, darker, brighter): (usize, usize, usize),
+) -> ImagingError {
+    ImagingError::BracketOutOfOrder {
+        what,
+        shorter,
+        longer,
+        t_shorter: times_s[shorter],
+        t_longer: times_s[longer],
+        compared,
+        darker,
+        brighter,
+    }
 }

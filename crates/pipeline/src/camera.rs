@@ -114,6 +114,11 @@ pub struct ExposureEstimate {
     pub pairs: Vec<usize>,
     /// The largest |factor − 1|.
     pub max_correction: f64,
+    /// Per frame, the standard error of ln factor: from the spread of the ratios of the pairs it
+    /// belongs to (the median's, 1.2533·1.4826·MAD/√n, Kendall & Stuart), the larger of its two
+    /// pairs; 0 where a pair had too few values to be estimated (the nominal step kept).
+    #[serde(skip)]
+    pub stderr_ln: Vec<f64>,
 }
 
 /// Relative exposures from the frames themselves: for each pair of frames adjacent in time, the
@@ -134,6 +139,7 @@ pub fn estimate_exposures(
     let step = (n / 200_000).max(1);
     let mut ln_t = vec![0.0; p];
     let mut pairs = Vec::with_capacity(p.saturating_sub(1));
+    let mut pair_se = Vec::with_capacity(p.saturating_sub(1));
     for j in 0..p.saturating_sub(1) {
         let mut r: Vec<f64> = (0..n)
             .step_by(step)
@@ -146,8 +152,14 @@ pub fn estimate_exposures(
         let nominal = (times_s[j + 1] / times_s[j]).ln();
         let step_ln = if r.len() >= 100 {
             r.sort_by(f64::total_cmp);
-            r[r.len() / 2]
+            let median = r[r.len() / 2];
+            let mut dev: Vec<f64> = r.iter().map(|v| (v - median).abs()).collect();
+            dev.sort_by(f64::total_cmp);
+            let mad = dev[dev.len() / 2];
+            pair_se.push(1.2533 * 1.4826 * mad / (r.len() as f64).sqrt());
+            median
         } else {
+            pair_se.push(0.0);
             nominal
         };
         ln_t[j + 1] = ln_t[j] + step_ln;
@@ -167,10 +179,18 @@ pub fn estimate_exposures(
     }
     let factor: Vec<f64> = d.iter().map(|v| v.exp()).collect();
     let max_correction = factor.iter().map(|f| (f - 1.0).abs()).fold(0.0, f64::max);
+    let stderr_ln = (0..p)
+        .map(|j| {
+            let before = if j > 0 { pair_se[j - 1] } else { 0.0 };
+            let after = pair_se.get(j).copied().unwrap_or(0.0);
+            f64::max(before, after)
+        })
+        .collect();
     ExposureEstimate {
         factor,
         pairs,
         max_correction,
+        stderr_ln,
     }
 }
 

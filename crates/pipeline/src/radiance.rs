@@ -44,6 +44,24 @@ pub struct MergeSummary {
     pub read_s: f64,
     /// Wall time for response recovery and merge \[s\].
     pub merge_s: f64,
+    /// 8-bit merges: the sample weighting used (`noise-optimal` or `debevec-hat`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weighting: Option<String>,
+    /// 8-bit merges: the RMS difference in code values between every well-exposed code (10 < z <
+    /// 245) of every frame and the code the merged radiance and the response predict at the
+    /// frame's stated time ([`scatterfit_imaging::self_consistency`]); per channel after it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub self_consistency: Option<f64>,
+    /// The same per channel.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub self_consistency_per_channel: Vec<f64>,
+    /// Per frame merged (shortest first), the exposure the map implies over the stated one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub implied_time_factor: Vec<f64>,
+    /// Frames left out of the merge because they carry no signal (all at the noise floor or
+    /// clipped).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub frames_without_signal: Vec<PathBuf>,
 }
 
 impl MergeSummary {
@@ -81,6 +99,30 @@ impl MergeSummary {
             response_out,
             read_s: stage.read_s,
             merge_s: stage.merge_s,
+            weighting: stage.corrections.weighting.map(|w| {
+                match w {
+                    scatterfit_imaging::Weighting::DebevecHat => "debevec-hat",
+                    _ => "noise-optimal",
+                }
+                .to_string()
+            }),
+            self_consistency: stage.corrections.self_consistency.as_ref().map(|c| c.rms),
+            self_consistency_per_channel: stage
+                .corrections
+                .self_consistency
+                .as_ref()
+                .map_or_else(Vec::new, |c| c.per_channel.clone()),
+            implied_time_factor: stage
+                .corrections
+                .self_consistency
+                .as_ref()
+                .map_or_else(Vec::new, |c| c.implied_time_factor.clone()),
+            frames_without_signal: stage
+                .corrections
+                .no_signal
+                .iter()
+                .filter_map(|&j| stage.frames.get(j).map(|f| f.file.clone()))
+                .collect(),
         }
     }
 
@@ -113,7 +155,28 @@ impl MergeSummary {
             format!(" (weighted RMS residual {})", v.join(", "))
         };
         let _ = writeln!(s, "response      {}{rms}", self.response);
+        for f in &self.frames_without_signal {
+            let _ = writeln!(
+                s,
+                "note          {} carries no signal (all at its noise floor or clipped): left out \
+                 of the merge",
+                f.display()
+            );
+        }
         let _ = writeln!(s, "merge         {:.3} s", self.merge_s);
+        if let (Some(w), Some(rms)) = (&self.weighting, self.self_consistency) {
+            let per: Vec<String> = self
+                .self_consistency_per_channel
+                .iter()
+                .map(|r| format!("{r:.2}"))
+                .collect();
+            let _ = writeln!(
+                s,
+                "consistency   {rms:.2} code values RMS ({}) between the frames' well-exposed codes \
+                 and what the map and response predict at the stated times; weighting {w}",
+                per.join(", ")
+            );
+        }
         let _ = writeln!(
             s,
             "radiance      {:.4e} … {:.4e} (relative), dynamic range {:.1} stops ({:.1} decades)",

@@ -1,0 +1,176 @@
+//! How well a merged radiance map and its response explain the frames they came from.
+//!
+//! A merge is self-consistent when every well-exposed code of every frame is the code the camera
+//! would write for the merged radiance at the frame's stated time: z ≈ f(E·Δt) with f = exp g⁻¹,
+//! the response's inverse (Debevec & Malik 1997, eq. 1–2). The RMS of z − f(E·Δt) in code values
+//! is a score that needs no ground truth, so it compares two merges of a real bracket — ours and
+//! OpenCV's `CalibrateDebevec` + `MergeDebevec` — on equal terms (BENCHMARKS.md, "Real brackets").
+
+use rayon::prelude::*;
+
+use crate::error::{ImagingError, Result, check_bracket, check_shape};
+use crate::{HdrImage, ImageBuf, LEVELS, ResponseCurve};
+
+/// The codes a frame's value must lie strictly between to count in [`self_consistency`]: well
+/// exposed, away from the noise floor and the clip (10 < z < 245).
+pub const WELL_EXPOSED: (u8, u8) = (10, 245);
+
+/// The outcome of [`self_consistency`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelfConsistency {
+    /// RMS over every frame's well-exposed codes of z − f(E·Δt) \[code values\].
+    pub rms: f64,
+    /// The same per channel.
+    pub per_channel: Vec<f64>,
+    /// The same per frame (as given).
+    pub per_frame: Vec<f64>,
+    /// Per frame, the exposure the map implies over the stated one: exp of the mean of
+    /// g(z) − ln(E·Δt) over its well-exposed codes (1 when the map implies the stated time).
+    pub implied_time_factor: Vec<f64>,
+    /// Codes counted.
+    pub count: usize,
+}
+
+/// The code the response predicts for log exposure `u`: the piecewise-linear inverse of g made
+/// non-decreasing (`g` already is), z* = m + (u − g(m))/(g(m + 1) − g(m)) where m is the number of
+/// codes 1..=255 with g ≤ u, clamped to 0..=255.
+fn predicted_code(g: &[f64; LEVELS], u: f64) -> f64 {
+    // m = #{z in 1..=255 : g(z) ≤ u}
+    let m = g[1..].partition_point(|&v| v <= u);
+    if m >= LEVELS - 1 {
+        return (LEVELS - 1) as f64;
+    }
+    let (g0, g1) = (g[m], g[m + 1]);
+    let frac = if g1 > g0 {
+        ((u - g0) / (g1 - g0)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    m as f64 + frac
+}
+
+/// The self-consistency of a merge (module docs): for every frame j and every value z of it with
+/// 10 < z < 245 ([`WELL_EXPOSED`]) at a pixel-channel that has a radiance E (finite, > 0), the
+/// difference between z and the code the response predicts for E·Δt_j at the frame's *stated*
+/// time (the response's piecewise-linear inverse, the response made non-decreasing by a running
+/// maximum first). A response with one channel serves every channel.
+///
+/// # Errors
+/// Bracket errors, [`ImagingError::ShapeMismatch`] for a map of another shape,
+/// [`ImagingError::ChannelMismatch`].
+pub fn self_consistency(
+    frames: &[ImageBuf<u8>],
+    times_s: &[f64],
+    response: &ResponseCurve,
+    hdr: &HdrImage,
+) -> Result<SelfConsistency> {
+    check_bracket(frames, times_s)?;
+    check_shape(&frames[0], &hdr.radiance, || "radiance map".to_string())?;
+    let ch = frames[0].channels();
+    if response.channels() != ch && response.channels() != 1 {
+        return Err(ImagingError::ChannelMismatch {
+            response: response.channels(),
+            image: ch,
+        });
+    }
+    let g: Vec<[f64; LEVELS]> = (0..ch)
+        .map(|c| {
+            let mut t = response.tables()[if response.channels() == 1 { 0 } else { c }];
+            for z in 1..LEVELS {
+                t[z] = t[z].max(t[z - 1]);
+            }
+            t
+        })
+        .collect();
+    let p = frames.len();
+    let ln_t: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();
+    let (lo, hi) = WELL_EXPOSED;
+    let rad = hdr.radiance.data();
+    let stride = frames[0].width() * ch;
+    // Per row: per frame and channel the sum of squares, the count, and the sum of g(z) − ln(EΔt).
+    let zero = || (vec![0.0f64; p * ch], vec![0usize; p * ch], vec![0.0f64; p]);
+    let (ss, cnt, off) = rad
+        .par_chunks(stride)
+        .enumerate()
+        .fold(zero, |(mut ss, mut cnt, mut off), (y, row)| {
+            for (k, &e) in row.iter().enumerate() {
+                let e = f64::from(e);
+                if !(e.is_finite() && e > 0.0) {
+                    continue;
+                }
+                let c = k % ch;
+                let ln_e = e.ln();
+                for j in 0..p {
+                    let z = frames[j].data()[y * stride + k];
+                    if z <= lo || z >= hi {
+                        continue;
+                    }
+                    let u = ln_e + ln_t[j];
+                    let d = f64::from(z) - predicted_code(&g[c], u);
+                    ss[j * ch + c] += d * d;
+                    cnt[j * ch + c] += 1;
+                    off[j] += g[c][usize::from(z)] - u;
+                }
+            }
+            (ss, cnt, off)
+        })
+        .reduce(zero, |mut a, b| {
+            a.0.iter_mut().zip(&b.0).for_each(|(x, y)| *x += y);
+            a.1.iter_mut().zip(&b.1).for_each(|(x, y)| *x += y);
+            a.2.iter_mut().zip(&b.2).for_each(|(x, y)| *x += y);
+            a
+        });
+    let rms_of = |s: f64, n: usize| if n > 0 { (s / n as f64).sqrt() } else { 0.0 };
+    let total_ss: f64 = ss.iter().sum();
+    let count: usize = cnt.iter().sum();
+    let per_channel = (0..ch)
+        .map(|c| {
+            let s: f64 = (0..p).map(|j| ss[j * ch + c]).sum();
+            let n: usize = (0..p).map(|j| cnt[j * ch + c]).sum();
+            rms_of(s, n)
+        })
+        .collect();
+    let frame_n: Vec<usize> = (0..p)
+        .map(|j| cnt[j * ch..(j + 1) * ch].iter().sum())
+        .collect();
+    let per_frame = (0..p)
+        .map(|j| rms_of(ss[j * ch..(j + 1) * ch].iter().sum(), frame_n[j]))
+        .collect();
+    let implied_time_factor = (0..p)
+        .map(|j| {
+            if frame_n[j] > 0 {
+                (off[j] / frame_n[j] as f64).exp()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    Ok(SelfConsistency {
+        rms: rms_of(total_ss, count),
+        per_channel,
+        per_frame,
+        implied_time_factor,
+        count,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_inverse_is_piecewise_linear_and_clamped() {
+        let mut g = [0.0; LEVELS];
+        for (z, v) in g.iter_mut().enumerate() {
+            *v = z as f64;
+        }
+        assert_eq!(predicted_code(&g, 10.25), 10.25);
+        assert_eq!(predicted_code(&g, -3.0), 0.0);
+        assert_eq!(predicted_code(&g, 300.0), 255.0);
+        // A flat stretch g(5..=7) = 5: u = 5 passes it.
+        g[6..=7].fill(5.0);
+        assert_eq!(predicted_code(&g, 5.0), 7.0);
+        // Then from g(7) = 5 to g(8) = 8.
+        assert!((predicted_code(&g, 7.5) - (7.0 + 2.5 / 3.0)).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,114 @@
+//! Brackets photographed by real cameras (scanned film, phones, compacts, DSLRs; PNG and JPEG):
+//! every good one merges with the default settings, and one whose times truly disagree with its
+//! frames is still refused.
+//!
+//! The brackets committed under `data/brackets/NAME/` (each with `exposures.csv` and `SOURCE.md`)
+//! are always merged. With `SCATTERFIT_REAL_BRACKETS=DIR` the folders of DIR are merged too (a
+//! corpus kept outside the repository where the sources give no licence to copy; BENCHMARKS.md,
+//! "Real brackets", names them). A folder holding a file `EXPECT_REFUSED` is a bracket whose listed
+//! times disagree with its frames (the shutter did not change): it must be refused, saying so.
+//! Without the variable the corpus part is skipped.
+
+use std::path::{Path, PathBuf};
+
+use scatterfit_imaging::{ImageBuf, ImagingError, check_bracket_order};
+use scatterfit_io::image_files::{CameraFrame, read_camera_frame};
+use scatterfit_pipeline::hdr::{HdrInputs, read_and_merge};
+
+fn brackets_in(dir: &Path) -> Vec<PathBuf> {
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut v: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("exposures.csv").is_file())
+        .collect();
+    v.sort();
+    v
+}
+
+fn committed() -> Vec<PathBuf> {
+    brackets_in(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/brackets"))
+}
+
+fn corpus() -> Option<PathBuf> {
+    std::env::var_os("SCATTERFIT_REAL_BRACKETS").map(PathBuf::from)
+}
+
+/// Merges `dir` with the default settings; `Ok(consistency)` or the error's text.
+fn merge(dir: &Path) -> Result<f64, String> {
+    let inputs = HdrInputs::new(Some(dir.join("exposures.csv")), Vec::new());
+    let stage = read_and_merge(&inputs, &|_| {}).map_err(|e| format!("{e:#}"))?;
+    Ok(stage
+        .corrections
+        .self_consistency
+        .as_ref()
+        .map_or(f64::NAN, |c| c.rms))
+}
+
+#[test]
+fn every_good_real_bracket_merges_and_a_wrong_one_is_refused() {
+    let mut dirs = committed();
+    if let Some(c) = corpus() {
+        dirs.extend(brackets_in(&c));
+    } else {
+        eprintln!("SCATTERFIT_REAL_BRACKETS not set: the uncommitted corpus is skipped");
+    }
+    let mut failures = Vec::new();
+    for dir in &dirs {
+        let name = dir
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into());
+        let expect_refused = dir.join("EXPECT_REFUSED").is_file();
+        match (merge(dir), expect_refused) {
+            (Ok(rms), false) => eprintln!("{name}: merged, self-consistency {rms:.2} code values"),
+            (Err(e), true) => {
+                eprintln!("{name}: refused as expected: {e}");
+                if !(e.contains("do not brighten") || e.contains("right file for that time")) {
+                    failures.push(format!("{name}: refused for another reason: {e}"));
+                }
+            }
+            (Ok(rms), true) => failures.push(format!("{name}: merged ({rms:.2}), not refused")),
+            (Err(e), false) => failures.push(format!("{name}: refused: {e}")),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The memorial's frames, longest first as listed, as 8-bit buffers and times.
+fn memorial() -> Option<(Vec<ImageBuf<u8>>, Vec<f64>)> {
+    let dir = corpus()?.join("memorial");
+    let list = scatterfit_io::bracket::read_exposures_csv(&dir.join("exposures.csv")).ok()?;
+    let mut frames = Vec::new();
+    let mut times = Vec::new();
+    for e in list {
+        match read_camera_frame(&e.path).ok()?.frame {
+            CameraFrame::U8(b) => frames.push(b),
+            CameraFrame::U16(_) => return None,
+        }
+        times.push(e.time_s);
+    }
+    Some((frames, times))
+}
+
+/// Debevec's memorial: its two shortest frames (1/1024 s, 1/512 s) sit on the film's pedestal
+/// (mean code 19, darker in sum at 1/512 s than at 1/1024 s); they are no evidence of disorder —
+/// the whole bracket passes — while a deliberately reversed pair of well-exposed frames (1/4 s and
+/// 1 s swapped) is refused.
+#[test]
+fn the_memorials_noise_floor_is_not_evidence_and_a_reversed_pair_is() {
+    let Some((frames, times)) = memorial() else {
+        eprintln!("SCATTERFIT_REAL_BRACKETS/memorial not found: skipped");
+        return;
+    };
+    check_bracket_order(&frames, &times, u8::MAX).expect("the memorial is in order");
+    let mut swapped = times.clone();
+    let a = times.iter().position(|&t| t == 0.25).unwrap();
+    let b = times.iter().position(|&t| t == 1.0).unwrap();
+    swapped.swap(a, b);
+    let err = check_bracket_order(&frames, &swapped, u8::MAX).unwrap_err();
+    assert!(
+        matches!(err, ImagingError::BracketOutOfOrder { .. }),
+        "{err:?}"
+    );
+}
