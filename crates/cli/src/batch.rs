@@ -144,7 +144,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut entries: Vec<Entry> = Vec::new();
     let mut todo: Vec<(usize, PathBuf)> = Vec::new();
     for (i, dir) in dirs.iter().enumerate().filter(|(i, _)| owned(*i)) {
-        match (!args.samples.force).then(|| reusable(dir, &overrides)).flatten() {
+        match (!args.samples.force)
+            .then(|| reusable(dir, &overrides))
+            .flatten()
+        {
             Some(r) => entries.push(Entry {
                 index: i,
                 dir: dir.clone(),

@@ -349,7 +349,7 @@ pub fn frame_agreement(m: &Measurement) -> Option<Vec<FrameAgreement>> {
                 .and_then(|f| f.get(j))
                 .copied()
                 .unwrap_or(1.0);
-        if !(t > 0.0) {
+        if t.is_nan() || t <= 0.0 {
             continue;
         }
         let mut d = Vec::new();
@@ -367,7 +367,11 @@ pub fn frame_agreement(m: &Measurement) -> Option<Vec<FrameAgreement>> {
                 for c in 0..ch {
                     let zc = z[c.min(z.len() - 1)];
                     let ec = f64::from(e[c]);
-                    if zc < AGREEMENT_CODES.0 || zc > AGREEMENT_CODES.1 || cl[c] != 0 || !(ec > 0.0)
+                    if zc < AGREEMENT_CODES.0
+                        || zc > AGREEMENT_CODES.1
+                        || cl[c] != 0
+                        || ec.is_nan()
+                        || ec <= 0.0
                     {
                         continue;
                     }
