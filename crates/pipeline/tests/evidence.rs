@@ -16,22 +16,25 @@ use scatterfit_synth::{RigSpec, SyntheticSample, synthesize};
 
 const MATERIAL: &str = "pink-plastic";
 
+/// The quick rig twin of a built-in material, seed 1.
+fn quick(name: &str) -> SyntheticSample {
+    let m = by_name(name).unwrap();
+    synthesize(
+        m.name,
+        m.sigma_s_prime,
+        m.sigma_a,
+        m.eta,
+        &RigSpec::quick(),
+        1,
+        None,
+        &|_, _, _| {},
+    )
+    .unwrap()
+}
+
 fn twin() -> &'static SyntheticSample {
     static TWIN: OnceLock<SyntheticSample> = OnceLock::new();
-    TWIN.get_or_init(|| {
-        let m = by_name(MATERIAL).unwrap();
-        synthesize(
-            m.name,
-            m.sigma_s_prime,
-            m.sigma_a,
-            m.eta,
-            &RigSpec::quick(),
-            1,
-            None,
-            &|_, _, _| {},
-        )
-        .unwrap()
-    })
+    TWIN.get_or_init(|| quick(MATERIAL))
 }
 
 /// The twin's folder, with another reading, L*a*b*, scale or manifest lines if given.
@@ -283,20 +286,7 @@ fn frames_the_merge_does_not_predict_are_suspect() {
     assert!(agreement.len() >= n / 2, "{agreement:?}");
     assert!(none_has(&q, ReasonKind::FrameDisagrees), "{q:?}");
     // Three frames from another sample (sulfur, about as bright, same rig and seed).
-    let other = {
-        let m = by_name("sulfur").unwrap();
-        synthesize(
-            m.name,
-            m.sigma_s_prime,
-            m.sigma_a,
-            m.eta,
-            &RigSpec::quick(),
-            1,
-            None,
-            &|_, _, _| {},
-        )
-        .unwrap()
-    };
+    let other = quick("sulfur");
     let mut mixed = f.clone();
     for j in [n - 5, n - 4, n - 3] {
         mixed[j] = other.bracket.frames[j].clone();
@@ -324,20 +314,7 @@ fn frames_the_merge_does_not_predict_are_suspect() {
     }
     // Frames of a darker sample in the bracket's longer half are refused outright: the bracket
     // is out of order (the longer exposure darker), and the message names the frames.
-    let dark = {
-        let m = by_name("brown-leather").unwrap();
-        synthesize(
-            m.name,
-            m.sigma_s_prime,
-            m.sigma_a,
-            m.eta,
-            &RigSpec::quick(),
-            1,
-            None,
-            &|_, _, _| {},
-        )
-        .unwrap()
-    };
+    let dark = quick("brown-leather");
     let mut mixed = f.clone();
     for j in [n - 5, n - 4, n - 3] {
         mixed[j] = dark.bracket.frames[j].clone();
