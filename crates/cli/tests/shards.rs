@@ -29,9 +29,11 @@ fn table(cwd: &Path, extra: &[&str]) -> Run {
 }
 
 fn parts(dir: &Path) -> Vec<String> {
+    // (Not the folder's ledger of what scatterfit wrote, `.scatterfit-written.json`.)
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .flatten()
+        .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
         .map(|e| e.path().to_string_lossy().into_owned())
         .filter(|p| p.ends_with(".json"))
         .collect();
