@@ -1,8 +1,8 @@
 //! The hostile and careless cases of a shared lab, tried on the real binary: one input-path policy
 //! for every manifest key, one output policy for every command that writes, bounds before work,
 //! downstream honesty about results the data checks did not trust, and flags whose extreme values
-//! once gave NaN, black images or 309-digit messages (RELIABILITY.md, "Paths and outputs", "Bounds
-//! before work", "Downstream honesty").
+//! once gave NaN, black images or 309-digit messages (RELIABILITY.md, "Paths, outputs, bounds,
+//! honesty").
 
 use std::fs;
 use std::path::{Path, PathBuf};

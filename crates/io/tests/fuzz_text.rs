@@ -478,7 +478,8 @@ fn enormous_files_are_refused_and_large_ones_parse_fast() {
     assert!(e.contains("more than"), "{e}");
     assert!(start.elapsed() < Duration::from_secs(1));
 
-    // 400 000 rows (≈ 9 MB): the line numbering must not be quadratic.
+    // 400 000 rows (≈ 9 MB): refused at the row cap (a spectrum has one row per wavelength),
+    // quickly — the reader stops there instead of numbering every line.
     let mut big = String::from("wavelength_nm,sci,sce\n");
     for i in 0..400_000 {
         big.push_str(&format!("{},0.5,0.4\n", 400.0 + i as f64 * 0.00075));
@@ -486,7 +487,7 @@ fn enormous_files_are_refused_and_large_ones_parse_fast() {
     big.push_str("700,0.5,zzz\n");
     let start = Instant::now();
     let e = spectro(big.as_bytes()).unwrap_err();
-    assert!(e.contains("line 400002") && e.contains("zzz"), "{e}");
+    assert!(e.contains("more than 10000 rows"), "{e}");
     assert!(start.elapsed() < TIME_BOUND, "{:?}", start.elapsed());
 }
 
