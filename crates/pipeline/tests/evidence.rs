@@ -352,3 +352,37 @@ fn a_heavily_compressed_jpeg_bracket_is_suspect() {
         }
     }
 }
+
+/// The bracket's shortest frame given as the dark frame (it holds the spot) is refused, naming the
+/// file and the lit block; a dark frame of the camera's own noise floor is used.
+#[test]
+fn a_lit_frame_given_as_the_dark_frame_is_refused() {
+    use scatterfit_io::image_files::{CameraFrame, write_camera_frame};
+    let root = tempfile::tempdir().unwrap();
+    let s = twin();
+    let lit = s.bracket.frames[0].clone();
+    // The camera's floor with the light off: the same frame's codes, none above 2.
+    let data = lit.data().iter().map(|&z| z.min(2)).collect();
+    let floor =
+        scatterfit_imaging::ImageBuf::new(lit.width(), lit.height(), lit.channels(), data).unwrap();
+    for (label, dark, refused) in [("lit dark frame", lit, true), ("dark frame", floor, false)] {
+        let d = root.path().join(label.replace(' ', "_"));
+        write_frames(&d, &s.bracket.frames);
+        write_camera_frame(&d.join("dark.png"), &CameraFrame::U8(dark)).unwrap();
+        let toml = d.join("sample.toml");
+        let text = std::fs::read_to_string(&toml).unwrap();
+        std::fs::write(
+            &toml,
+            text.replacen("[camera]\n", "[camera]\ndark = \"dark.png\"\n", 1),
+        )
+        .unwrap();
+        let got = measure_sample(&d, &Overrides::default(), &|_| {});
+        println!("{label}: {:?}", got.as_ref().err().map(ToString::to_string));
+        if refused {
+            let e = got.expect_err("refused").to_string();
+            assert!(e.contains("dark.png") && e.contains("shows light"), "{e}");
+        } else {
+            assert!(got.is_ok(), "{:?}", got.err());
+        }
+    }
+}
