@@ -24,11 +24,13 @@ pub struct Args {
     /// Relative refractive index η, in [1, 3].
     #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: f64,
-    /// Reduced albedo α′ per channel R,G,B, each in (0, 1] (the proposed method needs it).
+    /// Reduced albedo α′ per channel R,G,B, each in (0, 1] (the proposed method needs it or --rd).
     #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
     pub albedo: Option<[f64; 3]>,
-    /// The spectrophotometer's diffuse reflectance Rd per channel R,G,B, each in (0, 1] (for
-    /// --normalise-with-spectro; default: the model's Rd of the given α′).
+    /// The spectrophotometer's total diffuse reflectance Rd per channel R,G,B, each in (0, 1].
+    /// Without --albedo, α′ is inverted from it through --model at --eta and g; with --albedo,
+    /// the two must agree through that model within 0.01 in Rd. Default: the model's Rd of the
+    /// given α′.
     #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
     pub rd: Option<[f64; 3]>,
     /// The fitting method.
@@ -89,10 +91,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let method: Method = args.method.into();
-    if method == Method::Proposed && args.albedo.is_none() {
+    if method == Method::Proposed && args.albedo.is_none() && args.rd.is_none() {
         bail!(
             "the proposed method needs the reduced albedo per channel: --albedo R,G,B (from \
-             `scatterfit spectro`), or use --method existing"
+             `scatterfit spectro`), or the spectrophotometer's --rd R,G,B to invert it from, or \
+             use --method existing"
         );
     }
     if let Some(a) = args.albedo

@@ -123,6 +123,46 @@ fn synth_then_measure() {
     let f: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     let refit = f["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
     assert!((refit / got - 1.0).abs() < 1e-6, "{refit} vs {got}");
+    // `--rd` alone: α′ is inverted from the measurement's Rd through the same model, so the same
+    // σ′s; beside an --albedo it contradicts, bad usage naming both (it used to be ignored).
+    let rd: Vec<f64> = ["r", "g", "b"]
+        .iter()
+        .map(|c| r["channels"][c]["rd_total"].as_f64().unwrap())
+        .collect();
+    let rd_arg = |shift: f64| {
+        rd.iter()
+            .map(|v| (v + shift).to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let fit_rd = |extra: &[&str]| {
+        let mut args = vec!["fit", "wood/profile.csv", "--eta", &eta];
+        args.extend_from_slice(extra);
+        args.push("--json");
+        run_cached(dir.path(), &args)
+    };
+    let rd0 = rd_arg(0.0);
+    let out = fit_rd(&["--rd", &rd0]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let f_rd: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let from_rd = f_rd["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
+    assert!((from_rd / got - 1.0).abs() < 1e-4, "{from_rd} vs {got}");
+    // An approximate model's error joins the bars as the `model` term (the same rings fitted
+    // again with exact transport); exact transport itself has none.
+    let out = fit_rd(&["--rd", &rd0, "--model", "dipole"]);
+    assert!(out.code == 0 || out.code == 1, "{}", out.stderr);
+    let d: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let term = &d["channels"]["r"]["sigma_s_prime_stderr_model"];
+    assert!(term.as_f64().is_some_and(|t| t > 0.0), "{term}");
+    assert!(f_rd["channels"]["r"]["sigma_s_prime_stderr_model"].is_null());
+    let off = rd_arg(0.05);
+    let out = fit_rd(&["--albedo", &a.join(","), "--rd", &off]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("--albedo and --rd disagree"),
+        "{}",
+        out.stderr
+    );
     // Issue 15: no g stated, so the default range's term; `--g` makes it 0 and leaves the value;
     // a range that excludes the given g is bad usage.
     assert_eq!(f["g_uncertainty"]["source"], "default_range");

@@ -93,6 +93,9 @@ pub enum ReasonKind {
     /// A frame of the bracket that the merged radiance does not predict (a frame from elsewhere,
     /// a gain or light changed during the bracket).
     FrameDisagrees,
+    /// The black level subtracted from linear frames (given, from the RAW metadata, or a dark
+    /// frame) disagrees with the level the bracket's far corners show at zero exposure time.
+    BlackLevel,
 }
 
 /// One finding of a check.

@@ -38,6 +38,11 @@ pub struct BlackLevelEstimate {
     /// Per channel, the slope [DN/s]: what grows with time in the corners (veiling glare, dark
     /// current, the profile's own tail); removed later as the profile's background.
     pub rate: Vec<f64>,
+    /// Per channel, the standard error of `level` \[DN\]: the corner means' own scatter (the
+    /// pixels' sample variance over their count, per frame) carried through the straight-line
+    /// fit's intercept (a linear combination Σ cⱼ mⱼ of the frame means; NaN with fewer than two
+    /// usable frames).
+    pub level_stderr: Vec<f64>,
     /// Fraction of the shortest frame's corner samples at 0: a camera that clips its data at 0 has
     /// no pedestal (level then 0).
     pub zero_fraction: f64,
@@ -66,20 +71,27 @@ pub fn estimate_black_level(
     let zero_fraction = zeros as f64 / (corners.len() * ch).max(1) as f64;
     let mut level = vec![0.0; ch];
     let mut rate = vec![0.0; ch];
+    let mut level_stderr = vec![f64::NAN; ch];
+    let count = corners.len().max(1) as f64;
     for c in 0..ch {
-        let pts: Vec<(f64, f64)> = frames
+        // (time, corner mean, the mean's variance) per frame.
+        let pts: Vec<(f64, f64, f64)> = frames
             .iter()
             .zip(times_s)
             .filter_map(|(f, &t)| {
-                let mut sum = 0.0;
+                let (mut sum, mut sum2) = (0.0, 0.0);
                 for &p in &corners {
                     let v = f.data()[p * ch + c];
                     if v >= saturation {
                         return None;
                     }
-                    sum += f64::from(v);
+                    let v = f64::from(v);
+                    sum += v;
+                    sum2 += v * v;
                 }
-                Some((t, sum / corners.len().max(1) as f64))
+                let mean = sum / count;
+                let var = (sum2 / count - mean * mean).max(0.0) / (count - 1.0).max(1.0);
+                Some((t, mean, var))
             })
             .collect();
         if pts.len() < 2 {
@@ -91,6 +103,20 @@ pub fn estimate_black_level(
         let stt: f64 = pts.iter().map(|p| (p.0 - mt).powi(2)).sum();
         let stm: f64 = pts.iter().map(|p| (p.0 - mt) * (p.1 - mm)).sum();
         let slope = if stt > 0.0 { stm / stt } else { 0.0 };
+        // The intercept mm − slope·mt = Σ cⱼ mⱼ with cⱼ = 1/n − mt (tⱼ − mt)/stt.
+        level_stderr[c] = pts
+            .iter()
+            .map(|p| {
+                let cj = 1.0 / n
+                    - if stt > 0.0 {
+                        mt * (p.0 - mt) / stt
+                    } else {
+                        0.0
+                    };
+                cj * cj * p.2
+            })
+            .sum::<f64>()
+            .sqrt();
         rate[c] = slope;
         level[c] = if zero_fraction > 0.01 {
             0.0
@@ -101,6 +127,7 @@ pub fn estimate_black_level(
     BlackLevelEstimate {
         level,
         rate,
+        level_stderr,
         zero_fraction,
     }
 }

@@ -70,45 +70,56 @@ impl Measurement {
             self.evidence =
                 crate::checks::evidence::gather(&data, &x.spectro, &x.settings, &model, &x.fits);
         }
-        for c in scatterfit_optics::Channel::ALL {
-            let ChannelOutcome::Fitted(f) = &mut self.fits[c] else {
-                continue;
-            };
-            let x = match &exact {
-                Ok(m) => match &m.fits[c] {
-                    ChannelOutcome::Fitted(x) if x.report.converged => Ok(x),
-                    ChannelOutcome::Fitted(x) => Err(format!(
-                        "the exact fit did not converge ({})",
-                        x.report.termination
-                    )),
-                    ChannelOutcome::NotFitted { problem } => Err(problem.clone()),
-                },
-                Err(e) => Err(e.to_string()),
-            };
-            match x {
-                Ok(x) => {
-                    let term = |a: f64, b: f64| (a - b).abs();
-                    f.sigma_s_prime.model =
-                        Some(term(f.sigma_s_prime.value, x.sigma_s_prime.value));
-                    f.sigma_a.model = Some(term(f.sigma_a.value, x.sigma_a.value));
-                    f.albedo_prime.model = Some(term(f.albedo_prime.value, x.albedo_prime.value));
-                    f.exact = Some(ExactFit {
-                        sigma_s_prime: x.sigma_s_prime.value,
-                        sigma_a: x.sigma_a.value,
-                        albedo_prime: x.albedo_prime.value,
-                        chi2_reduced: x.report.chi2_reduced,
-                        scale: x.report.scale.value,
-                    });
-                }
-                Err(e) => {
-                    f.model_note = Some(format!(
-                        "the {} model's error could not be measured against exact transport \
-                         (the mc tables) on this channel: {e}",
-                        self.settings.model
-                    ));
-                }
+        let exact = exact.as_ref().map(|m| &m.fits).map_err(ToString::to_string);
+        apply(&mut self.fits, exact, self.settings.model);
+        self
+    }
+}
+
+/// Each fitted channel of `fits` with its `model` term from exact transport's fits of the same
+/// data (`exact`, or why they could not be made): |approximate − exact| of σ′s, σa and α′ and
+/// exact transport's fit beside it ([`ExactFit`]); a channel without a usable exact fit gets a
+/// note saying why instead.
+pub fn apply(
+    fits: &mut scatterfit_optics::Rgb<ChannelOutcome>,
+    exact: Result<&scatterfit_optics::Rgb<ChannelOutcome>, String>,
+    model: ModelName,
+) {
+    for c in scatterfit_optics::Channel::ALL {
+        let ChannelOutcome::Fitted(f) = &mut fits[c] else {
+            continue;
+        };
+        let x = match &exact {
+            Ok(m) => match &m[c] {
+                ChannelOutcome::Fitted(x) if x.report.converged => Ok(x),
+                ChannelOutcome::Fitted(x) => Err(format!(
+                    "the exact fit did not converge ({})",
+                    x.report.termination
+                )),
+                ChannelOutcome::NotFitted { problem } => Err(problem.clone()),
+            },
+            Err(e) => Err(e.clone()),
+        };
+        match x {
+            Ok(x) => {
+                let term = |a: f64, b: f64| (a - b).abs();
+                f.sigma_s_prime.model = Some(term(f.sigma_s_prime.value, x.sigma_s_prime.value));
+                f.sigma_a.model = Some(term(f.sigma_a.value, x.sigma_a.value));
+                f.albedo_prime.model = Some(term(f.albedo_prime.value, x.albedo_prime.value));
+                f.exact = Some(ExactFit {
+                    sigma_s_prime: x.sigma_s_prime.value,
+                    sigma_a: x.sigma_a.value,
+                    albedo_prime: x.albedo_prime.value,
+                    chi2_reduced: x.report.chi2_reduced,
+                    scale: x.report.scale.value,
+                });
+            }
+            Err(e) => {
+                f.model_note = Some(format!(
+                    "the {model} model's error could not be measured against exact transport \
+                     (the mc tables) on this channel: {e}"
+                ));
             }
         }
-        self
     }
 }

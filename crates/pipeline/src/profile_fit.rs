@@ -20,10 +20,12 @@ pub struct ProfileFitRequest {
     pub profile_file: Option<String>,
     /// The relative refractive index η.
     pub eta: f64,
-    /// α′ per channel (the proposed method needs it).
+    /// α′ per channel (the proposed method needs it, or `rd` to invert it from).
     pub albedo_prime: Option<Rgb<f64>>,
-    /// The spectrophotometer's Rd per channel (for normalising with it); default: the model's
-    /// total Rd of the given α′.
+    /// The spectrophotometer's total diffuse reflectance Rd per channel. Without `albedo_prime`,
+    /// α′ is inverted from it through the fit's model at η and g (as a measurement inverts the
+    /// spectrophotometer's Rd); with it, the two must agree through that model
+    /// ([`MAX_RD_DISAGREEMENT`]). Default: the model's total Rd of the given α′.
     pub rd: Option<Rgb<f64>>,
     /// proposed | existing.
     pub method: Method,
@@ -40,6 +42,13 @@ pub struct ProfileFitRequest {
     /// g; without, α′ is held at the given value and the term is the profile's part only.
     pub g_prior: crate::anisotropy::GPrior,
 }
+
+/// How far (absolute, in Rd) a given Rd may lie from the fit model's total Rd of the given α′
+/// before the two are refused as contradictory: 1 % of full reflectance, about what a d/8
+/// instrument's repeatability and the models' own spread near α′ = 1 allow; a pair further apart
+/// is two different materials' numbers or two different albedo models, and either way one of
+/// them would be silently ignored.
+pub const MAX_RD_DISAGREEMENT: f64 = 0.01;
 
 /// A given profile, fitted.
 #[derive(Debug, Clone)]
@@ -85,7 +94,7 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
     let model = scatterfit_optics::AtG::new(scatterfit_mc::family(request.model)?, g)
         .map_err(|e| crate::PipelineError::Input(format!("g: {e}")))?;
     let model = &model;
-    let albedo = request.albedo_prime.map_or(Rgb::default(), |a| a.map(Some));
+    let albedo = given_albedo(request, model, g)?;
     let rd = request.rd.unwrap_or_else(|| {
         albedo.map(|a| {
             a.map_or(f64::NAN, |a| {
@@ -111,13 +120,98 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
     } else {
         AlbedoAtG::Fixed
     };
-    let fits = with_g_term(profile, &spectro, &settings, fits, albedo_at_g);
+    let mut fits = with_g_term(profile, &spectro, &settings, fits, albedo_at_g);
+    // An approximate model's error: the same rings fitted again with exact transport (α′ as
+    // given, or inverted from the given Rd through the `mc` total), |approximate − exact| the
+    // `model` term of each estimate (crate::model_term).
+    if request.model != ModelName::Mc {
+        let exact = exact_fits(profile, request, &settings, g);
+        crate::model_term::apply(
+            &mut fits,
+            exact.as_ref().map_err(Clone::clone),
+            request.model,
+        );
+    }
     Ok(ProfileFit {
         request: request.clone(),
         settings,
         spectro,
         fits,
     })
+}
+
+/// The profile fitted with exact transport (values only), everything else as `settings`.
+fn exact_fits(
+    profile: &Rgb<ProfileData>,
+    request: &ProfileFitRequest,
+    settings: &FitSettings,
+    g: f64,
+) -> std::result::Result<Rgb<ChannelOutcome>, String> {
+    let model = scatterfit_optics::AtG::new(
+        scatterfit_mc::family(ModelName::Mc).map_err(|e| e.to_string())?,
+        g,
+    )
+    .map_err(|e| e.to_string())?;
+    let exact_request = ProfileFitRequest {
+        model: ModelName::Mc,
+        ..request.clone()
+    };
+    let albedo = given_albedo(&exact_request, &model, g).map_err(|e| e.to_string())?;
+    let rd = request.rd.unwrap_or_else(|| {
+        albedo.map(|a| {
+            a.map_or(f64::NAN, |a| {
+                model.rd_total(a, request.eta, g).unwrap_or(f64::NAN)
+            })
+        })
+    });
+    let spectro = SpectroStage::given(request.eta, rd, albedo);
+    let settings = crate::model_term::exact_settings(settings);
+    Ok(fit_stage(profile, &spectro, &settings, &model))
+}
+
+/// α′ per channel from the request: as given, inverted from the given Rd through `model` at η
+/// and g, or checked against the given Rd where both are given.
+fn given_albedo(
+    request: &ProfileFitRequest,
+    model: &dyn ModelFamily,
+    g: f64,
+) -> Result<Rgb<Option<f64>>> {
+    let eta = request.eta;
+    let input = |m: String| crate::PipelineError::Input(m);
+    match (request.albedo_prime, request.rd) {
+        (None, None) => Ok(Rgb::default()),
+        (Some(a), None) => Ok(a.map(Some)),
+        (None, Some(rd)) => rd
+            .map_with_channel(|c, rd| {
+                model.albedo_from_rd(rd, eta, g).map(Some).map_err(|e| {
+                    input(format!(
+                        "--rd: channel {}: no reduced albedo of the {} model gives Rd {rd} at \
+                         η {eta}, g {g} ({e})",
+                        c.name(),
+                        request.model.name()
+                    ))
+                })
+            })
+            .transpose(),
+        (Some(a), Some(rd)) => {
+            for (c, (a, rd)) in a.zip(rd).iter_channels() {
+                let modelled = model
+                    .rd_total(*a, eta, g)
+                    .map_err(|e| input(format!("--albedo: channel {}: α′ {a}: {e}", c.name())))?;
+                if (modelled - rd).abs() > MAX_RD_DISAGREEMENT {
+                    return Err(input(format!(
+                        "--albedo and --rd disagree in channel {}: the {} model's total Rd of \
+                         α′ {a} at η {eta}, g {g} is {modelled:.4}, --rd says {rd:.4} (more than \
+                         {MAX_RD_DISAGREEMENT} apart). Give one of them: α′ is inverted from \
+                         --rd when --albedo is absent",
+                        c.name(),
+                        request.model.name()
+                    )));
+                }
+            }
+            Ok(a.map(Some))
+        }
+    }
 }
 
 impl ProfileFit {
@@ -141,9 +235,9 @@ impl ProfileFit {
             channels: self.fits.as_ref().map_with_channel(|c, outcome| {
                 // The fit's own checks (no image here: the residuals and the ranges).
                 let mut r = channel_result(outcome, &self.spectro, c);
-                r.quality = Some(crate::checks::Quality::from_reasons(
-                    crate::checks::fit_reasons(outcome, self.request.eta),
-                ));
+                let mut reasons = crate::checks::fit_reasons(outcome, self.request.eta);
+                reasons.extend(crate::checks::model_reasons(outcome, s.model));
+                r.quality = Some(crate::checks::Quality::from_reasons(reasons));
                 r
             }),
             inputs: Inputs {

@@ -589,6 +589,79 @@ fn black_level_is_found_in_the_corners() {
     assert!(on < 0.03 && off > 3.0 * on, "{on} vs {off}");
 }
 
+/// A black level stated wrongly (0.2 % of full scale, 131 DN, either way) for a linear 16-bit
+/// camera (1024 DN) bends every dim ring; the far corners' intercept at Δt = 0 contradicts it and
+/// the check says so, while the right level (and a dark frame of the right level) passes.
+#[test]
+fn a_stated_black_level_the_corners_contradict_is_suspect() {
+    use scatterfit_pipeline::checks::{ReasonKind, black_level_reasons};
+    use scatterfit_pipeline::hdr::BlackLevel;
+    let mut rig = RigSpec::quick();
+    rig.camera = CameraModel::named("linear16").unwrap();
+    let eta = 1.3;
+    let profile = dipole(albedo_for(0.4, eta), eta);
+    let b = render_bracket_fn(&|_, r| profile(r), None, &rig, 5).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut csv = String::from("file,time_s\n");
+    for (j, f) in b.frames_u16.iter().enumerate() {
+        let name = format!("frame_{j:02}.png");
+        write_camera_frame(&dir.path().join(&name), &CameraFrame::U16(f.clone())).unwrap();
+        csv.push_str(&format!("{name},{}\n", b.times_s[j]));
+    }
+    std::fs::write(dir.path().join("exposures.csv"), csv).unwrap();
+    // A dark frame: the pedestal alone, as the camera reads with the cap on.
+    let (w, h, ch) = (
+        b.frames_u16[0].width(),
+        b.frames_u16[0].height(),
+        b.frames_u16[0].channels(),
+    );
+    let dark = |level: u16| ImageBuf::new(w, h, ch, vec![level; w * h * ch]).unwrap();
+    let kinds = |level: BlackLevel, dark_level: Option<u16>| {
+        let mut inputs = HdrInputs::new(Some(dir.path().join("exposures.csv")), Vec::new());
+        inputs.black_level = level;
+        if let Some(d) = dark_level {
+            let path = dir.path().join(format!("dark_{d}.png"));
+            write_camera_frame(&path, &CameraFrame::U16(dark(d))).unwrap();
+            inputs.dark = Some(path);
+        }
+        let stage = match read_and_merge(&inputs, &|_| {}) {
+            Ok(s) => s,
+            // Refused (a pedestal left in makes the short frames too bright for their times):
+            // the message must name the black level.
+            Err(e) => {
+                let text = format!("{e:#}");
+                eprintln!("{:?}: refused: {text}", inputs.black_level);
+                assert!(text.contains("black_level"), "{text}");
+                return (true, vec![ReasonKind::BlackLevel]);
+            }
+        };
+        let check = stage.corrections.black_level_check.clone();
+        let reasons = check.as_ref().map(black_level_reasons).unwrap_or_default();
+        eprintln!("{:?}: {check:?} → {reasons:?}", inputs.black_level);
+        (
+            check.is_some(),
+            reasons.iter().map(|r| r.kind).collect::<Vec<_>>(),
+        )
+    };
+    // The right level, given or as a dark frame: checked, nothing found.
+    assert_eq!(kinds(BlackLevel::Given(vec![1024.0]), None), (true, vec![]));
+    assert_eq!(kinds(BlackLevel::Auto, Some(1024)), (true, vec![]));
+    // Off by 131 DN either way, given or as a dark frame at other settings; or said to be none.
+    for (level, dark_level) in [
+        (BlackLevel::Given(vec![1155.0]), None),
+        (BlackLevel::Given(vec![893.0]), None),
+        (BlackLevel::Auto, Some(1155)),
+        (BlackLevel::None, None),
+    ] {
+        assert_eq!(
+            kinds(level, dark_level),
+            (true, vec![ReasonKind::BlackLevel])
+        );
+    }
+    // The level found in the corners is its own evidence: nothing to check.
+    assert_eq!(kinds(BlackLevel::Auto, None), (false, vec![]));
+}
+
 /// Vignetting (30 % at the corner) bends the far profile; the flat frame divides it out.
 #[test]
 fn the_flat_frame_removes_vignetting() {

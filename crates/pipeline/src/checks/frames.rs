@@ -95,6 +95,62 @@ pub fn code_reasons(m: &Measurement) -> Vec<Reason> {
     Vec::new()
 }
 
+/// A stated black level may lie this far from the far corners' intercept, as a fraction of the
+/// full scale, beyond five of the intercept's standard errors: 0.05 % (33 DN at 16 bits, 8 DN at
+/// 14). A level off by 0.2 % of full scale moves σ′s and σa of the rig twin's linear camera by
+/// about 9 %; one off by this much, by about 2 %.
+pub const MAX_BLACK_LEVEL_OFFSET: f64 = 5e-4;
+
+/// The black level subtracted from linear frames against the bracket's own evidence
+/// ([`crate::hdr::BlackLevelCheck`]): suspect when a channel's stated level and the far corners'
+/// intercept at Δt = 0 differ by more than five standard errors and
+/// [`MAX_BLACK_LEVEL_OFFSET`] of the full scale. Silent when the corners clip at 0 (no pedestal
+/// to read) or have no intercept.
+pub fn black_level_reasons(b: &crate::hdr::BlackLevelCheck) -> Vec<Reason> {
+    if b.clipped_at_zero {
+        return Vec::new();
+    }
+    let off: Vec<String> = b
+        .stated
+        .iter()
+        .zip(&b.corners)
+        .zip(&b.corners_stderr)
+        .enumerate()
+        .filter(|(_, ((stated, corners), se))| {
+            se.is_finite()
+                && (*stated - *corners).abs()
+                    > (5.0 * **se).max(MAX_BLACK_LEVEL_OFFSET * b.saturation)
+        })
+        .map(|(c, ((stated, corners), se))| {
+            format!(
+                "{} {stated:.0} DN against {corners:.0} ± {se:.1} DN",
+                ["R", "G", "B", "A"].get(c).copied().unwrap_or("?")
+            )
+        })
+        .collect();
+    if off.is_empty() {
+        return Vec::new();
+    }
+    let what = match b.source {
+        "dark frame" => "the dark frame's level (its far corners' mean)",
+        "metadata" => "the RAW file's black level",
+        "none" => "camera.black_level = \"none\" (no pedestal)",
+        _ => "camera.black_level",
+    };
+    vec![suspect(
+        ReasonKind::BlackLevel,
+        format!(
+            "{what} disagrees with the level the bracket's far corners show at zero exposure \
+             time ({}; more than 5 standard errors and {:.2} % of the full scale {:.0} DN apart): \
+             every dim ring is off by the difference — check the black level (or the dark frame \
+             was taken at other camera settings)",
+            off.join(", "),
+            100.0 * MAX_BLACK_LEVEL_OFFSET,
+            b.saturation,
+        ),
+    )]
+}
+
 /// Where the spot is in each frame of a bracket, to see whether the camera moved.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Registration {

@@ -26,11 +26,12 @@ pub mod evidence;
 mod frames;
 
 pub use frames::{
-    AGREEMENT_CODES, AGREEMENT_MIN_SAMPLES, CodeRange, FrameAgreement, MAX_FRAME_OFFSET_LN,
-    MAX_FRAME_SHIFT_PX, MAX_FRAME_SPREAD_LN, MAX_STEP_8BIT, MAX_STEP_LINEAR, MAX_STEP_RECOVERED,
-    MIN_JPEG_QUALITY, PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS, Registration, bracket_reasons,
-    code_range, code_reasons, compression_reasons, frame_agreement, frame_agreement_reasons,
-    jpeg_quality, registration, registration_reasons,
+    AGREEMENT_CODES, AGREEMENT_MIN_SAMPLES, CodeRange, FrameAgreement, MAX_BLACK_LEVEL_OFFSET,
+    MAX_FRAME_OFFSET_LN, MAX_FRAME_SHIFT_PX, MAX_FRAME_SPREAD_LN, MAX_STEP_8BIT, MAX_STEP_LINEAR,
+    MAX_STEP_RECOVERED, MIN_JPEG_QUALITY, PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS,
+    Registration, black_level_reasons, bracket_reasons, code_range, code_reasons,
+    compression_reasons, frame_agreement, frame_agreement_reasons, jpeg_quality, registration,
+    registration_reasons,
 };
 
 /// A fit whose rms log residual exceeds this is suspect: the profile differs from the model by
@@ -148,6 +149,9 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
     }
     // (e) The codes the frames use; (f) the frames registered.
     reasons.extend(code_reasons(m));
+    if let Some(b) = &m.hdr.corrections.black_level_check {
+        reasons.extend(black_level_reasons(b));
+    }
     reasons.extend(registration_reasons(m));
     reasons.extend(bracket_reasons(m));
     reasons.extend(frame_agreement_reasons(m));

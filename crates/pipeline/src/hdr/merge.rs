@@ -376,6 +376,41 @@ pub(super) fn merge_linear(
             },
         }
     };
+    // A level stated rather than read off the bracket is checked against the far corners'
+    // intercept: a wrong level shifts every dim ring by a constant and bends the profile's tail.
+    let stated_black: Option<(Vec<f64>, &'static str)> = match (&dark, &black) {
+        (Some(d), _) => {
+            let corners = crate::camera::corner_pixels(d.width(), d.height(), 1);
+            let dch = d.channels();
+            Some((
+                (0..dch.min(ch))
+                    .map(|c| {
+                        corners
+                            .iter()
+                            .map(|&p| f64::from(d.data()[p * dch + c]))
+                            .sum::<f64>()
+                            / corners.len().max(1) as f64
+                    })
+                    .collect(),
+                "dark frame",
+            ))
+        }
+        (None, Some((b, source))) if *source != "far corners" => Some((b.clone(), *source)),
+        (None, None) if cx.inputs.black_level == BlackLevel::None => Some((vec![0.0; ch], "none")),
+        _ => None,
+    };
+    if let Some((levels, source)) = stated_black {
+        let refs: Vec<&ImageBuf<u16>> = bufs.iter().collect();
+        let est = estimate_black_level(&refs, stated, saturation);
+        corrections.black_level_check = Some(crate::hdr::BlackLevelCheck {
+            source,
+            stated: levels,
+            corners: est.level,
+            corners_stderr: est.level_stderr,
+            saturation: f64::from(saturation),
+            clipped_at_zero: est.zero_fraction > 0.01,
+        });
+    }
     let black_of = |c: usize| black.as_ref().map_or(0.0, |(b, _)| b[c]);
     // Exposure times from the frames: ratios of the linear values in the well-exposed range.
     let mut times_used = stated.to_vec();
@@ -393,7 +428,21 @@ pub(super) fn merge_linear(
             },
             false,
         );
-        check_exposure(&est, stated)?;
+        // A pedestal left in (or taken out twice) makes the short frames look too bright (or too
+        // dark) for their times: where the black level disagrees with the corners, say so first.
+        check_exposure(&est, stated).map_err(|e| match (e, &corrections.black_level_check) {
+            (PipelineError::Imaging { context, source }, Some(b)) => {
+                let found = crate::checks::black_level_reasons(b);
+                PipelineError::Imaging {
+                    context: match found.first() {
+                        Some(r) => format!("{context} ({})", r.message),
+                        None => context,
+                    },
+                    source,
+                }
+            }
+            (e, _) => e,
+        })?;
         let apply = cx.inputs.exposure_correction == ExposureCorrection::Always
             || est.max_correction > EXPOSURE_AUTO_THRESHOLD;
         if apply {

@@ -85,6 +85,11 @@ pub struct Corrections {
     /// The black level subtracted from linear frames [DN per channel] and where it came from
     /// (`dark frame`, `metadata`, `given`, `far corners`); `None` when none was.
     pub black_level: Option<(Vec<f64>, &'static str)>,
+    /// A black level not read off the bracket itself (given, stated as none, from the RAW
+    /// metadata, or a dark frame) against the far corners' intercept at Δt = 0 ([`crate::checks::black_level_reasons`];
+    /// not written).
+    #[serde(skip)]
+    pub black_level_check: Option<BlackLevelCheck>,
     /// The exposure times estimated from the frames, and whether they replaced the nominal ones.
     pub exposure: Option<ExposureEstimate>,
     /// True when the estimated times were used.
@@ -115,6 +120,26 @@ pub struct Corrections {
     /// times ([`scatterfit_imaging::self_consistency`]; not written).
     #[serde(skip)]
     pub self_consistency: Option<SelfConsistency>,
+}
+
+/// A stated black level beside what the bracket's far corners say it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlackLevelCheck {
+    /// Where the stated level came from: `given`, `none` (stated as no pedestal), `metadata` or
+    /// `dark frame`.
+    pub source: &'static str,
+    /// The level subtracted, per channel \[DN\] (a dark frame's: its far corners' mean).
+    pub stated: Vec<f64>,
+    /// The far corners' level at Δt = 0 and its standard error, per channel \[DN\]
+    /// ([`crate::camera::estimate_black_level`]).
+    pub corners: Vec<f64>,
+    /// The standard errors of `corners` \[DN\].
+    pub corners_stderr: Vec<f64>,
+    /// The saturation code the merge uses \[DN\] (the full scale the tolerance is a part of).
+    pub saturation: f64,
+    /// True when the shortest frame's corners clip at 0 (no pedestal to read: the check says
+    /// nothing).
+    pub clipped_at_zero: bool,
 }
 
 /// The 8-bit code at which a pixel counts as detected in the longest exposure. Below it the tone
