@@ -353,6 +353,51 @@ fn a_heavily_compressed_jpeg_bracket_is_suspect() {
     }
 }
 
+/// A frame of the bracket given as the flat frame (it holds the spot) is refused, naming the file
+/// and what a flat looks like; a flat of a uniform target through a vignetting lens is used.
+#[test]
+fn a_frame_of_the_spot_given_as_the_flat_is_refused() {
+    use scatterfit_io::image_files::{CameraFrame, write_camera_frame};
+    let root = tempfile::tempdir().unwrap();
+    let s = twin();
+    let lit = s.bracket.frames[s.bracket.frames.len() / 2].clone();
+    // A uniform target through a lens vignetted to 40 % at the corners (mid-range codes).
+    let (w, h, ch) = (lit.width(), lit.height(), lit.channels());
+    let half_diag2 = 0.25 * ((w * w + h * h) as f64);
+    let mut vignetted = Vec::with_capacity(w * h * ch);
+    for y in 0..h {
+        for x in 0..w {
+            let rho2 = ((x as f64 - 0.5 * w as f64).powi(2) + (y as f64 - 0.5 * h as f64).powi(2))
+                / half_diag2;
+            vignetted.extend(std::iter::repeat_n((180.0 * (1.0 - 0.6 * rho2)) as u8, ch));
+        }
+    }
+    let flat = scatterfit_imaging::ImageBuf::new(w, h, ch, vignetted).unwrap();
+    for (label, frame, refused) in [("spot as flat", lit, true), ("flat", flat, false)] {
+        let d = root.path().join(label.replace(' ', "_"));
+        write_frames(&d, &s.bracket.frames);
+        write_camera_frame(&d.join("flat.png"), &CameraFrame::U8(frame)).unwrap();
+        let toml = d.join("sample.toml");
+        let text = std::fs::read_to_string(&toml).unwrap();
+        std::fs::write(
+            &toml,
+            text.replacen("[camera]\n", "[camera]\nflat = \"flat.png\"\n", 1),
+        )
+        .unwrap();
+        let got = measure_sample(&d, &Overrides::default(), &|_| {});
+        println!("{label}: {:?}", got.as_ref().err().map(ToString::to_string));
+        if refused {
+            let e = got.expect_err("refused").to_string();
+            assert!(
+                e.contains("flat.png") && e.contains("not a flat frame"),
+                "{e}"
+            );
+        } else {
+            got.expect("a plausible flat is used");
+        }
+    }
+}
+
 /// The bracket's shortest frame given as the dark frame (it holds the spot) is refused, naming the
 /// file and the lit block; a dark frame of the camera's own noise floor is used.
 #[test]

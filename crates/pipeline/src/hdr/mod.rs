@@ -27,6 +27,7 @@ use crate::error::{PipelineError, Result};
 pub use scatterfit_io::result_json::ResponseKind;
 
 mod merge;
+pub use merge::{FLAT_MAX_PEAK, FLAT_MIN_LOW};
 
 use merge::*;
 
