@@ -278,7 +278,7 @@ fn thin_slab_in_metres_matches_adding_doubling() {
     );
 }
 
-/// Issue 18: a material whose mean free path is sub-millimetre (σ′t = 5 mm⁻¹, 0.2 mm), in a metre
+/// A material whose mean free path is sub-millimetre (σ′t = 5 mm⁻¹, 0.2 mm), in a metre
 /// scene. Mitsuba offsets rays leaving a surface by ≈ 9·10⁻⁵ (1 + |p|) scene units — 0.09 mm at the
 /// origin in metres, 0.45 mean free paths — which moves the first scattering deeper and darkens the
 /// render. The export must say so (stderr and header), the metre render must show the documented
@@ -330,7 +330,7 @@ fn metre_scene_with_submillimetre_mean_free_path_is_flagged() {
 }
 
 /// Two materials' fragments in one scene — "pink plastic" and "pink-plastic", whose ids collided
-/// before issue 18 — load together, and each shape gets its own medium: each render, with the other
+/// before each got its own medium — load together, and each shape gets its own medium: each render, with the other
 /// material present beside it, shows its own Rd (α′ = 0.8 and 0.9, η = 1.4).
 #[test]
 fn two_fragments_in_one_scene() {
@@ -406,7 +406,7 @@ fn directional_light_renders_the_medium_black() {
     assert_eq!(r.max, [0.0; 3], "{r:?}");
 }
 
-/// Issue 18: a spectral variant (`scalar_spectral`) uplifts RGB coefficients to smooth spectra, and a
+/// A spectral variant (`scalar_spectral`) uplifts RGB coefficients to smooth spectra, and a
 /// strongly coloured medium renders shifted (red aluminium's red: −42 %, BENCHMARKS.md). A rig-twin
 /// red aluminium measured with the exact model keeps its spectrophotometer spectrum in the result,
 /// and `--mitsuba-variant spectral` writes a medium per wavelength from it: rendered in

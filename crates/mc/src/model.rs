@@ -83,7 +83,7 @@ pub enum AlbedoSpacing {
     /// crowds the nodes toward α′ → 1 less than at g = 0 (1 − a ≈ (1 − g)(1 − α′) there): at
     /// g = 0.9 only two of 64 nodes lie above α′ 0.998, and the far field between them is 1–5 %
     /// off (BENCHMARKS.md, "Weak absorption"). This spacing gives a g ≠ 0 table the g = 0 table's
-    /// node density in α′, where the profile's shape is set (issue 15).
+    /// node density in α′, where the profile's shape is set.
     SqrtOneMinusReducedAlbedo,
 }
 

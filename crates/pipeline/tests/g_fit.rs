@@ -1,4 +1,4 @@
-//! `[fit] g = "fit"` (issue 15): g fitted per channel from the profile where the data determine it,
+//! `[fit] g = "fit"`: g fitted per channel from the profile where the data determine it,
 //! and not printed where they do not.
 //!
 //! Quick-rig twins simulated by the Monte Carlo engine at Henyey–Greenstein g = 0.9 — profile and
