@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 16 effects on the quick twin: σ′s, σa errors with and without each handling (model mc).
+# A real camera's effects on the quick twin: σ′s, σa errors with and without each handling (model mc).
 B=${SCATTERFIT:-$(cd "$(dirname "$0")/.." && pwd)/target/debug/scatterfit}
 M=${MAT:-wood-tile}
 W=${1:-/tmp/scatterfit-camera-effects}; mkdir -p "$W"; cd "$W"

@@ -31,7 +31,7 @@ pub struct Figure {
     pub value: f64,
     /// Its unit, e.g. "µs", "photons/s", "s".
     pub unit: String,
-    /// Context: problem size, threads, the target from the issue.
+    /// Context: problem size, threads, the target (BENCHMARKS.md).
     pub note: String,
 }
 

@@ -6,7 +6,7 @@ use scatterfit_mc::{Beam, Layer, RadialGrid, Sample, Simulation};
 
 use crate::{Figure, Result};
 
-/// The two speed cases: (name, sample, photons at full size).
+/// The two speed cases timed against MCML: (name, sample, photons at full size).
 fn speed_cases(quick: bool) -> Result<Vec<(&'static str, Sample, u64, &'static str)>> {
     let k = if quick { 10 } else { 1 };
     Ok(vec![

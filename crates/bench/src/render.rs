@@ -7,7 +7,7 @@ use scatterfit_render::{Material, Method, RenderOptions, Shape, render, studio, 
 
 use crate::{Figure, Result};
 
-/// The case — the statue at about 100 000 triangles, 512 × 512, both methods, pink plastic
+/// The reference case — the statue at about 100 000 triangles, 512 × 512, both methods, pink plastic
 /// (Table 1) under the studio lights — with the time of each stage.
 pub fn figures(quick: bool) -> Result<Vec<Figure>> {
     let (size, triangles) = if quick { (128, 20_000) } else { (512, 100_000) };

@@ -10,7 +10,7 @@
 //! `--shard K/N` does every Nth sample of the grid (round-robin) and writes its rows into a partial
 //! file; `scatterfit combine` makes the tables and the figure of all (`study_set`).
 //!
-//! `--g` gives the study a g axis (issue 15): the twins are made at each Henyey–Greenstein g, fitted
+//! `--g` gives the study a g axis: the twins are made at each Henyey–Greenstein g, fitted
 //! every way assuming g = 0 and once more with the g-aware `mc` model told the true g
 //! (`scatterfit_pipeline::study::g_given_combo`); `study.md` gains a table per model over g.
 

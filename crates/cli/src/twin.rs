@@ -40,7 +40,7 @@ pub fn synthesize(
     synthesize_on(m, &rig, seed, cache, quiet)
 }
 
-/// Synthesises `m` on `rig` (a camera or effects of issue 16), with a progress bar.
+/// Synthesises `m` on `rig` (a camera, or a real rig's effects), with a progress bar.
 pub fn synthesize_on(
     m: &Material,
     rig: &RigSpec,

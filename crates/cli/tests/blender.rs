@@ -12,17 +12,17 @@
 //! bias fails it too (then update the docstring).
 //!
 //! The interpreter is `$SCATTERFIT_BLENDER_PYTHON`, else `.ci/blender-venv/bin/python` (made by
-//! `.ci/run`: `pip install bpy==5.0.1` under CPython 3.11). Without it the tests are skipped with a
-//! message, unless `SCATTERFIT_REQUIRE_BLENDER=1` (set by `.ci/run`), which makes its absence a
-//! failure.
+//! `.ci/run`: `pip install bpy==5.0.1` under CPython 3.11). Without it `cargo test` reports the
+//! tests as ignored, saying why (this file is its own harness: `tests/common/peer.rs`), unless
+//! `SCATTERFIT_REQUIRE_BLENDER=1` (set by `.ci/run`), which makes its absence a failure.
 
 mod common;
 
+use common::peer::{self, Peer};
 use common::{command, temp_dir, workspace_root};
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, ExitCode};
 
 use scatterfit_io::export::MaterialNames;
 
@@ -31,12 +31,8 @@ use scatterfit_io::export::MaterialNames;
 const ETA: f64 = 1.4;
 const CASES: [(f64, f64); 3] = [(0.8, 0.153054), (0.9, 0.250608), (0.95, 0.359139)];
 
-fn required() -> bool {
-    std::env::var("SCATTERFIT_REQUIRE_BLENDER").is_ok_and(|v| v == "1")
-}
-
-/// The Python that has `bpy`, or `None` (after saying why) when the test is to be skipped.
-fn blender_python(test: &str) -> Option<PathBuf> {
+/// The Python that has `bpy`, or why there is none.
+fn blender_python() -> Result<PathBuf, String> {
     let python = std::env::var_os("SCATTERFIT_BLENDER_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| workspace_root().join(".ci/blender-venv/bin/python"));
@@ -48,20 +44,28 @@ fn blender_python(test: &str) -> Option<PathBuf> {
             .output()
             .is_ok_and(|o| o.status.success());
     if ok {
-        return Some(python);
+        return Ok(python);
     }
-    let why = format!(
-        "{test}: no Python with the `bpy` package at {} (make one with `python3.11 -m venv \
+    Err(format!(
+        "no Python with the `bpy` package at {} (make one with `python3.11 -m venv \
          .ci/blender-venv && .ci/blender-venv/bin/pip install bpy==5.0.1`, or set \
          SCATTERFIT_BLENDER_PYTHON)",
         python.display()
-    );
-    assert!(
-        !required(),
-        "{why}; SCATTERFIT_REQUIRE_BLENDER=1 makes this test required"
-    );
-    let _ = writeln!(std::io::stderr(), "skipped {why}");
-    None
+    ))
+}
+
+fn main() -> ExitCode {
+    let blender = Peer::new(blender_python(), "SCATTERFIT_REQUIRE_BLENDER");
+    peer::run(vec![
+        blender.trial(
+            "blender_script_sets_the_material",
+            blender_script_sets_the_material,
+        ),
+        blender.trial(
+            "cycles_renders_within_the_stated_error",
+            cycles_renders_within_the_stated_error,
+        ),
+    ])
 }
 
 /// Writes a result named `name` with the thick slab's channels and exports it to `out.py`.
@@ -148,16 +152,12 @@ fn floats(v: &serde_json::Value) -> Vec<f64> {
 /// (no `Material.use_nodes`), make exactly one material — the hashed name within 63 bytes, found
 /// again on a second run — and set the Principled BSDF to the exported values: Base Color = Rd,
 /// IOR = η, and a radius · scale from which Cycles' own dipole inversion gives back σ′t = 1 mm⁻¹.
-#[test]
-fn blender_script_sets_the_material() {
-    let Some(python) = blender_python("blender_script_sets_the_material") else {
-        return;
-    };
+fn blender_script_sets_the_material(python: &Path) {
     let dir = temp_dir();
     let name =
         "Pâte \"de\" verre\n\\ 翡翠 — a sample name far longer than Blender's sixty-three bytes";
     let script = export(dir.path(), name);
-    let ast = Command::new(&python)
+    let ast = Command::new(python)
         .args([
             "-c",
             "import ast, sys; ast.parse(open(sys.argv[1], encoding='utf-8').read())",
@@ -170,7 +170,7 @@ fn blender_script_sets_the_material() {
         "{}",
         String::from_utf8_lossy(&ast.stderr)
     );
-    let r = run(&python, &script, false);
+    let r = run(python, &script, false);
     eprintln!("Blender {}", r.blender);
     assert!(r.warnings.is_empty(), "{:?}", r.warnings);
     let want = MaterialNames::new(name).blender;
@@ -200,11 +200,7 @@ fn blender_script_sets_the_material() {
 
 /// Cycles renders a uniform half-space of the exported material within the docstring's stated
 /// error of R0 + Rd (see the module documentation for the band).
-#[test]
-fn cycles_renders_within_the_stated_error() {
-    let Some(python) = blender_python("cycles_renders_within_the_stated_error") else {
-        return;
-    };
+fn cycles_renders_within_the_stated_error(python: &Path) {
     let dir = temp_dir();
     let script = export(dir.path(), "blender test slab");
     let text = std::fs::read_to_string(&script).unwrap();
@@ -212,7 +208,7 @@ fn cycles_renders_within_the_stated_error() {
         text.contains("6-9 % darker in total reflectance at"),
         "{text}"
     );
-    let r = run(&python, &script, true);
+    let r = run(python, &script, true);
     let r0 = ((ETA - 1.0) / (ETA + 1.0)).powi(2);
     eprintln!(
         "Blender {}: 16 × 16 px × 128 samples in {:.2} s",

@@ -16,27 +16,25 @@
 //! `target/ci-artefacts/browser/`); the test prints the folder.
 //!
 //! The browser is `$SCATTERFIT_CHROMIUM`, else `chromium` on the PATH (Debian's package; `.ci/run`
-//! installs it). Without one the test is skipped with a message, unless
-//! `SCATTERFIT_REQUIRE_CHROMIUM=1` (set by `.ci/run`), which makes its absence a failure.
+//! installs it). Without one `cargo test` reports the test as ignored, saying why (this file is its
+//! own harness: `tests/common/peer.rs`), unless `SCATTERFIT_REQUIRE_CHROMIUM=1` (set by `.ci/run`),
+//! which makes its absence a failure.
 
 mod common;
 
+use common::peer::{self, Peer};
 use common::{run_cached, temp_dir, workspace_root};
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, ExitCode};
 
 /// The screenshot's width [CSS px]; the wrapper frames the report at the same width, so the boxes
 /// it measures are where the screenshot has them.
 const WIDTH: u32 = 1280;
 
-fn required() -> bool {
-    std::env::var("SCATTERFIT_REQUIRE_CHROMIUM").is_ok_and(|v| v == "1")
-}
-
-/// The browser, or `None` (after saying why) when the test is to be skipped.
-fn chromium() -> Option<PathBuf> {
+/// The browser, or why there is none.
+fn chromium() -> Result<PathBuf, String> {
     let candidates: Vec<PathBuf> = match std::env::var_os("SCATTERFIT_CHROMIUM") {
         Some(p) => vec![PathBuf::from(p)],
         None => std::env::var_os("PATH")
@@ -47,17 +45,19 @@ fn chromium() -> Option<PathBuf> {
             })
             .unwrap_or_default(),
     };
-    if let Some(p) = candidates.into_iter().find(|p| p.is_file()) {
-        return Some(p);
-    }
-    let why = "no Chromium (install Debian's `chromium`: apt-get install -y \
-               --no-install-recommends chromium, or set SCATTERFIT_CHROMIUM)";
-    assert!(
-        !required(),
-        "{why}; SCATTERFIT_REQUIRE_CHROMIUM=1 makes this test required"
-    );
-    let _ = writeln!(std::io::stderr(), "skipped the browser test: {why}");
-    None
+    candidates.into_iter().find(|p| p.is_file()).ok_or_else(|| {
+        "no Chromium (install Debian's `chromium`: apt-get install -y --no-install-recommends \
+         chromium, or set SCATTERFIT_CHROMIUM)"
+            .to_string()
+    })
+}
+
+fn main() -> ExitCode {
+    let chromium = Peer::new(chromium(), "SCATTERFIT_REQUIRE_CHROMIUM");
+    peer::run(vec![chromium.trial(
+        "demo_pages_load_and_draw_in_chromium",
+        demo_pages_load_and_draw_in_chromium,
+    )])
 }
 
 /// Where the screenshots go (created).
@@ -238,11 +238,7 @@ fn drawn_pixels(img: &image::RgbaImage, b: &Box) -> (usize, usize) {
     (total - top, total)
 }
 
-#[test]
-fn demo_pages_load_and_draw_in_chromium() {
-    let Some(chrome) = chromium() else {
-        return;
-    };
+fn demo_pages_load_and_draw_in_chromium(chrome: &Path) {
     let temp = temp_dir();
     let run = run_cached(
         temp.path(),
@@ -267,7 +263,7 @@ fn demo_pages_load_and_draw_in_chromium() {
     );
 
     // The index: loads without errors, its script ran, seven rows linked to their pages.
-    let (dom, stderr) = browse(&chrome, &profile, &["--dump-dom"], &file_url(&index));
+    let (dom, stderr) = browse(chrome, &profile, &["--dump-dom"], &file_url(&index));
     let errors = console_errors(&stderr);
     assert!(errors.is_empty(), "index.html: {errors:#?}");
     assert!(
@@ -277,28 +273,22 @@ fn demo_pages_load_and_draw_in_chromium() {
     assert!(dom.contains("<th class=\"sortable\""), "no sort headers");
     assert_eq!(dom.matches("/report.html\">report</a>").count(), 7, "{dom}");
     // Sorting by η: a click sorts ascending, a second descending.
-    let [loaded, once, twice] = sorted_by_clicks(&chrome, &profile, temp.path(), &index);
+    let [loaded, once, twice] = sorted_by_clicks(chrome, &profile, temp.path(), &index);
     assert_eq!(loaded.len(), 7);
     let mut up = loaded.clone();
     up.sort_by(f64::total_cmp);
     assert_eq!(once, up, "one click");
     up.reverse();
     assert_eq!(twice, up, "two clicks");
-    let (h, _) = measure_boxes(&chrome, &profile, temp.path(), &index);
-    let stderr = screenshot(
-        &chrome,
-        &profile,
-        &index,
-        h.max(400),
-        &out.join("index.png"),
-    );
+    let (h, _) = measure_boxes(chrome, &profile, temp.path(), &index);
+    let stderr = screenshot(chrome, &profile, &index, h.max(400), &out.join("index.png"));
     assert!(console_errors(&stderr).is_empty(), "{stderr}");
 
     // The sample page: no errors, every figure drawn.
-    let (height, boxes) = measure_boxes(&chrome, &profile, temp.path(), &sample);
+    let (height, boxes) = measure_boxes(chrome, &profile, temp.path(), &sample);
     assert!(height > 1000, "page height {height}");
     let png = out.join("wood-tile-report.png");
-    let stderr = screenshot(&chrome, &profile, &sample, height, &png);
+    let stderr = screenshot(chrome, &profile, &sample, height, &png);
     let errors = console_errors(&stderr);
     assert!(errors.is_empty(), "report.html: {errors:#?}");
     let img = image::open(&png).unwrap().to_rgba8();
@@ -322,7 +312,7 @@ fn demo_pages_load_and_draw_in_chromium() {
     let pdf = out.join("wood-tile-report.pdf");
     let _ = std::fs::remove_file(&pdf);
     let (_, stderr) = browse(
-        &chrome,
+        chrome,
         &profile,
         &[
             &format!("--print-to-pdf={}", pdf.display()),

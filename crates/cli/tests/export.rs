@@ -195,7 +195,7 @@ fn bad_input_exits_2() {
     assert_eq!(bad_format.code, 2);
 }
 
-/// Issue 18: a number outside its documented range (here σ′s = 1e300, which is ∞ per metre and
+/// A number outside its documented range (here σ′s = 1e300, which is ∞ per metre and
 /// beyond float32 either way) is refused with exit 2 naming the field, and nothing is written.
 #[test]
 fn out_of_range_value_exits_2_naming_the_field() {
@@ -218,7 +218,7 @@ fn out_of_range_value_exits_2_naming_the_field() {
     }
 }
 
-/// Issue 18: a dipole result exported for an exact renderer warns on stderr and in the header, with
+/// A dipole result exported for an exact renderer warns on stderr and in the header, with
 /// exact transport's Rd (from the Monte Carlo tables) beside the measured one; the same numbers
 /// labelled `mc` / `mc` do not warn.
 #[test]
@@ -250,7 +250,7 @@ fn model_mismatch_warns_with_exact_transport_figures() {
     assert!(!mc.stdout.contains("MODEL WARNING"));
 }
 
-/// Issue 18: the pbrt export says where to include it and what integrator the medium needs.
+/// The pbrt export says where to include it and what integrator the medium needs.
 #[test]
 fn pbrt_header_gives_the_integrator_and_placement() {
     let dir = temp_dir();

@@ -250,7 +250,7 @@ fn table_rebuilds_the_shipped_table() {
     }
 }
 
-/// Issue 10: runs that would never finish, or exhaust memory, are refused before any work with exit
+/// Regression: runs that would never finish, or exhaust memory, are refused before any work with exit
 /// 2 and a message giving the estimate and the way out; counts accept `1e4`.
 #[test]
 fn simulate_refuses_unbounded_work_and_memory_up_front() {
@@ -335,7 +335,7 @@ fn simulate_refuses_unbounded_work_and_memory_up_front() {
     assert_eq!(out.status.code(), Some(2));
 }
 
-/// Issue 10 for `table`: work beyond the budget is refused with its cost; absurd sizes are refused
+/// The same for `table`: work beyond the budget is refused with its cost; absurd sizes are refused
 /// with their ranges; nothing is written to the cache. (Every white run is bounded — photons stop
 /// after at most ⌈12/−ln a_max⌉ = 120 000 interactions — so the budget, not g, is what refuses.)
 #[test]

@@ -8,7 +8,7 @@ use common::{read_json, read_text, run_cached, synth_quick, temp_dir};
 
 /// synth → measure: the folder has every file the manifest names, measure writes its six files,
 /// result.json has the documented shape with channels keyed r, g, b, and σ′s is near the truth in
-/// truth.json (the fit issue's 5 % target on a channel well inside its range).
+/// truth.json (the 5 % target on a channel well inside its range).
 #[test]
 fn synth_then_measure() {
     let dir = temp_dir();
@@ -68,7 +68,7 @@ fn synth_then_measure() {
     let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert_eq!(v["name"], "wood-tile");
     assert!(dir.path().join("out/fit.png").exists());
-    // `measure --g` as `[fit] g` (issue 15): a known g makes the ± g term 0 and the `mc` model is
+    // `measure --g` as `[fit] g`: a known g makes the ± g term 0 and the `mc` model is
     // evaluated at it; a g outside (−1, 1) and `--g fit` without the `mc` model are bad usage.
     let out = run_cached(
         dir.path(),
@@ -163,7 +163,7 @@ fn synth_then_measure() {
         "{}",
         out.stderr
     );
-    // Issue 15: no g stated, so the default range's term; `--g` makes it 0 and leaves the value;
+    // No g stated, so the default range's term; `--g` makes it 0 and leaves the value;
     // a range that excludes the given g is bad usage.
     assert_eq!(f["g_uncertainty"]["source"], "default_range");
     assert!(
@@ -462,8 +462,8 @@ fn compare_synth_safety_and_quick_demo() {
     }
 }
 
-/// The Monte Carlo forward model with α′ from the Monte Carlo total (issue 9's configuration): the
-/// bias study on one quick sample at η = 1.4 recovers σ′s and σa within the issue's 3 % worst case,
+/// The Monte Carlo forward model with α′ from the Monte Carlo total (exact transport for both): the
+/// bias study on one quick sample at η = 1.4 recovers σ′s and σa within the 3 % worst case of the target,
 /// and the study's tables and plot are written; `measure --model mc` records the models it used.
 #[test]
 fn study_and_the_mc_model() {
@@ -501,7 +501,7 @@ fn study_and_the_mc_model() {
     for f in ["study.md", "study.csv", "study.png", "study.svg"] {
         assert!(d.join("s").join(f).exists(), "{f}");
     }
-    // Without --g the study has no g axis: its rows and CSV are those of before issue 15.
+    // Without --g the study has no g axis: its rows and CSV are those of an isotropic study.
     for r in rows.as_array().unwrap() {
         assert!(r.get("g").is_none() && r.get("g_given").is_none(), "{r}");
     }
@@ -586,7 +586,7 @@ fn uncertainties_cover_the_truth_with_the_mc_model() {
     assert!(worst.0 < 4.0, "worst {worst:?}");
 }
 
-/// `synth --aperture-mm 8 --illuminated-mm 14` (issue 15): the twin's reading is made through the
+/// `synth --aperture-mm 8 --illuminated-mm 14`: the twin's reading is made through the
 /// port by the engine (a disc lit uniformly, read over the aperture) and the manifest names the port.
 /// The reading fraction F it reports for skin2's red channel (α′ 0.988, whose light spreads
 /// millimetres) agrees with F of the `mc` model at the truth through the same port

@@ -18,19 +18,20 @@
 //! thin slab's 0.27 into 0.36 or 0.04.
 //!
 //! The interpreter is `$SCATTERFIT_MITSUBA_PYTHON`, else `.ci/venv/bin/python` (made by `.ci/run`).
-//! Without it the tests are skipped with a message, unless `SCATTERFIT_REQUIRE_MITSUBA=1` (set by
-//! `.ci/run`), which makes its absence a failure.
+//! Without it `cargo test` reports the tests as ignored, saying why (this file is its own harness:
+//! `tests/common/peer.rs`), unless `SCATTERFIT_REQUIRE_MITSUBA=1` (set by `.ci/run`), which makes
+//! its absence a failure.
 //!
 //! `forward_models_against_mitsuba` (ignored; run by hand) is the higher-quality comparison of each
 //! forward model's total Rd with the path tracer that BENCHMARKS.md reports.
 
 mod common;
 
+use common::peer::{self, Peer};
 use common::{command, read_json, run_cached, synth_quick, temp_dir, workspace_root};
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, ExitCode};
 
 /// Slab reflectance at normal incidence from exact transport (iadpython adding-doubling;
 /// docs/physics.md §4.3, "n=1.4 R_d = UR1(Q40) − 0.027778"): a = α′ and Rd, semi-infinite, η = 1.4,
@@ -45,12 +46,8 @@ const THIN_ETA: f64 = 1.5;
 const THIN_ALBEDO: f64 = 0.95;
 const THIN_UR1: f64 = 0.27452;
 
-fn required() -> bool {
-    std::env::var("SCATTERFIT_REQUIRE_MITSUBA").is_ok_and(|v| v == "1")
-}
-
-/// The Python that has `mitsuba`, or `None` (after saying why) when the test is to be skipped.
-fn mitsuba_python(test: &str) -> Option<PathBuf> {
+/// The Python that has `mitsuba`, or why there is none.
+fn mitsuba_python() -> Result<PathBuf, String> {
     let python = std::env::var_os("SCATTERFIT_MITSUBA_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| workspace_root().join(".ci/venv/bin/python"));
@@ -62,20 +59,51 @@ fn mitsuba_python(test: &str) -> Option<PathBuf> {
             .output()
             .is_ok_and(|o| o.status.success());
     if ok {
-        return Some(python);
+        return Ok(python);
     }
-    let why = format!(
-        "{test}: no Python with the `mitsuba` package at {} (make one with `python3 -m venv .ci/venv && \
+    Err(format!(
+        "no Python with the `mitsuba` package at {} (make one with `python3 -m venv .ci/venv && \
          .ci/venv/bin/pip install mitsuba`, or set SCATTERFIT_MITSUBA_PYTHON)",
         python.display()
-    );
-    assert!(
-        !required(),
-        "{why}; SCATTERFIT_REQUIRE_MITSUBA=1 makes this test required"
-    );
-    // Written past the test harness's output capture, so that a skip is visible in `cargo test`.
-    let _ = writeln!(std::io::stderr(), "skipped {why}");
-    None
+    ))
+}
+
+fn main() -> ExitCode {
+    let mitsuba = Peer::new(mitsuba_python(), "SCATTERFIT_REQUIRE_MITSUBA");
+    peer::run(vec![
+        mitsuba.trial(
+            "thick_slab_shows_total_diffuse_reflectance",
+            thick_slab_shows_total_diffuse_reflectance,
+        ),
+        mitsuba.trial(
+            "thin_slab_in_metres_matches_adding_doubling",
+            thin_slab_in_metres_matches_adding_doubling,
+        ),
+        mitsuba.trial(
+            "metre_scene_with_submillimetre_mean_free_path_is_flagged",
+            metre_scene_with_submillimetre_mean_free_path_is_flagged,
+        ),
+        mitsuba.trial("two_fragments_in_one_scene", two_fragments_in_one_scene),
+        mitsuba.trial(
+            "directional_light_renders_the_medium_black",
+            directional_light_renders_the_medium_black,
+        ),
+        mitsuba.trial(
+            "spectral_variant_renders_the_measured_colour",
+            spectral_variant_renders_the_measured_colour,
+        ),
+        mitsuba.trial(
+            "chromatic_media_render_their_reflectance_with_the_advised_integrator",
+            chromatic_media_render_their_reflectance_with_the_advised_integrator,
+        ),
+        // A benchmark of minutes: run by hand with `-- --ignored`; BENCHMARKS.md reports its output.
+        mitsuba
+            .trial(
+                "forward_models_against_mitsuba",
+                forward_models_against_mitsuba,
+            )
+            .with_ignored_flag(true),
+    ])
 }
 
 /// A result file with per-channel (σ′s, σa, Rd) [mm⁻¹, mm⁻¹, 1].
@@ -225,11 +253,7 @@ fn check(label: &str, got: f64, stderr: f64, want: f64) {
 
 /// A thick slab (200 mean free paths, 400 wide) in a millimetre scene: every channel must show
 /// rd_total + R0, with α′ = 0.8, 0.9, 0.95 and η = 1.4 (σ′t = 1 mm⁻¹).
-#[test]
-fn thick_slab_shows_total_diffuse_reflectance() {
-    let Some(python) = mitsuba_python("thick_slab_shows_total_diffuse_reflectance") else {
-        return;
-    };
+fn thick_slab_shows_total_diffuse_reflectance(python: &Path) {
     let dir = temp_dir();
     write_result(
         &dir.path().join("result.json"),
@@ -237,7 +261,7 @@ fn thick_slab_shows_total_diffuse_reflectance() {
         THICK_CASES.map(|(a, rd)| (a, 1.0 - a, Some(rd))),
     );
     let fragment = export(dir.path(), "mm");
-    let r = render(&python, &fragment, 400.0, 200.0, false, 256);
+    let r = render(python, &fragment, 400.0, 200.0, false, 256);
     eprintln!(
         "Mitsuba {}: {} px × {} spp in {:.2} s",
         r.mitsuba, r.pixels, r.spp, r.seconds
@@ -254,11 +278,7 @@ fn thick_slab_shows_total_diffuse_reflectance() {
 
 /// A slab of optical thickness 1 on a black backing, exported with `--scale m` (σt = 10 m⁻¹, 0.1 m
 /// thick): checks the unit conversion, which a half-space cannot see.
-#[test]
-fn thin_slab_in_metres_matches_adding_doubling() {
-    let Some(python) = mitsuba_python("thin_slab_in_metres_matches_adding_doubling") else {
-        return;
-    };
+fn thin_slab_in_metres_matches_adding_doubling(python: &Path) {
     let dir = temp_dir();
     // σt = 0.01 mm⁻¹ = 10 m⁻¹: τ = 1 at 0.1 m.
     let sigma_t_mm = 0.01;
@@ -269,7 +289,7 @@ fn thin_slab_in_metres_matches_adding_doubling() {
     );
     write_result(&dir.path().join("result.json"), THIN_ETA, [c, c, c]);
     let fragment = export(dir.path(), "m");
-    let r = render(&python, &fragment, 4.0, 0.1, true, 256);
+    let r = render(python, &fragment, 4.0, 0.1, true, 256);
     check(
         "thin slab (τ = 1, α = 0.95, η = 1.5), metres",
         r.mean[1],
@@ -278,18 +298,13 @@ fn thin_slab_in_metres_matches_adding_doubling() {
     );
 }
 
-/// Issue 18: a material whose mean free path is sub-millimetre (σ′t = 5 mm⁻¹, 0.2 mm), in a metre
+/// A material whose mean free path is sub-millimetre (σ′t = 5 mm⁻¹, 0.2 mm), in a metre
 /// scene. Mitsuba offsets rays leaving a surface by ≈ 9·10⁻⁵ (1 + |p|) scene units — 0.09 mm at the
 /// origin in metres, 0.45 mean free paths — which moves the first scattering deeper and darkens the
 /// render. The export must say so (stderr and header), the metre render must show the documented
 /// darkening (measured 17–23 %; the test asks for more than 8 % in every channel), and the same
 /// material exported in millimetres (the default) must render right.
-#[test]
-fn metre_scene_with_submillimetre_mean_free_path_is_flagged() {
-    let Some(python) = mitsuba_python("metre_scene_with_submillimetre_mean_free_path_is_flagged")
-    else {
-        return;
-    };
+fn metre_scene_with_submillimetre_mean_free_path_is_flagged(python: &Path) {
     let dir = temp_dir();
     let k = 5.0;
     write_result(
@@ -304,8 +319,8 @@ fn metre_scene_with_submillimetre_mean_free_path_is_flagged() {
     let (mm, stderr) = export_file(dir.path(), "result.json", "mm", "mm.xml");
     assert!(!stderr.contains("render dark"), "{stderr}");
     // Half-spaces: 400 mean free paths deep, 800 wide, in each unit.
-    let in_m = render(&python, &metre, 0.16, 0.08, false, 256);
-    let in_mm = render(&python, &mm, 160.0, 80.0, false, 256);
+    let in_m = render(python, &metre, 0.16, 0.08, false, 256);
+    let in_mm = render(python, &mm, 160.0, 80.0, false, 256);
     for (c, (albedo, rd)) in THICK_CASES.iter().enumerate() {
         let want = rd + r0(THICK_ETA);
         check(
@@ -330,13 +345,9 @@ fn metre_scene_with_submillimetre_mean_free_path_is_flagged() {
 }
 
 /// Two materials' fragments in one scene — "pink plastic" and "pink-plastic", whose ids collided
-/// before issue 18 — load together, and each shape gets its own medium: each render, with the other
+/// before each got its own medium — load together, and each shape gets its own medium: each render, with the other
 /// material present beside it, shows its own Rd (α′ = 0.8 and 0.9, η = 1.4).
-#[test]
-fn two_fragments_in_one_scene() {
-    let Some(python) = mitsuba_python("two_fragments_in_one_scene") else {
-        return;
-    };
+fn two_fragments_in_one_scene(python: &Path) {
     let dir = temp_dir();
     let cases = [
         ("pink plastic", THICK_CASES[0]),
@@ -356,7 +367,7 @@ fn two_fragments_in_one_scene() {
     for (k, (name, (a, rd))) in cases.iter().enumerate() {
         let other = &fragments[1 - k];
         let r = render_scene(
-            &python,
+            python,
             &fragments[k],
             400.0,
             200.0,
@@ -378,11 +389,7 @@ fn two_fragments_in_one_scene() {
 /// The documented behaviour under a delta light: a `directional` emitter along the normal lights
 /// nothing behind the smooth dielectric (no path can connect to a delta light through it), so every
 /// pixel is exactly black, as the fragment's header says.
-#[test]
-fn directional_light_renders_the_medium_black() {
-    let Some(python) = mitsuba_python("directional_light_renders_the_medium_black") else {
-        return;
-    };
+fn directional_light_renders_the_medium_black(python: &Path) {
     let dir = temp_dir();
     write_result(
         &dir.path().join("result.json"),
@@ -393,7 +400,7 @@ fn directional_light_renders_the_medium_black() {
     let header = std::fs::read_to_string(&fragment).unwrap();
     assert!(header.contains("renders BLACK under point, spot and directional"));
     let r = render_scene(
-        &python,
+        python,
         &fragment,
         400.0,
         200.0,
@@ -406,7 +413,7 @@ fn directional_light_renders_the_medium_black() {
     assert_eq!(r.max, [0.0; 3], "{r:?}");
 }
 
-/// Issue 18: a spectral variant (`scalar_spectral`) uplifts RGB coefficients to smooth spectra, and a
+/// A spectral variant (`scalar_spectral`) uplifts RGB coefficients to smooth spectra, and a
 /// strongly coloured medium renders shifted (red aluminium's red: −42 %, BENCHMARKS.md). A rig-twin
 /// red aluminium measured with the exact model keeps its spectrophotometer spectrum in the result,
 /// and `--mitsuba-variant spectral` writes a medium per wavelength from it: rendered in
@@ -414,11 +421,7 @@ fn directional_light_renders_the_medium_black() {
 /// as elsewhere, plus 1.5 % for the two colour conversions (ours: ASTM E308 10-nm D65 weights; Mitsuba's
 /// CIE 1931 fits and D65 spectrum). The RGB fragment in the same variant must stay > 20 % dark in R
 /// (measured −42 %), which is why the option exists.
-#[test]
-fn spectral_variant_renders_the_measured_colour() {
-    let Some(python) = mitsuba_python("spectral_variant_renders_the_measured_colour") else {
-        return;
-    };
+fn spectral_variant_renders_the_measured_colour(python: &Path) {
     let dir = temp_dir();
     synth_quick(dir.path(), "red-aluminum", "ra");
     let measured = run_cached(
@@ -468,7 +471,7 @@ fn spectral_variant_renders_the_measured_colour() {
         variant: Some("scalar_spectral"),
         ..Scene::default()
     };
-    let r = render_scene(&python, &spectral, 400.0, 200.0, &scene, 128);
+    let r = render_scene(python, &spectral, 400.0, 200.0, &scene, 128);
     for (c, label) in ["R", "G", "B"].iter().enumerate() {
         let tol = 4.0 * r.stderr[c] + 0.002 + 0.015 * want[c];
         eprintln!(
@@ -484,7 +487,7 @@ fn spectral_variant_renders_the_measured_colour() {
             want[c]
         );
     }
-    let shifted = render_scene(&python, &rgb, 400.0, 200.0, &scene, 128);
+    let shifted = render_scene(python, &rgb, 400.0, 200.0, &scene, 128);
     let dark = 1.0 - shifted.mean[0] / want[0];
     eprintln!(
         "red aluminium R, scalar_spectral, RGB medium: {:.1} % dark",
@@ -499,13 +502,8 @@ fn spectral_variant_renders_the_measured_colour() {
 /// BENCHMARKS.md "exports": each forward model's total Rd against Mitsuba's volumetric path tracer
 /// on half-spaces, at high sample counts. Run by hand (minutes):
 /// `cargo test -p scatterfit --test mitsuba -- --ignored --nocapture`.
-#[test]
-#[ignore = "benchmark: minutes of rendering; BENCHMARKS.md reports its output"]
-fn forward_models_against_mitsuba() {
+fn forward_models_against_mitsuba(python: &Path) {
     use scatterfit_optics::{DiffusionModel, ModelFamily, ModelName};
-    let Some(python) = mitsuba_python("forward_models_against_mitsuba") else {
-        return;
-    };
     let spp: u32 = std::env::var("SCATTERFIT_BENCH_SPP")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -530,7 +528,7 @@ fn forward_models_against_mitsuba() {
                 [(a, 1.0 - a, None); 3],
             );
             let fragment = export(dir.path(), "mm");
-            let r = render(&python, &fragment, 2000.0, 400.0, false, spp);
+            let r = render(python, &fragment, 2000.0, 400.0, false, spp);
             let truth = r.mean[1] - r0(eta);
             let dipole = scatterfit_optics::dipole::rd_total(a, eta);
             let mc = mc_family.rd_total(a, eta, 0.0).unwrap();
@@ -562,13 +560,7 @@ fn forward_models_against_mitsuba() {
 /// driving the distance sampling — skin's R came out 4.5 % low at 8192 spp and marble's B 19 %
 /// high at 2048 (heavy-tailed weights on long paths); here at 512 spp volpath gives marble's R
 /// −7 % with a 1.1 % error bar, volpathmis −0.4 % with 0.25 %.
-#[test]
-fn chromatic_media_render_their_reflectance_with_the_advised_integrator() {
-    let Some(python) =
-        mitsuba_python("chromatic_media_render_their_reflectance_with_the_advised_integrator")
-    else {
-        return;
-    };
+fn chromatic_media_render_their_reflectance_with_the_advised_integrator(python: &Path) {
     let spp: u32 = std::env::var("SCATTERFIT_CHROMATIC_SPP")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -601,7 +593,7 @@ fn chromatic_media_render_their_reflectance_with_the_advised_integrator() {
         let (fragment, _) = export_file(dir.path(), "result.json", "mm", "m.xml");
         let text = std::fs::read_to_string(&fragment).unwrap();
         assert!(text.contains("<integrator type=\"volpathmis\""), "{text}");
-        let r = render(&python, &fragment, 400.0, 200.0, false, spp);
+        let r = render(python, &fragment, 400.0, 200.0, false, spp);
         eprintln!(
             "{name}: {} px × {} spp in {:.1} s (Mitsuba {})",
             r.pixels, r.spp, r.seconds, r.mitsuba

@@ -1,4 +1,4 @@
-//! Issue 10, second round, with the real binary: a closed stdout ends every command quietly, the
+//! Robustness, with the real binary: a closed stdout ends every command quietly, the
 //! exit-code classes of the imaging, Monte Carlo and renderer families (the measurement family's and
 //! spectro's are pinned in measure.rs, spectro.rs and export.rs), outputs checked before the work,
 //! never overwritten without --force, and Ctrl-C ending a run with 130 and no temporary file.

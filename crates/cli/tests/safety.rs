@@ -1,4 +1,4 @@
-//! Issue 17, "Files and paths": the attacks and accidents of a shared sample folder, tried on the
+//! Files and paths: the attacks and accidents of a shared sample folder, tried on the
 //! real binary. Each test plants the hostile thing in a copy of one quick rig-twin sample and checks
 //! that nothing outside is touched, nothing is read that should not be, nothing is echoed that did
 //! not parse, and no input is destroyed (RELIABILITY.md, "Files and paths").

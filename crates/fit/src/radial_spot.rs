@@ -1,5 +1,5 @@
 //! A light spot of any radial shape — Gaussian, or measured from an image of the spot on a thin
-//! opaque white target — as a mixture of uniform disks (issue 16).
+//! opaque white target — as a mixture of uniform disks.
 //!
 //! A radial irradiance I(ρ) that is constant on annuli a_{k−1} ≤ ρ < a_k (a_0 = 0) is a sum of
 //! concentric uniform disks: I(ρ) = Σ_k (I_k − I_{k+1}) 1\[ρ < a_k\] (the "layer-cake"

@@ -389,7 +389,7 @@ fn a_flat_direction_is_reported_unconstrained() {
 /// should hold best (α′ ≥ 0.99, η ≤ 1.4), fitted from one mean free path to 15 mean free paths. The
 /// fit converges to the right neighbourhood, but the dipole's shape is not exact transport's: σ′s
 /// is biased low by 7–14 % (BENCHMARKS.md, "The dipole on exact transport"), within the 20 % band
-/// the issue tracker reports for the paper's method at these albedos, and the misfit shows in χ².
+/// reported for the paper's method at these albedos, and the misfit shows in χ².
 #[test]
 fn proposed_method_on_mcml_profiles() {
     let path = concat!(

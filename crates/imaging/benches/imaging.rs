@@ -1,4 +1,4 @@
-//! Benchmarks of the in-memory imaging stage (issue 4's targets): the HDR merge of a 13-exposure
+//! Benchmarks of the in-memory imaging stage (targets: BENCHMARKS.md, "Summary"): the HDR merge of a 13-exposure
 //! bracket of 24-megapixel 8-bit RGB frames, and the radial profile of a 24-megapixel radiance map.
 //!
 //! Run: `cargo bench -p scatterfit-imaging` (figures in BENCHMARKS.md, "imaging (in-memory)").

@@ -11,7 +11,7 @@ fn frames_u8(n: usize) -> Vec<ImageBuf<u8>> {
         .collect()
 }
 
-/// Every refusal of the issue: fewer than 2 frames, a time per frame, positive and distinct times,
+/// Every refusal of bad input: fewer than 2 frames, a time per frame, positive and distinct times,
 /// same shapes, a response with the images' channel count, a dark frame of the right shape.
 #[test]
 fn merge_refuses_bad_brackets() {
@@ -266,7 +266,7 @@ fn noise_aware_formula_by_hand() {
     assert_eq!(hdr.clipped.data()[0], CLIPPED_HIGH);
 }
 
-/// Issue 10: a bracket saturated (or black) everywhere gave an all-NaN map and exit 0. Now fewer
+/// Regression: a bracket saturated (or black) everywhere gave an all-NaN map and exit 0. Now fewer
 /// than `MIN_VALID_FRACTION` of a channel's pixels with an estimate is a failed measurement naming
 /// the channel and what to change; 0.1 % valid pixels is still a map.
 #[test]
@@ -311,7 +311,7 @@ fn all_clipped_map_is_refused() {
     );
 }
 
-/// Issue 10: a dark frame brighter than the bracket wrote an all-NaN map. It is refused before the
+/// Regression: a dark frame brighter than the bracket wrote an all-NaN map. It is refused before the
 /// merge (bad input, not a failed measurement), for 8- and 16-bit data; a dark frame below the
 /// signal where the spot is, equal to it elsewhere, is accepted.
 #[test]

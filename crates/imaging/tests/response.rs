@@ -357,7 +357,7 @@ fn noise_aware_weighting_removes_dim_pixel_bias() {
     );
 }
 
-/// Issue 10: exposure times listed in reverse order gave a response running downward, accepted
+/// Regression: exposure times listed in reverse order gave a response running downward, accepted
 /// without a word. Now it is a failed measurement that asks whether the times are in the right
 /// order; two swapped neighbours in the middle of the bracket are refused as well.
 #[test]
@@ -382,7 +382,7 @@ fn reversed_or_shuffled_times_are_refused() {
     );
 }
 
-/// Issue 10: `--samples 1` gave a 35.6-stop dynamic range from a 13.5-stop bracket. The sample
+/// Regression: `--samples 1` gave a 35.6-stop dynamic range from a 13.5-stop bracket. The sample
 /// count must make N·(P − 1) ≥ 256 (Debevec & Malik 1997, §2.1): 22 for 13 frames, 256 for 2; and
 /// at most MAX_RESPONSE_SAMPLES. Refused before any work, as bad input.
 #[test]

@@ -61,7 +61,7 @@ fn noisy_spot(cx: f64, cy: f64, seed: u64) -> ImageBuf<f32> {
 }
 
 /// The centre of a noisy spot with a clipped (NaN) core and a bright dust speck is found within
-/// 0.05 px (the issue's target) for several noise seeds and non-integer centres.
+/// 0.05 px (the target) for several noise seeds and non-integer centres.
 #[test]
 fn center_within_005_px_on_noisy_clipped_spot_with_speck() {
     for (seed, cx, cy) in [
@@ -237,7 +237,7 @@ fn profile_refuses_bad_input() {
     let ok = ProfileOptions::default();
     assert!(radial_profile(&img, [10.0, 10.0], None, 0.0, &ok).is_err());
     assert!(radial_profile(&img, [f64::NAN, 10.0], None, 0.1, &ok).is_err());
-    // Ring options are refused when made: a bad width, and (issue 10) a width that asks for an
+    // Ring options are refused when made: a bad width, and a width that asks for an
     // impossible number of rings ("capacity overflow" once) or a radius of 1e13 px.
     for (width, r_max) in [(-1.0, 300.0), (1e-300, 300.0), (1.0, 1e13), (f64::NAN, 1.0)] {
         assert!(

@@ -293,7 +293,7 @@ mod tests {
         assert_eq!(back["name"], name);
     }
 
-    /// Hostile names of our own (not only the issue's): an ANSI colour and title-setting sequence,
+    /// Hostile names of our own (beyond the first ones found): an ANSI colour and title-setting sequence,
     /// an 8-bit CSI, a carriage return that would overwrite "failed" with "ok", a right-to-left
     /// override that reorders a file name, a NUL, DEL.
     #[test]

@@ -68,7 +68,7 @@ pub enum ReasonKind {
     /// g is not known, but the anisotropy's uncertainty term could be evaluated over only part
     /// of its range, or not at all (the `mc` tables at some g do not cover the material's η): the
     /// error bars leave out what g can do to the values (5–25 % in σa for forward-scattering
-    /// materials; issue 15).
+    /// materials).
     GTermIncomplete,
     /// A value outside its documented range.
     OutOfRange,

@@ -47,7 +47,7 @@ fn with_fit_error(c: &ChannelResult, v: Option<Estimate>, name: &str) -> String 
 }
 
 /// "value ± fit" or, when the spectrophotometer's part is known, "value ± fit ± spectro", then
-/// " ± g" when the anisotropy's part is known (issue 15); "failed" or "unconstrained" where there is
+/// " ± g" when the anisotropy's part is known; "failed" or "unconstrained" where there is
 /// no measurement (`name` is the parameter's name in `unconstrained`).
 pub fn value_with_errors(c: &ChannelResult, v: Option<Estimate>, name: &str) -> String {
     if c.status == ChannelStatus::Failed {
@@ -98,7 +98,7 @@ pub fn sigma_cells(c: &ChannelResult) -> [String; 2] {
 }
 
 /// The lines under a table that say what its ± mean (empty when no result carries the
-/// spectrophotometer's part or the g term), with how g entered each result (issue 15).
+/// spectrophotometer's part or the g term), with how g entered each result.
 pub fn errors_note(results: &[MeasurementResult]) -> String {
     let mut t = spectro_errors_note(results);
     if results.iter().any(|r| {
@@ -121,7 +121,7 @@ pub fn errors_note(results: &[MeasurementResult]) -> String {
     }
     t.push_str(
         "± … g: the anisotropy's part — how far the estimate moves over the range of the \
-         Henyey–Greenstein g, from the g-aware `mc` model (0 where g was given; issue 15); a bound, \
+         Henyey–Greenstein g, from the g-aware `mc` model (0 where g was given); a bound, \
          not a standard error: add it to the quadrature sum of the others for the total.\n",
     );
     if with_g.iter().any(|r| {
@@ -183,7 +183,7 @@ fn spectro_errors_note(results: &[MeasurementResult]) -> String {
     )
 }
 
-/// The lines under a table that say how the spectrophotometer's port was handled (issue 15): per
+/// The lines under a table that say how the spectrophotometer's port was handled: per
 /// result with a port, what it read of Rd per channel (the correction applied); when no result
 /// names a port, one line saying the readings were taken as loss-free.
 pub fn port_note(results: &[MeasurementResult]) -> String {

@@ -250,8 +250,8 @@ pub fn file_names(frames: usize, truth: bool) -> Vec<String> {
 }
 
 /// What a real rig adds to a sample folder: linear frames instead of the 8-bit ones, a flat frame,
-/// a spot image and the `[camera]` keys that name them (issue 16), and the spectrophotometer's port
-/// (issue 15). Default: nothing.
+/// a spot image and the `[camera]` keys that name them, and the spectrophotometer's port. Default:
+/// nothing.
 #[derive(Debug, Clone, Default)]
 pub struct CameraFiles {
     /// Linear 16-bit frames (written instead of [`SampleFiles::frames`] when not empty), shortest

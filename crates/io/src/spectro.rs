@@ -345,7 +345,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
     }
     check_coverage(&wavelengths)
         .map_err(|message| SpectroCsvError::Coverage { path: p(), message })?;
-    // Percent columns holding fractions (issue 17 §3): no reflectance reaches 1 %, where a real
+    // Percent columns holding fractions: no reflectance reaches 1 %, where a real
     // sample's SCI (specular included) is several percent somewhere in 400–700 nm.
     let max = sci.iter().chain(&sce).copied().fold(0.0f64, f64::max) / scale;
     if scale != 1.0 && max <= 1.0 {

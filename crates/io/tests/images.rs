@@ -487,7 +487,7 @@ fn profile_csv_round_trip_keeps_empty_rings() {
     );
 }
 
-/// Issue 10: two runs on the same inputs wrote EXR files that differed byte-wise (RLE tiles in
+/// Regression: two runs on the same inputs wrote EXR files that differed byte-wise (RLE tiles in
 /// completion order). Now two writes of the same map are identical, and the map reads back exactly.
 #[test]
 fn exr_output_is_byte_reproducible_and_lossless() {

@@ -1,4 +1,4 @@
-//! Photon-transport speed on the two cases (run: `cargo bench -p scatterfit-mc`).
+//! Photon-transport speed on the two cases timed against MCML (BENCHMARKS.md, "Summary") (run: `cargo bench -p scatterfit-mc`).
 //!
 //! 1. "10 cm slab": μa = 0.1/cm, μs = 10/cm, g = 0, n = 1.4, d = 10 cm (in mm: σa = 0.01, σs = 1,
 //!    d = 100), radial grid 0.1 mm × 200 — MCML: ~1.0e5 photons/s on one core.

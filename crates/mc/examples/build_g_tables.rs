@@ -1,4 +1,4 @@
-//! Builds the anisotropic (g ≠ 0) `mc` tables of issue 15 with the layout of
+//! Builds the anisotropic (g ≠ 0) `mc` tables with the layout of
 //! `common/g_tables_layout.rs` (albedo nodes over α′ 0.2–0.99995, strata at 64/(1 − g) and
 //! 1024/(1 − g) interactions) and writes each in compact form as
 //! `OUT/mc-white-eta<η>-g<g>.json` (η and g to two decimals). Tables already in OUT are skipped, so

@@ -1,4 +1,4 @@
-//! The `mc` model over (η, g) (`McGridSet`, issue 15) against independent data: how large its
+//! The `mc` model over (η, g) (`McGridSet`) against independent data: how large its
 //! interpolation errors are (BENCHMARKS.md, "The `mc` model over g").
 //!
 //! ```text

@@ -2,7 +2,7 @@
 //! (`Simulation`, pencil beam, half-space; a different tracer from the white runs the tables come
 //! from): mean relative difference ± standard error and χ²/bins per window of reduced radius
 //! ρ′ = σ′t r, and the totals. For the channels whose error on the rig twin stays above the target
-//! with g given (issue 15): is it the model's or the twin's?
+//! with g given: is it the model's or the twin's?
 //!
 //! ```text
 //! cargo run --release -p scatterfit-mc --example g_point_check -- ALBEDO_PRIME ETA G PHOTONS [SEED]

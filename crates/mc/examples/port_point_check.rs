@@ -1,7 +1,7 @@
 //! A port's reading fraction F at one material: the `mc` model's (`Port::reading_of`, the form the
 //! pipeline's correction uses) against a direct Monte Carlo twin of the port
 //! (`mc::port::simulate_port_reading`: a disc lit uniformly, one bin over the aperture), and the
-//! reading Rd·F beside it. Issue 15: is the correction's F right at the *true* material?
+//! reading Rd·F beside it: is the correction's F right at the *true* material?
 //!
 //! ```text
 //! cargo run --release -p scatterfit-mc --example port_point_check -- \

@@ -1,5 +1,5 @@
 //! What a spectrophotometer port reads of a material: the reading fraction F = C/(K(0)·Rd)
-//! (`scatterfit_optics::port`) of the shipped g = 0 `mc` model, for ports of issue 15 over σ′t and α′
+//! (`scatterfit_optics::port`) of the shipped g = 0 `mc` model, for common d/8 ports over σ′t and α′
 //! at η = 1.5 (BENCHMARKS.md, "The spectrophotometer port").
 //!
 //! Run: `cargo run --release -p scatterfit-mc --example port_table`

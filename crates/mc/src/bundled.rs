@@ -5,7 +5,7 @@
 //! [`McTableSpec::shipped`] (128 albedo nodes, 4·10⁶ full-length photons and 1.6·10⁷ / 3.2·10⁷ in
 //! the shorter strata, a seed per η), in compact form ([`McTable::compact`]). Made by
 //! `cargo run --release -p scatterfit-mc --example build_mc_tables -- crates/mc/tables <η…>`
-//! (rebuilt 2026-11-27 from 64 nodes and 2·10⁶ photons: BENCHMARKS.md, "The g = 0 tables rebuilt").
+//! (rebuilt 2026-11-27 from 64 nodes and 2·10⁶ photons: CHANGELOG.md, "The g = 0 tables rebuilt").
 //!
 //! [`McTableSpec::shipped`]: crate::model::McTableSpec::shipped
 
@@ -60,7 +60,7 @@ macro_rules! g_table {
 /// compact JSON). g = 0.15, 0.3, 0.5, 0.7 and 0.9 at η 1.0, 1.05, 1.1–1.8 (0.1 apart), 2.0–2.4 (0.2
 /// apart) and 2.5; g = 0.8 and 0.95 at η 1.0, 1.05, 1.1, 1.2, 1.3, 1.4, 1.6–2.4 (0.2 apart) and 2.5
 /// (g 0.95 had η 1.0, 1.4, 1.8, 2.4 until 2026-11-27: Catmull-Rom over 0.4–0.6 in η was up to 4.6 %
-/// off in shape and 6.7·10⁻³ in the total, BENCHMARKS.md "The g 0.95 node's η layout filled in");
+/// off in shape and 6.7·10⁻³ in the total, CHANGELOG.md "The g 0.95 node's η layout filled in");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
 /// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)).
 /// About 45 KB each, 4.2 MB in all (the g = 0 set: 0.75 MB).
@@ -164,7 +164,7 @@ pub const BUNDLED_G: [(f64, f64, &str); 94] = [
 
 /// The largest g step the shipped grid interpolates across: 0.2 (between 0.3, 0.5 and 0.7; 0.15
 /// between 0, 0.15 and 0.3; 0.1 and 0.05 above). Measured against tables built between the nodes
-/// (BENCHMARKS.md "The g tables rebuilt, and the whole g range", and "η 2.5 at g ≠ 0 and a g 0.15
+/// (CHANGELOG.md "The g tables rebuilt, and the whole g range", and "η 2.5 at g ≠ 0, a g 0.15
 /// node"): ≤ 0.6 % RMS over 0.3–10 reduced mean free paths at α′ ≥ 0.5 (1–3 % at α′ 0.3, where the
 /// profile is short), totals within 9·10⁻⁴.
 pub const BUNDLED_MAX_G_STEP: f64 = 0.2 + 1e-9;

@@ -83,7 +83,7 @@ pub enum AlbedoSpacing {
     /// crowds the nodes toward α′ → 1 less than at g = 0 (1 − a ≈ (1 − g)(1 − α′) there): at
     /// g = 0.9 only two of 64 nodes lie above α′ 0.998, and the far field between them is 1–5 %
     /// off (BENCHMARKS.md, "Weak absorption"). This spacing gives a g ≠ 0 table the g = 0 table's
-    /// node density in α′, where the profile's shape is set (issue 15).
+    /// node density in α′, where the profile's shape is set.
     SqrtOneMinusReducedAlbedo,
 }
 
@@ -115,7 +115,7 @@ impl McTableSpec {
     /// 2026-11-27): the default one with 128 albedo nodes instead of 64 (√(1 − a) spacing 0.0078),
     /// 4·10⁶ full-length photons, 1.6·10⁷ stopped at 1024 interactions and 3.2·10⁷ at 64, and the
     /// seed 1000 + round(100 η), so that the tables' Monte Carlo noise is independent from one η to
-    /// the next. Why (BENCHMARKS.md, "The g = 0 tables rebuilt"): between the 64 nodes' last two
+    /// the next. Why (CHANGELOG.md, "The g = 0 tables rebuilt"): between the 64 nodes' last two
     /// (α′ 0.99935–0.9999) Catmull-Rom put the far field 1–2 % low beyond 30 mean free paths — the
     /// light a spectrophotometer's port loses, and the g ≠ 0 model's continuation past its join
     /// ([`crate::model::McProfile::far_field_join`]) — and the full-length stratum's 2·10⁶ photons,
@@ -998,7 +998,7 @@ pub const FAR_FIELD_JOIN: f64 = 0.8;
 /// paths, then +0.7 … −1.9 % to 50 and −2 … −4 % beyond; continued from 25 it is within 0.7 % to
 /// 100 (from 20: +0.9 … +1.5 %, the g = 0 shape not yet the g = 0.8 one there; from 30: within
 /// 1.0 %); against MCML (`data/reference/mcml_far_field_g.csv`) within 0.4 % from 10 to 97.5, where
-/// the node's own profile was 2.6 % low at 40–60. BENCHMARKS.md, "The far field's join at 25
+/// the node's own profile was 2.6 % low at 40–60. CHANGELOG.md, "The far field's join at 25
 /// reduced mean free paths".
 pub const FAR_FIELD_JOIN_REDUCED: f64 = 25.0;
 
@@ -1104,14 +1104,14 @@ impl McProfile {
     /// g = 0.9 and 0.95 is only 50 and 25 reduced ones (σ′t r) — 8 mm at σ′s = 3 mm⁻¹ for g 0.95,
     /// inside the paper rig's 25 mm field, where at α′ → 1 the light still travels tens of
     /// millimetres. Beyond, the smoother's extrapolation (a power law times e^{−κ₀ρ}) was 10–50 %
-    /// off (BENCHMARKS.md, "The far field beyond the g tables' radius"). The far field follows
+    /// off (CHANGELOG.md, "The far field beyond the g tables' radius"). The far field follows
     /// similarity (in reduced units it is the same at every g: Wyman, Patterson & Wilson 1989;
     /// d'Eon 2012 §4 for the diffusion asymptote), and the g = 0 set's tables reach 500 reduced mean
     /// free paths, so its shape carries the profile on; the join's factor c keeps the g ≠ 0 set's
     /// own amplitude (which the near field sets). And where a g ≠ 0 set's data do reach, they are
     /// reliable only to about 25 reduced mean free paths at α′ → 1 ([`FAR_FIELD_JOIN_REDUCED`]): a
     /// fit that weights the far field read σ′s 2–2.5 % low at g 0.8, α′ 0.9999 from the set's own
-    /// far field (BENCHMARKS.md, "The far field's join at 25 reduced mean free paths"). The total
+    /// far field (CHANGELOG.md, "The far field's join at 25 reduced mean free paths"). The total
     /// is the set's own (tallied, not the profile's integral). Unchanged where the donor does not
     /// answer.
     #[must_use]

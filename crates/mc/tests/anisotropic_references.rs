@@ -1,4 +1,4 @@
-//! The tracer at g ≠ 0 against independent references (issue 15): adding-doubling totals of
+//! The tracer at g ≠ 0 against independent references: adding-doubling totals of
 //! anisotropic half-spaces (`data/reference/iad_totals_g.csv`, iadpython 0.5.3) for the engine and for
 //! the white run behind the `mc` tables, and MCML's own radial profiles and totals at g = 0.5–0.95
 //! (`data/reference/mcml_profiles_g.csv`, original MCML C code). Fixed seeds; tolerances in standard

@@ -1,5 +1,5 @@
 //! The cost model of `Simulation::cost_estimate` against measured interaction counts, and the
-//! refusal of runs that never end (issue 10: `simulate --sigma-a 0` on a half-space never finished).
+//! refusal of runs that never end (`simulate --sigma-a 0` on a half-space never finished).
 
 use std::time::Instant;
 

@@ -1,5 +1,5 @@
-//! The `mc` forward model over (η, g) (`McGridSet`, the family `mc::family(ModelName::Mc)`, issue
-//! 15) against independent values: MCML's profiles and totals at g = 0.8 and 0.9
+//! The `mc` forward model over (η, g) (`McGridSet`, the family `mc::family(ModelName::Mc)`)
+//! against independent values: MCML's profiles and totals at g = 0.8 and 0.9
 //! (`data/reference/mcml_profiles_g.csv`), adding-doubling totals (`iad_totals_g.csv`), a fresh
 //! engine run between the g nodes (g = 0.85, a seed no table used), and a table left out in η.
 //! Tolerances in standard errors of the reference (MCML's estimated from a short engine run of the
@@ -353,8 +353,8 @@ fn between_g_nodes_matches_a_fresh_engine_run() {
     }
 }
 
-/// The far field at weak absorption, where the measurement's rings weigh most at α′ → 1 (issue 15,
-/// BENCHMARKS.md "The far field's join at 25 reduced mean free paths"): the model at g 0.8, η 1.0,
+/// The far field at weak absorption, where the measurement's rings weigh most at α′ → 1
+/// (CHANGELOG.md "The far field's join at 25 reduced mean free paths"): the model at g 0.8, η 1.0,
 /// α′ 0.9999 against MCML's profile to 97.5 reduced mean free paths
 /// (`data/reference/mcml_far_field_g.csv`, 4·10⁶ photons) in four windows from 10 on, within
 /// 3 √(s.e.² + (0.3 %)²) — MCML's standard error estimated from a short engine run of the same case

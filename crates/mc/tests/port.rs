@@ -1,4 +1,4 @@
-//! The spectrophotometer port (issue 15): the analytic reading (`scatterfit_optics::port`, the
+//! The spectrophotometer port: the analytic reading (`scatterfit_optics::port`, the
 //! two-disc kernel integrated against a pencil-beam profile) against the engine's direct twin of the
 //! reading (uniform illumination over the lit disc, collection over the aperture) — two different
 //! computations of the same number; fixed seeds, tolerances in standard errors.
@@ -14,7 +14,7 @@ fn half_space(g: f64) -> Sample {
     Sample::new(vec![layer], 1.0, 1.0).unwrap()
 }
 
-/// Ports of issue 15 (8 mm lit over 14 mm and over 8 mm): the disc-beam twin's collected fraction
+/// Two common d/8 ports (8 mm lit over 14 mm and over 8 mm): the disc-beam twin's collected fraction
 /// equals the kernel integral of a pencil-beam profile (0.05 mm bins to the port's reach; the
 /// profile as a step function) within 4 combined standard errors plus 0.2 % for the binning, and
 /// the edge loss is real (reading fraction well below 1).

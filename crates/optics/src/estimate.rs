@@ -2,7 +2,7 @@
 //!
 //! A measured σ′s is uncertain for more than one reason: the profile's noise (the fit's standard
 //! error, from its Jacobian), the spectrophotometer's repeatability (its η and α′, propagated by
-//! refits) and, when the anisotropy g is not known exactly, g (issue 15). Each is kept apart, so a
+//! refits) and, when the anisotropy g is not known exactly, g. Each is kept apart, so a
 //! report can print "value ± fit ± spectro ± g" and a program can weigh them, and
 //! [`Estimate::total`] combines them (the standard errors in quadrature, the g term's bound
 //! linearly).
@@ -32,8 +32,8 @@ pub struct Estimate {
     /// Standard error from the spectrophotometer: its η and α′ at the reading's repeatability,
     /// propagated to the value by refits (`scatterfit_pipeline::fit::propagate_spectro`).
     pub spectro: Option<f64>,
-    /// The part from the anisotropy g of the phase function, when g is not known exactly (issue
-    /// 15): how far the estimate of the g-aware exact model (the `mc` tables over g, for the
+    /// The part from the anisotropy g of the phase function, when g is not known exactly: how
+    /// far the estimate of the g-aware exact model (the `mc` tables over g, for the
     /// profile and the α′ inversion) moves over the stated range of g — the largest deviation from
     /// the estimate at the values' g, or half the spread when the values are the middle of the
     /// range (`scatterfit_pipeline::anisotropy`). A bound-like half-width rather than a standard

@@ -1,10 +1,10 @@
 //! Every citation in the repository resolves inside the repository.
 //!
 //! The code cites its physics as `docs/physics.md §N.M`, its reference data as files under `data/`,
-//! and its own documents (`ARCHITECTURE.md`, `BENCHMARKS.md`, `RELIABILITY.md`, `README.md`), often
-//! with a quoted section name. A reader of the published code must be able to follow each one, so
-//! this test scans every `.rs`, `.md` and `.toml` file of the workspace (not `target/` or hidden
-//! folders) and fails, listing them all, on
+//! and its own documents (`ARCHITECTURE.md`, `BENCHMARKS.md`, `CHANGELOG.md`, `RELIABILITY.md`,
+//! `README.md`), often with a quoted section name. A reader of the published code must be able to
+//! follow each one, so this test scans every `.rs`, `.md` and `.toml` file of the workspace (not
+//! `target/` or hidden folders) and fails, listing them all, on
 //! - a section number after `docs/physics.md` that is not a heading of that file (ranges such as
 //!   `§4.2–4.4` and lists such as `§3, §10` check every number);
 //! - the physics notes named without their folder, which is how the code cited the project's old
@@ -161,6 +161,7 @@ fn every_citation_resolves_in_the_repository() {
     let documents = [
         "ARCHITECTURE.md",
         "BENCHMARKS.md",
+        "CHANGELOG.md",
         "RELIABILITY.md",
         "README.md",
     ];

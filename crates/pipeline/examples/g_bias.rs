@@ -1,5 +1,5 @@
 //! What assuming g = 0 costs on anisotropic media, and what the g-aware `mc` model gives back
-//! (issue 15; BENCHMARKS.md, "The `mc` model over g"): MCML's profiles at g = 0.8 and 0.9
+//! (BENCHMARKS.md, "The `mc` model over g"): MCML's profiles at g = 0.8 and 0.9
 //! (`data/reference/mcml_profiles_g.csv`, σ′t = 1 mm⁻¹, pencil beam) as the camera's rings
 //! (1–15 mm, the rig's span from the spot's edge to 300 px at 0.05 mm), adding-doubling's total
 //! (`iad_totals_g.csv`) as the spectrophotometer's loss-free reading, measured with the proposed

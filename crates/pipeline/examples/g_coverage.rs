@@ -1,4 +1,4 @@
-//! Does the reported uncertainty cover the truth when g is not known (issue 15)? Quick-rig twins
+//! Does the reported uncertainty cover the truth when g is not known? Quick-rig twins
 //! (`RigSpec::quick`, fixed seeds) of six materials simulated by the Monte Carlo engine at each
 //! Henyey–Greenstein g of the list (profile and spectrophotometer reading), written with a manifest
 //! that does **not** state g, measured with `--model mc --albedo-model mc` as a user who does not

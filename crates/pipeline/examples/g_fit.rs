@@ -1,4 +1,4 @@
-//! `[fit] g = "fit"` on rig twins (issue 15): quick-rig twins (`RigSpec::quick`, or the paper's rig)
+//! `[fit] g = "fit"` on rig twins: quick-rig twins (`RigSpec::quick`, or the paper's rig)
 //! of materials simulated by the Monte Carlo engine at Henyey–Greenstein g = `G` (profile and
 //! spectrophotometer reading), measured with `--model mc --albedo-model mc` and `g = "fit"`. Per
 //! channel: the truth's α′ and g, the fitted g ± sd(g) (its fit and model parts, the shape signal

@@ -1,4 +1,4 @@
-//! The whole measurement on rig-twin samples that scatter forward (issue 15): quick-rig twins
+//! The whole measurement on rig-twin samples that scatter forward: quick-rig twins
 //! (`RigSpec::quick`, fixed seeds) of three materials simulated by the Monte Carlo engine at
 //! Henyey–Greenstein g = 0.8 or `G` (profile and spectrophotometer reading), measured with `--model mc
 //! --albedo-model mc` and the manifest's `[fit] g = 0.8`, and refitted from the same frames and
@@ -13,8 +13,8 @@
 //! nice -n 19 cargo run -p scatterfit-pipeline --example g_twin [G] [paper|quick] [MATERIAL,…] [PHOTONS×]
 //! ```
 //!
-//! A material named `range-etaX` (for example `range-eta1.0`, `range-eta2.4`) is issue 15's
-//! target range at η = X: R at α′ 0.3 (σ′s 1 mm⁻¹), G at α′ 0.99 (σ′s 1.5 mm⁻¹), B at α′ 0.9999
+//! A material named `range-etaX` (for example `range-eta1.0`, `range-eta2.4`) spans the
+//! range of α′ the `mc` model over g is meant for, at η = X: R at α′ 0.3 (σ′s 1 mm⁻¹), G at α′ 0.99 (σ′s 1.5 mm⁻¹), B at α′ 0.9999
 //! (σ′s 3 mm⁻¹, so that its light, which travels 1/σtr ≈ 19 mm, stays inside the paper rig's field).
 //!
 //! `PHOTONS×` multiplies the twin's photon budget (its Monte Carlo noise falls as 1/√×): a channel
@@ -152,13 +152,13 @@ fn main() {
     }
 }
 
-/// Issue 15's target range at one η (module docs): α′ 0.3, 0.99 and 0.9999.
+/// The α′ range the g-aware model is meant for, at one η (module docs): α′ 0.3, 0.99 and 0.9999.
 fn range_material(name: &str, eta: f64) -> scatterfit_synth::materials::PublishedMaterial {
     let sigma_s_prime = [1.0, 1.5, 3.0];
     let albedo = [0.3, 0.99, 0.9999];
     scatterfit_synth::materials::PublishedMaterial {
         name: Box::leak(name.to_string().into_boxed_str()),
-        source: "issue 15's range",
+        source: "the α′ range of the g-aware model (0.3–0.9999)",
         sigma_s_prime,
         sigma_a: std::array::from_fn(|c| sigma_s_prime[c] * (1.0 / albedo[c] - 1.0)),
         eta,

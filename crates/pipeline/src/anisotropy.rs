@@ -1,4 +1,4 @@
-//! The anisotropy g when it is not known exactly (issue 15): a stated range of g propagated into
+//! The anisotropy g when it is not known exactly: a stated range of g propagated into
 //! σ′s, σa and α′ as a separate uncertainty term ([`scatterfit_optics::Estimate::g`]) beside the
 //! fit's and the spectrophotometer's.
 //!
@@ -41,7 +41,7 @@ use crate::spectro::SpectroStage;
 /// The range of g propagated when neither `[fit] g` nor `[fit] g_range` is stated: 0 (the
 /// isotropic scattering the paper assumes) to 0.95 (the most forward-scattering of real
 /// translucent materials — skin, marble, milk, wax, plastics are 0.7–0.95). An unstated g is an
-/// unknown g; the values stay at g = 0 (what every result before issue 15 was computed at), and
+/// unknown g; the values stay at g = 0 (what the paper's method and isotropic models assume), and
 /// the term shows how far they could be off.
 pub const DEFAULT_G_RANGE: [f64; 2] = [0.0, 0.95];
 

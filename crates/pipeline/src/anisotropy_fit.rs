@@ -1,4 +1,4 @@
-//! Fitting the anisotropy g from the profile (issue 15, `[fit] g = "fit"`): a one-dimensional
+//! Fitting the anisotropy g from the profile (`[fit] g = "fit"`): a one-dimensional
 //! profile likelihood over g per channel, and the rule that decides whether the data determine g.
 //!
 //! **The profile likelihood** (Press et al., *Numerical Recipes*, 3rd ed., §15.6.4–15.6.5;

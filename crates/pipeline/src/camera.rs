@@ -1,4 +1,4 @@
-//! What a real camera adds to the rig's ideal one (issue 16), estimated from the frames and
+//! What a real camera adds to the rig's ideal one, estimated from the frames and
 //! removed: the black level of linear data, exposure times that are not what the camera says, and
 //! vignetting (a flat frame). Veiling glare is estimated on the profile ([`crate::profile`]); the
 //! spot's shape is the fit's kernel ([`crate::fit`]).

@@ -22,7 +22,7 @@ pub struct FitSettings {
     /// (`spot`), the radius holding 99 % of its power (which sets the default r_min).
     pub spot_radius_mm: f64,
     /// The spot's shape: a uniform disk of `spot_radius_mm`, or a radial profile (a Gaussian, a
-    /// measured spot image; issue 16).
+    /// measured spot image).
     pub spot: SpotShape,
     /// Innermost fitted radius \[mm\] (default: the spot's diameter).
     pub r_min_mm: Option<f64>,

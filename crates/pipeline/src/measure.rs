@@ -49,7 +49,7 @@ pub struct Overrides {
     pub g: Option<f64>,
     /// A g range instead of the manifest's `[fit] g_range`.
     pub g_range: Option<[f64; 2]>,
-    /// Fit g instead of the manifest's `[fit] g` (`g = "fit"`; issue 15).
+    /// Fit g instead of the manifest's `[fit] g` (`g = "fit"`).
     pub g_fit: bool,
     /// Allow the manifest to name files outside the sample folder (the input path policy,
     /// `scatterfit_io::inputs`; `--allow-outside-paths`).
@@ -193,7 +193,7 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
             "normalising with the spectrophotometer applies to the proposed method only".into(),
         ));
     }
-    // The spot: a disk (the paper's), or a Gaussian of that 1/e² diameter (issue 16); a spot
+    // The spot: a disk (the paper's), or a Gaussian of that 1/e² diameter; a spot
     // image replaces this once the bracket is merged (measure_sample).
     let diameter = manifest.camera.spot_diameter_mm.unwrap_or(1.0);
     let (spot, spot_radius_mm) = match manifest.camera.spot_profile {
@@ -204,7 +204,7 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         }
         _ => (SpotShape::Disk, 0.5 * diameter),
     };
-    // What is known about g (issue 15): an override replaces both manifest keys.
+    // What is known about g: an override replaces both manifest keys.
     let g_prior = if o.g.is_some() || o.g_range.is_some() || o.g_fit {
         GPrior {
             g: o.g,
@@ -290,7 +290,7 @@ pub fn values_g_on(grid: &scatterfit_mc::McGridSet, prior: &GPrior) -> Result<f6
     }
 }
 
-/// The profile model and the albedo model of `settings`, both at its g (issue 15).
+/// The profile model and the albedo model of `settings`, both at its g.
 ///
 /// # Errors
 /// [`PipelineError::Input`] for a g the Monte Carlo tables do not cover when either model is `mc`.
@@ -374,7 +374,7 @@ fn measure_from(
                 .as_ref()
                 .map(|p| manifest.resolve(p));
             inputs.dark = manifest.camera.dark.as_ref().map(|p| manifest.resolve(p));
-            // A real camera (issue 16): black level, shutter times, flat frame.
+            // A real camera: black level, shutter times, flat frame.
             inputs.flat = manifest.camera.flat.as_ref().map(|p| manifest.resolve(p));
             inputs.exposure_correction = manifest.camera.exposure_correction.unwrap_or_default();
             if let Some(s) = manifest.camera.saturation {
@@ -722,7 +722,7 @@ pub fn g_record(
     }
 }
 
-/// The SCE spectrum the channels' Rd came from (issue 18: spectral renderers need it), when the
+/// The SCE spectrum the channels' Rd came from (spectral renderers need it), when the
 /// colour came from the spectrum rather than a measured L*a*b*.
 fn rd_spectrum(
     analysis: Option<&scatterfit_optics::spectro::SpectroAnalysis>,

@@ -1,5 +1,5 @@
 //! The checks made on a run's outputs before any work, so that a mistake costs milliseconds, not a
-//! measurement, and a run never destroys what it reads (issue 17 §1): an output is never one of the
+//! measurement, and a run never destroys what it reads: an output is never one of the
 //! sample's inputs (compared by [`same_file`]: canonical paths), never written through a link, into
 //! another sample's folder or over another sample's results without `force`; its folder exists and
 //! is writable. Every failure is an [`OutputError`] whose message names the flag, the path and what

@@ -1,4 +1,4 @@
-//! Stage 3½ (issue 15): the spectrophotometer port's edge loss, corrected from the measurement
+//! Stage 3½: the spectrophotometer port's edge loss, corrected from the measurement
 //! itself.
 //!
 //! A d/8 instrument lights a disc and measures through a concentric aperture; light that enters

@@ -37,7 +37,7 @@ pub struct ProfileFitRequest {
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by Rd (proposed method).
     pub normalise_with_spectro: bool,
-    /// What is known about g (`--g`, `--g-range`; issue 15): the values' g and the g term, as for
+    /// What is known about g (`--g`, `--g-range`): the values' g and the g term, as for
     /// a measurement ([`crate::anisotropy`]). With `rd` the term's α′ is inverted from it at each
     /// g; without, α′ is held at the given value and the term is the profile's part only.
     pub g_prior: crate::anisotropy::GPrior,

@@ -8,7 +8,7 @@
 //! progress display); this module names them ([`samples`]), fits them ([`study_sample`]) and
 //! tabulates the rows ([`rows_csv`], [`summary_markdown`]).
 //!
-//! **The g axis** (issue 15). Real translucent materials scatter forward (Henyey–Greenstein g ≈
+//! **The g axis**. Real translucent materials scatter forward (Henyey–Greenstein g ≈
 //! 0.7–0.95), and at fixed reduced coefficients both the total diffuse reflectance (hence α′ from
 //! the spectrophotometer) and the profile's near field depend on g: the similarity relation
 //! σ′s = σs(1 − g) holds only in the far field (Wyman, Patterson & Wilson 1989). A study over a list
@@ -41,7 +41,7 @@ pub struct Combo {
     pub albedo: AlbedoModel,
     /// The paper's method.
     pub method: Method,
-    /// The fit is told the twin's g (`[fit] g` = the truth's; issue 15); otherwise it assumes
+    /// The fit is told the twin's g (`[fit] g` = the truth's); otherwise it assumes
     /// g = 0, as a manifest without `[fit] g` does.
     pub g_given: bool,
 }
@@ -336,8 +336,8 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
 }
 
 /// Writes a synthesised twin (8-bit bracket) into `dir` as a sample folder with `fit` as its
-/// manifest's `[fit]` and no truth.json — what a user's rig would hand the tool; the twin's g (issue
-/// 15) is never written into the manifest (`fit` decides what the user states).
+/// manifest's `[fit]` and no truth.json — what a user's rig would hand the tool; the twin's g is
+/// never written into the manifest (`fit` decides what the user states).
 ///
 /// # Errors
 /// The folder cannot be written.
@@ -508,7 +508,7 @@ pub fn summary_markdown(rows: &[Row], combos: &[Combo]) -> String {
     t
 }
 
-/// The g axis of `study.md` (issue 15): per model, each of its configurations over the twins' g —
+/// The g axis of `study.md`: per model, each of its configurations over the twins' g —
 /// median / worst |error| of σ′s, σa and α′ — the configurations assuming g = 0 first, then the
 /// g-aware `mc` model told the twin's g ("not covered" where the `mc` tables do not answer).
 /// `combos` in the order given; `gs` the study's g list.

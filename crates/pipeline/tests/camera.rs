@@ -1,6 +1,6 @@
-//! Real cameras (issue 16): the HDR stage on the rig twin's brackets from many cameras — tone
+//! Real cameras: the HDR stage on the rig twin's brackets from many cameras — tone
 //! curves, channel gains, reflectances and noise levels — must never refuse a good bracket and must
-//! give the profile's shape within 1 % on the rings it calls measurable (issue 16's aim; this build
+//! give the profile's shape within 1 % on the rings it calls measurable (the aim; this build
 //! meets it on all 120 channels, see `sweep`); a bracket in the wrong order is
 //! still refused, saying what was seen.
 //!
@@ -239,7 +239,7 @@ fn shape_errors(
     Ok(worst)
 }
 
-/// Issue 16's sweep: five tone curves (linear, gamma 2.2, sRGB, log, a filmic S-curve with a
+/// The camera sweep: five tone curves (linear, gamma 2.2, sRGB, log, a filmic S-curve with a
 /// shoulder), channel gains 0.3–1, total reflectance 0.005–0.9, read noise 3 and 15 e⁻ (with shot
 /// noise): no bracket refused; on the measurable rings the profile's shape within 0.65 % of the
 /// truth for 90 % of the channels and within 1 % for every one (BENCHMARKS.md, "Real cameras").
@@ -256,7 +256,7 @@ fn no_good_bracket_is_refused_and_shapes_hold_on_a_third_of_the_sweep() {
     sweep(3, 36);
 }
 
-/// Runs issue 16's sweep over every `stride`-th combination of three channels (per curve and noise
+/// Runs the camera sweep over every `stride`-th combination of three channels (per curve and noise
 /// level) and asserts the bounds; `min_measured` channels must have had measurable rings.
 fn sweep(stride: usize, min_measured: usize) {
     let curves = [
@@ -319,7 +319,7 @@ fn sweep(stride: usize, min_measured: usize) {
                                 None => by_curve.push((key, e[c])),
                             }
                             all.push(e[c]);
-                            // Issue 16's bound, met on every channel (worst 0.93 %). With the
+                            // The bound, met on every channel (worst 0.93 %). With the
                             // trusted codes from 100 instead of 120: 1.31 % (two log channels
                             // above 1 %); before the toe's smoothing and second-order term:
                             // 1.37 % (116 of 120 within 1 %); before the merge's expected-signal
@@ -380,12 +380,12 @@ fn sweep(stride: usize, min_measured: usize) {
     );
 }
 
-/// Issue 16's failing case, made exactly: an sRGB-like 8-bit camera, 13 exposures 1/600–3 s, a
+/// The dim channel beside bright ones, made exactly: an sRGB-like 8-bit camera, 13 exposures 1/600–3 s, a
 /// dark channel (Rd ≈ 0.02: α′ = 0.5 at η = 1.94) at gain 0.6 beside bright ones, shot and read
 /// noise. Without the monotone recovery the response "falls" at low codes and the bracket is
 /// refused; with it the bracket measures and the shape holds.
 #[test]
-fn the_issues_dark_channel_measures() {
+fn a_dim_channel_beside_bright_ones_measures() {
     let camera = CameraModel::named("srgb").unwrap();
     for seed in 1..=4 {
         let e = shape_errors(camera, [(0.02, 0.6), (0.2, 1.0), (0.41, 0.75)], seed).unwrap();

@@ -1,4 +1,4 @@
-//! Diagnosis (issue 16): the merged radiance of a *flat field* of known rate through each tone
+//! Diagnosis: the merged radiance of a *flat field* of known rate through each tone
 //! curve and noise level of the sweep, merged with the camera's true response, so that neither the
 //! response recovery nor the profile is involved. Prints the bias per expected code of the longest
 //! frame.

@@ -191,10 +191,10 @@ fn a_fit_the_noise_does_not_explain_is_suspect() {
         "{q:?}"
     );
     // The bracket's overlap: 1800× between the two frames (and a response from 2 frames) makes
-    // every channel suspect, including the one whose residuals look fine (issue 17: R +712 %).
+    // every channel suspect, including the one whose residuals look fine (R +712 %).
     assert!(has(&q, ReasonKind::BracketGap), "{q:?}");
     // Every other frame of the good bracket (steps of 3.5×) still overlaps, but a response
-    // recovered from steps that wide can carry a ripple the bracket cannot see (13 % on issue 16's
+    // recovered from steps that wide can carry a ripple the bracket cannot see (13 % on the camera sweep's
     // sweep): suspect for that, and only that.
     let d = root.path().join("every-other");
     let (fs, ts): (Vec<_>, Vec<_>) = f
@@ -279,7 +279,7 @@ fn frames_that_do_not_use_their_bit_depth_are_found() {
 /// saturation) biases σ′s by −15 %, −6 %, −7 % (R, G, B) against the same frames without the
 /// shoulder; with `camera.saturation = 1000` in the manifest the bias is −1.5 %, −0.5 %, −0.5 % (the
 /// rest: fewer codes per frame). The test asks for < 2 % stated and a third of the unstated bias or
-/// less (issue 17 §2: the frames' codes, or `camera.saturation`); 8-bit frames with the key are
+/// less (the frames' codes, or `camera.saturation`); 8-bit frames with the key are
 /// refused with the reason.
 #[test]
 fn a_stated_saturation_is_used() {

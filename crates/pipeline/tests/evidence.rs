@@ -118,7 +118,7 @@ fn exact_by_default_and_an_approximate_model_carries_its_error() {
     for c in Channel::ALL {
         let f = m.fits[c].fit().unwrap();
         assert_eq!(f.sigma_s_prime.model, None);
-        // The exact model on its quick twin: within 2 % (the bar for the full rig).
+        // The exact model on its quick twin: within 2 % (the bar for the full rig).
         let e = f.sigma_s_prime.value / t.sigma_s_prime[c.index()] - 1.0;
         assert!(e.abs() < 0.02, "{c:?}: σ′s {e:+.4}");
     }

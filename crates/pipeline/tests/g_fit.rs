@@ -1,4 +1,4 @@
-//! `[fit] g = "fit"` (issue 15): g fitted per channel from the profile where the data determine it,
+//! `[fit] g = "fit"`: g fitted per channel from the profile where the data determine it,
 //! and not printed where they do not.
 //!
 //! Quick-rig twins simulated by the Monte Carlo engine at Henyey–Greenstein g = 0.9 — profile and
@@ -11,7 +11,7 @@
 //!   too, at 0.897, until the g 0.95 node got its η 1.3 table (2026-11-27): the node's Catmull-Rom
 //!   over η 1.0–1.4 had been 1–3 % off in shape there, which raised χ² at g 0.95; with the right
 //!   table the quick twin's 3 % misfit puts skin1 G's minimum at the range's end, and the channel is
-//!   withheld with that reason — BENCHMARKS.md, "The g 0.95 node's η layout filled in");
+//!   withheld with that reason — CHANGELOG.md, "The g 0.95 node's η layout filled in");
 //! - honesty: no channel is printed as determined with its g more than 2 of its sd(g) from the
 //!   truth, and sulfur R and G (α′ 0.9988, 0.9979 ≥ 0.99, where a change of g barely changes the
 //!   profile's shape) are "not determined", with no g, a reason, and the range's ± g term. (On the

@@ -1,4 +1,4 @@
-//! The manifest's `[fit] g` (issue 15) reaches the fit settings, and a g the `mc` tables do not cover
+//! The manifest's `[fit] g` reaches the fit settings, and a g the `mc` tables do not cover
 //! is refused before any work with a message that names the key and the tables; the model and the
 //! albedo inversion are then evaluated at that g (`scatterfit_optics::AtG`).
 
@@ -16,7 +16,7 @@ fn manifest(model: ModelName, g: Option<f64>) -> SampleManifest {
 #[test]
 fn manifest_g_reaches_the_settings_and_is_checked_against_the_tables() {
     let o = Overrides::default();
-    // Default: isotropic, as before issue 15.
+    // Default: isotropic, as the paper assumes.
     assert_eq!(
         fit_settings(&manifest(ModelName::Mc, None), &o).unwrap().g,
         0.0

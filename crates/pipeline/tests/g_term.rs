@@ -1,4 +1,4 @@
-//! The g term (issue 15): when g is not known, the error bars must say so.
+//! The g term: when g is not known, the error bars must say so.
 //!
 //! A rig twin of wood tile (quick rig, seed 7) is simulated by the Monte Carlo engine at
 //! Henyey–Greenstein g = 0.8 — profile and spectrophotometer reading, an independent truth the

@@ -1,4 +1,4 @@
-//! The spectrophotometer port's edge loss (issue 15), on rig-twin samples whose spectrophotometer
+//! The spectrophotometer port's edge loss, on rig-twin samples whose spectrophotometer
 //! reading is what a d/8 instrument with an 8 mm aperture reads: the engine lights a disc
 //! uniformly and tallies what leaves inside the aperture (`scatterfit_mc::port`, a Monte Carlo run
 //! of its own: the correction, which integrates the fitted model's profile against the two-disc
@@ -273,7 +273,7 @@ fn reading_slope(
     }
 }
 
-/// An 8 mm aperture lit over 14 mm (issue 15's first case), two materials whose light travels
+/// An 8 mm aperture lit over 14 mm (a common d/8 instrument's port), two materials whose light travels
 /// millimetres (skin, α′ 0.93–0.99; wood tile, 0.91–0.99). Each sample is measured three times from
 /// the same frames: with the port's reading taken as loss-free, with the port corrected, and with
 /// the loss-free reading (the twin's own error on the quick rig, up to 8 % in skin's red channel,
@@ -607,7 +607,7 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
             100.0 * sa[sa.len() - 1],
             sa.len()
         );
-        // Issue 15's target: corrected against the truth, α′ 0.3–0.9999.
+        // The target (1 % median, 3 % worst): corrected against the truth, α′ 0.3–0.9999.
         let in_range: Vec<&(f64, f64, f64)> = truth
             .iter()
             .filter(|t| (0.3..=0.9999).contains(&t.0))

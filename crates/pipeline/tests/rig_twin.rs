@@ -1,6 +1,6 @@
 //! The whole measurement on Monte Carlo rig-twin samples (never made by the fitted model): sample
 //! folders written as a rig would leave them, measured by `measure_sample`, compared with the
-//! truth. Tolerances are the fit issue's targets for the proposed method with the dipole — σ′s
+//! truth. Tolerances are the targets for the proposed method with the dipole — σ′s
 //! within 5 % and σa within 12 % (median over channels with α′ in [0.9, 0.9995] and η ≤ 1.6), η
 //! within 0.005 — on the quick rig (256² px at 0.1 mm/px, a tenth of the photons; fixed seeds).
 

@@ -1,4 +1,4 @@
-//! The bias study's g axis (issue 15): what assuming g = 0 costs on a forward-scattering twin, and
+//! The bias study's g axis: what assuming g = 0 costs on a forward-scattering twin, and
 //! what the g-aware `mc` model told the true g gives back.
 //!
 //! One quick-rig study sample (`RigSpec::quick`, seed 3; σ′t = 2 mm⁻¹, η = 1.4, α′ 0.9 / 0.95 /
@@ -10,7 +10,7 @@
 //! Physics behind the margins: at fixed reduced coefficients the total diffuse reflectance of a
 //! g = 0.8 medium is lower than the isotropic one's, so α′ inverted at g = 0 is too low and σa =
 //! σ′s(1/α′ − 1) too high — by +10 % at α′ 0.9 and +5 % at α′ 0.99 (η 1.4, BENCHMARKS.md "What
-//! assuming g = 0 costs", from MCML profiles and adding-doubling totals; the issue's outside
+//! assuming g = 0 costs", from MCML profiles and adding-doubling totals; an outside
 //! measurement at g = 0.85: +8 … +11 % at α′ 0.9–0.96). With g given the quick twin's σa is within
 //! about 1 % (BENCHMARKS.md "The rig twin at g ≠ 0"). So: assuming g = 0, every σa is biased high
 //! and the median |σa error| is ≥ 4 %; with g given it is ≤ 1.5 % and at most a quarter of the

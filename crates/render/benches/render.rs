@@ -1,4 +1,4 @@
-//! Renderer hot paths on the case: the statue at about 100 000 triangles, 512 × 512, pink
+//! Renderer hot paths on the reference case: the statue at about 100 000 triangles, 512 × 512, pink
 //! plastic (Choi et al. 2014, Table 1) under the studio lights, 1 sample per pixel.
 //! Run: `cargo bench -p scatterfit-render --bench render`.
 

@@ -200,7 +200,7 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         Some(e) => format!("{:.4} ± {}", r.eta, sig4(e)),
         None => format!("{:.4}", r.eta),
     };
-    // The Henyey–Greenstein g the models were evaluated at (issue 15), when the result records it;
+    // The Henyey–Greenstein g the models were evaluated at, when the result records it;
     // how g entered the error bars follows the table (errors_note).
     let g = match (&r.g_uncertainty, r.inputs.options.g) {
         (Some(u), _) if u.source == scatterfit_io::result_json::GSource::Given => {

@@ -1,4 +1,4 @@
-//! What the sample page costs beside the measurement (issue 19: under 10 % of a sample's
+//! What the sample page costs beside the measurement (under 10 % of a sample's
 //! measurement time). Ignored: a timing, run by hand on a sample folder of the full rig, e.g. one
 //! of `scatterfit demo`'s:
 //!

@@ -101,7 +101,7 @@ fn a_measured_sample_gets_its_report_files() {
     let summary = summary_text(&written.result);
     assert!(summary.starts_with("wood-tile: η = "), "{summary}");
     let md = std::fs::read_to_string(out.join("result.md")).unwrap();
-    // The g the models assumed (issue 15): the manifest has none, so the values are at 0, g is
+    // The g the models assumed: the manifest has none, so the values are at 0, g is
     // taken as unknown over the default range, and both say so — the term in every channel.
     assert_eq!(back.inputs.options.g, Some(0.0));
     assert!(

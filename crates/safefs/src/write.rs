@@ -456,7 +456,7 @@ mod tests {
         assert_eq!(entries(&target), ["keep"]);
     }
 
-    /// The attack of issue 17: a symbolic link planted at the destination must not redirect the
+    /// The classic attack on a shared folder: a symbolic link planted at the destination must not redirect the
     /// write to the file it points to. It is refused, and the file outside is untouched.
     #[cfg(unix)]
     #[test]

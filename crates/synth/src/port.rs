@@ -1,4 +1,4 @@
-//! The twin's spectrophotometer port (issue 15): a reading made through a d/8 instrument's port
+//! The twin's spectrophotometer port: a reading made through a d/8 instrument's port
 //! instead of the loss-free total. Per channel the engine lights a disc uniformly and tallies what
 //! leaves inside the concentric aperture (`scatterfit_mc::port::simulate_port_reading`: no kernel,
 //! no profile), so the pipeline's correction (`scatterfit_optics::port`, which integrates a fitted

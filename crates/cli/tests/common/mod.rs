@@ -5,6 +5,8 @@
 //! and uses a part of it, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
+pub mod peer;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;

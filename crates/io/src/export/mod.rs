@@ -534,7 +534,7 @@ mod tests {
         assert_eq!(identifier(""), format!("material_{}", name_hash("")));
     }
 
-    /// The collisions: "pink plastic" and "pink-plastic", and non-ASCII names.
+    /// The collisions seen in practice: "pink plastic" and "pink-plastic", and non-ASCII names.
     #[test]
     fn similar_names_get_different_ids() {
         let names = [

@@ -124,7 +124,7 @@ pub struct SpectroSection {
     pub repeatability: Option<f64>,
     /// Diameter of the instrument's measured area \[mm\] (its port, e.g. 4, 8 or 25 mm). Given, the
     /// reading's edge loss (light that enters inside the lit area and leaves beyond the measured
-    /// one) is corrected from the fitted profile (issue 15; `scatterfit_optics::port`); absent, the
+    /// one) is corrected from the fitted profile (`scatterfit_optics::port`); absent, the
     /// reading is taken as loss-free and the result says so.
     pub aperture_mm: Option<f64>,
     /// Diameter of the illuminated area \[mm\] when the instrument lights a different area than it
@@ -235,7 +235,7 @@ pub struct CameraSection {
 /// The largest g a `[fit] g_range` may reach (the grid the `mc` tables are built for ends at 0.95).
 pub const G_RANGE_MAX: f64 = 0.95;
 
-/// `[fit] g`: a known or assumed Henyey–Greenstein g, or `"fit"` (issue 15).
+/// `[fit] g`: a known or assumed Henyey–Greenstein g, or `"fit"`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum GSetting {
     /// A known or assumed g in (−1, 1): the models are evaluated at it.
@@ -325,9 +325,9 @@ pub struct FitSection {
     pub r_min_mm: Option<f64>,
     /// Fix the profile's scale by the spectrophotometer (proposed method).
     pub normalise_with_spectro: Option<bool>,
-    /// The material's Henyey–Greenstein asymmetry g, known or assumed (issue 15): the forward model
+    /// The material's Henyey–Greenstein asymmetry g, known or assumed: the forward model
     /// and the α′ inversion are evaluated at it (σs = σ′s/(1 − g)). Default 0 — isotropic
-    /// scattering, what the paper and every model before issue 15 assume; the diffusion dipoles do
+    /// scattering, what the paper and the diffusion models assume; the diffusion dipoles do
     /// not depend on g, photon beam diffusion and the `mc` tables do (the tables cover g 0–0.95;
     /// another g with `mc` is refused with the tables' coverage). Real translucent
     /// materials have g ≈ 0.7–0.95: assuming 0 for them biases σa high (BENCHMARKS.md, "The `mc`
@@ -339,7 +339,7 @@ pub struct FitSection {
     /// determine it; elsewhere the channel gets the range's "± g" term (ARCHITECTURE.md, "Fitting
     /// g").
     pub g: Option<GSetting>,
-    /// The range `[lo, hi]` (0 ≤ lo ≤ hi ≤ 0.95) the material's g is known to lie in (issue 15):
+    /// The range `[lo, hi]` (0 ≤ lo ≤ hi ≤ 0.95) the material's g is known to lie in:
     /// propagated into σ′s, σa and α′ as a separate "g" uncertainty term beside "fit" and
     /// "spectro", from the g-aware `mc` model. With `g`, the values are computed at `g` (which must
     /// lie in the range) and the term is the largest change of the estimate over the range;
@@ -899,7 +899,7 @@ r_max_px = 300
         assert_eq!(back.camera, m.camera);
         assert_eq!(back.fit, m.fit, "{text}");
         assert_eq!(back.name, m.name);
-        // `g = "fit"` too (issue 15).
+        // `g = "fit"` too.
         let mut fitted = m.clone();
         fitted.fit.g = Some(GSetting::Fit);
         let text = manifest_to_toml(&fitted, "");

@@ -130,11 +130,11 @@ pub struct ChannelResult {
     pub albedo_prime_stderr: Option<f64>,
     /// The part of α′'s uncertainty that comes from the profile's fit: behind a spectrophotometer
     /// port (`spectro_port`) the corrected Rd, hence α′, depends on the fitted σ′s through the
-    /// port's reading fraction F (issue 15); add it in quadrature to `albedo_prime_stderr`.
+    /// port's reading fraction F; add it in quadrature to `albedo_prime_stderr`.
     /// Absent without a port (α′ is then the reading's alone).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub albedo_prime_stderr_fit: Option<f64>,
-    /// The part of σ′s's uncertainty that comes from the anisotropy g (issue 15): how far the
+    /// The part of σ′s's uncertainty that comes from the anisotropy g: how far the
     /// g-aware estimate moves over the stated range of g ([`MeasurementResult::g_uncertainty`]
     /// says which range and which g were evaluated) \[mm⁻¹\]; `Some(0)` when g was given, `None`
     /// when it could not be evaluated (or in a file written before the term).
@@ -383,12 +383,12 @@ pub struct MeasurementResult {
     /// `port::correct_spectrum`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rd_spectrum: Option<RdSpectrum>,
-    /// The spectrophotometer port's edge-loss correction (issue 15; `spectro.aperture_mm` in the
+    /// The spectrophotometer port's edge-loss correction (`spectro.aperture_mm` in the
     /// manifest): the channels' `rd_total` and `albedo_prime` are then the corrected values. Absent:
     /// the reading was taken as loss-free (no port given). Never written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spectro_port: Option<PortResult>,
-    /// How the anisotropy g entered the result (issue 15): given, or a range propagated into the
+    /// How the anisotropy g entered the result: given, or a range propagated into the
     /// channels' `*_stderr_g` terms, with the g that were evaluated. Absent in files written before
     /// the term (and by commands that fit no sample); never written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -1,5 +1,5 @@
-//! The result's sample-level records beside the channels: how g entered it ([`GUncertainty`],
-//! issue 15), what the spectrophotometer port correction did ([`PortResult`]) and the measured
+//! The result's sample-level records beside the channels: how g entered it ([`GUncertainty`]),
+//! what the spectrophotometer port correction did ([`PortResult`]) and the measured
 //! diffuse reflectance spectrum ([`RdSpectrum`]).
 
 use serde::{Deserialize, Serialize};
@@ -33,7 +33,7 @@ impl GSource {
 }
 
 /// How g entered a result
-/// ([`MeasurementResult::g_uncertainty`](super::MeasurementResult::g_uncertainty), issue 15).
+/// ([`MeasurementResult::g_uncertainty`](super::MeasurementResult::g_uncertainty)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GUncertainty {
     /// Given, a stated range, or the default range.
@@ -56,7 +56,7 @@ pub struct GUncertainty {
     pub fitted: Option<scatterfit_optics::Rgb<Option<GFitRecord>>>,
 }
 
-/// One channel's fit of g (issue 15, `[fit] g = "fit"`): a profile likelihood over g with the
+/// One channel's fit of g (`[fit] g = "fit"`): a profile likelihood over g with the
 /// `mc` model. The g and its errors are given only where the data determine g
 /// ([`GFitRecord::determined`]); elsewhere [`GFitRecord::reason`] says why not, and the channel's
 /// values carry the search range's "± g" term instead.

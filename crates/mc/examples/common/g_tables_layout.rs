@@ -1,10 +1,10 @@
-//! The layout of the anisotropic `mc` tables (issue 15), shared by the `build_g_tables` and
+//! The layout of the anisotropic `mc` tables, shared by the `build_g_tables` and
 //! `g_table_study` examples (included with `#[path]`; not an example of its own).
 #![allow(dead_code)]
 
 use scatterfit_mc::model::McTableSpec;
 
-/// Smallest and largest reduced albedo α′ a g ≠ 0 table must serve (issue 15: 0.3–0.9999, with a
+/// Smallest and largest reduced albedo α′ a g ≠ 0 table must serve (0.3–0.9999, with a
 /// margin so that Catmull-Rom has a node on each side).
 pub const ALBEDO_PRIME_RANGE: (f64, f64) = (0.2, 0.99995);
 

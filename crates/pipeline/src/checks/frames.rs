@@ -1,4 +1,4 @@
-//! The checks on the bracket's frames (issue 17 §2): the codes they use (8- or 12-bit data in
+//! The checks on the bracket's frames: the codes they use (8- or 12-bit data in
 //! 16-bit files, the clipping plateau), their registration (the spot's centroid per frame) and the
 //! bracket's overlap (consecutive exposures, frames for a recovered response).
 
@@ -252,7 +252,7 @@ pub const MAX_STEP_LINEAR: f64 = 256.0;
 /// The largest *typical* (median) ratio of consecutive times from which a camera response is
 /// recovered without a check: with times in a constant ratio k the bracket cannot see a ripple of
 /// the response periodic in ln X with period ln k (the fractal ambiguity, docs/physics.md §7.1a),
-/// and the wider the steps the less of the curve holds it. Measured on issue 16's sweep (five tone
+/// and the wider the steps the less of the curve holds it. Measured on the camera sweep (five tone
 /// curves, two noise levels, BENCHMARKS.md "Real cameras"): worst shape error 0.93 % at 1.87×,
 /// 2.8 % at 2.5× (a filmic S-curve), 13–15 % at 3.5× (S-curve; a log curve at 15 e⁻), and some
 /// good dark brackets refused at 4× — while the same brackets through the true response are
@@ -262,7 +262,7 @@ pub const MAX_STEP_RECOVERED: f64 = 2.6;
 /// The bracket's overlap: consecutive exposures more than [`MAX_STEP_8BIT`] (8-bit frames through
 /// a recovered or given response) or [`MAX_STEP_LINEAR`] (linear frames) apart, or a recovered
 /// response from fewer than 3 frames, make every channel suspect: the merge then interpolates
-/// across radiances no frame measured (issue 17: a 2-frame bracket of 1/600 and 3 s measured
+/// across radiances no frame measured (a 2-frame bracket of 1/600 and 3 s measured
 /// +712 % and was called ok).
 pub fn bracket_reasons(m: &Measurement) -> Vec<Reason> {
     let limit = match m.hdr.response_kind {

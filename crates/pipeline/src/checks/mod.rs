@@ -1,5 +1,5 @@
 //! The data checks a careful experimentalist makes before calling a value a measurement
-//! (issue 17 §2, RELIABILITY.md "Numbers that look right and are not"), and the per-channel
+//! (RELIABILITY.md "Numbers that look right and are not"), and the per-channel
 //! [`Quality`] verdict they give.
 //!
 //! Each check is a function of what the stages produced (the radiance map, the profile, the fits,
@@ -422,7 +422,7 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
         ));
     }
     // An unknown g whose term could not be evaluated over its whole range: the error bars would
-    // look complete and are not (issue 15: never a 10 % bias behind a 0.3 % bar).
+    // look complete and are not (never a 10 % bias behind a 0.3 % bar).
     if let ChannelOutcome::Fitted(f) = outcome
         && let Some(gap) = &f.g_term_gap
     {

@@ -142,7 +142,7 @@ pub(crate) struct ResultView {
     pub version: String,
     /// The port correction, as a sentence, when one was made.
     pub port: Option<String>,
-    /// How g entered (issue 15), as a sentence, when the result records it.
+    /// How g entered, as a sentence, when the result records it.
     pub g: Option<String>,
 }
 

@@ -21,12 +21,12 @@ pub struct CameraModel {
 }
 
 /// The twin camera's tone curve, from linear signal s ∈ [0, 1] (electrons / full well) to display
-/// value [0, 1]: the curves a lab's cameras use (issue 16's sweep). Each is monotone with T(0) = 0,
+/// value [0, 1]: the curves a lab's cameras use (the camera sweep's). Each is monotone with T(0) = 0,
 /// T(1) = 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ToneCurve {
-    /// T(s) = (1 + b)s/(s + b), b = [`CameraModel::tone_knee`] (the twin's camera since issue 3).
+    /// T(s) = (1 + b)s/(s + b), b = [`CameraModel::tone_knee`] (the twin's default camera).
     #[default]
     NakaRushton,
     /// T(s) = s (a machine-vision camera with gamma off).

@@ -67,13 +67,13 @@ pub struct RigSpec {
     /// The brightest channel's spot centre reaches this fraction of the full well in the shortest
     /// exposure (so that the bracket holds the peak unclipped once).
     pub peak_fill: f64,
-    /// What a real rig adds (issue 16): glare, vignetting, shutter errors, a Gaussian spot; all off
+    /// What a real rig adds: glare, vignetting, shutter errors, a Gaussian spot; all off
     /// by default.
     #[serde(default, skip_serializing_if = "RigEffects::is_none")]
     pub effects: RigEffects,
 }
 
-/// What a real rig adds to the ideal one (issue 16), each a switch of the twin; all zero (off) by
+/// What a real rig adds to the ideal one, each a switch of the twin; all zero (off) by
 /// default.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -470,7 +470,7 @@ pub fn render_bracket_fn(
             Frame::U8(ImageBuf::new(w, h, 3, codes).expect("w × h × 3 samples"))
         }
     };
-    // Without effects the mean is gains·Rd·t exactly as before issue 16 (v = 1, glare 0).
+    // Without effects the mean is gains·Rd·t exactly, as for an ideal rig (v = 1, glare 0).
     let scene = |x: usize, y: usize, c: usize| {
         vignette(x, y) * (gains[c] * f64::from(rd[(y * w + x) * 3 + c]) + glare[c])
     };
