@@ -129,10 +129,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         true,
     )?;
     let measure_s = t1.elapsed().as_secs_f64();
-    let rows = scatterfit_pipeline::accuracy::accuracy_rows(&pairs, &papers, &truths);
+    let rows = scatterfit_lab::accuracy::accuracy_rows(&pairs, &papers, &truths);
     let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
     let out = &args.output_dir;
-    let accuracy = scatterfit_report::accuracy_markdown(&rows);
+    let accuracy = scatterfit_lab::accuracy_markdown(&rows);
     scatterfit_report::write_table1(out, &proposed)?;
     scatterfit_report::write_table2(out, &pairs)?;
     let json = serde_json::to_string_pretty(&rows).context("serialising the summary")? + "\n";

@@ -12,7 +12,7 @@
 //!
 //! `--g` gives the study a g axis: the twins are made at each Henyey–Greenstein g, fitted
 //! every way assuming g = 0 and once more with the g-aware `mc` model told the true g
-//! (`scatterfit_pipeline::study::g_given_combo`); `study.md` gains a table per model over g.
+//! (`scatterfit_lab::study::g_given_combo`); `study.md` gains a table per model over g.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -20,7 +20,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use rayon::prelude::*;
-use scatterfit_pipeline::study::{
+use scatterfit_lab::study::{
     Row, StudySample, combos, g_given_combo, has_g_axis, samples, study_sample,
 };
 

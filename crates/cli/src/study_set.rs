@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use scatterfit_pipeline::study::{
+use scatterfit_lab::study::{
     Combo, Row, combos, dedup, g_axis_markdown, g_given_combo, has_g_axis, rows_csv,
     summary_markdown,
 };
@@ -233,7 +233,7 @@ pub fn write(
         scatterfit_io::atomic::write_atomic(&p, text.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
     }
-    let mut figure = scatterfit_report::study::study_figure(&first_g, &assuming_g_0);
+    let mut figure = scatterfit_lab::study_figure::study_figure(&first_g, &assuming_g_0);
     if g_axis {
         // Say which twins the figure shows: study.md has the g axis's tables.
         figure.title = format!(

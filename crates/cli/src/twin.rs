@@ -5,8 +5,7 @@ use std::path::Path;
 use std::sync::Mutex;
 
 use anyhow::Context;
-use scatterfit_io::image_files::CameraFrame;
-use scatterfit_io::sample_folder::{CameraFiles, SampleFiles, write_sample_folder_with};
+use scatterfit_lab::twin::{TwinFolder, synth_provenance, write_twin_folder};
 use scatterfit_synth::{RigSpec, SyntheticSample};
 
 use crate::common::bar;
@@ -79,65 +78,20 @@ pub fn synthesize_on(
     Ok(sample)
 }
 
-/// Writes a synthetic sample into `dir` (its manifest's `[fit]` at the defaults).
+/// Writes a synthetic sample into `dir` (its manifest's `[fit]` at the defaults), with its
+/// truth.json.
 pub fn write_sample(dir: &Path, s: &SyntheticSample) -> anyhow::Result<()> {
     write_sample_with(dir, s, scatterfit_io::manifest::FitSection::default())
 }
 
-/// Writes a synthetic sample into `dir` with this `[fit]` in its manifest.
+/// Writes a synthetic sample into `dir` with this `[fit]` in its manifest, and its truth.json
+/// (`scatterfit_lab::twin`).
 pub fn write_sample_with(
     dir: &Path,
     s: &SyntheticSample,
     fit: scatterfit_io::manifest::FitSection,
 ) -> anyhow::Result<()> {
-    let truth = serde_json::to_string_pretty(&s.truth).context("serialising the truth")?;
-    let frame = |f: &scatterfit_synth::rig::Frame| match f {
-        scatterfit_synth::rig::Frame::U8(b) => CameraFrame::U8(b.clone()),
-        scatterfit_synth::rig::Frame::U16(b) => CameraFrame::U16(b.clone()),
-    };
-    let rig = &s.truth.rig;
-    let extra = CameraFiles {
-        frames_u16: s.bracket.frames_u16.clone(),
-        dng_levels: match rig.camera.output {
-            scatterfit_synth::rig::SensorOutput::Linear {
-                black_level,
-                white_level,
-            } if white_level < 65535.0 => Some((
-                black_level.map(|b| b.round() as u16),
-                white_level.round() as u16,
-            )),
-            _ => None,
-        },
-        flat: s.bracket.flat.as_ref().map(frame),
-        spot_image: s.bracket.spot_image.as_ref().map(frame),
-        spot_profile: (rig.effects.gaussian_spot && s.bracket.spot_image.is_none())
-            .then_some(scatterfit_io::manifest::SpotProfileName::Gaussian),
-        spectro_port_mm: s
-            .truth
-            .port
-            .as_ref()
-            .map(|p| [p.illuminated_mm, p.aperture_mm]),
-    };
-    write_sample_folder_with(
-        dir,
-        &SampleFiles {
-            name: &s.truth.name,
-            reading: &s.reading,
-            lab10: Some([s.lab10.l, s.lab10.a, s.lab10.b]),
-            frames: &s.bracket.frames,
-            times_s: &s.bracket.times_s,
-            mm_per_pixel: s.truth.rig.mm_per_pixel,
-            spot_diameter_mm: 2.0 * s.truth.rig.spot_radius_mm,
-            truth_json: Some(&truth),
-            provenance: &format!(
-                "synthetic sample `{}` made by `scatterfit synth` (Monte Carlo rig twin, seed {}); \
-                 truth.json holds the parameters",
-                s.truth.name, s.truth.seed
-            ),
-            fit,
-        },
-        &extra,
-    )
-    .map_err(anyhow::Error::msg)?;
+    let how = TwinFolder::new(fit, synth_provenance(s)).with_truth();
+    write_twin_folder(dir, s, &how).map_err(anyhow::Error::msg)?;
     Ok(())
 }

@@ -15,10 +15,10 @@
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::ChannelResult;
+use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, ModelName};
 use scatterfit_pipeline::anisotropy::GPrior;
 use scatterfit_pipeline::fit::FitSettings;
-use scatterfit_pipeline::study::write_twin_folder;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
@@ -130,7 +130,7 @@ fn main() {
                 albedo_model: Some(AlbedoModel::Mc),
                 ..Default::default()
             };
-            write_twin_folder(&folder, &s, fit, "g_coverage example").unwrap();
+            write_twin_folder(&folder, &s, &TwinFolder::new(fit, "g_coverage example")).unwrap();
             let t_synth = t.elapsed().as_secs_f64();
             let t = std::time::Instant::now();
             let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();

@@ -9,8 +9,8 @@
 //! ```
 
 use scatterfit_io::manifest::{FitSection, GSetting};
+use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
-use scatterfit_pipeline::study::write_twin_folder;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
@@ -55,7 +55,7 @@ fn main() {
             g: Some(GSetting::Fit),
             ..Default::default()
         };
-        write_twin_folder(&folder, &s, fit, "g_fit example").unwrap();
+        write_twin_folder(&folder, &s, &TwinFolder::new(fit, "g_fit example")).unwrap();
         let t = std::time::Instant::now();
         let measured = measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap();
         let fit_s = measured.timings.fit_s;

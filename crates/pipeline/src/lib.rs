@@ -35,12 +35,11 @@
 //! # Ok::<(), scatterfit_pipeline::PipelineError>(())
 //! ```
 //! `crates/pipeline/examples/` has the whole of it: `measure_folder.rs` (one folder) and
-//! `batch_report.rs` (many folders, with the report files). [`study`] is the bias study's measuring
-//! and tabulating over a grid of rig-twin samples.
+//! `batch_report.rs` (many folders, with the report files). The bias study over rig-twin samples
+//! and the demo's accuracy table are `scatterfit-lab`'s, above this crate.
 
 #![forbid(unsafe_code)]
 
-pub mod accuracy;
 pub mod anisotropy;
 pub mod anisotropy_fit;
 pub mod batch;
@@ -60,7 +59,6 @@ pub mod profile_fit;
 pub mod radiance;
 pub mod samples;
 pub mod spectro;
-pub mod study;
 
 pub use batch::{
     BatchError, BatchEvent, BatchOutcome, BatchRequest, BatchSample, JobPlan, SampleOutcome,

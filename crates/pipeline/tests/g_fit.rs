@@ -21,8 +21,8 @@
 
 use scatterfit_io::manifest::{FitSection, GSetting};
 use scatterfit_io::result_json::GSource;
+use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
-use scatterfit_pipeline::study::write_twin_folder;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
@@ -53,7 +53,7 @@ fn measured(dir: &std::path::Path, name: &str, seed: u64) -> scatterfit_pipeline
         g: Some(GSetting::Fit),
         ..Default::default()
     };
-    write_twin_folder(&folder, &s, fit, "g_fit test").unwrap();
+    write_twin_folder(&folder, &s, &TwinFolder::new(fit, "g_fit test")).unwrap();
     measure_sample(&folder, &Overrides::default(), &|_| {}).unwrap()
 }
 

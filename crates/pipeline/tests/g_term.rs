@@ -15,8 +15,8 @@
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::GSource;
+use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, ModelName};
-use scatterfit_pipeline::study::write_twin_folder;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
@@ -47,7 +47,7 @@ fn twin(
     )
     .unwrap();
     let folder = dir.path().join(m.name);
-    write_twin_folder(&folder, &s, fit, "g_term test").unwrap();
+    write_twin_folder(&folder, &s, &TwinFolder::new(fit, "g_term test")).unwrap();
     (dir, folder)
 }
 

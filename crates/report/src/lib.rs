@@ -40,17 +40,14 @@
 
 #![forbid(unsafe_code)]
 
-pub mod accuracy;
 pub mod error;
 pub mod figures;
 pub mod html;
 pub mod measurement;
 pub mod plot;
 pub mod spectro;
-pub mod study;
 pub mod tables;
 
-pub use accuracy::accuracy_markdown;
 pub use error::{ReportError, Result};
 pub use figures::{compare_figure, fit_figure};
 pub use measurement::{

@@ -4,7 +4,7 @@
 //! One quick-rig study sample (`RigSpec::quick`, seed 3; σ′t = 2 mm⁻¹, η = 1.4, α′ 0.9 / 0.95 /
 //! 0.99) is simulated by the Monte Carlo engine at Henyey–Greenstein g = 0.8 — profile and
 //! spectrophotometer reading, an independent truth the `mc` tables never saw — and fitted by
-//! `pipeline::study::study_sample` with the exact model (`mc` profile, `mc` α′, proposed method)
+//! `lab::study::study_sample` with the exact model (`mc` profile, `mc` α′, proposed method)
 //! twice: assuming g = 0, and with `[fit] g` = 0.8 (the study's "g given" row).
 //!
 //! Physics behind the margins: at fixed reduced coefficients the total diffuse reflectance of a
@@ -21,10 +21,9 @@
 use std::path::Path;
 
 use scatterfit_io::manifest::FitSection;
+use scatterfit_lab::study::{Combo, Row, g_given_combo, samples, study_sample};
+use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
-use scatterfit_pipeline::study::{
-    Combo, Row, g_given_combo, samples, study_sample, write_twin_folder,
-};
 use scatterfit_synth::{RigSpec, synthesize};
 
 fn median_abs(rows: &[&Row], f: impl Fn(&Row) -> Option<f64>) -> f64 {
@@ -54,7 +53,12 @@ fn at_g_0_8_the_g_aware_row_removes_the_sigma_a_bias() {
         &|_, _, _| {},
     )
     .unwrap();
-    write_twin_folder(&sample.dir, &s, FitSection::default(), "study_g test").unwrap();
+    write_twin_folder(
+        &sample.dir,
+        &s,
+        &TwinFolder::new(FitSection::default(), "study_g test"),
+    )
+    .unwrap();
     std::fs::write(
         sample.dir.join("truth.json"),
         serde_json::to_string(&s.truth).unwrap(),

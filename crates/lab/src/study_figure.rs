@@ -1,11 +1,11 @@
 //! The bias study's figure (`scatterfit study`'s study.svg and study.png): per configuration
 //! (proposed method, each model with its own α′ inversion), |σ′s error| against −log₁₀(1 − α′), one
-//! line per η. The rows come from `scatterfit_pipeline::study`.
+//! line per η. The rows come from [`crate::study`].
 
+use crate::study::{Combo, Row, distinct};
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
-use scatterfit_pipeline::study::{Combo, Row, distinct};
 
-use crate::plot::{Figure, Panel, Series, SeriesStyle};
+use scatterfit_report::plot::{Figure, Panel, Series, SeriesStyle};
 
 /// Each model's colour (the darkest shade of its lines).
 fn model_colour(model: ModelName) -> (u8, u8, u8) {

@@ -1,8 +1,8 @@
-//! The demo's accuracy table as Markdown ([`scatterfit_pipeline::accuracy`] makes its rows).
+//! The demo's accuracy table as Markdown ([`crate::accuracy`] makes its rows).
 
 use std::fmt::Write as _;
 
-use scatterfit_pipeline::accuracy::{ChannelRow, MaterialRow};
+use crate::accuracy::{ChannelRow, MaterialRow};
 
 fn pct(v: Option<f64>) -> String {
     v.map_or("—".into(), |v| format!("{:+.1} %", 100.0 * v))

@@ -25,9 +25,9 @@ use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_synth::Truth;
 use serde::Serialize;
 
-use crate::anisotropy::GPrior;
-use crate::fit::FitSettings;
-use crate::{Measurement, Overrides, PipelineError, measure_sample};
+use scatterfit_pipeline::anisotropy::GPrior;
+use scatterfit_pipeline::fit::FitSettings;
+use scatterfit_pipeline::{Measurement, Overrides, PipelineError, measure_sample};
 
 /// The status of a row whose `mc` fit at the twin's g the tables do not cover ([`mc_covers`]).
 pub const NOT_COVERED: &str = "not covered";
@@ -333,28 +333,6 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
         }
     }
     Ok(rows)
-}
-
-/// Writes a synthesised twin (8-bit bracket) into `dir` as a sample folder with `fit` as its
-/// manifest's `[fit]` and no truth.json — what a user's rig would hand the tool; the twin's g is
-/// never written into the manifest (`fit` decides what the user states).
-///
-/// # Errors
-/// The folder cannot be written.
-pub fn write_twin_folder(
-    dir: &Path,
-    s: &scatterfit_synth::SyntheticSample,
-    fit: scatterfit_io::manifest::FitSection,
-    provenance: &str,
-) -> Result<(), scatterfit_io::sample_folder::SampleFolderError> {
-    let rig = &s.truth.rig;
-    let files = scatterfit_io::sample_folder::SampleFiles::new(&s.truth.name, &s.reading)
-        .bracket(&s.bracket.frames, &s.bracket.times_s)
-        .mm_per_pixel(rig.mm_per_pixel)
-        .spot_diameter_mm(2.0 * rig.spot_radius_mm)
-        .provenance(provenance)
-        .fit(fit);
-    scatterfit_io::sample_folder::write_sample_folder(dir, &files).map(|_| ())
 }
 
 /// Keeps one row per grid point and configuration (a padded triple repeats its last albedo).

@@ -1,0 +1,20 @@
+//! The research tools above the measurement: what the project uses to check the method, not what
+//! a lab needs to measure a sample.
+//!
+//! - [`twin`]: a rig twin (a [`scatterfit_synth::SyntheticSample`]) written as a sample folder, the
+//!   one writer `scatterfit synth`, the demo, the study and the tests share;
+//! - [`study`]: the bias study over α′, η and g (`scatterfit study`), its rows and tables, and
+//!   [`study_figure`], its figure;
+//! - [`accuracy`]: the demo's table of each measured value against the twin's truth, and
+//!   [`accuracy_markdown`], its Markdown.
+//!
+//! The layers below ([`scatterfit_pipeline`], [`scatterfit_report`], `scatterfit-render`) know
+//! nothing of the twin; this crate joins the two (ARCHITECTURE.md, "Workspace layout").
+
+pub mod accuracy;
+pub mod accuracy_markdown;
+pub mod study;
+pub mod study_figure;
+pub mod twin;
+
+pub use accuracy_markdown::accuracy_markdown;
