@@ -180,11 +180,12 @@ fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
     } else {
         RigSpec::paper()
     };
+    let g_max = scatterfit_io::manifest::G_RANGE_MAX;
     crate::numeric::ensure(
-        (0.0..=0.95).contains(&args.g),
+        (0.0..=g_max).contains(&args.g),
         "--g",
         args.g,
-        "the twin's Henyey–Greenstein g must lie in [0, 0.95]",
+        &format!("the twin's Henyey–Greenstein g must lie in [0, {g_max}]"),
     )?;
     rig.g = args.g;
     let mut rig = args.photons.apply(rig)?;

@@ -43,7 +43,7 @@ use crate::spectro::SpectroStage;
 /// translucent materials — skin, marble, milk, wax, plastics are 0.7–0.95). An unstated g is an
 /// unknown g; the values stay at g = 0 (what the paper's method and isotropic models assume), and
 /// the term shows how far they could be off.
-pub const DEFAULT_G_RANGE: [f64; 2] = [0.0, 0.95];
+pub const DEFAULT_G_RANGE: [f64; 2] = [0.0, scatterfit_io::manifest::G_RANGE_MAX];
 
 /// Two g closer than this are one point (a g typed as 0.8 is the node 0.8).
 const SAME_G: f64 = 1e-9;

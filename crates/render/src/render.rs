@@ -19,12 +19,14 @@ use crate::texture_space::{
     DipoleParams, Evaluation, PointCloud, auto_light_rays, irradiance_points,
 };
 
-/// Which of the paper's methods shades the surface.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which of the paper's methods shades the surface (written as its [`Method::name`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum Method {
     /// Subsurface colour, §4.1, eqs. (3)–(5).
+    #[serde(rename = "color")]
     Colour,
     /// Texture-space dipole, §4.2, eq. (6).
+    #[serde(rename = "dipole")]
     Dipole,
 }
 

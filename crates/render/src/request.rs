@@ -346,7 +346,7 @@ impl Summary {
             m.source, m.triangles, m.size_mm[0], m.size_mm[1], m.size_mm[2], m.bvh_build_s
         );
         for r in &self.renders {
-            let extra = if r.method == "dipole" {
+            let extra = if r.method == Method::Dipole {
                 format!(
                     " (irradiance {:.3} s, {} rays, {} points; hierarchy {:.3} s; {:.0} nodes per \
                      sample)",
@@ -362,7 +362,7 @@ impl Summary {
             let _ = writeln!(
                 t,
                 "render   {:<6} {} ({}): {}x{}, {} spp, shading {:.3} s{extra}",
-                r.method, r.material, r.parameters, r.width, r.height, r.spp, r.shading_s
+                r.method.name(), r.material, r.parameters, r.width, r.height, r.spp, r.shading_s
             );
             if r.invalid_samples > 0 {
                 let _ = writeln!(
@@ -452,7 +452,7 @@ pub struct RenderSummary {
     /// Where the parameters came from.
     pub parameters: String,
     /// `color` or `dipole`.
-    pub method: &'static str,
+    pub method: Method,
     /// η.
     pub eta: f64,
     /// σ′s per channel [mm⁻¹].
@@ -513,7 +513,7 @@ impl RenderSummary {
         Self {
             material: p.name.clone(),
             parameters: p.source.clone(),
-            method: r.method.name(),
+            method: r.method,
             eta: p.eta,
             sigma_s_prime: coefficients.map(|c| c.0),
             sigma_a: coefficients.map(|c| c.1),
