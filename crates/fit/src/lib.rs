@@ -65,7 +65,7 @@ use problem::{Data, Forward, Problem, Unknowns};
 /// Which unknowns are fitted (the vocabulary's [`Method`], re-exported): `Proposed` — Choi, Lee &
 /// Chin 2014, α′ from the spectrophotometer, unknowns σ′s and the scale k; `Existing` — Jensen et al.
 /// 2001, unknowns σ′s, σa and k.
-pub use scatterfit_optics::Method;
+pub use scatterfit_optics::{Method, Parameter};
 /// The forward model's family and name (re-exported from `scatterfit_optics`).
 pub use scatterfit_optics::{ModelFamily, ModelName};
 
@@ -174,13 +174,13 @@ pub struct FitReport {
     pub albedo_prime: f64,
     /// The scale k: measured = k · model [relative units per mm⁻²].
     pub scale: Estimate,
-    /// Names of the free parameters, in the order of `correlation`.
-    pub parameters: Vec<String>,
+    /// The free parameters, in the order of `correlation`.
+    pub parameters: Vec<Parameter>,
     /// Correlation matrix of the free parameters (rows of `parameters.len()`).
     pub correlation: Vec<Vec<f64>>,
     /// Parameters the data do not constrain (standard error of the logarithm above
     /// [`UNCONSTRAINED_SD_LN`], or a singular Jacobian): the values are the solver's end point, not measurements.
-    pub unconstrained: Vec<String>,
+    pub unconstrained: Vec<Parameter>,
     /// Whether the solver met a convergence criterion.
     pub converged: bool,
     /// Why the solver stopped.
@@ -399,10 +399,10 @@ impl<'a> PreparedFit<'a> {
         let chi2: f64 = res.iter().map(|e| e * e).sum();
         let dof = (n - p).max(1) as f64;
         let chi2_reduced = chi2 / dof;
-        let names: Vec<String> = match self.unknowns {
-            Unknowns::Proposed { .. } => vec!["sigma_s_prime".into(), "scale".into()],
-            Unknowns::Normalised { .. } => vec!["sigma_s_prime".into()],
-            Unknowns::Existing => vec!["sigma_s_prime".into(), "sigma_a".into(), "scale".into()],
+        let names: Vec<Parameter> = match self.unknowns {
+            Unknowns::Proposed { .. } => vec![Parameter::SigmaSPrime, Parameter::Scale],
+            Unknowns::Normalised { .. } => vec![Parameter::SigmaSPrime],
+            Unknowns::Existing => vec![Parameter::SigmaSPrime, Parameter::SigmaA, Parameter::Scale],
         };
         // Covariance of the full problem's unknowns (x, ln k): (JᵀJ)⁻¹, inflated by the reduced
         // χ² when the model misfits (the ring errors then understate the scatter), never
@@ -447,17 +447,17 @@ impl<'a> PreparedFit<'a> {
                     }
                 }
             }
-            None => unconstrained.extend(names.iter().filter(|n| *n != "scale").cloned()),
+            None => unconstrained.extend(names.iter().filter(|n| **n != Parameter::Scale)),
         }
         if cov.is_some() {
             // NaN (a negative variance) counts as unconstrained too.
             if sd[0].is_nan() || sd[0] > UNCONSTRAINED_SD_LN {
-                unconstrained.push("sigma_s_prime".into());
+                unconstrained.push(Parameter::SigmaSPrime);
             }
             if self.unknowns == Unknowns::Existing
                 && (sd[1].is_nan() || sd[1] > UNCONSTRAINED_SD_LN)
             {
-                unconstrained.push("sigma_a".into());
+                unconstrained.push(Parameter::SigmaA);
             }
         }
         let (sp_err, sa_err, k_err) = match self.unknowns {

@@ -53,7 +53,7 @@ pub fn value_with_errors(c: &ChannelResult, v: Option<Estimate>, name: &str) -> 
     if c.status == ChannelStatus::Failed {
         return "failed".into();
     }
-    if c.unconstrained.iter().any(|u| u == name) {
+    if c.unconstrained.iter().any(|u| u.name() == name) {
         return "unconstrained".into();
     }
     // The systematic terms, each named: the anisotropy's and an approximate model's.

@@ -50,6 +50,6 @@ pub use error::{OpticsError, Result};
 pub use estimate::Estimate;
 pub use family::{AtG, ModelFamily, ProfileModel, ProfileSample};
 pub use model::DiffusionModel;
-pub use names::{AlbedoModel, Method, ModelName};
+pub use names::{AlbedoModel, Method, ModelName, Parameter};
 pub use properties::OpticalProperties;
 pub use rgb::{Channel, Rgb};

@@ -174,3 +174,32 @@ mod tests {
         }
     }
 }
+
+/// A fitted quantity, as results name it (`sigma_s_prime`, `sigma_a`, `scale`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Parameter {
+    /// The reduced scattering coefficient σ′s \[mm⁻¹\]: `sigma_s_prime`.
+    SigmaSPrime,
+    /// The absorption coefficient σa \[mm⁻¹\]: `sigma_a`.
+    SigmaA,
+    /// The profile's scale k (measured = k · model): `scale`.
+    Scale,
+}
+
+impl Parameter {
+    /// The name used in files and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::SigmaSPrime => "sigma_s_prime",
+            Self::SigmaA => "sigma_a",
+            Self::Scale => "scale",
+        }
+    }
+}
+
+impl std::fmt::Display for Parameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -515,7 +515,11 @@ pub fn channel_result(
                 Some(format!(
                     "the profile does not constrain {} (standard error of its logarithm above {}): \
                      the values are the solver's end point, not a measurement",
-                    r.unconstrained.join(" and "),
+                    r.unconstrained
+                        .iter()
+                        .map(|p| p.name())
+                        .collect::<Vec<_>>()
+                        .join(" and "),
                     scatterfit_fit::UNCONSTRAINED_SD_LN
                 ))
             } else {

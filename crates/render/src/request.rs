@@ -362,7 +362,13 @@ impl Summary {
             let _ = writeln!(
                 t,
                 "render   {:<6} {} ({}): {}x{}, {} spp, shading {:.3} s{extra}",
-                r.method.name(), r.material, r.parameters, r.width, r.height, r.spp, r.shading_s
+                r.method.name(),
+                r.material,
+                r.parameters,
+                r.width,
+                r.height,
+                r.spp,
+                r.shading_s
             );
             if r.invalid_samples > 0 {
                 let _ = writeln!(

@@ -492,7 +492,7 @@ mod tests {
     fn unconstrained_channel_is_exported_with_a_warning() {
         let mut r = marble();
         r.channels.g.status = ChannelStatus::Unconstrained;
-        r.channels.g.unconstrained = vec!["sigma_a".into()];
+        r.channels.g.unconstrained = vec![scatterfit_optics::Parameter::SigmaA];
         let e = export(&r, Format::Pbrt, SceneUnit::Millimetre).unwrap();
         let w: Vec<&String> = e
             .warnings

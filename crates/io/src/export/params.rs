@@ -262,7 +262,11 @@ impl RendererParameters {
                 let what = if c.unconstrained.is_empty() {
                     "some parameters".to_string()
                 } else {
-                    one_line(&c.unconstrained.join(", "))
+                    c.unconstrained
+                        .iter()
+                        .map(|p| p.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 };
                 warnings.push(format!(
                     "channel {name} is unconstrained (the data do not constrain {what}): its values \

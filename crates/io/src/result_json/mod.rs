@@ -98,8 +98,8 @@ pub enum ChannelStatus {
 /// The correlation matrix of a channel's fitted parameters (from the Jacobian at the solution).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Correlation {
-    /// Parameter names in matrix order, e.g. `["sigma_s_prime", "scale"]`.
-    pub parameters: Vec<String>,
+    /// The parameters in matrix order, e.g. `["sigma_s_prime", "scale"]`.
+    pub parameters: Vec<scatterfit_optics::Parameter>,
     /// Row-major correlation coefficients, `parameters.len()` rows.
     pub matrix: Vec<Vec<f64>>,
 }
@@ -173,7 +173,7 @@ pub struct ChannelResult {
     pub correlation: Option<Correlation>,
     /// Parameters the data do not constrain (empty when every parameter is measured).
     #[serde(default)]
-    pub unconstrained: Vec<String>,
+    pub unconstrained: Vec<scatterfit_optics::Parameter>,
     /// Wall time of the fit \[s\].
     #[serde(default)]
     pub fit_time_s: f64,

@@ -92,8 +92,12 @@ fn albedo_check(
     // ln(1 − α′) = ln σa − ln(σ′s + σa), so d ln(1 − α′) = α′ (dσa/σa − dσ′s/σ′s): its variance
     // from the relative errors and their correlation (delta method).
     let (rs, ra) = (s.stderr / s.value, a.stderr / a.value);
-    let index = |name: &str| free.parameters.iter().position(|p| p == name);
-    let rho = match (index("sigma_s_prime"), index("sigma_a")) {
+    let index =
+        |name: scatterfit_optics::Parameter| free.parameters.iter().position(|p| *p == name);
+    let rho = match (
+        index(scatterfit_optics::Parameter::SigmaSPrime),
+        index(scatterfit_optics::Parameter::SigmaA),
+    ) {
         (Some(i), Some(j)) => free
             .correlation
             .get(i)

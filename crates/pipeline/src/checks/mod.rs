@@ -417,7 +417,11 @@ pub fn fit_reasons(outcome: &ChannelOutcome, eta: f64) -> Vec<Reason> {
             ReasonKind::Unconstrained,
             format!(
                 "the profile does not constrain {}",
-                r.unconstrained.join(" and ")
+                r.unconstrained
+                    .iter()
+                    .map(|p| p.name())
+                    .collect::<Vec<_>>()
+                    .join(" and ")
             ),
         ));
     }
