@@ -500,8 +500,8 @@ fn spectral_variant_renders_the_measured_colour(python: &Path) {
 }
 
 /// BENCHMARKS.md "exports": each forward model's total Rd against Mitsuba's volumetric path tracer
-/// on half-spaces, at high sample counts. Run by hand (minutes):
-/// `cargo test -p scatterfit --test mitsuba -- --ignored --nocapture`.
+/// on half-spaces, at high sample counts, and the `mc` tables' total checked against it. By hand
+/// (minutes): `cargo test -p scatterfit --test mitsuba -- --ignored --nocapture`.
 fn forward_models_against_mitsuba(python: &Path) {
     use scatterfit_optics::{DiffusionModel, ModelFamily, ModelName};
     let spp: u32 = std::env::var("SCATTERFIT_BENCH_SPP")
@@ -548,6 +548,14 @@ fn forward_models_against_mitsuba(python: &Path) {
             eprintln!(
                 "η = {eta}, α′ = {a}: {} px × {} spp in {:.1} s (Mitsuba {})",
                 r.pixels, r.spp, r.seconds, r.mitsuba
+            );
+            // Exact transport two ways: the `mc` tables' total and the path tracer's must agree
+            // within the file's tolerance (every row of BENCHMARKS.md's table is within 2 s.e.).
+            check(
+                &format!("η = {eta}, α′ = {a}: Mitsuba Rd vs the mc tables' total"),
+                truth,
+                r.stderr[1],
+                mc,
             );
         }
     }

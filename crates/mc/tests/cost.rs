@@ -117,11 +117,15 @@ fn memory_estimate_counts_bins_not_photons() {
     );
 }
 
-/// The interaction rate of this machine (REFERENCE_INTERACTIONS_PER_SECOND): run with
+/// The interaction rate of this machine against `REFERENCE_INTERACTIONS_PER_SECOND`, the rate that
+/// turns cost estimates into the times the refusal messages quote: on paths of many steps it must be
+/// within a factor 4 of the constant either way (the standard VM measures 1.6–2.2·10⁷ per thread,
+/// BENCHMARKS.md "Monte Carlo cost model"), or the messages mislead. A timing, so run by hand:
 /// `cargo test --release -p scatterfit-mc --test cost -- --ignored --nocapture`.
 #[test]
-#[ignore = "measurement, not a check"]
+#[ignore = "a timing of this machine (release build): run by hand"]
 fn measure_interaction_rate() {
+    let reference = scatterfit_mc::REFERENCE_INTERACTIONS_PER_SECOND;
     for &(name, layer, photons) in CASES {
         let sim = simulation(layer, photons * 20);
         let pool = rayon::ThreadPoolBuilder::new()
@@ -131,10 +135,16 @@ fn measure_interaction_rate() {
         let start = Instant::now();
         let r = pool.install(|| sim.run());
         let s = start.elapsed().as_secs_f64();
-        eprintln!(
-            "{name}: {:.3e} interactions/s on 1 thread ({:.1} per photon)",
-            r.interactions as f64 / s,
-            r.interactions as f64 / r.photons as f64
-        );
+        let rate = r.interactions as f64 / s;
+        let per_photon = r.interactions as f64 / r.photons as f64;
+        eprintln!("{name}: {rate:.3e} interactions/s on 1 thread ({per_photon:.1} per photon)");
+        // Short paths are dominated by the launch, not by interactions: the rate there says nothing
+        // about the constant.
+        if per_photon >= 50.0 {
+            assert!(
+                (reference / 4.0..=reference * 4.0).contains(&rate),
+                "{name}: {rate:.3e} interactions/s, more than 4× from the reference {reference:.1e}"
+            );
+        }
     }
 }

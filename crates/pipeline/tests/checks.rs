@@ -4,6 +4,8 @@
 //! right reason — where, without the check, it was "ok" with σ′s off (the errors each case gave
 //! before the checks are in RELIABILITY.md). The good twin itself must stay ok.
 
+mod common;
+
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -11,28 +13,14 @@ use scatterfit_imaging::ImageBuf;
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
 use scatterfit_pipeline::checks::{Quality, ReasonKind, Verdict};
 use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
 use scatterfit_synth::mishaps;
-use scatterfit_synth::{CameraModel, RigSpec, SyntheticSample, synthesize};
+use scatterfit_synth::{CameraModel, RigSpec, SyntheticSample};
 
 const MATERIAL: &str = "pink-plastic";
 
 fn twin() -> &'static SyntheticSample {
     static TWIN: OnceLock<SyntheticSample> = OnceLock::new();
-    TWIN.get_or_init(|| {
-        let m = by_name(MATERIAL).unwrap();
-        synthesize(
-            m.name,
-            m.sigma_s_prime,
-            m.sigma_a,
-            m.eta,
-            &RigSpec::quick(),
-            1,
-            None,
-            &|_, _, _| {},
-        )
-        .unwrap()
-    })
+    TWIN.get_or_init(|| common::quick_twin(MATERIAL, 1))
 }
 
 fn write(dir: &Path, frames: &[ImageBuf<u8>], times: &[f64], mm_per_pixel: f64) {
@@ -59,7 +47,7 @@ fn write(dir: &Path, frames: &[ImageBuf<u8>], times: &[f64], mm_per_pixel: f64) 
 fn measure(label: &str, dir: &Path) -> (Measurement, [Quality; 3]) {
     let m = measure_sample(dir, &Overrides::default(), &|_| {}).unwrap();
     let q = m.quality().into_array();
-    let truth = by_name(MATERIAL).unwrap().sigma_s_prime;
+    let truth = common::material(MATERIAL).sigma_s_prime;
     let mut line = format!("{label:24}");
     for c in 0..3 {
         let err = m.fits[scatterfit_optics::Channel::ALL[c]]

@@ -4,6 +4,8 @@
 //! plastic, seed 1) and must be caught for the right reason; the good twin stays ok. Every case
 //! here measured "ok" before these checks (the errors are in RELIABILITY.md).
 
+mod common;
+
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -11,25 +13,13 @@ use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
 use scatterfit_pipeline::checks::{Quality, ReasonKind, Verdict};
 use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
-use scatterfit_synth::{RigSpec, SyntheticSample, synthesize};
+use scatterfit_synth::{RigSpec, SyntheticSample};
 
 const MATERIAL: &str = "pink-plastic";
 
 /// The quick rig twin of a built-in material, seed 1.
 fn quick(name: &str) -> SyntheticSample {
-    let m = by_name(name).unwrap();
-    synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        &RigSpec::quick(),
-        1,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap()
+    common::quick_twin(name, 1)
 }
 
 fn twin() -> &'static SyntheticSample {
@@ -74,7 +64,7 @@ fn write(
 fn measure(label: &str, dir: &Path, overrides: &Overrides) -> (Measurement, [Quality; 3]) {
     let m = measure_sample(dir, overrides, &|_| {}).unwrap();
     let q = m.quality().into_array();
-    let t = by_name(MATERIAL).unwrap();
+    let t = common::material(MATERIAL);
     let mut line = format!("{label:28}");
     for c in Channel::ALL {
         let (es, ea) = m.fits[c].report().map_or((f64::NAN, f64::NAN), |r| {
@@ -114,7 +104,7 @@ fn exact_by_default_and_an_approximate_model_carries_its_error() {
     assert_eq!(m.settings.model, ModelName::Mc);
     assert_eq!(m.settings.albedo_model, AlbedoModel::Mc);
     assert!(q.iter().all(|q| q.verdict == Verdict::Ok), "{q:?}");
-    let t = by_name(MATERIAL).unwrap();
+    let t = common::material(MATERIAL);
     for c in Channel::ALL {
         let f = m.fits[c].fit().unwrap();
         assert_eq!(f.sigma_s_prime.model, None);
@@ -170,7 +160,7 @@ fn a_scale_ten_percent_off_is_suspect() {
 #[test]
 fn another_samples_spectro_file_is_suspect() {
     let root = tempfile::tempdir().unwrap();
-    let other = by_name("brown-leather").unwrap();
+    let other = common::material("brown-leather");
     let albedo = scatterfit_mc::albedo_family(AlbedoModel::Mc, ModelName::Mc).unwrap();
     let rd: [f64; 3] = std::array::from_fn(|c| {
         let a = other.sigma_s_prime[c] / (other.sigma_s_prime[c] + other.sigma_a[c]);

@@ -19,13 +19,14 @@
 //!   part of sd(g) 0.2–1; BENCHMARKS.md "Can g be fitted from the rig's profile?".)
 //! - a g-given run's `g_uncertainty` has no `fitted` record (its outputs do not change).
 
+mod common;
+
 use scatterfit_io::manifest::{FitSection, GSetting};
 use scatterfit_io::result_json::GSource;
 use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
 use scatterfit_pipeline::{Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
-use scatterfit_synth::{RigSpec, synthesize};
+use scatterfit_synth::RigSpec;
 
 /// Standard errors allowed between the fitted g and the truth.
 const K: f64 = 2.0;
@@ -34,18 +35,8 @@ const K: f64 = 2.0;
 fn measured(dir: &std::path::Path, name: &str, seed: u64) -> scatterfit_pipeline::Measurement {
     let mut rig = RigSpec::quick();
     rig.g = 0.9;
-    let m = by_name(name).unwrap();
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        &rig,
-        seed,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap();
+    let m = common::material(name);
+    let s = common::twin(name, &rig, seed);
     let folder = dir.join(m.name);
     let fit = FitSection {
         model: Some(ModelName::Mc),

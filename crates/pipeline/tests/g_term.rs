@@ -13,13 +13,14 @@
 //! 2.9–4.2 % of σa inside the total and 2.9–8.8 % outside fit ⊕ spectro, while the twin's error with
 //! g given is ≈ 1 % (BENCHMARKS.md "The rig twin at g ≠ 0").
 
+mod common;
+
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::GSource;
 use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, ModelName};
 use scatterfit_pipeline::{Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
-use scatterfit_synth::{RigSpec, synthesize};
+use scatterfit_synth::RigSpec;
 
 /// A quick-rig twin of the built-in material `name` at η and the twin's g (seed `seed`), written as a
 /// sample folder with the `[fit]` section `fit` (the manifest states no g, as a user who does not
@@ -34,18 +35,8 @@ fn twin(
     let dir = tempfile::tempdir().unwrap();
     let mut rig = RigSpec::quick();
     rig.g = g;
-    let m = by_name(name).unwrap();
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        eta.unwrap_or(m.eta),
-        &rig,
-        seed,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap();
+    let m = common::material(name);
+    let s = common::twin_of(m, eta.unwrap_or(m.eta), &rig, seed, None);
     let folder = dir.path().join(m.name);
     write_twin_folder(&folder, &s, &TwinFolder::new(fit, "g_term test")).unwrap();
     (dir, folder)
@@ -83,7 +74,7 @@ fn exact() -> FitSection {
 
 #[test]
 fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
-    let m = by_name("wood-tile").unwrap();
+    let m = common::material("wood-tile");
     let (_dir, folder) = twin(m.name, None, 0.8, 7, exact());
     let measured = measured_at(&folder, None);
     let r = measured.to_result(None);

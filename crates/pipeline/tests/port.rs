@@ -6,6 +6,8 @@
 //! when the reading is taken as loss-free and back near the truth once the manifest names the port.
 //! Fixed seeds; tolerances below.
 
+mod common;
+
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::sample_folder::{CameraFiles, SampleFiles, write_sample_folder_with};
 use scatterfit_mc::port::simulate_port_reading;
@@ -13,9 +15,8 @@ use scatterfit_mc::{Layer, Sample};
 use scatterfit_optics::port::Port;
 use scatterfit_optics::{AlbedoModel, ModelName};
 use scatterfit_pipeline::{Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
+use scatterfit_synth::RigSpec;
 use scatterfit_synth::spectro::reading_for;
-use scatterfit_synth::{RigSpec, synthesize};
 
 /// σa's relative error per channel of `name`: the port's reading taken as loss-free, the port's
 /// reading corrected (the manifest names the port), and the loss-free reading (the twin's baseline).
@@ -59,19 +60,9 @@ fn errors_both(
     rig: &RigSpec,
     cache: Option<&std::path::Path>,
 ) -> PortErrors {
-    let m = by_name(name).unwrap();
+    let m = common::material(name);
     let t = std::time::Instant::now();
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        rig,
-        seed,
-        cache,
-        &|_, _, _| {},
-    )
-    .unwrap();
+    let s = common::twin_of(m, m.eta, rig, seed, cache);
     eprintln!("{name}: twin in {:.0} s", t.elapsed().as_secs_f64());
     let port = Port::new(illuminated_mm, aperture_mm).unwrap();
     let env = |key: &str, default: f64| {
@@ -313,17 +304,7 @@ fn quick_twin_behind_8_mm_port(
     scatterfit_synth::SyntheticSample,
     scatterfit_optics::spectro::SpectroReading,
 ) {
-    let s = synthesize(
-        m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        &RigSpec::quick(),
-        seed,
-        None,
-        &|_, _, _| {},
-    )
-    .unwrap();
+    let s = common::twin_of(m, m.eta, &RigSpec::quick(), seed, None);
     let port = Port::new(8.0, 8.0).unwrap();
     let read: [f64; 3] = std::array::from_fn(|c| {
         let layer =
@@ -350,7 +331,7 @@ fn quick_twin_behind_8_mm_port(
 /// −43 … −2 % on other materials: pink plastic, potato, skin2 R).
 #[test]
 fn the_port_corrected_albedo_error_follows_the_reading() {
-    let m = by_name("wood-tile").unwrap();
+    let m = common::material("wood-tile");
     let rig = RigSpec::quick();
     let (s, reading) = quick_twin_behind_8_mm_port(m, 5, 50);
     let eps = 0.005;
@@ -427,7 +408,7 @@ fn the_port_corrected_albedo_error_follows_the_reading() {
 #[test]
 fn the_fit_error_reaches_the_port_corrected_values_through_f() {
     use scatterfit_optics::Channel;
-    let m = by_name("pink-plastic").unwrap();
+    let m = common::material("pink-plastic");
     let rig = RigSpec::quick();
     let (s, reading) = quick_twin_behind_8_mm_port(m, 9, 70);
     let dir = tempfile::tempdir().unwrap();
@@ -493,11 +474,11 @@ fn the_fit_error_reaches_the_port_corrected_values_through_f() {
 /// The port study behind BENCHMARKS.md "The spectrophotometer port: the correction on the twin":
 /// materials from α′ 0.35 to 0.9995, an 8 mm aperture lit over 14 mm and over 8 mm; per channel
 /// σ′s and σa as read (loss-free), corrected, and the twin's baseline (the loss-free reading).
-/// Prints a Markdown table; about 3 min on 2 cores.
+/// Prints a Markdown table and asserts the medians within 2.5 %; about 3 min on 2 cores.
 #[test]
-#[ignore = "study: prints BENCHMARKS.md's table (cargo test -p scatterfit-pipeline --test port -- --ignored --nocapture)"]
+#[ignore = "study: minutes; prints BENCHMARKS.md's table and asserts the medians (cargo test -p scatterfit-pipeline --test port -- --ignored --nocapture)"]
 fn port_study() {
-    port_study_on(&QUICK_STUDY_MATERIALS, &RigSpec::quick(), None);
+    port_study_on(&QUICK_STUDY_MATERIALS, &RigSpec::quick(), None, 0.025);
 }
 
 /// The quick-rig study's materials, α′ 0.02–0.9996.
@@ -550,12 +531,21 @@ fn port_study_paper() {
     let rig = RigSpec::paper()
         .with_photon_scale(scale)
         .expect("PORT_TWIN_SCALE in [0.01, 1000]");
-    port_study_on(&names, &rig, cache.as_deref());
+    port_study_on(&names, &rig, cache.as_deref(), 0.01);
 }
 
 /// Prints the port study's table for `materials` on `rig` (seeds 20, 21, … in the quick study's
 /// material order, so a material has the same seed in both studies).
-fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Path>) {
+/// Measures `materials` behind both ports on `rig`, prints the table, and asserts the target in the
+/// median: corrected against the truth over α′ 0.3–0.9999, σ′s's and σa's median |error| within
+/// `median_bound` (the paper rig meets 1 % with a margin of 2; the quick rig's 12.8 mm field is its
+/// own limit at α′ ≥ 0.99, BENCHMARKS.md "The spectrophotometer port: the correction on the twin").
+fn port_study_on(
+    materials: &[&str],
+    rig: &RigSpec,
+    cache: Option<&std::path::Path>,
+    median_bound: f64,
+) {
     println!(
         "| port (lit / aperture) | material | ch | α′ | σ′s read / corrected / baseline | σa read / corrected / baseline | σa from the reading's noise (1 s.e.) | corrected σa's reported bar (fit ⊕ spectro) |"
     );
@@ -566,7 +556,7 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
         let mut truth = Vec::new();
         let mut covered = Vec::new();
         for name in materials {
-            let m = by_name(name).unwrap();
+            let m = common::material(name);
             let k = QUICK_STUDY_MATERIALS
                 .iter()
                 .position(|q| q == name)
@@ -632,6 +622,14 @@ fn port_study_on(materials: &[&str], rig: &RigSpec, cache: Option<&std::path::Pa
             100.0 * sa[sa.len() - 1],
             sa.len(),
             in_range.len()
+        );
+        let (sp_median, sa_median) = (sp[sp.len() / 2], sa[sa.len() / 2]);
+        assert!(
+            sp_median <= median_bound && sa_median <= median_bound,
+            "port {ill}/{ap} mm: median |error| σ′s {:.2} %, σa {:.2} %, beyond {:.1} %",
+            100.0 * sp_median,
+            100.0 * sa_median,
+            100.0 * median_bound
         );
         let in_range: Vec<bool> = covered
             .iter()

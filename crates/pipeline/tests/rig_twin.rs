@@ -4,12 +4,13 @@
 //! within 5 % and σa within 12 % (median over channels with α′ in [0.9, 0.9995] and η ≤ 1.6), η
 //! within 0.005 — on the quick rig (256² px at 0.1 mm/px, a tenth of the photons; fixed seeds).
 
+mod common;
+
 use scatterfit_io::result_json::{ChannelStatus, parse_result_json};
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
 use scatterfit_optics::Method;
 use scatterfit_pipeline::{Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
-use scatterfit_synth::{RigSpec, synthesize};
+use scatterfit_synth::RigSpec;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -25,18 +26,8 @@ fn proposed_method_meets_the_targets_on_twin_samples() {
         .iter()
         .enumerate()
     {
-        let m = by_name(name).unwrap();
-        let s = synthesize(
-            m.name,
-            m.sigma_s_prime,
-            m.sigma_a,
-            m.eta,
-            &rig,
-            7 + k as u64,
-            None,
-            &|_, _, _| {},
-        )
-        .unwrap();
+        let m = common::material(name);
+        let s = common::twin(name, &rig, 7 + k as u64);
         let folder = dir.path().join(m.name);
         write_sample_folder(
             &folder,

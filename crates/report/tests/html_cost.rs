@@ -25,10 +25,12 @@ fn median(mut v: Vec<f64>) -> f64 {
 #[test]
 #[ignore = "a timing; run by hand with SCATTERFIT_BENCH_SAMPLE"]
 fn sample_page_costs_under_a_tenth_of_the_measurement() {
-    let Some(dir) = std::env::var_os("SCATTERFIT_BENCH_SAMPLE").map(PathBuf::from) else {
-        eprintln!("set SCATTERFIT_BENCH_SAMPLE to a sample folder");
-        return;
-    };
+    // Run by hand, so a missing folder is a failure that says what to set, not a silent pass.
+    let dir = std::env::var_os("SCATTERFIT_BENCH_SAMPLE")
+        .map(PathBuf::from)
+        .expect(
+            "set SCATTERFIT_BENCH_SAMPLE to a sample folder (one that `scatterfit demo` wrote)",
+        );
     let out = tempfile::tempdir().unwrap();
     let runs = 5;
     let mut measure = Vec::new();
