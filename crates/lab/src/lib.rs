@@ -6,7 +6,7 @@
 //! - [`study`]: the bias study over α′, η and g (`scatterfit study`), its rows and tables, and
 //!   [`study_figure`], its figure;
 //! - [`accuracy`]: the demo's table of each measured value against the twin's truth, and
-//!   [`accuracy_markdown`], its Markdown.
+//!   [`accuracy_markdown()`], its Markdown.
 //!
 //! The layers below ([`scatterfit_pipeline`], [`scatterfit_report`], `scatterfit-render`) know
 //! nothing of the twin; this crate joins the two (ARCHITECTURE.md, "Workspace layout").
