@@ -12,7 +12,7 @@ use crate::{Figure, Result};
 pub fn figures(quick: bool) -> Result<Vec<Figure>> {
     let (size, triangles) = if quick { (128, 20_000) } else { (512, 100_000) };
     let threads = rayon::current_num_threads();
-    let m = &scatterfit_synth::materials::CHOI_2014[0];
+    let m = &scatterfit_optics::materials::CHOI_2014[0];
     let material = Material::dipole(
         scatterfit_optics::Rgb::from_fn(|c| (m.sigma_s_prime[c.index()], m.sigma_a[c.index()])),
         m.eta,

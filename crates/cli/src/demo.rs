@@ -15,7 +15,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use scatterfit_io::result_json::MeasurementResult;
-use scatterfit_synth::materials::CHOI_2014;
+use scatterfit_optics::materials::CHOI_2014;
 
 use crate::common::CacheArgs;
 use crate::output::{errln, out, outln};

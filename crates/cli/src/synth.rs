@@ -7,7 +7,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use scatterfit_io::sample_folder::file_names;
-use scatterfit_synth::{RigSpec, materials};
+use scatterfit_optics::materials;
+use scatterfit_synth::RigSpec;
 use serde::Serialize;
 
 use crate::common::{CacheArgs, check_output_files, parse_rgb, shutter};

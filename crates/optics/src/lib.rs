@@ -33,6 +33,7 @@ pub mod dipole;
 pub mod estimate;
 pub mod family;
 pub mod fresnel;
+pub mod materials;
 pub mod model;
 pub mod names;
 pub mod pbd;

@@ -10,9 +10,9 @@
 
 use scatterfit_io::manifest::{FitSection, GSetting};
 use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
+use scatterfit_optics::materials::by_name;
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
 use scatterfit_pipeline::{Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
 
 fn main() {

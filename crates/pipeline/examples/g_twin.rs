@@ -22,10 +22,10 @@
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
+use scatterfit_optics::materials::by_name;
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
 use scatterfit_pipeline::fit::FitSettings;
 use scatterfit_pipeline::{Overrides, measure_sample};
-use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
 
 fn main() {
@@ -153,10 +153,10 @@ fn main() {
 }
 
 /// The α′ range the g-aware model is meant for, at one η (module docs): α′ 0.3, 0.99 and 0.9999.
-fn range_material(name: &str, eta: f64) -> scatterfit_synth::materials::PublishedMaterial {
+fn range_material(name: &str, eta: f64) -> scatterfit_optics::materials::PublishedMaterial {
     let sigma_s_prime = [1.0, 1.5, 3.0];
     let albedo = [0.3, 0.99, 0.9999];
-    scatterfit_synth::materials::PublishedMaterial {
+    scatterfit_optics::materials::PublishedMaterial {
         name: Box::leak(name.to_string().into_boxed_str()),
         source: "the α′ range of the g-aware model (0.3–0.9999)",
         sigma_s_prime,

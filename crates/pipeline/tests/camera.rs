@@ -714,7 +714,7 @@ fn a_raw_bracket_agrees_with_the_8_bit_one() {
     use scatterfit_io::manifest::ModelName;
     use scatterfit_io::sample_folder::{CameraFiles, SampleFiles, write_sample_folder_with};
     use scatterfit_pipeline::{Overrides, measure_sample};
-    let m = scatterfit_synth::materials::by_name("wood-tile").unwrap();
+    let m = scatterfit_optics::materials::by_name("wood-tile").unwrap();
     let dir = tempfile::tempdir().unwrap();
     let mut results = Vec::new();
     for camera in ["naka-rushton", "dng"] {

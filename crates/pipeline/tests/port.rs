@@ -297,7 +297,7 @@ fn an_8_mm_port_lit_over_14_mm_is_corrected() {
 /// The quick-rig twin of `m` (seed `seed`) and its spectrophotometer reading through an 8 mm port
 /// lit over 8 mm, traced by the engine with 10⁵ photons per channel (seeds `port_seed` + channel).
 fn quick_twin_behind_8_mm_port(
-    m: &scatterfit_synth::materials::PublishedMaterial,
+    m: &scatterfit_optics::materials::PublishedMaterial,
     seed: u64,
     port_seed: u64,
 ) -> (

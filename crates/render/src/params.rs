@@ -1,6 +1,6 @@
 //! Where a render's parameters come from: a `result.json` of `scatterfit measure` (read through
 //! `scatterfit_io::result_json`'s checked reader), or one of Choi et al.'s published sets by name
-//! (`scatterfit_synth::materials`: Table 1, and the existing method's values quoted with Figure 5).
+//! (`scatterfit_optics::materials`: Table 1, and the existing method's values quoted with Figure 5).
 //! The material the renderer shades with is made by the one name → model factory,
 //! `scatterfit_mc::family`, with the model the parameters were fitted with unless the caller
 //! overrides it.
@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use scatterfit_io::result_json::{
     MeasurementResult, ResultJsonError, read_result_json, read_result_json_assuming,
 };
+use scatterfit_optics::materials::{PublishedSet, choi_2014_set, choi_2014_sets};
 use scatterfit_optics::{ModelName, Rgb};
-use scatterfit_synth::materials::{PublishedSet, choi_2014_set, choi_2014_sets};
 
 use crate::error::{RenderError, Result};
 use crate::profile::Material;

@@ -8,13 +8,13 @@ use std::path::Path;
 
 use scatterfit_io::result_json::parse_result_json;
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
+use scatterfit_optics::materials::by_name;
 use scatterfit_pipeline::Method;
 use scatterfit_pipeline::{Measurement, Overrides, measure_sample};
 use scatterfit_report::{
     ReportError, compare_figure, fit_figure, render_png, summary_text, write_figure,
     write_measurement,
 };
-use scatterfit_synth::materials::by_name;
 use scatterfit_synth::{RigSpec, synthesize};
 
 /// Wood tile on the quick rig, seed 3, written as a sample folder and measured.

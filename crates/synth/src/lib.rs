@@ -3,12 +3,11 @@
 //! From known optical parameters it produces what the instruments would record — a d/8
 //! spectrophotometer reading ([`spectro`]) and the imaging rig's exposure bracket ([`rig`]) — with
 //! the Monte Carlo engine (`scatterfit-mc`), never with the diffusion model the tool fits, so that
-//! the whole pipeline can be tested end to end against a known truth. [`materials`] holds the
-//! published materials that drive the demo; [`synthesize`] puts the pieces together.
+//! the whole pipeline can be tested end to end against a known truth. The published materials that drive
+//! the demo are `scatterfit_optics::materials`; [`synthesize`] puts the pieces together.
 
 #![forbid(unsafe_code)]
 
-pub mod materials;
 pub mod mishaps;
 pub mod port;
 pub mod rig;

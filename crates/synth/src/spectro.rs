@@ -139,8 +139,8 @@ fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::materials::CHOI_2014;
     use scatterfit_optics::dipole::rd_total;
+    use scatterfit_optics::materials::CHOI_2014;
 
     /// The synthetic SCE reproduces the wanted linear sRGB through the independent colour pipeline,
     /// and SCI − SCE is the exact Fresnel reflectance, for every material of the demo.

@@ -2,7 +2,7 @@
 //! the fit and the whole measurement timed on it (`scatterfit_bench::fit`).
 
 use anyhow::Context;
-use scatterfit_synth::materials::by_name;
+use scatterfit_optics::materials::by_name;
 
 use super::{Args, Figure};
 

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use scatterfit_synth::materials::{PublishedMaterial, by_name};
+use scatterfit_optics::materials::{PublishedMaterial, by_name};
 use scatterfit_synth::{RigSpec, SyntheticSample, synthesize};
 
 /// The built-in material `name` (`scatterfit synth --material` lists them).

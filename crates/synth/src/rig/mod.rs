@@ -642,7 +642,7 @@ mod tests {
     fn photon_budget() {
         for (rig, budget) in [(RigSpec::paper(), 2e7), (RigSpec::quick(), 2e6)] {
             let mut inside_the_bounds = 0;
-            for m in crate::materials::CHOI_2014 {
+            for m in scatterfit_optics::materials::CHOI_2014 {
                 for c in 0..3 {
                     let (sp, sa) = (m.sigma_s_prime[c], m.sigma_a[c]);
                     let photons = photons_for(sp, sa, &rig);

@@ -2,7 +2,7 @@
 //! tests: the one place the workspace keeps them ([`CHOI_2014`], [`CHOI_2014_EXISTING`],
 //! [`JENSEN_2001`]; [`choi_2014_set`] finds a set of Choi et al. by name).
 
-use scatterfit_optics::Method;
+use crate::Method;
 
 /// A material's published parameters per linear-sRGB channel (R, G, B).
 #[derive(Debug, Clone, Copy, PartialEq)]
