@@ -343,11 +343,27 @@ fn a_heavily_compressed_jpeg_bracket_is_suspect() {
     }
 }
 
+/// The good twin's folder with `frame` written as `KEY.png` and named by `camera.KEY` (`flat`,
+/// `dark`), measured.
+fn measure_with_camera_file(
+    dir: &Path,
+    key: &str,
+    frame: scatterfit_imaging::ImageBuf<u8>,
+) -> Result<Measurement, scatterfit_pipeline::PipelineError> {
+    use scatterfit_io::image_files::{CameraFrame, write_camera_frame};
+    write_frames(dir, &twin().bracket.frames);
+    write_camera_frame(&dir.join(format!("{key}.png")), &CameraFrame::U8(frame)).unwrap();
+    let toml = dir.join("sample.toml");
+    let text = std::fs::read_to_string(&toml).unwrap();
+    let line = format!("[camera]\n{key} = \"{key}.png\"\n");
+    std::fs::write(&toml, text.replacen("[camera]\n", &line, 1)).unwrap();
+    measure_sample(dir, &Overrides::default(), &|_| {})
+}
+
 /// A frame of the bracket given as the flat frame (it holds the spot) is refused, naming the file
 /// and what a flat looks like; a flat of a uniform target through a vignetting lens is used.
 #[test]
 fn a_frame_of_the_spot_given_as_the_flat_is_refused() {
-    use scatterfit_io::image_files::{CameraFrame, write_camera_frame};
     let root = tempfile::tempdir().unwrap();
     let s = twin();
     let lit = s.bracket.frames[s.bracket.frames.len() / 2].clone();
@@ -364,17 +380,8 @@ fn a_frame_of_the_spot_given_as_the_flat_is_refused() {
     }
     let flat = scatterfit_imaging::ImageBuf::new(w, h, ch, vignetted).unwrap();
     for (label, frame, refused) in [("spot as flat", lit, true), ("flat", flat, false)] {
-        let d = root.path().join(label.replace(' ', "_"));
-        write_frames(&d, &s.bracket.frames);
-        write_camera_frame(&d.join("flat.png"), &CameraFrame::U8(frame)).unwrap();
-        let toml = d.join("sample.toml");
-        let text = std::fs::read_to_string(&toml).unwrap();
-        std::fs::write(
-            &toml,
-            text.replacen("[camera]\n", "[camera]\nflat = \"flat.png\"\n", 1),
-        )
-        .unwrap();
-        let got = measure_sample(&d, &Overrides::default(), &|_| {});
+        let got =
+            measure_with_camera_file(&root.path().join(label.replace(' ', "_")), "flat", frame);
         println!("{label}: {:?}", got.as_ref().err().map(ToString::to_string));
         if refused {
             let e = got.expect_err("refused").to_string();
@@ -392,7 +399,6 @@ fn a_frame_of_the_spot_given_as_the_flat_is_refused() {
 /// file and the lit block; a dark frame of the camera's own noise floor is used.
 #[test]
 fn a_lit_frame_given_as_the_dark_frame_is_refused() {
-    use scatterfit_io::image_files::{CameraFrame, write_camera_frame};
     let root = tempfile::tempdir().unwrap();
     let s = twin();
     let lit = s.bracket.frames[0].clone();
@@ -401,17 +407,8 @@ fn a_lit_frame_given_as_the_dark_frame_is_refused() {
     let floor =
         scatterfit_imaging::ImageBuf::new(lit.width(), lit.height(), lit.channels(), data).unwrap();
     for (label, dark, refused) in [("lit dark frame", lit, true), ("dark frame", floor, false)] {
-        let d = root.path().join(label.replace(' ', "_"));
-        write_frames(&d, &s.bracket.frames);
-        write_camera_frame(&d.join("dark.png"), &CameraFrame::U8(dark)).unwrap();
-        let toml = d.join("sample.toml");
-        let text = std::fs::read_to_string(&toml).unwrap();
-        std::fs::write(
-            &toml,
-            text.replacen("[camera]\n", "[camera]\ndark = \"dark.png\"\n", 1),
-        )
-        .unwrap();
-        let got = measure_sample(&d, &Overrides::default(), &|_| {});
+        let got =
+            measure_with_camera_file(&root.path().join(label.replace(' ', "_")), "dark", dark);
         println!("{label}: {:?}", got.as_ref().err().map(ToString::to_string));
         if refused {
             let e = got.expect_err("refused").to_string();
