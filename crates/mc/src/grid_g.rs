@@ -330,30 +330,7 @@ impl McGridSet {
         let (lo, hi) = self.albedo_prime_range(g)?;
         // The nodes and weights once, not per bisection step (η is checked above).
         let weights = self.weights(g)?;
-        let total = |ap: f64| total_of(&weights, ap, eta);
-        let (r_lo, r_hi) = (total(lo)?, total(hi)?);
-        if !(rd >= r_lo && rd <= r_hi) {
-            return Err(McError::OutOfTable {
-                name: "rd_total",
-                value: rd,
-                min: r_lo,
-                max: r_hi,
-            });
-        }
-        let (mut u_lo, mut u_hi) = ((1.0 - hi).sqrt(), (1.0 - lo).sqrt());
-        for _ in 0..200 {
-            let u = 0.5 * (u_lo + u_hi);
-            if u <= u_lo || u >= u_hi || u_hi - u_lo < 1e-14 {
-                break;
-            }
-            if total(1.0 - u * u)? >= rd {
-                u_lo = u;
-            } else {
-                u_hi = u;
-            }
-        }
-        let u = 0.5 * (u_lo + u_hi);
-        Ok((1.0 - u * u).clamp(lo, hi))
+        crate::model::invert_increasing_total(rd, lo, hi, |ap| total_of(&weights, ap, eta))
     }
 }
 
