@@ -79,6 +79,21 @@ impl FitSettings {
     }
 }
 
+/// Exact transport's fit of a channel measured with an approximate model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ExactFit {
+    /// σ′s \[mm⁻¹\].
+    pub sigma_s_prime: f64,
+    /// σa \[mm⁻¹\].
+    pub sigma_a: f64,
+    /// α′.
+    pub albedo_prime: f64,
+    /// χ² per degree of freedom of its fit to the same rings.
+    pub chi2_reduced: f64,
+    /// Its fitted scale k (measured = k · model).
+    pub scale: f64,
+}
+
 /// A fitted channel: the solver's report and the measured values with their uncertainty terms.
 #[derive(Debug, Clone, Serialize)]
 pub struct ChannelFit {
@@ -104,7 +119,7 @@ pub struct ChannelFit {
     pub g_fit: Option<crate::anisotropy_fit::GFit>,
     /// With an approximate forward model: exact transport's fit of the same data
     /// ([`crate::model_term`]), whose distance from this one is each estimate's `model` term.
-    pub exact: Option<crate::model_term::ExactFit>,
+    pub exact: Option<ExactFit>,
     /// With an approximate forward model: why exact transport could not be evaluated (the
     /// estimates then have no `model` term and the channel is suspect).
     pub model_note: Option<String>,

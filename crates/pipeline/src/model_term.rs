@@ -14,25 +14,11 @@
 //! does not describe the profile.
 
 use scatterfit_optics::{AlbedoModel, ModelName};
-use serde::Serialize;
 
 use crate::fit::{ChannelOutcome, FitSettings};
 use crate::measure::Measurement;
 
-/// Exact transport's fit of a channel measured with an approximate model.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ExactFit {
-    /// σ′s \[mm⁻¹\].
-    pub sigma_s_prime: f64,
-    /// σa \[mm⁻¹\].
-    pub sigma_a: f64,
-    /// α′.
-    pub albedo_prime: f64,
-    /// χ² per degree of freedom of its fit to the same rings.
-    pub chi2_reduced: f64,
-    /// Its fitted scale k (measured = k · model).
-    pub scale: f64,
-}
+pub use crate::fit::ExactFit;
 
 /// Whether `settings` use an approximate model for the profile or for α′.
 pub fn is_approximate(settings: &FitSettings) -> bool {
