@@ -229,12 +229,48 @@ pub(super) fn merge_8bit(
         // constant in the linear signal, a sensor's) unless the paper's hat, robust to a
         // processed camera's noise and to the response's errors near the ends, explains them
         // clearly better.
-        let (a, sa) = merge_with(Weighting::NoiseOptimal, corrections)?;
-        let (b, sb) = merge_with(Weighting::DebevecHat, corrections)?;
-        if sb.rms < AUTO_HAT_MARGIN * sa.rms {
-            (b, sb, Weighting::DebevecHat)
+        // Chosen on the frames decimated to about CONSISTENCY_PIXELS pixels (every d-th pixel
+        // of every d-th row: both merges and their scores at a fraction of the cost), then the
+        // bracket merged once with the weighting chosen.
+        let n_px = bufs[0].width() * bufs[0].height();
+        let d = ((n_px as f64 / CONSISTENCY_PIXELS as f64).sqrt().ceil() as usize).max(1);
+        if d == 1 {
+            let (a, sa) = merge_with(Weighting::NoiseOptimal, corrections)?;
+            let (b, sb) = merge_with(Weighting::DebevecHat, corrections)?;
+            if sb.rms < AUTO_HAT_MARGIN * sa.rms {
+                (b, sb, Weighting::DebevecHat)
+            } else {
+                (a, sa, Weighting::NoiseOptimal)
+            }
         } else {
-            (a, sa, Weighting::NoiseOptimal)
+            let t = Instant::now();
+            let small = decimate(&bufs, d)?;
+            let score_on = |weighting: Weighting| -> Result<f64> {
+                let opts = MergeOptions {
+                    clipped_fill: cx.inputs.clipped_fill,
+                    weighting,
+                    expected_floor: Some(floor),
+                };
+                let hdr = scatterfit_imaging::merge(&small, &times_used, &response, None, &opts)
+                    .map_err(imaging("merging the decimated bracket"))?;
+                Ok(
+                    scatterfit_imaging::self_consistency(&small, stated, &response, &hdr)
+                        .map_err(imaging("scoring the decimated merge's self-consistency"))?
+                        .rms,
+                )
+            };
+            let (sa, sb) = (
+                score_on(Weighting::NoiseOptimal)?,
+                score_on(Weighting::DebevecHat)?,
+            );
+            corrections.time("weighting choice", t.elapsed().as_secs_f64());
+            let w = if sb < AUTO_HAT_MARGIN * sa {
+                Weighting::DebevecHat
+            } else {
+                Weighting::NoiseOptimal
+            };
+            let (h, s) = merge_with(w, corrections)?;
+            (h, s, w)
         }
     } else {
         let w = if cx.inputs.weighting_auto {
@@ -287,6 +323,27 @@ pub const CONSISTENCY_PIXELS: usize = 65_536;
 /// (processed JPEGs, phones; BENCHMARKS.md, "Real brackets"). On the twin the hat scores within
 /// 2–3 % of it (1.62 against 1.66 code values), on the JPEG brackets of the corpus 5–36 % lower.
 pub const AUTO_HAT_MARGIN: f64 = 0.95;
+
+/// Every `d`-th pixel of every `d`-th row of each frame (a regular decimation, for choosing the
+/// weighting on a sample of the bracket).
+fn decimate(bufs: &[ImageBuf<u8>], d: usize) -> Result<Vec<ImageBuf<u8>>> {
+    use rayon::prelude::*;
+    bufs.par_iter()
+        .map(|f| {
+            let (w, h, ch) = (f.width(), f.height(), f.channels());
+            let (sw, sh) = (w.div_ceil(d), h.div_ceil(d));
+            let mut data = Vec::with_capacity(sw * sh * ch);
+            for y in (0..h).step_by(d) {
+                let row = &f.data()[y * w * ch..(y + 1) * w * ch];
+                for x in (0..w).step_by(d) {
+                    data.extend_from_slice(&row[x * ch..(x + 1) * ch]);
+                }
+            }
+            ImageBuf::new(sw, sh, ch, data)
+                .map_err(|e| PipelineError::Input(format!("decimating a frame: {e}")))
+        })
+        .collect()
+}
 
 /// True when every step of `corrected` (times by rank) keeps at least half the stated step in
 /// log time: corrections move frames by a shutter's error, they do not merge or swap them.
