@@ -98,11 +98,30 @@ fn write_exposures_csv(dir: &Path, ext: &str, name: &str, times: &[f64]) -> Resu
     Ok(csv_path)
 }
 
+/// The parts of a merge's time ([`scatterfit_pipeline::hdr::Corrections::timings`]: the checks,
+/// the response recovery in all its rounds, the exposure estimate, each merge and its score), one
+/// figure each.
+fn merge_parts(stage: &scatterfit_pipeline::hdr::HdrStage, note: &str) -> Vec<Figure> {
+    stage
+        .corrections
+        .timings
+        .iter()
+        .map(|(part, s)| Figure {
+            name: format!("    {part}"),
+            value: *s,
+            unit: "s".into(),
+            note: note.to_string(),
+        })
+        .collect()
+}
+
 /// The end-to-end merge of a 13-exposure
 /// 24-MP 8-bit RGB bracket (PNG files read from disk, response recovered, merged; the same from
 /// quality-90 JPEGs) and the radial
-/// profile of the 24-MP radiance map. Set `SCATTERFIT_BENCH_BRACKET_DIR` to keep the bracket there
-/// (for timing `scatterfit merge` itself, e.g. under `/usr/bin/time -v`).
+/// profile of the 24-MP radiance map; each with the parts of the merge's time. Set
+/// `SCATTERFIT_BENCH_BRACKET_DIR` to keep the bracket there (for timing `scatterfit merge` itself,
+/// e.g. under `/usr/bin/time -v`), and `SCATTERFIT_BENCH_EXPOSURES` to an `exposures.csv` to see
+/// the parts of that bracket's merge too.
 pub fn figures(quick: bool) -> Result<Vec<Figure>> {
     let (width, height) = if quick { (1200, 800) } else { (6000, 4000) };
     let mp = (width * height) as f64 / 1e6;
@@ -149,9 +168,36 @@ pub fn figures(quick: bool) -> Result<Vec<Figure>> {
             name: "  of which response recovery + merge".into(),
             value: merged.merge_s,
             unit: "s".into(),
-            note,
+            note: note.clone(),
         },
     ];
+    figures.extend(merge_parts(&merged, &note));
+    // A bracket of the user's own (SCATTERFIT_BENCH_EXPOSURES=DIR/exposures.csv): where its merge's
+    // time goes, with the same parts.
+    if let Some(csv) = std::env::var_os("SCATTERFIT_BENCH_EXPOSURES").map(PathBuf::from) {
+        let t0 = Instant::now();
+        let own = read_and_merge(&HdrInputs::new(Some(csv.clone()), Vec::new()), &|_| {})?;
+        let own_note = format!("{} × {}, {threads} threads", own.frames.len(), own.image);
+        figures.push(Figure {
+            name: format!("merge end to end: {}", csv.display()),
+            value: t0.elapsed().as_secs_f64(),
+            unit: "s".into(),
+            note: own_note.clone(),
+        });
+        figures.push(Figure {
+            name: "  of which reading".into(),
+            value: own.read_s,
+            unit: "s".into(),
+            note: own_note.clone(),
+        });
+        figures.push(Figure {
+            name: "  of which response recovery + merge".into(),
+            value: own.merge_s,
+            unit: "s".into(),
+            note: own_note.clone(),
+        });
+        figures.extend(merge_parts(&own, &own_note));
+    }
     drop(merged.hdr.clipped);
     let radiance = merged.hdr.radiance;
     // The same bracket as quality-90 JPEGs (files as a camera writes them): reading only, then the

@@ -28,13 +28,15 @@ pub mod text;
 
 pub use buffer::{ImageBuf, ShapeError};
 pub use center::{CenterOptions, SpotCenter, find_spot_center};
-pub use consistency::{SelfConsistency, WELL_EXPOSED, self_consistency};
+pub use consistency::{SelfConsistency, WELL_EXPOSED, self_consistency, self_consistency_sampled};
 pub use error::{ImagingError, Result};
 pub use merge::{
     CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, LinearMergeOptions, MIN_VALID_FRACTION,
     MergeOptions, Weighting, merge, merge_linear_black, merge_linear_u16,
 };
-pub use order::{BracketSignal, bracket_signal, check_bracket_order};
+pub use order::{
+    BracketSignal, bracket_signal, check_bracket_order, check_bracket_order_with_signal,
+};
 pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{
     CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,

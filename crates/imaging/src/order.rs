@@ -11,6 +11,8 @@
 //! everywhere, the film's pedestal, which drifts by a code from frame to frame; compared value by
 //! value they look out of order by noise alone.
 
+use rayon::prelude::*;
+
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result, check_bracket};
 
@@ -60,7 +62,7 @@ fn subsample(n_pixels: usize) -> usize {
 /// Bracket errors.
 pub fn bracket_signal<T>(frames: &[ImageBuf<T>], times_s: &[f64], max: T) -> Result<BracketSignal>
 where
-    T: Copy + PartialOrd + Default + Into<f64>,
+    T: Copy + PartialOrd + Default + Sync + Into<f64>,
 {
     check_bracket(frames, times_s)?;
     let ch = frames[0].channels();
@@ -68,8 +70,10 @@ where
     let step = subsample(n_px);
     let p = frames.len();
     let zero = T::default();
-    // Per channel, per frame.
+    // Per channel, per frame (in parallel: every frame's floor is a selection over the channel's
+    // pixels).
     let by_channel: Vec<Vec<f64>> = (0..ch)
+        .into_par_iter()
         .map(|c| {
             // Pixels with some value above the low clip, and their summed codes.
             let (mut idx, mut total) = (Vec::new(), Vec::new());
@@ -92,19 +96,25 @@ where
             let take =
                 ((FLOOR_DARKEST_FRACTION * idx.len() as f64).ceil() as usize).clamp(1, idx.len());
             frames
-                .iter()
+                .par_iter()
                 .map(|f| {
                     // The darkest pixels by the *other* frames' codes, so that frame j's own noise does
-                    // not choose them (which would pull its floor low).
-                    let mut keyed: Vec<(f64, usize)> = idx
+                    // not choose them (which would pull its floor low). The codes are whole numbers:
+                    // the key (the others' sum) and the pixel's position packed into one integer,
+                    // so that equal sums are taken in raster order.
+                    let mut keyed: Vec<u64> = idx
                         .iter()
                         .zip(&total)
-                        .map(|(&k, &t)| (t - f.data()[k].into(), k))
+                        .enumerate()
+                        .map(|(pos, (&k, &t))| {
+                            let others = (t - f.data()[k].into()).max(0.0) as u64;
+                            (others.min(u64::from(u32::MAX)) << 32) | pos as u64
+                        })
                         .collect();
-                    keyed.select_nth_unstable_by(take - 1, |a, b| a.0.total_cmp(&b.0));
+                    keyed.select_nth_unstable(take - 1);
                     let mut v: Vec<f64> = keyed[..take]
                         .iter()
-                        .map(|&(_, k)| f.data()[k].into())
+                        .map(|&key| f.data()[idx[(key & u64::from(u32::MAX)) as usize]].into())
                         .collect();
                     v.sort_by(f64::total_cmp);
                     let q =
@@ -117,20 +127,23 @@ where
     let floor: Vec<Vec<f64>> = (0..p)
         .map(|j| by_channel.iter().map(|f| f[j]).collect())
         .collect();
-    let mut signal_fraction = vec![0.0; p];
-    for (j, f) in frames.iter().enumerate() {
-        let (mut above, mut total) = (0usize, 0usize);
-        for i in (0..n_px).step_by(step) {
-            for (c, fl) in floor[j].iter().enumerate() {
-                let v = f.data()[i * ch + c];
-                total += 1;
-                if v.into() > *fl && v < max {
-                    above += 1;
+    let signal_fraction: Vec<f64> = frames
+        .par_iter()
+        .zip(&floor)
+        .map(|(f, fl)| {
+            let (mut above, mut total) = (0usize, 0usize);
+            for i in (0..n_px).step_by(step) {
+                for (c, fl) in fl.iter().enumerate() {
+                    let v = f.data()[i * ch + c];
+                    total += 1;
+                    if v.into() > *fl && v < max {
+                        above += 1;
+                    }
                 }
             }
-        }
-        signal_fraction[j] = above as f64 / total.max(1) as f64;
-    }
+            above as f64 / total.max(1) as f64
+        })
+        .collect();
     // Kept generously: noise alone lifts up to 1 − FLOOR_QUANTILE of a dark frame's values above
     // its floor, so a frame of pure noise counts as one with signal (and is merged, harmlessly);
     // a short frame whose only signal is a small bright spot — the only unclipped reading of the
@@ -170,6 +183,33 @@ where
     [T]: PartialEq,
 {
     let signal = bracket_signal(frames, times_s, max)?;
+    check_bracket_order_with_signal(frames, times_s, max, &signal)
+}
+
+/// [`check_bracket_order`] with the frames' [`bracket_signal`] already measured (on the same
+/// frames and times; a caller that needs both measures it once).
+///
+/// # Errors
+/// Bracket errors, [`ImagingError::InvalidOption`] for a signal of another bracket,
+/// [`ImagingError::BracketOutOfOrder`].
+pub fn check_bracket_order_with_signal<T>(
+    frames: &[ImageBuf<T>],
+    times_s: &[f64],
+    max: T,
+    signal: &BracketSignal,
+) -> Result<()>
+where
+    T: Copy + PartialOrd + PartialEq + Default + Sync + Into<f64>,
+    [T]: PartialEq,
+{
+    check_bracket(frames, times_s)?;
+    if signal.floor.len() != frames.len() || signal.has_signal.len() != frames.len() {
+        return Err(ImagingError::InvalidOption {
+            name: "signal",
+            value: signal.floor.len() as f64,
+            reason: "the bracket signal must be measured on the same frames (one floor per frame)",
+        });
+    }
     let mut order: Vec<usize> = (0..frames.len()).collect();
     order.sort_by(|&a, &b| times_s[a].total_cmp(&times_s[b]));
     let zero = T::default();
@@ -194,31 +234,39 @@ where
         .copied()
         .filter(|&j| signal.has_signal[j])
         .collect();
-    for pair in with_signal.windows(2) {
-        let (s, l) = (pair[0], pair[1]);
-        let (a, b) = (frames[s].data(), frames[l].data());
-        let (fa, fb) = (&signal.floor[s], &signal.floor[l]);
-        let (mut darker, mut brighter, mut evidence) = (0usize, 0usize, 0usize);
-        let (mut sum, mut sum2) = (0.0f64, 0.0f64);
-        for i in (0..n_px).step_by(step) {
-            for c in 0..ch {
-                let k = i * ch + c;
-                let (x, y) = (a[k], b[k]);
-                let (xf, yf): (f64, f64) = (x.into(), y.into());
-                if xf <= fa[c] || yf <= fb[c] || x >= max || y >= max {
-                    continue;
-                }
-                evidence += 1;
-                let d = yf - xf;
-                sum += d;
-                sum2 += d * d;
-                if d < 0.0 {
-                    darker += 1;
-                } else if d > 0.0 {
-                    brighter += 1;
+    // Each pair's evidence (in parallel), then judged in order of time.
+    let per_pair: Vec<(usize, usize, usize, f64, f64)> = with_signal
+        .par_windows(2)
+        .map(|pair| {
+            let (s, l) = (pair[0], pair[1]);
+            let (a, b) = (frames[s].data(), frames[l].data());
+            let (fa, fb) = (&signal.floor[s], &signal.floor[l]);
+            let (mut darker, mut brighter, mut evidence) = (0usize, 0usize, 0usize);
+            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+            for i in (0..n_px).step_by(step) {
+                for c in 0..ch {
+                    let k = i * ch + c;
+                    let (x, y) = (a[k], b[k]);
+                    let (xf, yf): (f64, f64) = (x.into(), y.into());
+                    if xf <= fa[c] || yf <= fb[c] || x >= max || y >= max {
+                        continue;
+                    }
+                    evidence += 1;
+                    let d = yf - xf;
+                    sum += d;
+                    sum2 += d * d;
+                    if d < 0.0 {
+                        darker += 1;
+                    } else if d > 0.0 {
+                        brighter += 1;
+                    }
                 }
             }
-        }
+            (darker, brighter, evidence, sum, sum2)
+        })
+        .collect();
+    for (pair, &(darker, brighter, evidence, sum, sum2)) in with_signal.windows(2).zip(&per_pair) {
+        let (s, l) = (pair[0], pair[1]);
         if evidence < MIN_ORDER_EVIDENCE {
             continue;
         }

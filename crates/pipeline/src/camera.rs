@@ -164,31 +164,44 @@ pub fn estimate_exposures(
 ) -> ExposureEstimate {
     let p = times_s.len();
     let step = (n / 200_000).max(1);
+    // Per adjacent pair (in parallel): the median log ratio, the values it came from, and its
+    // standard error. The median and the median absolute deviation by selection (the middle
+    // element, as a full sort would give it).
+    let per_pair: Vec<(f64, usize, f64)> = {
+        use rayon::prelude::*;
+        (0..p.saturating_sub(1))
+            .into_par_iter()
+            .map(|j| {
+                let mut r: Vec<f64> = (0..n)
+                    .step_by(step)
+                    .filter_map(|i| {
+                        let (a, b) = (linear(j, i)?, linear(j + 1, i)?);
+                        (a > 0.0 && b > 0.0).then(|| (b / a).ln())
+                    })
+                    .collect();
+                let nominal = (times_s[j + 1] / times_s[j]).ln();
+                if r.len() >= 100 {
+                    let mid = r.len() / 2;
+                    let median = *r.select_nth_unstable_by(mid, f64::total_cmp).1;
+                    let mut dev: Vec<f64> = r.iter().map(|v| (v - median).abs()).collect();
+                    let mad = *dev.select_nth_unstable_by(mid, f64::total_cmp).1;
+                    (
+                        median,
+                        r.len(),
+                        1.2533 * 1.4826 * mad / (r.len() as f64).sqrt(),
+                    )
+                } else {
+                    (nominal, r.len(), 0.0)
+                }
+            })
+            .collect()
+    };
     let mut ln_t = vec![0.0; p];
     let mut pairs = Vec::with_capacity(p.saturating_sub(1));
     let mut pair_se = Vec::with_capacity(p.saturating_sub(1));
-    for j in 0..p.saturating_sub(1) {
-        let mut r: Vec<f64> = (0..n)
-            .step_by(step)
-            .filter_map(|i| {
-                let (a, b) = (linear(j, i)?, linear(j + 1, i)?);
-                (a > 0.0 && b > 0.0).then(|| (b / a).ln())
-            })
-            .collect();
-        pairs.push(r.len());
-        let nominal = (times_s[j + 1] / times_s[j]).ln();
-        let step_ln = if r.len() >= 100 {
-            r.sort_by(f64::total_cmp);
-            let median = r[r.len() / 2];
-            let mut dev: Vec<f64> = r.iter().map(|v| (v - median).abs()).collect();
-            dev.sort_by(f64::total_cmp);
-            let mad = dev[dev.len() / 2];
-            pair_se.push(1.2533 * 1.4826 * mad / (r.len() as f64).sqrt());
-            median
-        } else {
-            pair_se.push(0.0);
-            nominal
-        };
+    for (j, &(step_ln, count, se)) in per_pair.iter().enumerate() {
+        pairs.push(count);
+        pair_se.push(se);
         ln_t[j + 1] = ln_t[j] + step_ln;
     }
     let ln_nom: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();

@@ -177,9 +177,12 @@ pub fn registration(
     w: usize,
     h: usize,
     ch: usize,
-    level: &dyn Fn(usize, usize) -> f64,
+    level: &(dyn Fn(usize, usize) -> f64 + Sync),
 ) -> Registration {
+    use rayon::prelude::*;
+    // The frames in parallel.
     let centroids: Vec<Option<[f64; 2]>> = (0..frames)
+        .into_par_iter()
         .map(|j| {
             let (mut n, mut sx, mut sy) = (0usize, 0.0, 0.0);
             let mut edge = false;

@@ -121,6 +121,29 @@ pub struct Corrections {
     /// times ([`scatterfit_imaging::self_consistency`]; not written).
     #[serde(skip)]
     pub self_consistency: Option<SelfConsistency>,
+    /// Where the merge's time went: (part, wall seconds) in the order the parts ran, a part that
+    /// ran more than once (the response recovery's rounds) summed (not written; `scatterfit bench
+    /// imaging` shows them).
+    #[serde(skip)]
+    pub timings: Vec<(&'static str, f64)>,
+}
+
+impl Corrections {
+    /// Adds `seconds` to the part `name` of [`Corrections::timings`].
+    pub(crate) fn time(&mut self, name: &'static str, seconds: f64) {
+        match self.timings.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, s)) => *s += seconds,
+            None => self.timings.push((name, seconds)),
+        }
+    }
+
+    /// Runs `f`, adding its wall time to the part `name`.
+    pub(crate) fn timed<R>(&mut self, name: &'static str, f: impl FnOnce() -> R) -> R {
+        let t = Instant::now();
+        let r = f();
+        self.time(name, t.elapsed().as_secs_f64());
+        r
+    }
 }
 
 /// A stated black level beside what the bracket's far corners say it is.
