@@ -27,7 +27,7 @@ pub const MAX_RESPONSE_FALL: f64 = 0.05;
 
 /// Knot spacing of the response's final smoothing, in units of ln k (k: the bracket's median ratio
 /// of consecutive exposure times): knots 1.2 ln k apart in log exposure barely follow a ripple of
-/// period ln k, which the bracket's data cannot see (see [`recover_response`]). Measured on issue 16's sweep
+/// period ln k, which the bracket's data cannot see (see [`recover_response`]). Measured on the twin's camera sweep
 /// (BENCHMARKS.md): 1.2 and 1.5 remove most of the ripple; 2 bends the S-curve; 1.2 keeps the
 /// S-curve's toe within 0.5 % from code 30 up, where 1.5 bends it by 0.9 %.
 pub const AMBIGUITY_KNOT_STEP: f64 = 1.2;
@@ -35,7 +35,7 @@ pub const AMBIGUITY_KNOT_STEP: f64 = 1.2;
 /// Codes at and above this (up to [`TOE_TRUST_HI`]) are trusted as Debevec & Malik's least squares
 /// gives them; below it [`recover_response`] replaces g by the inverse of the mean code at known
 /// exposure ([`forward_toe`]). Chosen so that the trusted codes' noise is small against their
-/// signal for every camera of issue 16's sweep (at code 120, 15 e⁻ read noise is < 0.5 % of the
+/// signal for every camera of the twin's camera sweep (at code 120, 15 e⁻ read noise is < 0.5 % of the
 /// exposure through sRGB or gamma 2.2 and ~1.3 % through the log curve), and low enough that every
 /// pixel brighter than the longest frame's code 120 has two such frames (codes 120–230 span
 /// ln(230/120) = 0.65 in ln X even for a linear camera, more than the bracket's step ln 1.87).
@@ -679,7 +679,7 @@ const COMB_LO: usize = 10;
 /// (Grossberg & Nayar 2003, "What is the space of camera response functions?", CVPR, and "Modeling
 /// the space of camera response functions", IEEE PAMI 26(10) 2004 — the "fractal ambiguity";
 /// docs/physics.md §7.1a), so whatever of it the solution holds is noise, and it reaches the
-/// merged radiance as a ripple of period ln k in ln E — on issue 16's sweep ±1–1.5 % on gamma 2.2
+/// merged radiance as a ripple of period ln k in ln E — on the twin's camera sweep ±1–1.5 % on gamma 2.2
 /// and the log curve at 15 e⁻, seen in the profile as a ring-to-ring alternation where the profile
 /// falls by ln k every two rings and as a slow ripple where it falls slowly (BENCHMARKS.md).
 ///
@@ -1114,7 +1114,7 @@ fn recover_channel(
 /// Robertson et al.'s E\[X | Z = z\]) fits g(z) ≈ E\[ln X | Z = z\] over the sample population.
 /// Where the noise is a sizeable part of the signal this is pulled towards the exposures most
 /// pixels have — a dark frame's background — (regression dilution, Berkson 1950; Fuller 1987,
-/// *Measurement Error Models*, §1.1): on issue 16's sweep with 15 e⁻ read noise the sRGB curve's
+/// *Measurement Error Models*, §1.1): on the twin's camera sweep with 15 e⁻ read noise the sRGB curve's
 /// g came out 1–2 % low at codes 30–50 and 15–50 % low at codes 5–10 (BENCHMARKS.md). The merge
 /// needs the opposite direction, X(z) with E\[X(Z) | X\] ≈ X, which the inverse of the mean code
 /// gives to first order; to second order (the delta method, Casella & Berger 2002, *Statistical
@@ -1564,7 +1564,7 @@ mod tests {
         g.map(|v| v - g128)
     }
 
-    /// The spline keeps the smooth tone curves of issue 16's sweep (sRGB, log, the filmic S-curve)
+    /// The spline keeps the smooth tone curves of the twin's camera sweep (sRGB, log, the filmic S-curve)
     /// within 0.5 % in X on codes 30–250, the codes above the detection limit (measured: 0.03 %,
     /// 0.05 %, 0.46 %), and cuts a 1 % ripple of period ln k in ln X (the fractal ambiguity of
     /// Grossberg & Nayar 2003) to under 0.5 % on codes 20–230 (measured: 0.35 %, 0.13 %, 0.45 %):

@@ -80,7 +80,7 @@ pub enum BlackLevel {
     Given(Vec<f64>),
 }
 
-/// What the HDR stage found and corrected of a real camera (issue 16).
+/// What the HDR stage found and corrected of a real camera (BENCHMARKS.md, "Real cameras").
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Corrections {
     /// The black level subtracted from linear frames [DN per channel] and where it came from
@@ -180,7 +180,7 @@ pub const DETECTION_CODE: u8 = 30;
 /// The per-pixel signal-to-noise ratio a code must reach in the longest exposure to count as
 /// detected (`merge::detection_codes`). The twin's default camera reaches about 14 at code 30; a log
 /// curve with 15 e⁻ read noise puts code 30 at about 30 e⁻ (SNR 2) and reaches 10 near code 75.
-/// Below it the merged radiance of issue 16's sweep was biased by up to 25 % (BENCHMARKS.md).
+/// Below it the merged radiance of the twin's camera sweep was biased by up to 25 % (BENCHMARKS.md).
 pub const DETECTION_SNR: f64 = 10.0;
 
 /// The merge's expected-signal floor as a fraction of the detection code's exposure X(z_det)
