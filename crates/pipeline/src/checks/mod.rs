@@ -25,13 +25,15 @@ use crate::measure::Measurement;
 pub mod evidence;
 mod frames;
 
+pub use crate::hdr::frames::{
+    CodeRange, MAX_BLACK_LEVEL_OFFSET, PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS, Registration,
+    code_range, registration,
+};
 pub use frames::{
-    AGREEMENT_CODES, AGREEMENT_MIN_SAMPLES, CodeRange, FrameAgreement, MAX_BLACK_LEVEL_OFFSET,
-    MAX_FRAME_OFFSET_LN, MAX_FRAME_SHIFT_PX, MAX_FRAME_SPREAD_LN, MAX_STEP_8BIT, MAX_STEP_LINEAR,
-    MAX_STEP_RECOVERED, MIN_JPEG_QUALITY, PLATEAU_MIN_SAMPLES, REGISTRATION_MIN_PIXELS,
-    Registration, black_level_reasons, bracket_reasons, code_range, code_reasons,
-    compression_reasons, frame_agreement, frame_agreement_reasons, jpeg_quality, registration,
-    registration_reasons,
+    AGREEMENT_CODES, AGREEMENT_MIN_SAMPLES, FrameAgreement, MAX_FRAME_OFFSET_LN,
+    MAX_FRAME_SHIFT_PX, MAX_FRAME_SPREAD_LN, MAX_STEP_8BIT, MAX_STEP_LINEAR, MAX_STEP_RECOVERED,
+    MIN_JPEG_QUALITY, black_level_reasons, bracket_reasons, code_reasons, compression_reasons,
+    frame_agreement, frame_agreement_reasons, jpeg_quality, registration_reasons,
 };
 
 /// A fit whose rms log residual exceeds this is suspect: the profile differs from the model by

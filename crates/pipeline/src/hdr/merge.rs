@@ -49,7 +49,7 @@ pub(super) fn merge_8bit(
         })
         .map_err(imaging(&(cx.order)()))?;
     corrections.registration = Some(corrections.timed("registration", || {
-        crate::checks::registration(
+        super::frames::registration(
             bufs.len(),
             bufs[0].width(),
             bufs[0].height(),
@@ -436,15 +436,15 @@ pub(super) fn merge_linear(
         }
         _ => cx.inputs.saturation,
     };
-    // The codes the frames use (8- or 12-bit data in 16-bit files; crate::checks); a stated
+    // The codes the frames use (8- or 12-bit data in 16-bit files; hdr::frames); a stated
     // saturation is used as stated.
     let code_range = raw
         .is_none()
-        .then(|| crate::checks::code_range(&bufs, saturation))
+        .then(|| super::frames::code_range(&bufs, saturation))
         .transpose()?
         .map(|c| {
             if cx.inputs.saturation_given {
-                crate::checks::CodeRange {
+                super::frames::CodeRange {
                     saturation,
                     plateau_found: false,
                     ..c
@@ -458,7 +458,7 @@ pub(super) fn merge_linear(
         .map_err(imaging(&(cx.order)()))?;
     let stated: &[f64] = &stated;
     check_order(&bufs, stated, saturation, signal.as_ref()).map_err(imaging(&(cx.order)()))?;
-    corrections.registration = Some(crate::checks::registration(
+    corrections.registration = Some(super::frames::registration(
         bufs.len(),
         bufs[0].width(),
         bufs[0].height(),
@@ -551,16 +551,13 @@ pub(super) fn merge_linear(
         // A pedestal left in (or taken out twice) makes the short frames look too bright (or too
         // dark) for their times: where the black level disagrees with the corners, say so first.
         check_exposure(&est, stated).map_err(|e| match (e, &corrections.black_level_check) {
-            (PipelineError::Imaging { context, source }, Some(b)) => {
-                let found = crate::checks::black_level_reasons(b);
-                PipelineError::Imaging {
-                    context: match found.first() {
-                        Some(r) => format!("{context} ({})", r.message),
-                        None => context,
-                    },
-                    source,
-                }
-            }
+            (PipelineError::Imaging { context, source }, Some(b)) => PipelineError::Imaging {
+                context: match b.disagreement() {
+                    Some(m) => format!("{context} ({m})"),
+                    None => context,
+                },
+                source,
+            },
             (e, _) => e,
         })?;
         let apply = cx.inputs.exposure_correction == ExposureCorrection::Always

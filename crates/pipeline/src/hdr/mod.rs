@@ -26,6 +26,7 @@ use crate::error::{PipelineError, Result};
 /// How the bracket became radiance (the name `result.json` records).
 pub use scatterfit_io::result_json::ResponseKind;
 
+pub mod frames;
 mod merge;
 pub use merge::{FLAT_MAX_PEAK, FLAT_MIN_LOW};
 
@@ -87,7 +88,7 @@ pub struct Corrections {
     /// (`dark frame`, `metadata`, `given`, `far corners`); `None` when none was.
     pub black_level: Option<(Vec<f64>, &'static str)>,
     /// A black level not read off the bracket itself (given, stated as none, from the RAW
-    /// metadata, or a dark frame) against the far corners' intercept at Δt = 0 ([`crate::checks::black_level_reasons`];
+    /// metadata, or a dark frame) against the far corners' intercept at Δt = 0 ([`BlackLevelCheck::disagreement`];
     /// not written).
     #[serde(skip)]
     pub black_level_check: Option<BlackLevelCheck>,
@@ -97,13 +98,13 @@ pub struct Corrections {
     pub exposure_applied: bool,
     /// The flat frame divided out, with its smoothed fall-off (min and max of the divisor).
     pub flat: Option<(PathBuf, f64, f64)>,
-    /// The codes 16-bit frames use and the saturation found ([`crate::checks::code_range`]; not
+    /// The codes 16-bit frames use and the saturation found ([`frames::code_range`]; not
     /// written: the quality verdict reports what matters).
     #[serde(skip)]
-    pub codes: Option<crate::checks::CodeRange>,
-    /// The spot's centroid per frame ([`crate::checks::registration`]; not written).
+    pub codes: Option<frames::CodeRange>,
+    /// The spot's centroid per frame ([`frames::registration`]; not written).
     #[serde(skip)]
-    pub registration: Option<crate::checks::Registration>,
+    pub registration: Option<frames::Registration>,
     /// 8-bit merges: the expected-signal floor per channel given to the merge
     /// ([`scatterfit_imaging::MergeOptions::expected_floor`]: the code whose exposure is
     /// [`EXPECTED_FLOOR_FRACTION`] of the noise-aware detection code's; not written).
