@@ -37,7 +37,12 @@ pub struct SelfConsistency {
 /// codes 1..=255 with g ≤ u, clamped to 0..=255.
 fn predicted_code(g: &[f64; LEVELS], u: f64) -> f64 {
     // m = #{z in 1..=255 : g(z) ≤ u}
-    let m = g[1..].partition_point(|&v| v <= u);
+    code_between(g, g[1..].partition_point(|&v| v <= u), u)
+}
+
+/// The code at log exposure `u` given m, the count of codes 1..=255 with g ≤ u: m plus the linear
+/// fraction of the way from g(m) to g(m + 1), clamped to 0..=255.
+fn code_between(g: &[f64; LEVELS], m: usize, u: f64) -> f64 {
     if m >= LEVELS - 1 {
         return (LEVELS - 1) as f64;
     }
@@ -99,16 +104,7 @@ impl<'a> CodeLookup<'a> {
         } else {
             g[1..].partition_point(|&v| v <= u)
         };
-        if m >= LEVELS - 1 {
-            return (LEVELS - 1) as f64;
-        }
-        let (g0, g1) = (g[m], g[m + 1]);
-        let frac = if g1 > g0 {
-            ((u - g0) / (g1 - g0)).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        m as f64 + frac
+        code_between(g, m, u)
     }
 }
 
