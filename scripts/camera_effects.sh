@@ -15,7 +15,7 @@ except Exception as e:
 out=[]
 for i,c in enumerate("rgb"):
   ch=r["channels"][c]; tc=t["channels"][i]
-  sp=ch.get("sigma_s_prime"); sa=ch.get("sigma_a")
+  sp=(ch.get("sigma_s_prime") or {}).get("value"); sa=(ch.get("sigma_a") or {}).get("value")
   if sp is None: out.append(f"{c.upper()}: –"); continue
   out.append(f"{c.upper()} {100*(sp/tc['sigma_s_prime']-1):+.1f}/{100*(sa/tc['sigma_a']-1):+.1f}")
 print("  ".join(out))

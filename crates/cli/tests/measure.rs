@@ -42,14 +42,14 @@ fn synth_then_measure() {
     assert_eq!(r["method"], "proposed");
     // Exact transport by default.
     assert_eq!(r["model"], "mc");
-    let got = r["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
+    let got = r["channels"]["r"]["sigma_s_prime"]["value"]
+        .as_f64()
+        .unwrap();
     let want = truth["channels"][0]["sigma_s_prime"].as_f64().unwrap();
     assert!((got / want - 1.0).abs() < 0.05, "{got} vs {want}");
     assert!((r["eta"].as_f64().unwrap() - truth["eta"].as_f64().unwrap()).abs() < 0.005);
     for k in [
-        "sigma_s_prime_stderr",
         "sigma_a",
-        "sigma_a_stderr",
         "albedo_prime",
         "rd_total",
         "fit_time_s",
@@ -57,6 +57,15 @@ fn synth_then_measure() {
         "mse",
     ] {
         assert!(!r["channels"]["g"][k].is_null(), "{k}");
+    }
+    // Each value is one record of its terms (schema 2): σ′s and σa have the fit's.
+    assert_eq!(r["schema_version"], 2);
+    for k in ["sigma_s_prime", "sigma_a"] {
+        let v = &r["channels"]["g"][k];
+        assert!(
+            v["fit"].as_f64().is_some() && v["total"].as_f64().is_some(),
+            "{k}: {v}"
+        );
     }
     assert_eq!(r["inputs"]["profile"], "profile.csv");
     // Measuring again replaces the command's own files; --output-dir writes elsewhere.
@@ -80,10 +89,7 @@ fn synth_then_measure() {
     let k: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert_eq!(k["g_uncertainty"]["source"], "given");
     assert_eq!(k["g_uncertainty"]["g"].as_f64(), Some(0.9));
-    assert_eq!(
-        k["channels"]["r"]["sigma_s_prime_stderr_g"].as_f64(),
-        Some(0.0)
-    );
+    assert_eq!(k["channels"]["r"]["sigma_s_prime"]["g"].as_f64(), Some(0.0));
     for (extra, says) in [
         (&["--g", "1.2"][..], "g"),
         (&["--g", "fit", "--model", "dipole"][..], "mc"),
@@ -100,7 +106,7 @@ fn synth_then_measure() {
     let a: Vec<String> = ["r", "g", "b"]
         .iter()
         .map(|c| {
-            r["channels"][c]["albedo_prime"]
+            r["channels"][c]["albedo_prime"]["value"]
                 .as_f64()
                 .unwrap()
                 .to_string()
@@ -121,7 +127,9 @@ fn synth_then_measure() {
     );
     assert_eq!(out.code, 0, "{}", out.stderr);
     let f: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
-    let refit = f["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
+    let refit = f["channels"]["r"]["sigma_s_prime"]["value"]
+        .as_f64()
+        .unwrap();
     assert!((refit / got - 1.0).abs() < 1e-6, "{refit} vs {got}");
     // `--rd` alone: α′ is inverted from the measurement's Rd through the same model, so the same
     // σ′s; beside an --albedo it contradicts, bad usage naming both (it used to be ignored).
@@ -145,16 +153,18 @@ fn synth_then_measure() {
     let out = fit_rd(&["--rd", &rd0]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let f_rd: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
-    let from_rd = f_rd["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
+    let from_rd = f_rd["channels"]["r"]["sigma_s_prime"]["value"]
+        .as_f64()
+        .unwrap();
     assert!((from_rd / got - 1.0).abs() < 1e-4, "{from_rd} vs {got}");
     // An approximate model's error joins the bars as the `model` term (the same rings fitted
     // again with exact transport); exact transport itself has none.
     let out = fit_rd(&["--rd", &rd0, "--model", "dipole"]);
     assert!(out.code == 0 || out.code == 1, "{}", out.stderr);
     let d: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
-    let term = &d["channels"]["r"]["sigma_s_prime_stderr_model"];
+    let term = &d["channels"]["r"]["sigma_s_prime"]["model"];
     assert!(term.as_f64().is_some_and(|t| t > 0.0), "{term}");
-    assert!(f_rd["channels"]["r"]["sigma_s_prime_stderr_model"].is_null());
+    assert!(f_rd["channels"]["r"]["sigma_s_prime"]["model"].is_null());
     let off = rd_arg(0.05);
     let out = fit_rd(&["--albedo", &a.join(","), "--rd", &off]);
     assert_eq!(out.code, 2, "{}", out.stderr);
@@ -166,12 +176,7 @@ fn synth_then_measure() {
     // No g stated, so the default range's term; `--g` makes it 0 and leaves the value;
     // a range that excludes the given g is bad usage.
     assert_eq!(f["g_uncertainty"]["source"], "default_range");
-    assert!(
-        f["channels"]["r"]["sigma_s_prime_stderr_g"]
-            .as_f64()
-            .unwrap()
-            > 0.0
-    );
+    assert!(f["channels"]["r"]["sigma_s_prime"]["g"].as_f64().unwrap() > 0.0);
     let fit_g = |extra: &[&str]| {
         let mut args = vec!["fit", "wood/profile.csv", "--eta", &eta, "--albedo"];
         let albedo = a.join(",");
@@ -184,13 +189,10 @@ fn synth_then_measure() {
     assert_eq!(out.code, 0, "{}", out.stderr);
     let k: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert_eq!(k["g_uncertainty"]["source"], "given");
+    assert_eq!(k["channels"]["r"]["sigma_s_prime"]["g"].as_f64(), Some(0.0));
     assert_eq!(
-        k["channels"]["r"]["sigma_s_prime_stderr_g"].as_f64(),
-        Some(0.0)
-    );
-    assert_eq!(
-        k["channels"]["r"]["sigma_s_prime"],
-        f["channels"]["r"]["sigma_s_prime"]
+        k["channels"]["r"]["sigma_s_prime"]["value"],
+        f["channels"]["r"]["sigma_s_prime"]["value"]
     );
     let out = fit_g(&["--g", "0.5", "--g-range", "0.8,0.9"]);
     assert_eq!(out.code, 2, "{}", out.stderr);
@@ -274,18 +276,17 @@ fn synth_then_measure() {
             "{q}"
         );
     }
-    let got = v["channels"]["r"]["sigma_s_prime"].as_f64().unwrap();
+    let got = v["channels"]["r"]["sigma_s_prime"]["value"]
+        .as_f64()
+        .unwrap();
     assert!((got / want - 1.0).abs() < 0.05, "3 frames: {got} vs {want}");
     // Every number has its uncertainty: η's and, per channel, α′'s and the spectrophotometer's part
     // of σ′s and σa (the default repeatability, 0.5 %), beside the fit's.
     assert_eq!(v["spectro_repeatability"].as_f64(), Some(0.005));
     assert!(v["eta_stderr"].as_f64().unwrap() > 0.0);
-    for key in [
-        "albedo_prime_stderr",
-        "sigma_s_prime_stderr_spectro",
-        "sigma_a_stderr_spectro",
-    ] {
-        assert!(v["channels"]["g"][key].as_f64().unwrap() > 0.0, "{key}");
+    for key in ["albedo_prime", "sigma_s_prime", "sigma_a"] {
+        let spectro = v["channels"]["g"][key]["spectro"].as_f64();
+        assert!(spectro.unwrap() > 0.0, "{key}");
     }
 }
 
@@ -569,9 +570,10 @@ fn uncertainties_cover_the_truth_with_the_mc_model() {
         for (i, c) in ["r", "g", "b"].iter().enumerate() {
             let ch = &r["channels"][c];
             for k in ["sigma_s_prime", "sigma_a"] {
-                let fit = ch[format!("{k}_stderr")].as_f64().unwrap();
-                let spectro = ch[format!("{k}_stderr_spectro")].as_f64().unwrap();
-                let err = ch[k].as_f64().unwrap() - truth["channels"][i][k].as_f64().unwrap();
+                let fit = ch[k]["fit"].as_f64().unwrap();
+                let spectro = ch[k]["spectro"].as_f64().unwrap();
+                let err =
+                    ch[k]["value"].as_f64().unwrap() - truth["channels"][i][k].as_f64().unwrap();
                 z.push((err.abs() / fit.hypot(spectro), format!("{m} {c} {k}")));
             }
         }

@@ -92,8 +92,8 @@ pub fn value_with_errors(c: &ChannelResult, v: Option<Estimate>, name: &str) -> 
 /// σ′s and σa of a channel as "value ± fit ± spectro" ([`value_with_errors`]).
 pub fn sigma_cells(c: &ChannelResult) -> [String; 2] {
     [
-        value_with_errors(c, c.sigma_s_prime_estimate(), "sigma_s_prime"),
-        value_with_errors(c, c.sigma_a_estimate(), "sigma_a"),
+        value_with_errors(c, c.sigma_s_prime, "sigma_s_prime"),
+        value_with_errors(c, c.sigma_a, "sigma_a"),
     ]
 }
 
@@ -104,7 +104,7 @@ pub fn errors_note(results: &[MeasurementResult]) -> String {
     if results.iter().any(|r| {
         r.channels
             .iter()
-            .any(|c| c.sigma_s_prime_stderr_model.is_some())
+            .any(|c| c.sigma_s_prime.is_some_and(|e| e.model.is_some()))
     }) {
         t.push_str(
             "± … model: an approximate forward model's part — how far the estimate moves to exact \
@@ -158,7 +158,7 @@ fn spectro_errors_note(results: &[MeasurementResult]) -> String {
         .filter(|r| {
             r.channels
                 .iter()
-                .any(|c| c.sigma_s_prime_stderr_spectro.is_some())
+                .any(|c| c.sigma_s_prime.is_some_and(|e| e.spectro.is_some()))
         })
         .filter_map(|r| r.spectro_repeatability)
         .collect();
@@ -249,9 +249,13 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
          sigma_s_prime_stderr_g,sigma_a_stderr_g,albedo_prime_stderr_g,albedo_prime_stderr_fit,\
          sigma_s_prime_stderr_model,sigma_a_stderr_model,albedo_prime_stderr_model\n",
     );
+    // The table is flat: one column per value and per term of its record.
+    let value = |e: Option<Estimate>| e.map(|e| e.value);
+    let term = |e: Option<Estimate>, t: fn(&Estimate) -> Option<f64>| e.as_ref().and_then(t);
     for r in results {
         for (ch, c) in r.channels.iter_channels() {
             let name = ch.name();
+            let (sp, sa, ap) = (c.sigma_s_prime, c.sigma_a, c.albedo_prime);
             let status = match c.status {
                 ChannelStatus::Ok => "ok",
                 ChannelStatus::Unconstrained => "unconstrained",
@@ -261,11 +265,11 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 t,
                 "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 csv_text(&r.name),
-                num(c.sigma_s_prime, 6),
-                num(c.sigma_s_prime_stderr, 6),
-                num(c.sigma_a, 8),
-                num(c.sigma_a_stderr, 8),
-                num(c.albedo_prime, 6),
+                num(value(sp), 6),
+                num(term(sp, |e| e.fit), 6),
+                num(value(sa), 8),
+                num(term(sa, |e| e.fit), 8),
+                num(value(ap), 6),
                 num(c.rd_total, 6),
                 num(Some(r.eta), 4),
                 r.method,
@@ -279,17 +283,17 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
                 c.rings_inside_spot,
                 c.rings_below_detection,
                 csv_text(c.problem.as_deref().unwrap_or("")),
-                num(c.sigma_s_prime_stderr_spectro, 6),
-                num(c.sigma_a_stderr_spectro, 8),
-                num(c.albedo_prime_stderr, 6),
+                num(term(sp, |e| e.spectro), 6),
+                num(term(sa, |e| e.spectro), 8),
+                num(term(ap, |e| e.spectro), 6),
                 num(r.eta_stderr, 6),
-                num(c.sigma_s_prime_stderr_g, 6),
-                num(c.sigma_a_stderr_g, 8),
-                num(c.albedo_prime_stderr_g, 6),
-                num(c.albedo_prime_stderr_fit, 6),
-                num(c.sigma_s_prime_stderr_model, 6),
-                num(c.sigma_a_stderr_model, 8),
-                num(c.albedo_prime_stderr_model, 6),
+                num(term(sp, |e| e.g), 6),
+                num(term(sa, |e| e.g), 8),
+                num(term(ap, |e| e.g), 6),
+                num(term(ap, |e| e.fit), 6),
+                num(term(sp, |e| e.model), 6),
+                num(term(sa, |e| e.model), 8),
+                num(term(ap, |e| e.model), 6),
             );
         }
     }
@@ -334,19 +338,24 @@ pub fn table1_markdown(results: &[MeasurementResult]) -> String {
                 "| {material} | {name} | {sp} | {sa} | {eta} | {} | {time} | {} |",
                 // Behind a spectrophotometer port α′ has a fit term too, first as in the σ
                 // columns (value ± fit ± spectro).
-                match (
-                    c.albedo_prime,
-                    c.albedo_prime_stderr_fit,
-                    c.albedo_prime_stderr
-                ) {
-                    (Some(a), Some(f), Some(e)) => format!("{a:.5} ± {} ± {}", sig4(f), sig4(e)),
-                    (Some(a), None, Some(e)) => format!("{a:.5} ± {}", sig4(e)),
-                    (Some(a), _, None) => format!("{a:.5}"),
-                    _ => "—".into(),
-                } + &c
-                    .albedo_prime_stderr_g
-                    .filter(|_| c.albedo_prime.is_some())
-                    .map_or(String::new(), |g| format!(" ± {} g", sig4(g))),
+                match c.albedo_prime {
+                    Some(Estimate {
+                        value: a,
+                        fit,
+                        spectro: Some(e),
+                        g,
+                        ..
+                    }) => {
+                        let f = fit.map_or(String::new(), |f| format!(" ± {}", sig4(f)));
+                        let g = g.map_or(String::new(), |g| format!(" ± {} g", sig4(g)));
+                        format!("{a:.5}{f} ± {}{g}", sig4(e))
+                    }
+                    Some(Estimate { value: a, g, .. }) => {
+                        let g = g.map_or(String::new(), |g| format!(" ± {} g", sig4(g)));
+                        format!("{a:.5}{g}")
+                    }
+                    None => "—".into(),
+                },
                 c.mse.map_or("—".into(), sig4),
             );
         }
@@ -416,12 +425,12 @@ pub fn table2_markdown(pairs: &[(MeasurementResult, MeasurementResult)]) -> Stri
             let _ = writeln!(
                 t,
                 "| {material} | {name} | {} | {} | {} | {:.0} | {} | {} | {} | {:.0} |",
-                with_fit_error(e, e.sigma_s_prime_estimate(), "sigma_s_prime"),
-                with_fit_error(e, e.sigma_a_estimate(), "sigma_a"),
+                with_fit_error(e, e.sigma_s_prime, "sigma_s_prime"),
+                with_fit_error(e, e.sigma_a, "sigma_a"),
                 e.mse.map_or("—".into(), sig4),
                 e.fit_time_s * 1e6,
-                with_fit_error(p, p.sigma_s_prime_estimate(), "sigma_s_prime"),
-                with_fit_error(p, p.sigma_a_estimate(), "sigma_a"),
+                with_fit_error(p, p.sigma_s_prime, "sigma_s_prime"),
+                with_fit_error(p, p.sigma_a, "sigma_a"),
                 p.mse.map_or("—".into(), sig4),
                 p.fit_time_s * 1e6,
             );
@@ -449,13 +458,13 @@ pub fn table2_csv(pairs: &[(MeasurementResult, MeasurementResult)]) -> String {
                 t,
                 "{},{name},{},{},{},{},{},{},{},{},{},{}",
                 csv_text(&e.name),
-                num(ce.sigma_s_prime, 6),
-                num(ce.sigma_a, 8),
+                num(ce.sigma_s_prime.map(|e| e.value), 6),
+                num(ce.sigma_a.map(|e| e.value), 8),
                 num(ce.mse, 8),
                 num(Some(ce.fit_time_s), 7),
                 status(ce),
-                num(cp.sigma_s_prime, 6),
-                num(cp.sigma_a, 8),
+                num(cp.sigma_s_prime.map(|e| e.value), 6),
+                num(cp.sigma_a.map(|e| e.value), 8),
                 num(cp.mse, 8),
                 num(Some(cp.fit_time_s), 7),
                 status(cp),

@@ -64,6 +64,11 @@ pub struct MaterialRow {
     pub channels: Vec<ChannelRow>,
 }
 
+/// A result's value, without its terms (the table compares values with the truth).
+fn value(e: Option<scatterfit_optics::Estimate>) -> Option<f64> {
+    e.map(|e| e.value)
+}
+
 fn rel(found: Option<f64>, truth: f64) -> Option<f64> {
     found.map(|f| f / truth - 1.0)
 }
@@ -96,21 +101,28 @@ pub fn accuracy_rows(
                             sigma_s_prime_true: tc.sigma_s_prime,
                             sigma_a_true: tc.sigma_a,
                             albedo_prime_true: tc.albedo_prime,
-                            proposed_sigma_s_prime: pc.sigma_s_prime,
-                            proposed_sigma_a: pc.sigma_a,
-                            proposed_albedo_prime: pc.albedo_prime,
-                            existing_sigma_s_prime: ec.sigma_s_prime,
-                            existing_sigma_a: ec.sigma_a,
-                            proposed_sigma_s_prime_error: rel(pc.sigma_s_prime, tc.sigma_s_prime),
-                            proposed_sigma_a_error: rel(pc.sigma_a, tc.sigma_a),
-                            existing_sigma_s_prime_error: rel(ec.sigma_s_prime, tc.sigma_s_prime),
-                            existing_sigma_a_error: rel(ec.sigma_a, tc.sigma_a),
-                            paper_sigma_s_prime: x.and_then(|x| x.channels[c].sigma_s_prime),
-                            paper_sigma_a: x.and_then(|x| x.channels[c].sigma_a),
-                            paper_sigma_s_prime_error: x
-                                .and_then(|x| rel(x.channels[c].sigma_s_prime, tc.sigma_s_prime)),
+                            proposed_sigma_s_prime: value(pc.sigma_s_prime),
+                            proposed_sigma_a: value(pc.sigma_a),
+                            proposed_albedo_prime: value(pc.albedo_prime),
+                            existing_sigma_s_prime: value(ec.sigma_s_prime),
+                            existing_sigma_a: value(ec.sigma_a),
+                            proposed_sigma_s_prime_error: rel(
+                                value(pc.sigma_s_prime),
+                                tc.sigma_s_prime,
+                            ),
+                            proposed_sigma_a_error: rel(value(pc.sigma_a), tc.sigma_a),
+                            existing_sigma_s_prime_error: rel(
+                                value(ec.sigma_s_prime),
+                                tc.sigma_s_prime,
+                            ),
+                            existing_sigma_a_error: rel(value(ec.sigma_a), tc.sigma_a),
+                            paper_sigma_s_prime: x.and_then(|x| value(x.channels[c].sigma_s_prime)),
+                            paper_sigma_a: x.and_then(|x| value(x.channels[c].sigma_a)),
+                            paper_sigma_s_prime_error: x.and_then(|x| {
+                                rel(value(x.channels[c].sigma_s_prime), tc.sigma_s_prime)
+                            }),
                             paper_sigma_a_error: x
-                                .and_then(|x| rel(x.channels[c].sigma_a, tc.sigma_a)),
+                                .and_then(|x| rel(value(x.channels[c].sigma_a), tc.sigma_a)),
                         }
                     })
                     .collect(),

@@ -326,9 +326,9 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
                 g: sample.g,
                 g_given: sample.g.map(|_| combo.g_given),
                 status: format!("{:?}", ch.status).to_lowercase(),
-                sigma_s_prime_error: rel(ch.sigma_s_prime, t.sigma_s_prime),
-                sigma_a_error: rel(ch.sigma_a, t.sigma_a),
-                albedo_prime_error: ch.albedo_prime.map(|a| a - albedo),
+                sigma_s_prime_error: rel(ch.sigma_s_prime.map(|e| e.value), t.sigma_s_prime),
+                sigma_a_error: rel(ch.sigma_a.map(|e| e.value), t.sigma_a),
+                albedo_prime_error: ch.albedo_prime.map(|a| a.value - albedo),
             });
         }
     }

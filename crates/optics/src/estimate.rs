@@ -22,7 +22,11 @@ use serde::{Deserialize, Serialize};
 /// assert!((sigma_s_prime.total().unwrap() - 0.005).abs() < 1e-12);
 /// assert_eq!(Estimate::new(1.0).total(), None);
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+///
+/// As a file's record (serde) it is `{"value", "fit", "spectro", "g", "model", "total"}`, every
+/// term present (`null` when unknown); `total` is [`Estimate::total`], written for the file's
+/// readers and recomputed, not read, when the record is read back.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
 pub struct Estimate {
     /// The value.
     pub value: f64,
@@ -46,8 +50,22 @@ pub struct Estimate {
     /// same data, |approximate − exact| (`scatterfit_pipeline::model_term`). Like the g term a
     /// bounded systematic, added linearly. `None` with the exact model itself, or where exact
     /// transport could not be evaluated (the channel is then suspect).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub model: Option<f64>,
+}
+
+impl Serialize for Estimate {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut r = s.serialize_struct("Estimate", 6)?;
+        r.serialize_field("value", &self.value)?;
+        r.serialize_field("fit", &self.fit)?;
+        r.serialize_field("spectro", &self.spectro)?;
+        r.serialize_field("g", &self.g)?;
+        r.serialize_field("model", &self.model)?;
+        r.serialize_field("total", &self.total())?;
+        r.end()
+    }
 }
 
 impl Estimate {

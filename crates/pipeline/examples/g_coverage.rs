@@ -34,7 +34,7 @@ struct Point {
 }
 
 fn points(c: &ChannelResult, truth: [f64; 2]) -> Vec<Point> {
-    [c.sigma_s_prime_estimate(), c.sigma_a_estimate()]
+    [c.sigma_s_prime, c.sigma_a]
         .into_iter()
         .zip(truth)
         .filter_map(|(e, t)| {
@@ -160,8 +160,8 @@ fn main() {
                     100.0 * pa.get(1).map_or(f64::NAN, |p| p.err),
                     100.0 * pa.first().and_then(|p| p.total).unwrap_or(f64::NAN),
                     100.0 * pa.get(1).and_then(|p| p.total).unwrap_or(f64::NAN),
-                    a.sigma_s_prime_stderr_g,
-                    a.sigma_a_stderr_g,
+                    a.sigma_s_prime.and_then(|e| e.g),
+                    a.sigma_a.and_then(|e| e.g),
                     100.0 * pb.first().map_or(f64::NAN, |p| p.err),
                     100.0 * pb.get(1).map_or(f64::NAN, |p| p.err),
                     100.0 * pb.first().and_then(|p| p.total).unwrap_or(f64::NAN),

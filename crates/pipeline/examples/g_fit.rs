@@ -105,14 +105,14 @@ fn main() {
                     .collect();
                 eprintln!("  {} χ² − min: {}", ch.name(), scan.join(" "));
             }
-            let sa = row.sigma_a_estimate();
+            let sa = row.sigma_a;
             println!(
                 "| {name} | {} | {} | {:.4} | {g} | {fitted} | {parts} | {shape} | {det} | {} | {} | {} |",
                 m.eta,
                 ch.name(),
                 m.albedo_prime()[c],
-                err(row.sigma_s_prime, m.sigma_s_prime[c]),
-                err(row.sigma_a, m.sigma_a[c]),
+                err(row.sigma_s_prime.map(|e| e.value), m.sigma_s_prime[c]),
+                err(row.sigma_a.map(|e| e.value), m.sigma_a[c]),
                 sa.and_then(|e| e.total()).map_or("—".into(), |t| format!(
                     "± {:.2} %",
                     100.0 * t / m.sigma_a[c]

@@ -143,10 +143,10 @@ fn main() {
                 "| {name} | {} | {:.4} | {} | {} | {} | {} |",
                 ch.name(),
                 m.albedo_prime()[c],
-                err(a.sigma_s_prime, m.sigma_s_prime[c]),
-                err(b.sigma_s_prime, m.sigma_s_prime[c]),
-                err(a.sigma_a, m.sigma_a[c]),
-                err(b.sigma_a, m.sigma_a[c]),
+                err(a.sigma_s_prime.map(|e| e.value), m.sigma_s_prime[c]),
+                err(b.sigma_s_prime.map(|e| e.value), m.sigma_s_prime[c]),
+                err(a.sigma_a.map(|e| e.value), m.sigma_a[c]),
+                err(b.sigma_a.map(|e| e.value), m.sigma_a[c]),
             );
         }
     }

@@ -309,6 +309,19 @@ fn finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
+/// An estimate as a file can hold it (JSON has no NaN): `None` without a finite value, a term that
+/// is not finite as unknown.
+fn finite_estimate(e: Estimate) -> Option<Estimate> {
+    let term = |t: Option<f64>| t.filter(|t| t.is_finite());
+    finite(e.value).map(|value| Estimate {
+        value,
+        fit: term(e.fit),
+        spectro: term(e.spectro),
+        g: term(e.g),
+        model: term(e.model),
+    })
+}
+
 /// Fits the three channels of a profile with the spectrophotometer's η and α′ (one after the
 /// other: microseconds each, not worth threads). The outcomes carry the fit's standard errors;
 /// [`propagate_spectro`] adds the spectrophotometer's.
@@ -471,9 +484,9 @@ pub fn propagate_spectro(
         })
 }
 
-/// Channel `c`'s row of `result.json`: the outcome's estimates flattened into the file's fields
-/// (`sigma_s_prime`, `sigma_s_prime_stderr`, `sigma_s_prime_stderr_spectro`, …), with the
-/// spectrophotometer's Rd (and, for a channel that was not fitted, its α′).
+/// Channel `c`'s row of `result.json`: the outcome's estimates as they are (one record of a value
+/// and its terms each), with the spectrophotometer's Rd (and, for a channel that was not fitted,
+/// its α′).
 pub fn channel_result(
     outcome: &ChannelOutcome,
     spectro: &SpectroStage,
@@ -484,20 +497,11 @@ pub fn channel_result(
         ChannelOutcome::NotFitted { problem } => ChannelResult {
             status: ChannelStatus::Failed,
             sigma_s_prime: None,
-            sigma_s_prime_stderr: None,
             sigma_a: None,
-            sigma_a_stderr: None,
-            sigma_s_prime_stderr_spectro: None,
-            sigma_a_stderr_spectro: None,
-            sigma_s_prime_stderr_g: None,
-            sigma_a_stderr_g: None,
-            albedo_prime_stderr_g: None,
-            sigma_s_prime_stderr_model: None,
-            sigma_a_stderr_model: None,
-            albedo_prime_stderr_model: None,
-            albedo_prime_stderr: spectro.uncertainty.albedo_prime_stderr[c],
-            albedo_prime_stderr_fit: None,
-            albedo_prime: spectro.albedo_prime[c],
+            albedo_prime: spectro.albedo_prime[c].map(|value| Estimate {
+                spectro: spectro.uncertainty.albedo_prime_stderr[c],
+                ..Estimate::new(value)
+            }),
             rd_total,
             scale: None,
             correlation: None,
@@ -547,21 +551,9 @@ pub fn channel_result(
             };
             ChannelResult {
                 status,
-                sigma_s_prime: finite(f.sigma_s_prime.value),
-                sigma_s_prime_stderr: f.sigma_s_prime.fit,
-                sigma_a: finite(f.sigma_a.value),
-                sigma_a_stderr: f.sigma_a.fit,
-                sigma_s_prime_stderr_spectro: f.sigma_s_prime.spectro,
-                sigma_a_stderr_spectro: f.sigma_a.spectro,
-                sigma_s_prime_stderr_g: f.sigma_s_prime.g,
-                sigma_a_stderr_g: f.sigma_a.g,
-                albedo_prime_stderr_g: f.albedo_prime.g,
-                sigma_s_prime_stderr_model: f.sigma_s_prime.model,
-                sigma_a_stderr_model: f.sigma_a.model,
-                albedo_prime_stderr_model: f.albedo_prime.model,
-                albedo_prime_stderr: f.albedo_prime.spectro,
-                albedo_prime_stderr_fit: f.albedo_prime.fit,
-                albedo_prime: finite(f.albedo_prime.value),
+                sigma_s_prime: finite_estimate(f.sigma_s_prime),
+                sigma_a: finite_estimate(f.sigma_a),
+                albedo_prime: finite_estimate(f.albedo_prime),
                 rd_total,
                 scale: finite(r.scale.value),
                 // JSON has no NaN: a singular fit has no correlation matrix.

@@ -625,6 +625,7 @@ impl Measurement {
         });
         let s = &self.settings;
         MeasurementResult {
+            schema_version: scatterfit_io::result_json::SCHEMA_VERSION,
             name: m.display_name(),
             eta: self.spectro.eta,
             eta_source: Some(self.spectro.eta_source),

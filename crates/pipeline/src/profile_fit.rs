@@ -224,6 +224,7 @@ impl ProfileFit {
     pub fn to_result(&self) -> MeasurementResult {
         let s = &self.settings;
         MeasurementResult {
+            schema_version: scatterfit_io::result_json::SCHEMA_VERSION,
             name: self.request.name.clone(),
             eta: self.request.eta,
             eta_source: Some(crate::spectro::EtaSource::Given),

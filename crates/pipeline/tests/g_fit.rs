@@ -78,7 +78,7 @@ fn g_is_fitted_where_determined_and_withheld_where_not() {
                     "{name} {}: g {g} ± {sd}",
                     ch.name()
                 );
-                assert!(r.channels[ch].sigma_a_stderr_g.unwrap() > 0.0);
+                assert!(r.channels[ch].sigma_a.and_then(|e| e.g).unwrap() > 0.0);
             }
         }
         for &ch in found {
@@ -102,7 +102,7 @@ fn g_is_fitted_where_determined_and_withheld_where_not() {
             assert!(!f.determined, "{name} {}: {f:?}", ch.name());
             assert_eq!((f.g, f.g_stderr), (None, None));
             assert!(f.reason.as_deref().is_some_and(|t| !t.is_empty()));
-            assert!(r.channels[ch].sigma_a_stderr_g.unwrap() > 0.0);
+            assert!(r.channels[ch].sigma_a.and_then(|e| e.g).unwrap() > 0.0);
         }
         let summary = scatterfit_report::summary_text(&r);
         assert!(summary.contains("g fitted"), "{summary}");

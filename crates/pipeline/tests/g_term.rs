@@ -85,7 +85,7 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
     assert!(g.evaluated.contains(&0.0) && g.evaluated.contains(&0.9));
     let mut outside_without_g = 0;
     for (c, ch) in Channel::ALL.iter().enumerate() {
-        let e = r.channels[*ch].sigma_a_estimate().unwrap();
+        let e = r.channels[*ch].sigma_a.unwrap();
         let truth = m.sigma_a[c];
         let err = (e.value - truth).abs();
         let total = e.total().unwrap();
@@ -117,7 +117,7 @@ fn an_unknown_g_widens_the_bars_to_cover_the_truth() {
     let known = measured_at(&folder, Some(0.8)).to_result(None);
     assert_eq!(known.g_uncertainty.unwrap().source, GSource::Given);
     for ch in Channel::ALL {
-        assert_eq!(known.channels[ch].sigma_a_stderr_g, Some(0.0));
+        assert_eq!(known.channels[ch].sigma_a.and_then(|e| e.g), Some(0.0));
     }
 }
 
@@ -142,7 +142,7 @@ fn a_g_term_the_tables_cannot_evaluate_makes_the_channel_suspect() {
     for ch in Channel::ALL {
         let c = &r.channels[ch];
         assert!(c.sigma_a.is_some(), "{}: no value", ch.name());
-        assert_eq!(c.sigma_a_stderr_g, None, "{}", ch.name());
+        assert_eq!(c.sigma_a.and_then(|e| e.g), None, "{}", ch.name());
         assert_eq!(
             q[ch].verdict,
             Verdict::Suspect,

@@ -131,14 +131,15 @@ fn errors_both(
             let ch = &result.channels[scatterfit_optics::Channel::ALL[c]];
             (
                 ch.sigma_s_prime
-                    .map_or(f64::NAN, |v| v / m.sigma_s_prime[c] - 1.0),
-                ch.sigma_a.map_or(f64::NAN, |v| v / m.sigma_a[c] - 1.0),
+                    .map_or(f64::NAN, |v| v.value / m.sigma_s_prime[c] - 1.0),
+                ch.sigma_a
+                    .map_or(f64::NAN, |v| v.value / m.sigma_a[c] - 1.0),
             )
         });
         if k == 1 {
             corrected_sigma_a_bar = std::array::from_fn(|c| {
                 result.channels[scatterfit_optics::Channel::ALL[c]]
-                    .sigma_a_estimate()
+                    .sigma_a
                     .and_then(|e| {
                         Some(scatterfit_optics::Estimate { g: None, ..e }.total()? / e.value)
                     })
@@ -360,10 +361,13 @@ fn the_port_corrected_albedo_error_follows_the_reading() {
     let grid = scatterfit_mc::bundled_grid().unwrap();
     for c in scatterfit_optics::Channel::ALL {
         let a = |r: &scatterfit_io::result_json::MeasurementResult| {
-            r.channels[c].albedo_prime.expect("α′")
+            r.channels[c].albedo_prime.expect("α′").value
         };
         let spread = 0.5 * (a(&hi) - a(&lo));
-        let reported = mid.channels[c].albedo_prime_stderr.expect("α′'s error");
+        let reported = mid.channels[c]
+            .albedo_prime
+            .and_then(|e| e.spectro)
+            .expect("α′'s error");
         let rd = mid.channels[c].rd_total.expect("corrected Rd");
         let (eta, d_eta) = (mid.eta, mid.eta_stderr.expect("η measured"));
         let loss_free = 0.5
@@ -436,25 +440,29 @@ fn the_fit_error_reaches_the_port_corrected_values_through_f() {
     let value = |m: &scatterfit_pipeline::Measurement| {
         let r = m.to_result(None);
         let ch = &r.channels[c];
-        (ch.sigma_a.expect("σa"), ch.albedo_prime.expect("α′"))
+        (
+            ch.sigma_a.expect("σa").value,
+            ch.albedo_prime.expect("α′").value,
+        )
     };
     let (sa_lo, a_lo) = value(&lo);
     let (sa_hi, a_hi) = value(&hi);
     let result = mid.to_result(None);
     let ch = &result.channels[c];
     let (reported_sa, reported_a) = (
-        ch.sigma_a_stderr.expect("σa's fit term"),
-        ch.albedo_prime_stderr_fit
+        ch.sigma_a.and_then(|e| e.fit).expect("σa's fit term"),
+        ch.albedo_prime
+            .and_then(|e| e.fit)
             .expect("α′'s fit term behind a port"),
     );
     let (spread_sa, spread_a) = (0.5 * (sa_hi - sa_lo).abs(), 0.5 * (a_hi - a_lo).abs());
-    let loss_free = rel * ch.sigma_a.unwrap();
+    let loss_free = rel * ch.sigma_a.unwrap().value;
     eprintln!(
         "R: s = {:.3} %, σa {:.4e}: fit term {reported_sa:.3e} (loss-free {loss_free:.3e}), \
          spread of the scaled worlds {spread_sa:.3e}; α′ fit term {reported_a:.3e}, spread \
          {spread_a:.3e}",
         100.0 * rel,
-        ch.sigma_a.unwrap()
+        ch.sigma_a.unwrap().value
     );
     assert!(
         (reported_sa / spread_sa - 1.0).abs() < 0.02,

@@ -64,8 +64,8 @@ fn proposed_method_meets_the_targets_on_twin_samples() {
                 continue;
             }
             assert_eq!(ch.status, ChannelStatus::Ok, "{name} {c}: {:?}", ch.problem);
-            sp_err.push((ch.sigma_s_prime.unwrap() / m.sigma_s_prime[c] - 1.0).abs());
-            sa_err.push((ch.sigma_a.unwrap() / m.sigma_a[c] - 1.0).abs());
+            sp_err.push((ch.sigma_s_prime.unwrap().value / m.sigma_s_prime[c] - 1.0).abs());
+            sa_err.push((ch.sigma_a.unwrap().value / m.sigma_a[c] - 1.0).abs());
         }
         // The existing method runs on the same profile without failing outright.
         let existing = meas.refit(Method::Existing).unwrap();

@@ -113,9 +113,10 @@ pub fn fit_figure(m: &Measurement, result: &MeasurementResult) -> Figure {
             let note = match (ch.sigma_s_prime, ch.sigma_a) {
                 (Some(sp), Some(sa)) => format!(
                     "σ′s = {} mm⁻¹, σa = {} mm⁻¹, α′ = {}{}",
-                    sig4(sp),
-                    sig4(sa),
-                    ch.albedo_prime.map_or("—".into(), |a| format!("{a:.4}")),
+                    sig4(sp.value),
+                    sig4(sa.value),
+                    ch.albedo_prime
+                        .map_or("—".into(), |a| format!("{:.4}", a.value)),
                     if ch.unconstrained.is_empty() {
                         ""
                     } else {

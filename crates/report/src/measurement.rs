@@ -251,7 +251,8 @@ pub fn summary_text(r: &MeasurementResult) -> String {
         let _ = writeln!(
             t,
             "  {name}   {sp:<40} {sa:<42} {:<8} {:<10} {:>9.1} {:>6}",
-            c.albedo_prime.map_or("—".into(), |a| format!("{a:.5}")),
+            c.albedo_prime
+                .map_or("—".into(), |a| format!("{:.5}", a.value)),
             c.mse.map_or("—".into(), sig4),
             c.fit_time_s * 1e6,
             c.rings_used

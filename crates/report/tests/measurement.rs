@@ -115,13 +115,14 @@ fn a_measured_sample_gets_its_report_files() {
     let g = back.g_uncertainty.as_ref().unwrap();
     assert_eq!(g.range, Some([0.0, 0.95]));
     for ch in back.channels.iter() {
-        assert!(ch.sigma_a_stderr_g.unwrap() > 0.0);
+        assert!(ch.sigma_a.and_then(|e| e.g).unwrap() > 0.0);
     }
     assert!(md.contains("± g"), "{md}");
     for ch in back.channels.iter() {
         let sp = ch
             .sigma_s_prime
-            .expect("every channel of the wood tile fits");
+            .expect("every channel of the wood tile fits")
+            .value;
         assert!(
             summary.contains(&scatterfit_io::result_table::sig4(sp)),
             "σ′s {sp} not in\n{summary}"

@@ -274,7 +274,10 @@ mod tests {
         }
         // σa = 0: the length comes from Base Color's dipole albedo, finite.
         let mut r = marble();
-        r.channels.g.sigma_a = Some(0.0);
+        r.channels.g.sigma_a = Some(scatterfit_optics::Estimate {
+            value: 0.0,
+            ..r.channels.g.sigma_a.unwrap_or_default()
+        });
         let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
         let v = BlenderValues::new(&p);
         assert!(v.subsurface_scale.is_finite());

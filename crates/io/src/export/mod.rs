@@ -392,21 +392,27 @@ mod fixtures {
     fn channel(sp: f64, sa: f64, rd: f64) -> ChannelResult {
         ChannelResult {
             status: ChannelStatus::Ok,
-            sigma_s_prime: Some(sp),
-            sigma_s_prime_stderr: Some(0.01),
-            sigma_a: Some(sa),
-            sigma_a_stderr: Some(0.001),
-            sigma_s_prime_stderr_spectro: None,
-            sigma_a_stderr_spectro: None,
-            sigma_s_prime_stderr_g: None,
-            sigma_a_stderr_g: None,
-            albedo_prime_stderr_g: None,
-            sigma_s_prime_stderr_model: None,
-            sigma_a_stderr_model: None,
-            albedo_prime_stderr_model: None,
-            albedo_prime_stderr: None,
-            albedo_prime_stderr_fit: None,
-            albedo_prime: Some(sp / (sp + sa)),
+            sigma_s_prime: Some(scatterfit_optics::Estimate {
+                value: sp,
+                fit: Some(0.01),
+                spectro: None,
+                g: None,
+                model: None,
+            }),
+            sigma_a: Some(scatterfit_optics::Estimate {
+                value: sa,
+                fit: Some(0.001),
+                spectro: None,
+                g: None,
+                model: None,
+            }),
+            albedo_prime: Some(scatterfit_optics::Estimate {
+                value: sp / (sp + sa),
+                fit: None,
+                spectro: None,
+                g: None,
+                model: None,
+            }),
             rd_total: Some(rd),
             scale: Some(1.0),
             correlation: None,
@@ -430,6 +436,7 @@ mod fixtures {
     /// σa = 0.0021, 0.0041, 0.0071 mm⁻¹; Rd at η = 1.5 from docs/physics.md's computed column.
     pub(super) fn marble() -> MeasurementResult {
         MeasurementResult {
+            schema_version: crate::result_json::SCHEMA_VERSION,
             name: "marble".into(),
             eta: 1.5,
             eta_source: Some(crate::result_json::EtaSource::Given),
@@ -774,8 +781,8 @@ mod tests {
         ) {
             let mut r = marble();
             r.eta = eta;
-            r.channels.g.sigma_s_prime = Some(sp);
-            r.channels.g.sigma_a = Some(sa);
+            r.channels.g.sigma_s_prime = Some(scatterfit_optics::Estimate { value: sp, ..r.channels.g.sigma_s_prime.unwrap_or_default() });
+            r.channels.g.sigma_a = Some(scatterfit_optics::Estimate { value: sa, ..r.channels.g.sigma_a.unwrap_or_default() });
             r.channels.g.rd_total = Some(rd);
             let ok = eta.is_finite() && (1.0..=4.0).contains(&eta)
                 && sp.is_finite() && (1e-6..=1e6).contains(&sp)

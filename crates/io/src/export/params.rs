@@ -251,8 +251,8 @@ impl RendererParameters {
                 });
             }
             let field = |f: &str| format!("channels.{name}.{f}");
-            let sp = in_range(field("sigma_s_prime"), sp, SIGMA_S_RANGE, " mm^-1")?;
-            let sa = in_range(field("sigma_a"), sa, SIGMA_A_RANGE, " mm^-1")?;
+            let sp = in_range(field("sigma_s_prime"), sp.value, SIGMA_S_RANGE, " mm^-1")?;
+            let sa = in_range(field("sigma_a"), sa.value, SIGMA_A_RANGE, " mm^-1")?;
             let rd = match c.rd_total {
                 Some(rd) => Some(in_range(field("rd_total"), rd, (0.0, 1.0), "")?),
                 None => None,

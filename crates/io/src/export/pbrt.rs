@@ -439,13 +439,22 @@ pub(super) mod tests {
     fn max_depth_follows_the_albedo() {
         let mut r = marble();
         for c in [&mut r.channels.r, &mut r.channels.g, &mut r.channels.b] {
-            c.sigma_s_prime = Some(0.6);
-            c.sigma_a = Some(0.4);
+            c.sigma_s_prime = Some(scatterfit_optics::Estimate {
+                value: 0.6,
+                ..c.sigma_s_prime.unwrap_or_default()
+            });
+            c.sigma_a = Some(scatterfit_optics::Estimate {
+                value: 0.4,
+                ..c.sigma_a.unwrap_or_default()
+            });
         }
         let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
         // 2 ⌈ln 1e-6 / ln 0.6⌉ = 2 · 28 = 56 → the floor of 100.
         assert_eq!(pbrt_max_depth(&p), 100);
-        r.channels.g.sigma_a = Some(0.0);
+        r.channels.g.sigma_a = Some(scatterfit_optics::Estimate {
+            value: 0.0,
+            ..r.channels.g.sigma_a.unwrap_or_default()
+        });
         let (p, _) = RendererParameters::from_result(&r, SceneUnit::Millimetre).unwrap();
         assert_eq!(pbrt_max_depth(&p), 1_000_000);
     }

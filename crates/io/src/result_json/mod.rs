@@ -4,13 +4,18 @@
 //! The shape follows ARCHITECTURE.md ("The measurement, as files"); the names listed there are stable,
 //! the others may grow. Units: mm⁻¹ for coefficients, seconds for times. Channels are keyed `"r"`,
 //! `"g"`, `"b"` (linear sRGB). A channel whose fit failed keeps its row with `status = "failed"`, the
-//! reason in `problem` and `null` for the values it could not give.
+//! reason in `problem` and `null` for the values it could not give. Each measured value is one record
+//! ([`Estimate`]: the value, its uncertainty terms and their total); a file of an earlier schema is
+//! brought to this one when read ([`SCHEMA_VERSION`]).
 //!
 //! ```json
-//! { "name": "pink plastic", "eta": 1.2886, "eta_source": "spectro", "method": "proposed",
-//!   "model": "dipole", "albedo_model": "diffusion",
-//!   "channels": { "r": { "status": "ok", "sigma_s_prime": 1.979, "sigma_s_prime_stderr": 0.004,
-//!                        "sigma_a": 0.000792, "sigma_a_stderr": 0.00002, "albedo_prime": 0.9996,
+//! { "schema_version": 2, "name": "pink plastic", "eta": 1.2886, "eta_source": "spectro",
+//!   "method": "proposed", "model": "mc", "albedo_model": "mc",
+//!   "channels": { "r": { "status": "ok",
+//!                        "sigma_s_prime": { "value": 1.979, "fit": 0.004, "spectro": 0.004,
+//!                                           "g": 0.0, "model": null, "total": 0.0057 },
+//!                        "sigma_a": { "value": 0.000792, "fit": 0.00002, … },
+//!                        "albedo_prime": { "value": 0.9996, "spectro": 0.00005, … },
 //!                        "rd_total": 0.87, "fit_time_s": 1.2e-5, "iterations": 9, "mse": 0.8, … },
 //!                 "g": { … }, "b": { … } },
 //!   "inputs": { "profile": "profile.csv", "mm_per_pixel": 0.05, "spot_radius_mm": 0.5, … },
@@ -30,8 +35,10 @@ use names::lenient;
 pub use names::{AlbedoSource, EtaSource, ResponseKind};
 
 mod records;
+mod schema;
 
 pub use records::{GFitRecord, GSource, GUncertainty, PortResult, RdSpectrum};
+pub use schema::SCHEMA_VERSION;
 
 /// What can go wrong reading or writing a result file.
 #[derive(Debug, thiserror::Error)]
@@ -109,59 +116,19 @@ pub struct Correlation {
 pub struct ChannelResult {
     /// How the measurement of this channel ended.
     pub status: ChannelStatus,
-    /// Reduced scattering coefficient σ′s [mm⁻¹].
-    pub sigma_s_prime: Option<f64>,
-    /// Its standard error [mm⁻¹].
-    pub sigma_s_prime_stderr: Option<f64>,
-    /// Absorption coefficient σa [mm⁻¹].
-    pub sigma_a: Option<f64>,
-    /// Its standard error [mm⁻¹].
-    pub sigma_a_stderr: Option<f64>,
-    /// The part of σ′s's uncertainty that comes from the spectrophotometer (its η and α′ at the
-    /// reading's repeatability, propagated through refits) [mm⁻¹]; add it in quadrature to the
-    /// fit's standard error for the total. `None` without a reading (or when a refit failed).
-    #[serde(default)]
-    pub sigma_s_prime_stderr_spectro: Option<f64>,
-    /// The same for σa [mm⁻¹].
-    #[serde(default)]
-    pub sigma_a_stderr_spectro: Option<f64>,
-    /// Standard error of α′ from the reading's repeatability (its Rd and η).
-    #[serde(default)]
-    pub albedo_prime_stderr: Option<f64>,
-    /// The part of α′'s uncertainty that comes from the profile's fit: behind a spectrophotometer
-    /// port (`spectro_port`) the corrected Rd, hence α′, depends on the fitted σ′s through the
-    /// port's reading fraction F; add it in quadrature to `albedo_prime_stderr`.
-    /// Absent without a port (α′ is then the reading's alone).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub albedo_prime_stderr_fit: Option<f64>,
-    /// The part of σ′s's uncertainty that comes from the anisotropy g: how far the
-    /// g-aware estimate moves over the stated range of g ([`MeasurementResult::g_uncertainty`]
-    /// says which range and which g were evaluated) \[mm⁻¹\]; `Some(0)` when g was given, `None`
-    /// when it could not be evaluated (or in a file written before the term).
-    #[serde(default)]
-    pub sigma_s_prime_stderr_g: Option<f64>,
-    /// The same for σa \[mm⁻¹\].
-    #[serde(default)]
-    pub sigma_a_stderr_g: Option<f64>,
-    /// The same for α′.
-    #[serde(default)]
-    pub albedo_prime_stderr_g: Option<f64>,
-    /// The part of σ′s's uncertainty from an approximate forward model (a diffusion dipole, photon
-    /// beam diffusion): |its estimate − exact transport's (the `mc` tables) on the same data|
-    /// \[mm⁻¹\], added linearly to the total like the g term. Absent with the exact model (and in
-    /// files written before the term) and where exact transport could not be evaluated (the
-    /// channel is then suspect).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sigma_s_prime_stderr_model: Option<f64>,
-    /// The same for σa \[mm⁻¹\].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sigma_a_stderr_model: Option<f64>,
-    /// The same for α′.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub albedo_prime_stderr_model: Option<f64>,
-    /// Reduced albedo α′ = σ′s/(σ′s + σa): from the spectrophotometer (proposed method) or from the
-    /// fitted coefficients (existing method).
-    pub albedo_prime: Option<f64>,
+    /// Reduced scattering coefficient σ′s \[mm⁻¹\] with its uncertainty terms, each in mm⁻¹:
+    /// `fit` (the profile's noise), `spectro` (the reading's η and α′ at its repeatability,
+    /// propagated through refits), `g` (how far the g-aware estimate moves over the stated range of
+    /// g; 0 when g was given) and `model` (an approximate model's distance to exact transport on
+    /// the same data), and their `total` ([`Estimate::total`]). `None` when the channel has no value.
+    pub sigma_s_prime: Option<Estimate>,
+    /// Absorption coefficient σa \[mm⁻¹\] with its uncertainty terms, as `sigma_s_prime`.
+    pub sigma_a: Option<Estimate>,
+    /// Reduced albedo α′ = σ′s/(σ′s + σa) with its uncertainty terms: from the spectrophotometer
+    /// (proposed method: `spectro` is the reading's repeatability; behind a spectrophotometer port
+    /// `fit` is the part through the port's reading fraction, which depends on the fitted σ′s) or
+    /// from the fitted coefficients (existing method).
+    pub albedo_prime: Option<Estimate>,
     /// Total diffuse reflectance Rd of the channel from the spectrophotometer (linear sRGB of SCE).
     pub rd_total: Option<f64>,
     /// The profile's fitted (or spectro-normalised) scale k: measured = k · model [relative units
@@ -212,43 +179,6 @@ pub struct ChannelResult {
     /// the checks, or where no check ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quality: Option<crate::quality::Quality>,
-}
-
-impl ChannelResult {
-    /// σ′s with its uncertainty terms (the fit's, the spectrophotometer's and g's), as
-    /// the pipeline had it before the file flattened it; `None` without a value.
-    pub fn sigma_s_prime_estimate(&self) -> Option<Estimate> {
-        self.sigma_s_prime.map(|value| Estimate {
-            value,
-            fit: self.sigma_s_prime_stderr,
-            spectro: self.sigma_s_prime_stderr_spectro,
-            g: self.sigma_s_prime_stderr_g,
-            model: self.sigma_s_prime_stderr_model,
-        })
-    }
-
-    /// σa with its uncertainty terms; `None` without a value.
-    pub fn sigma_a_estimate(&self) -> Option<Estimate> {
-        self.sigma_a.map(|value| Estimate {
-            value,
-            fit: self.sigma_a_stderr,
-            spectro: self.sigma_a_stderr_spectro,
-            g: self.sigma_a_stderr_g,
-            model: self.sigma_a_stderr_model,
-        })
-    }
-
-    /// α′ with the spectrophotometer's standard error (the proposed method's α′ is the reading's),
-    /// the fit's (behind a port) and g's; `None` without a value.
-    pub fn albedo_prime_estimate(&self) -> Option<Estimate> {
-        self.albedo_prime.map(|value| Estimate {
-            value,
-            fit: self.albedo_prime_stderr_fit,
-            spectro: self.albedo_prime_stderr,
-            g: self.albedo_prime_stderr_g,
-            model: self.albedo_prime_stderr_model,
-        })
-    }
 }
 
 /// The three channels, keyed `"r"`, `"g"`, `"b"` in the file.
@@ -344,6 +274,10 @@ fn lenient_options<'de, D: Deserializer<'de>>(d: D) -> Result<RunOptions, D::Err
 /// A whole result file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MeasurementResult {
+    /// The file's schema version ([`SCHEMA_VERSION`] when written by this scatterfit; earlier
+    /// files are brought to it when read).
+    #[serde(default = "current_schema")]
+    pub schema_version: u32,
     /// The sample's name.
     pub name: String,
     /// Relative refractive index η used by the fit.
@@ -427,7 +361,7 @@ impl MeasurementResult {
         self.channels
             .as_ref()
             .map_with_channel(|ch, c| match (c.sigma_s_prime, c.sigma_a) {
-                (Some(s), Some(a)) => Ok((s, a)),
+                (Some(s), Some(a)) => Ok((s.value, a.value)),
                 _ => Err(ch),
             })
             .transpose()
@@ -448,6 +382,10 @@ impl MeasurementResult {
             model: None,
         }
     }
+}
+
+fn current_schema() -> u32 {
+    SCHEMA_VERSION
 }
 
 /// Writes a result atomically as pretty JSON.
@@ -564,21 +502,23 @@ fn parse_result(
     let unknown_model = value
         .get("model")
         .and_then(serde_json::Value::as_str)
-        .filter(|m| lenient::model(m).is_none());
-    let result: MeasurementResult = match (unknown_model, assume_model) {
-        (None, _) => serde_json::from_str(text).map_err(shape)?,
+        .filter(|m| lenient::model(m).is_none())
+        .map(|m| m.trim().to_string());
+    let mut value = value;
+    match (unknown_model, assume_model) {
+        (None, _) => {}
         (Some(found), None) => {
             return Err(ResultJsonError::UnknownModel {
                 path: path.to_path_buf(),
-                found: found.trim().to_string(),
+                found,
             });
         }
-        (Some(_), Some(model)) => {
-            let mut value = value;
-            value["model"] = serde_json::Value::from(model.name());
-            serde_json::from_value(value).map_err(shape)?
-        }
-    };
+        (Some(_), Some(model)) => value["model"] = serde_json::Value::from(model.name()),
+    }
+    if let serde_json::Value::Object(file) = &mut value {
+        schema::upgrade(file).map_err(invalid)?;
+    }
+    let result: MeasurementResult = serde_json::from_value(value).map_err(shape)?;
     if !(result.eta.is_finite() && result.eta >= 1.0) {
         return Err(invalid(format!(
             "`eta` = {} must be a number ≥ 1 (relative refractive index)",
@@ -587,32 +527,36 @@ fn parse_result(
     }
     for (ch, c) in result.channels.iter_channels() {
         let name = ch.key();
-        let fields = [
-            ("sigma_s_prime", c.sigma_s_prime),
-            ("sigma_a", c.sigma_a),
-            ("sigma_s_prime_stderr", c.sigma_s_prime_stderr),
-            ("sigma_a_stderr", c.sigma_a_stderr),
-        ];
-        for (field, v) in fields {
-            if let Some(v) = v
-                && !(v.is_finite() && v >= 0.0)
-            {
-                return Err(invalid(format!(
-                    "`channels.{name}.{field}` = {} must be a finite number ≥ 0 [mm⁻¹]",
-                    crate::escape::number(v)
-                )));
+        for (field, e) in [("sigma_s_prime", c.sigma_s_prime), ("sigma_a", c.sigma_a)] {
+            let Some(e) = e else { continue };
+            let parts = [
+                ("value", Some(e.value)),
+                ("fit", e.fit),
+                ("spectro", e.spectro),
+                ("g", e.g),
+                ("model", e.model),
+            ];
+            for (part, v) in parts {
+                if let Some(v) = v
+                    && !(v.is_finite() && v >= 0.0)
+                {
+                    return Err(invalid(format!(
+                        "`channels.{name}.{field}.{part}` = {} must be a finite number ≥ 0 [mm⁻¹]",
+                        crate::escape::number(v)
+                    )));
+                }
             }
         }
-        if c.sigma_s_prime == Some(0.0) {
+        if c.sigma_s_prime.is_some_and(|e| e.value == 0.0) {
             return Err(invalid(format!(
-                "`channels.{name}.sigma_s_prime` = 0: a scattering material needs σ′s > 0"
+                "`channels.{name}.sigma_s_prime.value` = 0: a scattering material needs σ′s > 0"
             )));
         }
-        if let Some(a) = c.albedo_prime
+        if let Some(a) = c.albedo_prime.map(|e| e.value)
             && !(a.is_finite() && a > 0.0 && a <= 1.0)
         {
             return Err(invalid(format!(
-                "`channels.{name}.albedo_prime` = {} must lie in (0, 1]",
+                "`channels.{name}.albedo_prime.value` = {} must lie in (0, 1]",
                 crate::escape::number(a)
             )));
         }
@@ -627,21 +571,27 @@ mod tests {
     fn channel(sp: f64, sa: f64) -> ChannelResult {
         ChannelResult {
             status: ChannelStatus::Ok,
-            sigma_s_prime: Some(sp),
-            sigma_s_prime_stderr: Some(0.01),
-            sigma_a: Some(sa),
-            sigma_a_stderr: Some(0.001),
-            sigma_s_prime_stderr_spectro: None,
-            sigma_a_stderr_spectro: None,
-            sigma_s_prime_stderr_g: None,
-            sigma_a_stderr_g: None,
-            albedo_prime_stderr_g: None,
-            sigma_s_prime_stderr_model: None,
-            sigma_a_stderr_model: None,
-            albedo_prime_stderr_model: None,
-            albedo_prime_stderr: None,
-            albedo_prime_stderr_fit: None,
-            albedo_prime: Some(sp / (sp + sa)),
+            sigma_s_prime: Some(scatterfit_optics::Estimate {
+                value: sp,
+                fit: Some(0.01),
+                spectro: None,
+                g: None,
+                model: None,
+            }),
+            sigma_a: Some(scatterfit_optics::Estimate {
+                value: sa,
+                fit: Some(0.001),
+                spectro: None,
+                g: None,
+                model: None,
+            }),
+            albedo_prime: Some(scatterfit_optics::Estimate {
+                value: sp / (sp + sa),
+                fit: None,
+                spectro: None,
+                g: None,
+                model: None,
+            }),
             rd_total: Some(0.5),
             scale: Some(2.0),
             correlation: None,
@@ -663,6 +613,7 @@ mod tests {
 
     fn result() -> MeasurementResult {
         MeasurementResult {
+            schema_version: SCHEMA_VERSION,
             name: "pink plastic".into(),
             eta: 1.2886,
             eta_source: Some(EtaSource::Spectro),
@@ -817,20 +768,74 @@ mod tests {
         assert!(err.contains("proposed, existing"), "{err}");
     }
 
-    /// The file's flat error fields come back as estimates with their terms apart.
+    /// A file written before the schema version (version 1: each value's terms as flat keys
+    /// beside it; `scatterfit measure --model dipole` on the quick demo's pink plastic) reads into
+    /// one record per value with its terms apart — α′'s `albedo_prime_stderr` as its
+    /// spectrophotometer term — and is written back as version 2 with each record's total.
     #[test]
-    fn estimates_from_the_flat_fields() {
-        let mut c = channel(2.0, 0.01);
-        c.sigma_s_prime_stderr_spectro = Some(0.03);
-        let e = c.sigma_s_prime_estimate().unwrap();
-        assert_eq!(
-            (e.value, e.fit, e.spectro, e.g),
-            (2.0, Some(0.01), Some(0.03), None)
+    fn a_version_1_file_reads_into_records() {
+        let text = include_str!("../../tests/fixtures/result-v1-dipole.json");
+        let flat: serde_json::Value = serde_json::from_str(text).unwrap();
+        assert!(flat.get("schema_version").is_none());
+        let r = parse_result_json(text, Path::new("result.json")).unwrap();
+        assert_eq!(r.schema_version, SCHEMA_VERSION);
+        for (ch, c) in r.channels.iter_channels() {
+            let f = &flat["channels"][ch.key()];
+            let num = |k: &str| f[k].as_f64();
+            let record = |e: Option<Estimate>| {
+                let e = e.unwrap();
+                (Some(e.value), e.fit, e.spectro, e.g, e.model)
+            };
+            assert_eq!(
+                record(c.sigma_s_prime),
+                (
+                    num("sigma_s_prime"),
+                    num("sigma_s_prime_stderr"),
+                    num("sigma_s_prime_stderr_spectro"),
+                    num("sigma_s_prime_stderr_g"),
+                    num("sigma_s_prime_stderr_model")
+                )
+            );
+            assert_eq!(
+                record(c.sigma_a),
+                (
+                    num("sigma_a"),
+                    num("sigma_a_stderr"),
+                    num("sigma_a_stderr_spectro"),
+                    num("sigma_a_stderr_g"),
+                    num("sigma_a_stderr_model")
+                )
+            );
+            assert_eq!(
+                record(c.albedo_prime),
+                (
+                    num("albedo_prime"),
+                    num("albedo_prime_stderr_fit"),
+                    num("albedo_prime_stderr"),
+                    num("albedo_prime_stderr_g"),
+                    num("albedo_prime_stderr_model")
+                )
+            );
+            // Every term of the dipole's values is there: fit, spectro, g and model.
+            assert!(c.sigma_a.unwrap().terms().count() == 4, "{ch:?}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("result.json");
+        write_result_json(&path, &r).unwrap();
+        let written: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert_eq!(written["schema_version"], serde_json::json!(SCHEMA_VERSION));
+        let sa = &written["channels"]["g"]["sigma_a"];
+        let total = sa["total"].as_f64().unwrap();
+        let (fit, spectro, g, model) = (
+            sa["fit"].as_f64().unwrap(),
+            sa["spectro"].as_f64().unwrap(),
+            sa["g"].as_f64().unwrap(),
+            sa["model"].as_f64().unwrap(),
         );
-        let e = c.sigma_a_estimate().unwrap();
-        assert_eq!((e.fit, e.spectro), (Some(0.001), None));
-        c.sigma_a = None;
-        assert_eq!(c.sigma_a_estimate(), None);
+        assert!((total - ((fit * fit + spectro * spectro).sqrt() + g + model)).abs() < 1e-15);
+        assert!(written["channels"]["g"].get("sigma_a_stderr").is_none());
+        assert_eq!(read_result_json(&path).unwrap(), r);
         let mut r = result();
         r.eta_stderr = Some(0.002);
         assert_eq!(r.eta_estimate().total(), Some(0.002));
@@ -856,7 +861,10 @@ mod tests {
     #[test]
     fn bad_values_are_refused_with_the_field() {
         let mut r = result();
-        r.channels.g.sigma_a = Some(-1.0);
+        r.channels.g.sigma_a = Some(scatterfit_optics::Estimate {
+            value: -1.0,
+            ..r.channels.g.sigma_a.unwrap_or_default()
+        });
         let text = serde_json::to_string(&r).unwrap();
         let err = parse_result_json(&text, Path::new("r.json"))
             .unwrap_err()

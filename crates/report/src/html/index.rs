@@ -173,16 +173,16 @@ pub(crate) fn index_page(page: &IndexPage<'_>) -> String {
             verdict_rank(v.verdict),
             badge(v.verdict),
             channels.join(" · "),
-            num_cell(v.eta.value, v.eta.total_error())
+            num_cell(v.eta.value(), v.eta.total_error())
         );
         for c in &v.channels {
             p.push_str(&num_cell(
-                c.sigma_s_prime.value,
+                c.sigma_s_prime.value(),
                 c.sigma_s_prime.total_error(),
             ));
         }
         for c in &v.channels {
-            p.push_str(&num_cell(c.sigma_a.value, c.sigma_a.total_error()));
+            p.push_str(&num_cell(c.sigma_a.value(), c.sigma_a.total_error()));
         }
         let links: Vec<String> = e
             .page

@@ -39,9 +39,9 @@ fn valued_cells(v: &Valued, fit: bool) -> String {
     format!(
         "<td class=\"num\">{}</td>{}{}{}",
         v.value_text(),
-        if fit { term(v.fit) } else { String::new() },
-        term(v.spectro),
-        term(v.g)
+        if fit { term(v.fit()) } else { String::new() },
+        term(v.0.and_then(|e| e.spectro)),
+        term(v.0.and_then(|e| e.g))
     )
 }
 
@@ -101,7 +101,7 @@ pub(crate) fn sample_page(view: &ResultView, extras: &SampleExtras) -> String {
 
     // Table 1. α′ has a fit term only behind a spectrophotometer port (the fit's error reaches
     // the corrected α′ through the port's F); its column is shown when a channel has one.
-    let albedo_fit = view.channels.iter().any(|c| c.albedo_prime.fit.is_some());
+    let albedo_fit = view.channels.iter().any(|c| c.albedo_prime.fit().is_some());
     let _ = writeln!(
         p,
         "<section id=\"table1\"><h2>Table 1: parameters</h2><p>η = {} <span class=\"err\">{}</span> \
@@ -302,7 +302,7 @@ pub(crate) fn extras_for(
     let response_svg = evidence::response_figure(m).and_then(|f| crate::plot::render_svg(&f).ok());
     let swatch = view
         .coefficients()
-        .zip(view.eta.value)
+        .zip(view.eta.value())
         .and_then(|(c, eta)| evidence::swatch(c, eta));
     SampleExtras {
         fit_svg,

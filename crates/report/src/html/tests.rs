@@ -57,7 +57,7 @@ fn hostile_result() -> MeasurementResult {
                 { "kind": "poor_fit", "severity": verdict, "message": HOSTILE } ] }
         })
     };
-    serde_json::from_value(serde_json::json!({
+    let file = serde_json::json!({
         "name": HOSTILE, "eta": 1.3, "eta_source": "spectro", "method": "proposed",
         "model": "dipole", "albedo_model": "diffusion",
         "channels": { "r": channel("ok"), "g": channel("suspect"), "b": channel("failed") },
@@ -68,8 +68,10 @@ fn hostile_result() -> MeasurementResult {
             "options": { "note": HOSTILE }
         },
         "version": HOSTILE
-    }))
-    .expect("a result")
+    });
+    // A file of the first schema (flat error keys), read as every consumer reads one.
+    scatterfit_io::result_json::parse_result_json(&file.to_string(), std::path::Path::new("r.json"))
+        .expect("a result")
 }
 
 #[test]
@@ -264,7 +266,7 @@ fn table_1_shows_the_albedo_fit_term_when_there_is_one() {
     let mut r = hostile_result();
     let without = table(&sample_html(&r, &SampleExtras::default()));
     assert_eq!(without.matches("<th>± fit</th>").count(), 2, "{without}");
-    r.channels.r.albedo_prime_stderr_fit = Some(1.2345e-5);
+    r.channels.r.albedo_prime.as_mut().expect("α′").fit = Some(1.2345e-5);
     let with = table(&sample_html(&r, &SampleExtras::default()));
     assert_eq!(with.matches("<th>± fit</th>").count(), 3, "{with}");
     assert!(

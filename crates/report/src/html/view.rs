@@ -5,38 +5,42 @@
 use scatterfit_io::quality::Verdict;
 use scatterfit_io::result_json::{ChannelResult, ChannelStatus, MeasurementResult};
 use scatterfit_io::result_table::sig4;
+use scatterfit_optics::Estimate;
 
 /// The channel names in R, G, B order, as the tables write them.
 pub(crate) const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
-/// A value with its uncertainty terms, each a one-sigma standard error in the value's unit.
+/// A value of the result as the pages show it: the file's record of the value and its
+/// uncertainty terms ([`Estimate`]), or none (a failed channel).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub(crate) struct Valued {
-    /// The value, `None` where there is none (failed channel).
-    pub value: Option<f64>,
-    /// The fit's standard error (from the Jacobian at the solution).
-    pub fit: Option<f64>,
-    /// The spectrophotometer's part (its η and α′ at the reading's repeatability, propagated).
-    pub spectro: Option<f64>,
-    /// The anisotropy g's part (how far the estimate moves over the range of g).
-    pub g: Option<f64>,
-    /// An approximate forward model's part (how far the estimate moves to exact transport's).
-    pub model: Option<f64>,
-}
+pub(crate) struct Valued(pub Option<Estimate>);
 
 impl Valued {
-    /// The value in four significant figures, or `—`.
-    pub fn value_text(&self) -> String {
-        self.value.map_or("—".into(), sig4)
+    /// The value, `None` where there is none.
+    pub fn value(&self) -> Option<f64> {
+        self.0.map(|e| e.value)
     }
 
-    /// `± fit (fit) ± spectro (spectro) ± g (g)`, the known terms only, or empty.
+    /// The fit's term, `None` where unknown.
+    pub fn fit(&self) -> Option<f64> {
+        self.0.and_then(|e| e.fit)
+    }
+
+    /// The value in four significant figures, or `—`.
+    pub fn value_text(&self) -> String {
+        self.value().map_or("—".into(), sig4)
+    }
+
+    /// `± fit (fit) ± spectro (spectro) ± g (g) ± model (model)`, the known terms only, or empty.
     pub fn error_text(&self) -> String {
+        let Some(e) = self.0 else {
+            return String::new();
+        };
         [
-            (self.fit, "fit"),
-            (self.spectro, "spectro"),
-            (self.g, "g"),
-            (self.model, "model"),
+            (e.fit, "fit"),
+            (e.spectro, "spectro"),
+            (e.g, "g"),
+            (e.model, "model"),
         ]
         .into_iter()
         .filter_map(|(v, name)| v.map(|v| format!("± {} ({name})", sig4(v))))
@@ -44,17 +48,9 @@ impl Valued {
         .join(" ")
     }
 
-    /// The total uncertainty: fit and spectro in quadrature plus the g term
-    /// (`scatterfit_optics::Estimate::total`).
+    /// The total uncertainty ([`Estimate::total`]).
     pub fn total_error(&self) -> Option<f64> {
-        scatterfit_optics::Estimate {
-            value: 0.0,
-            fit: self.fit,
-            spectro: self.spectro,
-            g: self.g,
-            model: self.model,
-        }
-        .total()
+        self.0.and_then(|e| e.total())
     }
 }
 
@@ -177,27 +173,9 @@ fn channel(name: &'static str, c: &ChannelResult) -> ChannelView {
         name,
         verdict: verdict_of(c).name(),
         reasons,
-        sigma_s_prime: Valued {
-            value: c.sigma_s_prime,
-            fit: c.sigma_s_prime_stderr,
-            spectro: c.sigma_s_prime_stderr_spectro,
-            g: c.sigma_s_prime_stderr_g,
-            model: c.sigma_s_prime_stderr_model,
-        },
-        sigma_a: Valued {
-            value: c.sigma_a,
-            fit: c.sigma_a_stderr,
-            spectro: c.sigma_a_stderr_spectro,
-            g: c.sigma_a_stderr_g,
-            model: c.sigma_a_stderr_model,
-        },
-        albedo_prime: Valued {
-            value: c.albedo_prime,
-            fit: c.albedo_prime_stderr_fit,
-            spectro: c.albedo_prime_stderr,
-            g: c.albedo_prime_stderr_g,
-            model: c.albedo_prime_stderr_model,
-        },
+        sigma_s_prime: Valued(c.sigma_s_prime),
+        sigma_a: Valued(c.sigma_a),
+        albedo_prime: Valued(c.albedo_prime),
         rd_total: c.rd_total,
         mse: c.mse,
         rms_log_residual: c.rms_log_residual,
@@ -262,13 +240,7 @@ impl ResultView {
         });
         Self {
             name: r.name.clone(),
-            eta: Valued {
-                value: Some(r.eta),
-                fit: None,
-                spectro: r.eta_stderr,
-                g: None,
-                model: None,
-            },
+            eta: Valued(Some(r.eta_estimate())),
             eta_source: r.eta_source.map_or_else(|| "—".into(), |e| e.name().into()),
             method: r.method.to_string(),
             model: r.model.to_string(),
@@ -302,7 +274,7 @@ impl ResultView {
     pub fn coefficients(&self) -> Option<[(f64, f64); 3]> {
         let mut out = [(0.0, 0.0); 3];
         for (o, c) in out.iter_mut().zip(&self.channels) {
-            *o = (c.sigma_s_prime.value?, c.sigma_a.value?);
+            *o = (c.sigma_s_prime.value()?, c.sigma_a.value()?);
         }
         Some(out)
     }
