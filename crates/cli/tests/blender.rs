@@ -13,16 +13,18 @@
 //!
 //! The interpreter is `$SCATTERFIT_BLENDER_PYTHON`, else `.ci/blender-venv/bin/python` (made by
 //! `.ci/run`: `pip install bpy==5.0.1` under CPython 3.11). Without it `cargo test` reports the
-//! tests as ignored, saying why (this file is its own harness: `tests/common/peer.rs`), unless
-//! `SCATTERFIT_REQUIRE_BLENDER=1` (set by `.ci/run`), which makes its absence a failure.
+//! tests as ignored, saying why (the `peers` binary is its own harness: `tests/common/peer.rs`),
+//! unless `SCATTERFIT_REQUIRE_BLENDER=1` (set by `.ci/run`), which makes its absence a failure.
 
-mod common;
+use crate::common;
 
-use common::peer::{self, Peer};
+use common::peer::Peer;
 use common::{command, temp_dir, workspace_root};
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::Command;
+
+use libtest_mimic::Trial;
 
 use scatterfit_io::export::MaterialNames;
 
@@ -54,9 +56,10 @@ fn blender_python() -> Result<PathBuf, String> {
     ))
 }
 
-fn main() -> ExitCode {
-    let blender = Peer::new(blender_python(), "SCATTERFIT_REQUIRE_BLENDER");
-    peer::run(vec![
+/// The tests, named `blender::…` in the `peers` binary.
+pub fn trials() -> Vec<Trial> {
+    let blender = Peer::new("blender", blender_python, "SCATTERFIT_REQUIRE_BLENDER");
+    vec![
         blender.trial(
             "blender_script_sets_the_material",
             blender_script_sets_the_material,
@@ -65,7 +68,7 @@ fn main() -> ExitCode {
             "cycles_renders_within_the_stated_error",
             cycles_renders_within_the_stated_error,
         ),
-    ])
+    ]
 }
 
 /// Writes a result named `name` with the thick slab's channels and exports it to `out.py`.

@@ -16,18 +16,20 @@
 //! `target/ci-artefacts/browser/`); the test prints the folder.
 //!
 //! The browser is `$SCATTERFIT_CHROMIUM`, else `chromium` on the PATH (Debian's package; `.ci/run`
-//! installs it). Without one `cargo test` reports the test as ignored, saying why (this file is its
-//! own harness: `tests/common/peer.rs`), unless `SCATTERFIT_REQUIRE_CHROMIUM=1` (set by `.ci/run`),
-//! which makes its absence a failure.
+//! installs it). Without one `cargo test` reports the test as ignored, saying why (the `peers`
+//! binary is its own harness: `tests/common/peer.rs`), unless `SCATTERFIT_REQUIRE_CHROMIUM=1` (set
+//! by `.ci/run`), which makes its absence a failure.
 
-mod common;
+use crate::common;
 
-use common::peer::{self, Peer};
+use common::peer::Peer;
 use common::{run_cached, temp_dir, workspace_root};
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::Command;
+
+use libtest_mimic::Trial;
 
 /// The screenshot's width [CSS px]; the wrapper frames the report at the same width, so the boxes
 /// it measures are where the screenshot has them.
@@ -52,12 +54,13 @@ fn chromium() -> Result<PathBuf, String> {
     })
 }
 
-fn main() -> ExitCode {
-    let chromium = Peer::new(chromium(), "SCATTERFIT_REQUIRE_CHROMIUM");
-    peer::run(vec![chromium.trial(
+/// The tests, named `browser::…` in the `peers` binary.
+pub fn trials() -> Vec<Trial> {
+    let chromium = Peer::new("browser", chromium, "SCATTERFIT_REQUIRE_CHROMIUM");
+    vec![chromium.trial(
         "demo_pages_load_and_draw_in_chromium",
         demo_pages_load_and_draw_in_chromium,
-    )])
+    )]
 }
 
 /// Where the screenshots go (created).

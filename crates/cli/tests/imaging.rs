@@ -4,7 +4,7 @@
 //! (Z = round(255 · clip(E·Δt)^(1/2.2))), so the expectations (radiance ratios, the response up to its
 //! gauge, which pixels are clipped everywhere) come from the construction, not from the program.
 
-mod common;
+use crate::common;
 
 use common::{read_text, run, temp_dir};
 

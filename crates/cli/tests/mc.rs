@@ -1,7 +1,7 @@
 //! Integration tests of `scatterfit simulate` and `scatterfit table`: the real binary in a temporary
 //! folder.
 
-mod common;
+use crate::common;
 
 use common::{command, read_text, temp_dir, text};
 
@@ -203,7 +203,7 @@ fn table_builds_then_reuses_cache() {
 /// tallies became exact sums (`mc::exact`), which moves the raw tallies by a few ulps (≤ 2.2·10⁻¹⁵
 /// relative on a coarse table, BENCHMARKS.md "Sharded tables"), so a value on a rounding edge may
 /// round the other way. Minutes of work: run by hand,
-/// `cargo test -p scatterfit --test mc -- --ignored table_rebuilds_the_shipped_table`.
+/// `cargo test -p scatterfit --test suite -- --ignored mc::table_rebuilds_the_shipped_table`.
 #[test]
 #[ignore = "minutes: builds a full table (η = 1.0, the cheapest)"]
 fn table_rebuilds_the_shipped_table() {

@@ -2,7 +2,7 @@
 //! and `demo` — with the real binary in a temporary folder, on quick rig-twin samples. Each exit-code
 //! class is pinned: 0 success, 1 a measurement that ran and failed, 2 bad usage or input.
 
-mod common;
+use crate::common;
 
 use common::{read_json, read_text, run_cached, synth_quick, temp_dir};
 

@@ -18,20 +18,22 @@
 //! thin slab's 0.27 into 0.36 or 0.04.
 //!
 //! The interpreter is `$SCATTERFIT_MITSUBA_PYTHON`, else `.ci/venv/bin/python` (made by `.ci/run`).
-//! Without it `cargo test` reports the tests as ignored, saying why (this file is its own harness:
-//! `tests/common/peer.rs`), unless `SCATTERFIT_REQUIRE_MITSUBA=1` (set by `.ci/run`), which makes
-//! its absence a failure.
+//! Without it `cargo test` reports the tests as ignored, saying why (the `peers` binary is its own
+//! harness: `tests/common/peer.rs`), unless `SCATTERFIT_REQUIRE_MITSUBA=1` (set by `.ci/run`),
+//! which makes its absence a failure.
 //!
 //! `forward_models_against_mitsuba` (ignored; run by hand) is the higher-quality comparison of each
 //! forward model's total Rd with the path tracer that BENCHMARKS.md reports.
 
-mod common;
+use crate::common;
 
-use common::peer::{self, Peer};
+use common::peer::Peer;
 use common::{command, read_json, run_cached, synth_quick, temp_dir, workspace_root};
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::Command;
+
+use libtest_mimic::Trial;
 
 /// Slab reflectance at normal incidence from exact transport (iadpython adding-doubling;
 /// docs/physics.md §4.3, "n=1.4 R_d = UR1(Q40) − 0.027778"): a = α′ and Rd, semi-infinite, η = 1.4,
@@ -68,9 +70,10 @@ fn mitsuba_python() -> Result<PathBuf, String> {
     ))
 }
 
-fn main() -> ExitCode {
-    let mitsuba = Peer::new(mitsuba_python(), "SCATTERFIT_REQUIRE_MITSUBA");
-    peer::run(vec![
+/// The tests, named `mitsuba::…` in the `peers` binary.
+pub fn trials() -> Vec<Trial> {
+    let mitsuba = Peer::new("mitsuba", mitsuba_python, "SCATTERFIT_REQUIRE_MITSUBA");
+    vec![
         mitsuba.trial(
             "thick_slab_shows_total_diffuse_reflectance",
             thick_slab_shows_total_diffuse_reflectance,
@@ -103,7 +106,7 @@ fn main() -> ExitCode {
                 forward_models_against_mitsuba,
             )
             .with_ignored_flag(true),
-    ])
+    ]
 }
 
 /// A result file with per-channel (σ′s, σa, Rd) [mm⁻¹, mm⁻¹, 1].
@@ -501,7 +504,7 @@ fn spectral_variant_renders_the_measured_colour(python: &Path) {
 
 /// BENCHMARKS.md "exports": each forward model's total Rd against Mitsuba's volumetric path tracer
 /// on half-spaces, at high sample counts, and the `mc` tables' total checked against it. By hand
-/// (minutes): `cargo test -p scatterfit --test mitsuba -- --ignored --nocapture`.
+/// (minutes): `cargo test -p scatterfit --test peers mitsuba:: -- --ignored --nocapture`.
 fn forward_models_against_mitsuba(python: &Path) {
     use scatterfit_optics::{DiffusionModel, ModelFamily, ModelName};
     let spp: u32 = std::env::var("SCATTERFIT_BENCH_SPP")

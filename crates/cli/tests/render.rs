@@ -1,7 +1,7 @@
 //! `scatterfit render`, run as the real binary in a temporary folder: images, the Figure 5 grid,
 //! determinism, `--profile` against a measured profile made here from the model, and refusals.
 
-mod common;
+use crate::common;
 
 use common::{read_text, run, temp_dir};
 

@@ -3,7 +3,7 @@
 //! spectro's are pinned in measure.rs, spectro.rs and export.rs), outputs checked before the work,
 //! never overwritten without --force, and Ctrl-C ending a run with 130 and no temporary file.
 
-mod common;
+use crate::common;
 
 use common::{Run, cached_command, read_json, read_text, run_cached, synth_quick, temp_dir, text};
 

@@ -9,7 +9,7 @@ use std::process::Command;
 use std::sync::OnceLock;
 use std::time::{Duration, Instant, SystemTime};
 
-mod common;
+use crate::common;
 
 use common::{run_cached as scatterfit, synth_quick};
 

@@ -5,7 +5,7 @@
 //! result files match its inputs (unless --force); the Slurm script holds the job array and the
 //! dependent combine job. (A real Slurm cluster runs the scripts in `.ci/slurm-test.sh`.)
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -1,6 +1,6 @@
 //! Integration tests of `scatterfit spectro`: the real binary in a temporary folder.
 
-mod common;
+use crate::common;
 
 use common::{read_json, read_text, run, temp_dir};
 

@@ -6,7 +6,7 @@
 //! for more than the memory budget must be refused before its pixels are allocated.
 //!
 //! CI runs [`CI_CASES`] cases per property; `PROPTEST_CASES=20000 cargo test --release -p
-//! scatterfit-io --test fuzz_images` runs a long campaign (RELIABILITY.md).
+//! scatterfit-io --test suite fuzz_images::` runs a long campaign (RELIABILITY.md).
 
 use std::io::Cursor;
 use std::path::Path;

@@ -8,7 +8,7 @@
 //! the original file parses to.
 //!
 //! CI runs [`CI_CASES`] cases per property (seconds); `PROPTEST_CASES=20000 cargo test --release -p
-//! scatterfit-io --test fuzz_text` runs a long campaign (RELIABILITY.md).
+//! scatterfit-io --test suite fuzz_text::` runs a long campaign (RELIABILITY.md).
 
 use std::path::Path;
 use std::time::{Duration, Instant};

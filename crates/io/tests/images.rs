@@ -506,7 +506,7 @@ fn exr_output_is_byte_reproducible_and_lossless() {
 /// A 12-MP noisy radiance map (a spot falling off over 5 decades, 2 % multiplicative noise): EXR
 /// size and write time for PIZ in scan lines (now), RLE (the former encoding), ZIP and others, and
 /// the sizes the choice rests on checked. A measurement of seconds, run by hand:
-/// `cargo test --release -p scatterfit-io --test images -- --ignored --nocapture exr_size`.
+/// `cargo test --release -p scatterfit-io --test suite -- --ignored --nocapture images::exr_size`.
 #[test]
 #[ignore = "a measurement (12 MP, seconds): run by hand"]
 fn exr_size_12_mp() {

@@ -34,9 +34,9 @@ const WAVE_INTERACTIONS: f64 = 1e8;
 const TALLY_BYTES_PER_BIN: u64 = 16;
 
 /// Steps (interactions) per second per thread on the project's standard machine (2-core AMD EPYC VM,
-/// shared: 1.6e7–2.2e7 on paths of hundreds of steps), measured with `cargo test --release -p
-/// scatterfit-mc --test cost -- --ignored --nocapture` (BENCHMARKS.md, "Monte Carlo cost model"):
-/// only for turning a step count into an expected run time in messages.
+/// shared: 1.6e7–2.2e7 on paths of hundreds of steps; BENCHMARKS.md, "Monte Carlo cost model"),
+/// measured with `cargo test --release -p scatterfit-mc --test suite cost:: -- --ignored
+/// --nocapture`: only for turning a step count into an expected run time in messages.
 pub const REFERENCE_INTERACTIONS_PER_SECOND: f64 = 2.0e7;
 
 /// What a simulation is expected to cost, before it runs ([`Simulation::cost_estimate`]).

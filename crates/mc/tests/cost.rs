@@ -121,7 +121,7 @@ fn memory_estimate_counts_bins_not_photons() {
 /// turns cost estimates into the times the refusal messages quote: on paths of many steps it must be
 /// within a factor 4 of the constant either way (the standard VM measures 1.6–2.2·10⁷ per thread,
 /// BENCHMARKS.md "Monte Carlo cost model"), or the messages mislead. A timing, so run by hand:
-/// `cargo test --release -p scatterfit-mc --test cost -- --ignored --nocapture`.
+/// `cargo test --release -p scatterfit-mc --test suite cost:: -- --ignored --nocapture`.
 #[test]
 #[ignore = "a timing of this machine (release build): run by hand"]
 fn measure_interaction_rate() {

@@ -4,7 +4,7 @@
 //! right reason — where, without the check, it was "ok" with σ′s off (the errors each case gave
 //! before the checks are in RELIABILITY.md). The good twin itself must stay ok.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::sync::OnceLock;

@@ -4,7 +4,7 @@
 //! plastic, seed 1) and must be caught for the right reason; the good twin stays ok. Every case
 //! here measured "ok" before these checks (the errors are in RELIABILITY.md).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::sync::OnceLock;

@@ -19,7 +19,7 @@
 //!   part of sd(g) 0.2–1; BENCHMARKS.md "Can g be fitted from the rig's profile?".)
 //! - a g-given run's `g_uncertainty` has no `fitted` record (its outputs do not change).
 
-mod common;
+use crate::common;
 
 use scatterfit_io::manifest::{FitSection, GSetting};
 use scatterfit_io::result_json::GSource;

@@ -13,7 +13,7 @@
 //! 2.9–4.2 % of σa inside the total and 2.9–8.8 % outside fit ⊕ spectro, while the twin's error with
 //! g given is ≈ 1 % (BENCHMARKS.md "The rig twin at g ≠ 0").
 
-mod common;
+use crate::common;
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::GSource;

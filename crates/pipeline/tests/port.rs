@@ -6,7 +6,7 @@
 //! when the reading is taken as loss-free and back near the truth once the manifest names the port.
 //! Fixed seeds; tolerances below.
 
-mod common;
+use crate::common;
 
 use scatterfit_io::manifest::FitSection;
 use scatterfit_io::sample_folder::{CameraFiles, SampleFiles, write_sample_folder_with};
@@ -484,7 +484,7 @@ fn the_fit_error_reaches_the_port_corrected_values_through_f() {
 /// σ′s and σa as read (loss-free), corrected, and the twin's baseline (the loss-free reading).
 /// Prints a Markdown table and asserts the medians within 2.5 %; about 3 min on 2 cores.
 #[test]
-#[ignore = "study: minutes; prints BENCHMARKS.md's table and asserts the medians (cargo test -p scatterfit-pipeline --test port -- --ignored --nocapture)"]
+#[ignore = "study: minutes; prints BENCHMARKS.md's table and asserts the medians (cargo test -p scatterfit-pipeline --test suite port:: -- --ignored --nocapture)"]
 fn port_study() {
     port_study_on(&QUICK_STUDY_MATERIALS, &RigSpec::quick(), None, 0.025);
 }
@@ -511,7 +511,7 @@ const QUICK_STUDY_MATERIALS: [&str; 10] = [
 /// (default 1). Prints the same table as
 /// [`port_study`]; about 2–4 min per material on a shared 2-core machine.
 #[test]
-#[ignore = "study: the paper-rig table (PORT_MATERIALS=a,b cargo test --release -p scatterfit-pipeline --test port port_study_paper -- --ignored --nocapture)"]
+#[ignore = "study: the paper-rig table (PORT_MATERIALS=a,b cargo test --release -p scatterfit-pipeline --test suite port::port_study_paper -- --ignored --nocapture)"]
 fn port_study_paper() {
     let names: Vec<String> = std::env::var("PORT_MATERIALS").map_or_else(
         |_| {

@@ -4,7 +4,7 @@
 //! within 5 % and σa within 12 % (median over channels with α′ in [0.9, 0.9995] and η ≤ 1.6), η
 //! within 0.005 — on the quick rig (256² px at 0.1 mm/px, a tenth of the photons; fixed seeds).
 
-mod common;
+use crate::common;
 
 use scatterfit_io::result_json::{ChannelStatus, parse_result_json};
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};

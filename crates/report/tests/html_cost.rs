@@ -3,8 +3,8 @@
 //! of `scatterfit demo`'s:
 //!
 //! ```text
-//! SCATTERFIT_BENCH_SAMPLE=/tmp/demo/wood-tile cargo test -p scatterfit-report --test html_cost \
-//!     -- --ignored --nocapture
+//! SCATTERFIT_BENCH_SAMPLE=/tmp/demo/wood-tile cargo test -p scatterfit-report --test suite \
+//!     html_cost:: -- --ignored --nocapture
 //! ```
 //!
 //! Prints the medians of 5 runs: `measure_sample` (which includes the bracket's thumbnails, made

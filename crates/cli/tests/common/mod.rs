@@ -1,8 +1,8 @@
 //! What the CLI's integration tests share: the real binary run in a folder (ripgrep's shape), one
 //! Monte Carlo cache per test binary, temporary folders, and reading what a command wrote.
 //!
-//! Every file under `tests/` is a crate of its own that includes this module with `mod common;`
-//! and uses a part of it, hence the `dead_code` allowance.
+//! The test binaries (`tests/suite.rs`, `tests/peers.rs`) each declare this module once, and each
+//! file uses a part of it, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
 pub mod peer;

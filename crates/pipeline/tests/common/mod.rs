@@ -1,7 +1,7 @@
 //! What the pipeline's integration tests share: the rig twin of a built-in material, made one way.
 //!
-//! Every file under `tests/` is a crate of its own that includes this module with `mod common;`
-//! and uses a part of it, hence the `dead_code` allowance.
+//! The test binary (`tests/suite.rs`) declares this module once, and each file uses a part of it,
+//! hence the `dead_code` allowance.
 #![allow(dead_code)]
 
 use std::path::Path;

@@ -1,0 +1,8 @@
+//! The integration tests of `scatterfit-report` as one test binary: each file beside this one is a
+//! module of it, and `cargo test -p scatterfit-report --test suite FILE::` runs one file's tests.
+//! One binary instead of one per file: the dependencies' generics are instantiated and the
+//! executable linked once. `autotests = false` (Cargo.toml): a file added under `tests/` is
+//! declared here (`.ci/check-test-modules` fails when one is not).
+
+mod html_cost;
+mod measurement;
