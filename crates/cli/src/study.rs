@@ -279,7 +279,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some((shard, job)) = job {
         let n = samples.len();
         job.write(crate::study_set::StudyPart {
-            rows: rows.iter().map(crate::study_set::RowFile::from).collect(),
+            rows: rows.clone(),
             failed: failed.clone(),
             synth_s,
             fit_s: t0.elapsed().as_secs_f64() - synth_s,

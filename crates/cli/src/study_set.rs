@@ -35,71 +35,11 @@ pub struct StudyConfig {
     pub no_pbd: bool,
 }
 
-/// One row of the study as a file holds it (names as strings; [`RowFile::to_row`] turns them back
-/// into the configurations' own names).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct RowFile {
-    eta: f64,
-    albedo_prime: f64,
-    model: String,
-    albedo_model: String,
-    method: String,
-    g: Option<f64>,
-    g_given: Option<bool>,
-    status: String,
-    sigma_s_prime_error: Option<f64>,
-    sigma_a_error: Option<f64>,
-    albedo_prime_error: Option<f64>,
-}
-
-impl From<&Row> for RowFile {
-    fn from(r: &Row) -> Self {
-        Self {
-            eta: r.eta,
-            albedo_prime: r.albedo_prime,
-            model: r.model.to_owned(),
-            albedo_model: r.albedo_model.to_owned(),
-            method: r.method.to_owned(),
-            g: r.g,
-            g_given: r.g_given,
-            status: r.status.clone(),
-            sigma_s_prime_error: r.sigma_s_prime_error,
-            sigma_a_error: r.sigma_a_error,
-            albedo_prime_error: r.albedo_prime_error,
-        }
-    }
-}
-
-impl RowFile {
-    /// The row, its names those of the configuration in `combos` it was fitted with.
-    fn to_row(&self, combos: &[Combo]) -> Option<Row> {
-        let c = combos.iter().find(|c| {
-            c.model.name() == self.model
-                && c.albedo.name() == self.albedo_model
-                && c.method.name() == self.method
-                && c.g_given == self.g_given.unwrap_or(false)
-        })?;
-        Some(Row {
-            eta: self.eta,
-            albedo_prime: self.albedo_prime,
-            model: c.model.name(),
-            albedo_model: c.albedo.name(),
-            method: c.method.name(),
-            g: self.g,
-            g_given: self.g_given,
-            status: self.status.clone(),
-            sigma_s_prime_error: self.sigma_s_prime_error,
-            sigma_a_error: self.sigma_a_error,
-            albedo_prime_error: self.albedo_prime_error,
-        })
-    }
-}
-
 /// A shard's part of a study: its rows (in the order of its samples) and failures.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct StudyPart {
     /// The rows of the shard's samples.
-    pub rows: Vec<RowFile>,
+    pub rows: Vec<Row>,
     /// The samples that failed, with why.
     pub failed: Vec<String>,
     /// Seconds synthesising.
@@ -135,8 +75,8 @@ pub fn combine(
     let (mut rows, mut failed, mut synth_s, mut fit_s) = (Vec::new(), Vec::new(), 0.0, 0.0);
     for path in partials {
         let part = crate::shard::read::<StudyPart>(path)?.data;
-        for r in &part.rows {
-            let Some(row) = r.to_row(&all) else {
+        for r in part.rows {
+            if !all.iter().any(|c| c.matches(&r)) {
                 bail!(
                     "{}: a row fitted with {} + {} α′, {}, which this study does not fit",
                     path.display(),
@@ -144,8 +84,8 @@ pub fn combine(
                     r.albedo_model,
                     r.method
                 );
-            };
-            rows.push(row);
+            }
+            rows.push(r);
         }
         failed.extend(part.failed);
         synth_s += part.synth_s;

@@ -51,6 +51,7 @@ use std::time::Instant;
 
 use levenberg_marquardt::{LevenbergMarquardt, TerminationReason};
 use nalgebra::DMatrix;
+use scatterfit_optics::Termination;
 use serde::{Deserialize, Serialize};
 
 pub use error::{FitError, Result};
@@ -184,7 +185,7 @@ pub struct FitReport {
     /// Whether the solver met a convergence criterion.
     pub converged: bool,
     /// Why the solver stopped.
-    pub termination: String,
+    pub termination: Termination,
     /// Residual evaluations.
     pub evaluations: usize,
     /// Wall time of the start search and the solver \[s\].
@@ -516,9 +517,9 @@ impl<'a> PreparedFit<'a> {
             termination: if termination.was_successful() && !problem.valid {
                 // The solver's own criterion was met, but on a model that answered non-finite
                 // values: not a convergence (the message said "did not converge: converged (…)").
-                "stopped on non-finite model values (the parameters left the model's domain)".into()
+                Termination::NonFiniteModel
             } else {
-                termination_text(termination)
+                termination_of(termination)
             },
             evaluations,
             fit_time_s,
@@ -615,25 +616,19 @@ fn ring_areas(r: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-fn termination_text(t: &TerminationReason) -> String {
+/// The solver's reason as the report names it.
+fn termination_of(t: &TerminationReason) -> Termination {
     match t {
         TerminationReason::Converged { ftol, xtol } => match (ftol, xtol) {
-            (true, true) => "converged (residual and step tolerances)".into(),
-            (true, false) => "converged (residual tolerance)".into(),
-            _ => "converged (step tolerance)".into(),
+            (true, true) => Termination::ConvergedResidualAndStep,
+            (true, false) => Termination::ConvergedResidual,
+            _ => Termination::ConvergedStep,
         },
-        TerminationReason::Orthogonal => "converged (gradient orthogonal to residuals)".into(),
-        TerminationReason::ResidualsZero => "converged (residuals zero)".into(),
-        TerminationReason::LostPatience => {
-            "did not converge: evaluation limit reached (raise the patience or check the data)"
-                .into()
-        }
-        TerminationReason::Numerical(what) => {
-            format!("did not converge: non-finite {what} (the model left its domain)")
-        }
-        TerminationReason::NoImprovementPossible(what) => {
-            format!("stopped: no improvement possible ({what} tolerance at machine precision)")
-        }
-        other => format!("stopped: {other:?}"),
+        TerminationReason::Orthogonal => Termination::ConvergedOrthogonal,
+        TerminationReason::ResidualsZero => Termination::ConvergedResidualsZero,
+        TerminationReason::LostPatience => Termination::EvaluationLimit,
+        TerminationReason::Numerical(_) => Termination::NonFinite,
+        TerminationReason::NoImprovementPossible(_) => Termination::NoImprovement,
+        other => Termination::Other(format!("stopped: {other:?}")),
     }
 }

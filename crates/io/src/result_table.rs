@@ -256,11 +256,7 @@ pub fn table1_csv(results: &[MeasurementResult]) -> String {
         for (ch, c) in r.channels.iter_channels() {
             let name = ch.name();
             let (sp, sa, ap) = (c.sigma_s_prime, c.sigma_a, c.albedo_prime);
-            let status = match c.status {
-                ChannelStatus::Ok => "ok",
-                ChannelStatus::Unconstrained => "unconstrained",
-                ChannelStatus::Failed => "failed",
-            };
+            let status = c.status.name();
             let _ = writeln!(
                 t,
                 "{},{name},{status},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
@@ -445,11 +441,7 @@ pub fn table2_csv(pairs: &[(MeasurementResult, MeasurementResult)]) -> String {
         "material,channel,sigma_s_prime_existing,sigma_a_existing,mse_existing,fit_time_s_existing,\
          status_existing,sigma_s_prime_proposed,sigma_a_proposed,mse_proposed,fit_time_s_proposed,status_proposed\n",
     );
-    let status = |c: &ChannelResult| match c.status {
-        ChannelStatus::Ok => "ok",
-        ChannelStatus::Unconstrained => "unconstrained",
-        ChannelStatus::Failed => "failed",
-    };
+    let status = |c: &ChannelResult| c.status.name();
     for (e, p) in pairs {
         for ch in Channel::ALL {
             let name = ch.name();

@@ -21,16 +21,58 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use scatterfit_io::result_json::ChannelStatus;
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_synth::Truth;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use scatterfit_pipeline::anisotropy::GPrior;
 use scatterfit_pipeline::fit::FitSettings;
 use scatterfit_pipeline::{Measurement, Overrides, PipelineError, measure_sample};
 
-/// The status of a row whose `mc` fit at the twin's g the tables do not cover ([`mc_covers`]).
-pub const NOT_COVERED: &str = "not covered";
+/// How a row's fit ended: the channel's status, or not run where the `mc` tables do not cover the
+/// twin's (η, g) ([`mc_covers`]). In files the strings `ok`, `unconstrained`, `failed`, `not covered`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RowStatus {
+    /// Parameters found and constrained.
+    Ok,
+    /// The fit ran, but the data do not constrain every parameter.
+    Unconstrained,
+    /// No parameters.
+    Failed,
+    /// Not fitted: the `mc` tables do not answer at the twin's (η, g).
+    #[serde(rename = "not covered")]
+    NotCovered,
+}
+
+impl RowStatus {
+    /// The name in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ok => "ok",
+            Self::Unconstrained => "unconstrained",
+            Self::Failed => "failed",
+            Self::NotCovered => "not covered",
+        }
+    }
+}
+
+impl From<ChannelStatus> for RowStatus {
+    fn from(s: ChannelStatus) -> Self {
+        match s {
+            ChannelStatus::Ok => Self::Ok,
+            ChannelStatus::Unconstrained => Self::Unconstrained,
+            _ => Self::Failed,
+        }
+    }
+}
+
+impl std::fmt::Display for RowStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// One fit configuration of the study.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -60,26 +102,27 @@ impl Combo {
 
     /// True when `row` was fitted this way.
     pub fn matches(self, row: &Row) -> bool {
-        row.model == self.model.name()
-            && row.albedo_model == self.albedo.name()
-            && row.method == self.method.name()
+        row.model == self.model
+            && row.albedo_model == self.albedo
+            && row.method == self.method
             && row.g_given.unwrap_or(false) == self.g_given
     }
 }
 
-/// One grid point fitted one way (serialised as `scatterfit study --json` prints it).
-#[derive(Debug, Clone, Serialize)]
+/// One grid point fitted one way (serialised as `scatterfit study --json` prints it, and as a
+/// shard's partial file holds it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {
     /// η of the sample.
     pub eta: f64,
     /// The true α′ of the grid point.
     pub albedo_prime: f64,
-    /// The forward model's name.
-    pub model: &'static str,
-    /// The α′ inversion's name.
-    pub albedo_model: &'static str,
-    /// The method's name.
-    pub method: &'static str,
+    /// The forward model.
+    pub model: ModelName,
+    /// The α′ inversion.
+    pub albedo_model: AlbedoModel,
+    /// The method.
+    pub method: Method,
     /// The twin's Henyey–Greenstein g; absent in a study without a g axis.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub g: Option<f64>,
@@ -87,9 +130,9 @@ pub struct Row {
     /// g axis.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub g_given: Option<bool>,
-    /// The channel's fit status, lower case; [`NOT_COVERED`] where the `mc` tables do not answer
+    /// How the channel's fit ended; [`RowStatus::NotCovered`] where the `mc` tables do not answer
     /// at the sample's (η, g) (no fit, no errors).
-    pub status: String,
+    pub status: RowStatus,
     /// σ′s found / true − 1.
     pub sigma_s_prime_error: Option<f64>,
     /// σa found / true − 1.
@@ -259,7 +302,7 @@ pub fn samples(out: &Path, etas: &[f64], albedos: &[f64], gs: &[f64]) -> Vec<Stu
 /// Measures one synthesised sample and fits it every way in `combos`, against its truth.json.
 /// A configuration with [`Combo::g_given`] is fitted at the truth's g, or not at all where the
 /// `mc` tables do not cover the sample's (η, g) ([`mc_covers`]; rows with status
-/// [`NOT_COVERED`]).
+/// [`RowStatus::NotCovered`]).
 ///
 /// # Errors
 /// [`StudyError`]: the truth unreadable, or the measurement or a fit failed.
@@ -288,12 +331,12 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
                 rows.extend(sample.albedos.iter().map(|&albedo| Row {
                     eta,
                     albedo_prime: albedo,
-                    model: combo.model.name(),
-                    albedo_model: combo.albedo.name(),
-                    method: combo.method.name(),
+                    model: combo.model,
+                    albedo_model: combo.albedo,
+                    method: combo.method,
                     g: sample.g,
                     g_given: sample.g.map(|_| true),
-                    status: NOT_COVERED.into(),
+                    status: RowStatus::NotCovered,
                     sigma_s_prime_error: None,
                     sigma_a_error: None,
                     albedo_prime_error: None,
@@ -320,12 +363,12 @@ pub fn study_sample(sample: &StudySample, combos: &[Combo]) -> Result<Vec<Row>, 
             rows.push(Row {
                 eta,
                 albedo_prime: albedo,
-                model: combo.model.name(),
-                albedo_model: combo.albedo.name(),
-                method: combo.method.name(),
+                model: combo.model,
+                albedo_model: combo.albedo,
+                method: combo.method,
                 g: sample.g,
                 g_given: sample.g.map(|_| combo.g_given),
-                status: format!("{:?}", ch.status).to_lowercase(),
+                status: ch.status.into(),
                 sigma_s_prime_error: rel(ch.sigma_s_prime.map(|e| e.value), t.sigma_s_prime),
                 sigma_a_error: rel(ch.sigma_a.map(|e| e.value), t.sigma_a),
                 albedo_prime_error: ch.albedo_prime.map(|a| a.value - albedo),
@@ -384,7 +427,7 @@ pub fn rows_csv(rows: &[Row]) -> String {
 
 /// True when the row's fit was not run because the `mc` tables do not cover its (η, g).
 fn not_covered(r: &Row) -> bool {
-    r.status == NOT_COVERED
+    r.status == RowStatus::NotCovered
 }
 
 /// The distinct values of `f` over `rows`, ascending.
@@ -594,16 +637,16 @@ mod tests {
         }
     }
 
-    fn row(g: f64, g_given: bool, status: &str, err: Option<f64>) -> Row {
+    fn row(g: f64, g_given: bool, status: RowStatus, err: Option<f64>) -> Row {
         Row {
             eta: 1.4,
             albedo_prime: 0.9,
-            model: "mc",
-            albedo_model: "mc",
-            method: "proposed",
+            model: ModelName::Mc,
+            albedo_model: AlbedoModel::Mc,
+            method: Method::Proposed,
             g: Some(g),
             g_given: Some(g_given),
-            status: status.into(),
+            status,
             sigma_s_prime_error: err,
             sigma_a_error: err,
             albedo_prime_error: err,
@@ -613,10 +656,10 @@ mod tests {
     #[test]
     fn the_g_tables_say_not_covered_and_never_count_it_as_a_failure() {
         let rows = vec![
-            row(0.5, false, "converged", Some(0.06)),
-            row(0.5, true, NOT_COVERED, None),
-            row(0.8, false, "converged", Some(0.08)),
-            row(0.8, true, "converged", Some(-0.004)),
+            row(0.5, false, RowStatus::Ok, Some(0.06)),
+            row(0.5, true, RowStatus::NotCovered, None),
+            row(0.8, false, RowStatus::Ok, Some(0.08)),
+            row(0.8, true, RowStatus::Ok, Some(-0.004)),
         ];
         let combos = [
             Combo {

@@ -40,6 +40,7 @@ pub mod pbd;
 pub mod port;
 pub mod rgb;
 pub mod spectro;
+pub mod termination;
 
 mod diffusion;
 mod dual;
@@ -54,3 +55,4 @@ pub use model::DiffusionModel;
 pub use names::{AlbedoModel, Method, ModelName, Parameter};
 pub use properties::OpticalProperties;
 pub use rgb::{Channel, Rgb};
+pub use termination::Termination;

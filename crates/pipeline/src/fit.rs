@@ -508,7 +508,7 @@ pub fn channel_result(
             unconstrained: Vec::new(),
             fit_time_s: 0.0,
             iterations: 0,
-            termination: String::new(),
+            termination: scatterfit_optics::Termination::NotRun,
             mse: None,
             rms_log_residual: None,
             chi2_reduced: None,

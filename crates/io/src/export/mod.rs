@@ -419,7 +419,7 @@ mod fixtures {
             unconstrained: vec![],
             fit_time_s: 1e-5,
             iterations: 7,
-            termination: "converged".into(),
+            termination: scatterfit_optics::Termination::ConvergedResidual,
             mse: Some(1e-6),
             rms_log_residual: Some(0.01),
             chi2_reduced: Some(1.0),

@@ -102,6 +102,17 @@ pub enum ChannelStatus {
     Failed,
 }
 
+impl ChannelStatus {
+    /// The name in files and tables: `ok`, `unconstrained`, `failed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ok => "ok",
+            Self::Unconstrained => "unconstrained",
+            Self::Failed => "failed",
+        }
+    }
+}
+
 /// The correlation matrix of a channel's fitted parameters (from the Jacobian at the solution).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Correlation {
@@ -147,9 +158,9 @@ pub struct ChannelResult {
     /// Levenberg–Marquardt iterations (residual evaluations).
     #[serde(default)]
     pub iterations: usize,
-    /// Why the solver stopped.
+    /// Why the solver stopped (`not_run` for a channel without a fit).
     #[serde(default)]
-    pub termination: String,
+    pub termination: scatterfit_optics::Termination,
     /// Mean squared difference between the measured profile (in absolute units, divided by the
     /// scale) and the model over the fitted rings [mm⁻⁴] (Choi et al. 2014, Table 2's quantity).
     pub mse: Option<f64>,
@@ -598,7 +609,7 @@ mod tests {
             unconstrained: vec![],
             fit_time_s: 1e-5,
             iterations: 7,
-            termination: "converged".into(),
+            termination: scatterfit_optics::Termination::ConvergedResidual,
             mse: Some(1e-6),
             rms_log_residual: Some(0.01),
             chi2_reduced: Some(1.1),
