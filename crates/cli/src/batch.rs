@@ -62,9 +62,10 @@ struct BatchInputs {
 /// asked for on the command line is not recorded in a result: such runs measure every sample.
 fn reusable(dir: &Path, o: &Overrides) -> Option<MeasurementResult> {
     use scatterfit_io::result_set::{SetStatus, verify};
-    if o.g_range.is_some() || o.g_fit {
+    if o.g.is_some_and(|p| p.range.is_some() || p.fit) {
         return None;
     }
+    let given_g = o.g.and_then(|p| p.g);
     if !matches!(
         verify(dir, &["result.json", "profile.csv"]),
         Ok(SetStatus::Complete(_))
@@ -89,7 +90,7 @@ fn reusable(dir: &Path, o: &Overrides) -> Option<MeasurementResult> {
     (same(o.method.is_some(), opt.method == o.method)
         && same(o.model.is_some(), opt.model == o.model)
         && same(o.albedo_model.is_some(), opt.albedo_model == o.albedo_model)
-        && same(o.g.is_some(), opt.g == o.g)
+        && same(given_g.is_some(), opt.g == given_g)
         && same(o.eta.is_some(), Some(r.eta) == o.eta)
         && same(
             o.normalise_with_spectro.is_some(),

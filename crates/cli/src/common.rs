@@ -5,8 +5,10 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
+use scatterfit_io::manifest::GSetting;
 use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_pipeline::Overrides;
+use scatterfit_pipeline::anisotropy::GPrior;
 
 /// A measurement that ran and failed (exit code 1), as opposed to bad input (2).
 #[derive(Debug, thiserror::Error)]
@@ -244,7 +246,7 @@ pub struct FitArgs {
     /// only where the data determine it. Without --g and --g-range, the manifest's keys; with
     /// neither there, the values at g = 0 and a ± g term over 0–0.95 (g not stated is g not known).
     #[arg(long, value_name = "G|fit", value_parser = parse_g)]
-    pub g: Option<GArg>,
+    pub g: Option<GSetting>,
     /// The range LO,HI (0 ≤ LO ≤ HI ≤ 0.95) the material's g lies in (replaces `[fit] g_range`):
     /// propagated into σ′s, σa and α′ as the ± g term; with --g the values are at that g, without
     /// it the middle of the estimates over the range.
@@ -277,33 +279,20 @@ impl FitArgs {
             albedo_model: self.albedo_model.map(Into::into),
             eta: self.eta,
             normalise_with_spectro: self.normalise_with_spectro.then_some(true),
-            g: match self.g {
-                Some(GArg::Value(g)) => Some(g),
-                _ => None,
-            },
-            g_range: self.g_range,
-            g_fit: self.g == Some(GArg::Fit),
+            g: (self.g.is_some() || self.g_range.is_some())
+                .then(|| GPrior::from_setting(self.g, self.g_range)),
             allow_outside_paths: self.allow_outside_paths,
         })
     }
 }
 
-/// `--g`: a number or `fit`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum GArg {
-    /// A known or assumed g.
-    Value(f64),
-    /// Fit g from the profile.
-    Fit,
-}
-
-/// Parses `--g G|fit`.
-pub fn parse_g(text: &str) -> Result<GArg, String> {
+/// Parses `--g G|fit` into the manifest's `[fit] g` setting.
+pub fn parse_g(text: &str) -> Result<GSetting, String> {
     if text.trim() == "fit" {
-        return Ok(GArg::Fit);
+        return Ok(GSetting::Fit);
     }
     crate::numeric::parse_finite(text)
-        .map(GArg::Value)
+        .map(GSetting::Value)
         .map_err(|_| format!("`{text}` is neither a Henyey–Greenstein g in (−1, 1) nor `fit`"))
 }
 

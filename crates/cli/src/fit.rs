@@ -12,8 +12,8 @@ use scatterfit_optics::{Method, Rgb};
 use scatterfit_pipeline::profile::channel_from_table;
 use scatterfit_pipeline::profile_fit::{ProfileFitRequest, fit_profile};
 
-use crate::common::{GArg, parse_g, parse_g_range, parse_rgb};
 use crate::common::{MethodArg, ModelArg};
+use crate::common::{parse_g, parse_g_range, parse_rgb};
 use crate::output::out;
 
 /// Arguments of `scatterfit fit`.
@@ -55,7 +55,7 @@ pub struct Args {
     /// determine it (sd(g) ≤ 0.05, the minimum inside the range); elsewhere "not determined" and
     /// the range's ± g term.
     #[arg(long, value_name = "G|fit", value_parser = parse_g)]
-    pub g: Option<GArg>,
+    pub g: Option<scatterfit_io::manifest::GSetting>,
     /// The range LO,HI (0 ≤ LO ≤ HI ≤ 0.95) the material's g lies in (as `[fit] g_range`),
     /// propagated into σ′s, σa and α′ as a separate "± g" term from the g-aware `mc` model; with
     /// --g the values are at that g, without it the middle of the estimates over the range.
@@ -152,14 +152,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         spot_diameter_mm: args.spot_diameter_mm,
         r_min_mm: args.r_min_mm,
         normalise_with_spectro: args.normalise_with_spectro,
-        g_prior: scatterfit_pipeline::anisotropy::GPrior {
-            g: match args.g {
-                Some(GArg::Value(g)) => Some(g),
-                _ => None,
-            },
-            range: args.g_range,
-            fit: args.g == Some(GArg::Fit),
-        },
+        g_prior: scatterfit_pipeline::anisotropy::GPrior::from_setting(args.g, args.g_range),
     };
     let fitted = fit_profile(&data, &request)?;
     let result = fitted.to_result();

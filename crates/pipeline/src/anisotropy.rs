@@ -30,6 +30,7 @@
 //! evaluated (never extrapolated) and are named in the result ([`GPlan::not_covered`]).
 
 use scatterfit_fit::{ChannelInput, FitOptions, FitReport, ProfileData, Start};
+use scatterfit_io::manifest::GSetting;
 use scatterfit_io::result_json::{GSource, GUncertainty};
 use scatterfit_mc::McGridSet;
 use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
@@ -63,6 +64,16 @@ pub struct GPrior {
 }
 
 impl GPrior {
+    /// What a `[fit] g` (a number or `"fit"`) and a `[fit] g_range` say — the manifest's keys,
+    /// or the commands' `--g` and `--g-range`, which take the same [`GSetting`].
+    pub fn from_setting(g: Option<GSetting>, range: Option<[f64; 2]>) -> Self {
+        Self {
+            g: g.and_then(GSetting::value),
+            range,
+            fit: g.is_some_and(GSetting::is_fit),
+        }
+    }
+
     /// Where the knowledge came from: g alone is [`GSource::Given`], a range (with or without a g)
     /// [`GSource::Range`], neither [`GSource::DefaultRange`].
     pub fn source(&self) -> GSource {

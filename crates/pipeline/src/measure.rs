@@ -45,12 +45,9 @@ pub struct Overrides {
     pub eta: Option<f64>,
     /// Fix the scale by the spectrophotometer.
     pub normalise_with_spectro: Option<bool>,
-    /// A known g instead of the manifest's `[fit] g` (`fit --g`, a study's g axis).
-    pub g: Option<f64>,
-    /// A g range instead of the manifest's `[fit] g_range`.
-    pub g_range: Option<[f64; 2]>,
-    /// Fit g instead of the manifest's `[fit] g` (`g = "fit"`).
-    pub g_fit: bool,
+    /// What is known about g instead of the manifest's `[fit] g` and `[fit] g_range` (both
+    /// replaced; `--g`, `--g-range`).
+    pub g: Option<GPrior>,
     /// Allow the manifest to name files outside the sample folder (the input path policy,
     /// `scatterfit_io::inputs`; `--allow-outside-paths`).
     pub allow_outside_paths: bool,
@@ -205,25 +202,8 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         _ => (SpotShape::Disk, 0.5 * diameter),
     };
     // What is known about g: an override replaces both manifest keys.
-    let g_prior = if o.g.is_some() || o.g_range.is_some() || o.g_fit {
-        GPrior {
-            g: o.g,
-            range: o.g_range,
-            fit: o.g_fit,
-        }
-    } else {
-        GPrior {
-            g: manifest
-                .fit
-                .g
-                .and_then(scatterfit_io::manifest::GSetting::value),
-            range: manifest.fit.g_range,
-            fit: manifest
-                .fit
-                .g
-                .is_some_and(scatterfit_io::manifest::GSetting::is_fit),
-        }
-    };
+    let g_prior =
+        o.g.unwrap_or_else(|| GPrior::from_setting(manifest.fit.g, manifest.fit.g_range));
     g_prior.check()?;
     check_g_fit(&g_prior, model)?;
     let settings = FitSettings {

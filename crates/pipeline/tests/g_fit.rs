@@ -25,6 +25,7 @@ use scatterfit_io::manifest::{FitSection, GSetting};
 use scatterfit_io::result_json::GSource;
 use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
+use scatterfit_pipeline::anisotropy::GPrior;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::RigSpec;
 
@@ -114,7 +115,7 @@ fn g_is_fitted_where_determined_and_withheld_where_not() {
     let known = measure_sample(
         &dir.path().join("sulfur"),
         &Overrides {
-            g: Some(0.9),
+            g: Some(GPrior::from_setting(Some(GSetting::Value(0.9)), None)),
             ..Overrides::default()
         },
         &|_| {},

@@ -19,6 +19,7 @@ use scatterfit_io::manifest::FitSection;
 use scatterfit_io::result_json::GSource;
 use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, ModelName};
+use scatterfit_pipeline::anisotropy::GPrior;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::RigSpec;
 
@@ -45,7 +46,10 @@ fn twin(
 /// The sample in `folder` measured with g given (`Some`) or as its manifest says (`None`).
 fn measured_at(folder: &std::path::Path, g: Option<f64>) -> scatterfit_pipeline::Measurement {
     let overrides = Overrides {
-        g,
+        g: g.map(|g| GPrior {
+            g: Some(g),
+            ..GPrior::default()
+        }),
         ..Overrides::default()
     };
     measure_sample(folder, &overrides, &|_| {}).unwrap()
