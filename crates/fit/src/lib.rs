@@ -134,9 +134,10 @@ pub struct ChannelInput {
     pub rd_total: Option<f64>,
 }
 
-/// A fitted quantity and its standard error.
+/// A fitted quantity and its standard error from the fit alone (the pipeline makes it the `fit`
+/// term of a `scatterfit_optics::Estimate`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Estimate {
+pub struct FittedValue {
     /// The value.
     pub value: f64,
     /// Its standard error (NaN when the data do not constrain it).
@@ -168,13 +169,13 @@ pub struct FitReport {
     /// η used.
     pub eta: f64,
     /// σ′s [mm⁻¹].
-    pub sigma_s_prime: Estimate,
+    pub sigma_s_prime: FittedValue,
     /// σa [mm⁻¹] (proposed: σ′s(1/α′ − 1), its error from σ′s's alone).
-    pub sigma_a: Estimate,
+    pub sigma_a: FittedValue,
     /// α′ = σ′s/(σ′s + σa): the spectrophotometer's (proposed) or the fitted (existing).
     pub albedo_prime: f64,
     /// The scale k: measured = k · model [relative units per mm⁻²].
-    pub scale: Estimate,
+    pub scale: FittedValue,
     /// The free parameters, in the order of `correlation`.
     pub parameters: Vec<Parameter>,
     /// Correlation matrix of the free parameters (rows of `parameters.len()`).
@@ -497,16 +498,16 @@ impl<'a> PreparedFit<'a> {
             method: self.opts.method,
             model: self.model.name(),
             eta: self.input.eta,
-            sigma_s_prime: Estimate {
+            sigma_s_prime: FittedValue {
                 value: sp,
                 stderr: sp_err,
             },
-            sigma_a: Estimate {
+            sigma_a: FittedValue {
                 value: sa,
                 stderr: sa_err,
             },
             albedo_prime: sp / (sp + sa),
-            scale: Estimate {
+            scale: FittedValue {
                 value: k,
                 stderr: k_err,
             },

@@ -57,16 +57,17 @@ impl CostEstimate {
     }
 }
 
-/// A Monte Carlo estimate: the mean over photons and its standard error.
+/// A Monte Carlo estimate: the mean over photons and its standard error (named apart from
+/// `scatterfit_optics::Estimate`, a measured value with its uncertainty terms).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Estimate {
+pub struct McMean {
     /// The estimate.
     pub value: f64,
     /// Its standard error (one standard deviation of the mean).
     pub stderr: f64,
 }
 
-impl Estimate {
+impl McMean {
     /// Mean and standard error of per-photon scores from their sum `s1`, sum of squares `s2` and count.
     fn from_moments(s1: f64, s2: f64, n: u64) -> Self {
         let nf = n as f64;
@@ -305,21 +306,21 @@ pub struct SimulationResult {
     /// Specular reflectance at entry R_sp (exact, not sampled; not part of `rd_total`).
     pub specular: f64,
     /// Total diffuse reflectance Rd (excludes R_sp).
-    pub rd_total: Estimate,
+    pub rd_total: McMean,
     /// Total transmittance Tt (includes unscattered light; 0 for a half-space).
-    pub transmittance: Estimate,
+    pub transmittance: McMean,
     /// Absorbed fraction A.
-    pub absorbed: Estimate,
+    pub absorbed: McMean,
     /// R_sp + Rd + Tt + A, which is 1 up to Russian-roulette noise.
-    pub conservation: Estimate,
+    pub conservation: McMean,
     /// The radial grid \[mm\].
     pub grid: RadialGrid,
     /// Rd(r) per annulus of `grid` [mm⁻²]: reflected weight / (photons × annulus area).
-    pub rd_profile: Vec<Estimate>,
+    pub rd_profile: Vec<McMean>,
     /// Exit-angle bin edges θ \[radians\], empty when the tally is off.
     pub angle_edges: Vec<f64>,
     /// Diffuse reflectance per exit-angle bin per steradian of solid angle [sr⁻¹].
-    pub rd_angle: Vec<Estimate>,
+    pub rd_angle: Vec<McMean>,
 }
 
 /// Per-chunk sums of per-photon scores and their squares.
@@ -371,8 +372,7 @@ impl Accum {
         let s = &self.sums;
         let rd_profile = (0..sim.grid.bins())
             .map(|i| {
-                Estimate::from_moments(self.rd_w[i], self.rd_w2[i], n)
-                    .scaled(1.0 / sim.grid.area(i))
+                McMean::from_moments(self.rd_w[i], self.rd_w2[i], n).scaled(1.0 / sim.grid.area(i))
             })
             .collect();
         let nb = sim.angle_bins;
@@ -384,19 +384,19 @@ impl Accum {
         let rd_angle = (0..nb)
             .map(|i| {
                 let solid = 2.0 * PI * (angle_edges[i].cos() - angle_edges[i + 1].cos());
-                Estimate::from_moments(self.ang_w[i], self.ang_w2[i], n).scaled(1.0 / solid)
+                McMean::from_moments(self.ang_w[i], self.ang_w2[i], n).scaled(1.0 / solid)
             })
             .collect();
-        let mut conservation = Estimate::from_moments(s[6], s[7], n);
+        let mut conservation = McMean::from_moments(s[6], s[7], n);
         conservation.value += specular;
         SimulationResult {
             photons: n,
             interactions: self.interactions,
             seed: sim.seed,
             specular,
-            rd_total: Estimate::from_moments(s[0], s[1], n),
-            transmittance: Estimate::from_moments(s[2], s[3], n),
-            absorbed: Estimate::from_moments(s[4], s[5], n),
+            rd_total: McMean::from_moments(s[0], s[1], n),
+            transmittance: McMean::from_moments(s[2], s[3], n),
+            absorbed: McMean::from_moments(s[4], s[5], n),
             conservation,
             grid: sim.grid.clone(),
             rd_profile,

@@ -51,7 +51,7 @@ pub mod white;
 
 pub use beam::{Beam, BeamProfile};
 pub use engine::{
-    CHUNK_PHOTONS, CostEstimate, Estimate, REFERENCE_INTERACTIONS_PER_SECOND, ROULETTE_CHANCE,
+    CHUNK_PHOTONS, CostEstimate, McMean, REFERENCE_INTERACTIONS_PER_SECOND, ROULETTE_CHANCE,
     ROULETTE_THRESHOLD, Simulation, SimulationResult,
 };
 pub use error::{McError, Result};

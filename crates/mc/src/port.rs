@@ -6,7 +6,7 @@
 use scatterfit_optics::port::Port;
 
 use crate::beam::{Beam, BeamProfile};
-use crate::engine::{Estimate, Simulation};
+use crate::engine::{McMean, Simulation};
 use crate::error::Result;
 use crate::grid::RadialGrid;
 use crate::sample::Sample;
@@ -15,15 +15,15 @@ use crate::sample::Sample;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct McPortReading {
     /// Diffuse reflectance leaving inside the aperture per unit incident power (excluding R_sp).
-    pub collected: Estimate,
+    pub collected: McMean,
     /// Total diffuse reflectance of the same run (everything that leaves the top face).
-    pub rd_total: Estimate,
+    pub rd_total: McMean,
     /// What the instrument, calibrated on a white standard, reads as a fraction of the true Rd:
     /// collected / (K(0)·Rd) with K(0) = min(a, b)²/a² ([`Port::white_kernel`]). Its standard error
     /// is the collected fraction's alone (the two are positively correlated, so this overstates it).
-    pub reading_fraction: Estimate,
+    pub reading_fraction: McMean,
     /// The reading itself, Rd·F = collected / K(0): what the instrument reports as Rd.
-    pub rd_read: Estimate,
+    pub rd_read: McMean,
 }
 
 /// Simulates `photons` photons into `sample` from a beam uniform over the port's lit disc (normal
@@ -44,7 +44,7 @@ pub fn simulate_port_reading(
     let grid = RadialGrid::from_edges(vec![0.0, b])?;
     let r = Simulation::new(sample, beam, grid, photons, seed)?.run();
     let area = r.grid.area(0);
-    let collected = Estimate {
+    let collected = McMean {
         value: r.rd_profile[0].value * area,
         stderr: r.rd_profile[0].stderr * area,
     };
@@ -53,11 +53,11 @@ pub fn simulate_port_reading(
     Ok(McPortReading {
         collected,
         rd_total: r.rd_total,
-        reading_fraction: Estimate {
+        reading_fraction: McMean {
             value: collected.value / (k0 * rd),
             stderr: collected.stderr / (k0 * rd),
         },
-        rd_read: Estimate {
+        rd_read: McMean {
             value: collected.value / k0,
             stderr: collected.stderr / k0,
         },

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::cache::CacheStatus;
-use crate::{Estimate, McTable, McTableSpec, SimulationResult};
+use crate::{McMean, McTable, McTableSpec, SimulationResult};
 
 /// A simulation's result with its inputs and timing (`simulate --json` prints it as is).
 #[derive(Debug, Serialize)]
@@ -42,7 +42,7 @@ impl SimulationReport<'_> {
     /// of the energy balance with their standard errors, and the speed; one line each.
     pub fn text(&self) -> String {
         let r = self.result;
-        let e = |x: Estimate| format!("{:.6} ± {:.6}", x.value, x.stderr);
+        let e = |x: McMean| format!("{:.6} ± {:.6}", x.value, x.stderr);
         let mut s = String::new();
         let _ = writeln!(s, "photons            {}", r.photons);
         let _ = writeln!(

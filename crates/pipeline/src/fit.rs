@@ -129,7 +129,7 @@ impl ChannelFit {
     /// The report of a channel fitted with `method`, α′'s standard error from the reading
     /// (`albedo_prime_stderr`, used by the proposed method only); no spectrophotometer term yet.
     pub fn new(report: FitReport, albedo_prime_stderr: Option<f64>) -> Self {
-        let estimate = |e: scatterfit_fit::Estimate| Estimate {
+        let estimate = |e: scatterfit_fit::FittedValue| Estimate {
             value: e.value,
             fit: finite(e.stderr),
             spectro: None,

@@ -25,7 +25,7 @@ use rand_distr::{Distribution, Normal, Poisson};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use scatterfit_imaging::ImageBuf;
-use scatterfit_mc::{Beam, BeamProfile, Estimate, Layer, RadialGrid, Sample, Simulation};
+use scatterfit_mc::{Beam, BeamProfile, Layer, McMean, RadialGrid, Sample, Simulation};
 use serde::{Deserialize, Serialize};
 
 use crate::SynthError;
@@ -733,7 +733,7 @@ mod tests {
             value: centers.iter().map(|&r| f(r)).collect(),
             stderr: centers.iter().map(|&r| 1e-4 * f(r)).collect(),
             centers,
-            rd_total: Estimate {
+            rd_total: McMean {
                 value: 0.5,
                 stderr: 0.0,
             },

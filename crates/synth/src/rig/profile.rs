@@ -90,7 +90,7 @@ pub struct McProfile {
     /// Standard error per bin [mm⁻²].
     pub stderr: Vec<f64>,
     /// Total diffuse reflectance (excludes the specular reflection).
-    pub rd_total: Estimate,
+    pub rd_total: McMean,
 }
 
 pub(super) const PROFILE_FORMAT: &str = "scatterfit-synth-mc-profile-v1";
