@@ -6,16 +6,10 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum McError {
-    /// A physical or numerical parameter is outside its domain.
-    #[error("invalid parameter {name} = {}: {reason}", short_number(*value))]
-    InvalidParameter {
-        /// The parameter's name as the API spells it, e.g. `sigma_a`.
-        name: &'static str,
-        /// The offending value.
-        value: f64,
-        /// What the domain is, and what to do.
-        reason: &'static str,
-    },
+    /// A parameter outside its domain, or outside what the tables cover (η, α′, g): the optics
+    /// vocabulary's error, which every forward model answers with (no copy of its variants here).
+    #[error(transparent)]
+    Optics(#[from] scatterfit_optics::OpticsError),
     /// The simulation would never finish: photon paths without a finite mean length.
     #[error("{what}; {hint}")]
     NeverEnds {
@@ -23,54 +17,6 @@ pub enum McError {
         what: &'static str,
         /// What to do instead.
         hint: &'static str,
-    },
-    /// A Henyey–Greenstein g that the (η, g) grid of tables neither holds nor interpolates
-    /// ([`crate::McGridSet`]).
-    #[error(
-        "g = {given} is not covered by the Monte Carlo tables: they hold {tabulated}; use a g \
-         they cover (a g above the last node is not extrapolated: the nearest node is the closest \
-         the tool can model), or add tables at this g to the build (`cargo run --release -p \
-         scatterfit-mc --example build_g_tables -- --out DIR --g {given}`, then listed in \
-         crates/mc/src/bundled.rs and the tool rebuilt: crates/mc/tables-g/README.md)"
-    )]
-    AnisotropyNotTabulated {
-        /// The g asked for.
-        given: f64,
-        /// What the grid covers, in words.
-        tabulated: String,
-    },
-    /// η lies outside the tables of a g node the query needs (the nodes at g ≠ 0 span a
-    /// narrower η range than g = 0's).
-    #[error(
-        "η = {eta:.4} at g = {g}: the Monte Carlo tables at g = {node} cover η {min}–{max} only \
-         (the whole grid: {tabulated}); at this η give a g the tables cover, or use a diffusion \
-         model (`--model dipole`), which does not depend on g"
-    )]
-    EtaNotTabulatedAtG {
-        /// The η asked for.
-        eta: f64,
-        /// The g asked for.
-        g: f64,
-        /// The g node whose tables do not reach η.
-        node: f64,
-        /// That node's lowest η.
-        min: f64,
-        /// That node's highest η.
-        max: f64,
-        /// What the grid covers, in words.
-        tabulated: String,
-    },
-    /// A query falls outside what a profile table covers.
-    #[error("{name} = {value} is outside the table's range [{min}, {max}]")]
-    OutOfTable {
-        /// Which coordinate, e.g. `albedo_prime`.
-        name: &'static str,
-        /// The requested value.
-        value: f64,
-        /// The table's lower limit.
-        min: f64,
-        /// The table's upper limit.
-        max: f64,
     },
     /// A Monte Carlo table could not be smoothed into a model.
     #[error("cannot smooth the Monte Carlo table at albedo {albedo}: {reason}")]
@@ -132,20 +78,12 @@ pub(crate) fn check(ok: bool, name: &'static str, value: f64, reason: &'static s
     if ok {
         Ok(())
     } else {
-        Err(McError::InvalidParameter {
-            name,
-            value,
-            reason,
-        })
-    }
-}
-
-/// A number for messages: as written for ordinary magnitudes, in scientific notation beyond them
-/// (Display writes 1e300 as 301 digits).
-fn short_number(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&v.abs()) {
-        format!("{v}")
-    } else {
-        format!("{v:.4e}")
+        Err(McError::Optics(
+            scatterfit_optics::OpticsError::InvalidParameter {
+                name,
+                value,
+                reason,
+            },
+        ))
     }
 }

@@ -20,48 +20,11 @@ use crate::error::{McError, Result};
 use crate::grid_g::McGridSet;
 use crate::model::{McProfile, McTableSet};
 
-/// An [`McError`] from a table lookup as the optics vocabulary's error (a lookup only fails with
-/// `OutOfTable`, `AnisotropyNotTabulated`, `EtaNotTabulatedAtG` or `InvalidParameter`).
+/// An [`McError`] from a table lookup as the optics vocabulary's error: a lookup fails with
+/// [`McError::Optics`] (a value outside the tables or its domain), returned as it is.
 fn lookup_error(e: McError) -> OpticsError {
     match e {
-        McError::AnisotropyNotTabulated { given, tabulated } => {
-            OpticsError::AnisotropyNotTabulated { given, tabulated }
-        }
-        McError::EtaNotTabulatedAtG {
-            eta,
-            g,
-            node,
-            min,
-            max,
-            tabulated,
-        } => OpticsError::EtaNotTabulatedAtG {
-            eta,
-            g,
-            node,
-            min,
-            max,
-            tabulated,
-        },
-        McError::OutOfTable {
-            name,
-            value,
-            min,
-            max,
-        } => OpticsError::OutOfTable {
-            name,
-            value,
-            min,
-            max,
-        },
-        McError::InvalidParameter {
-            name,
-            value,
-            reason,
-        } => OpticsError::InvalidParameter {
-            name,
-            value,
-            reason,
-        },
+        McError::Optics(e) => e,
         _ => OpticsError::InvalidParameter {
             name: "mc tables",
             value: f64::NAN,

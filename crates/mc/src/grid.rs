@@ -63,10 +63,12 @@ impl RadialGrid {
         let mut edges = Vec::new();
         edges
             .try_reserve_exact(bins.saturating_add(1))
-            .map_err(|_| crate::McError::InvalidParameter {
-                name: "bins",
-                value: bins as f64,
-                reason: "too many radial bins to allocate; use fewer",
+            .map_err(|_| {
+                crate::McError::Optics(scatterfit_optics::OpticsError::InvalidParameter {
+                    name: "bins",
+                    value: bins as f64,
+                    reason: "too many radial bins to allocate; use fewer",
+                })
             })?;
         edges.extend((0..=bins).map(|i| i as f64 * dr));
         Ok(Self {

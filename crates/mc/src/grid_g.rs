@@ -21,7 +21,7 @@
 //! the short profile's far windows); totals within 7.1·10⁻⁴ (g 0.15) and 1.6·10⁻⁴ (0.4, 0.6) of
 //! adding-doubling's. Before the low nodes, interpolating across 0–0.8 was 1–6 % off MCML at
 //! g = 0.5, so a grid with such a gap (wider than `max_step`) refuses the g inside it with
-//! [`McError::AnisotropyNotTabulated`].
+//! [`McError::Optics`] (`OpticsError::AnisotropyNotTabulated`).
 //!
 //! Derivatives: Rd = Rd_lo^(1−t) Rd_hi^t, so ∂Rd/∂θ = Rd [(1 − t) ∂Rd_lo/∂θ / Rd_lo + t ∂Rd_hi/∂θ /
 //! Rd_hi] for θ = σ′s, σa (t depends on g only) — the derivatives of the interpolant, exactly.
@@ -185,10 +185,10 @@ impl McGridSet {
     }
 
     fn not_tabulated(&self, g: f64) -> McError {
-        McError::AnisotropyNotTabulated {
+        McError::Optics(scatterfit_optics::OpticsError::AnisotropyNotTabulated {
             given: g,
             tabulated: self.coverage(),
-        }
+        })
     }
 
     fn place(&self, g: f64) -> Result<Place> {
@@ -236,14 +236,16 @@ impl McGridSet {
             let (min, max) = set.eta_range();
             let tol = crate::model::ETA_EDGE_TOLERANCE;
             if eta.is_finite() && !(eta >= min - tol && eta <= max + tol) {
-                return Err(McError::EtaNotTabulatedAtG {
-                    eta,
-                    g,
-                    node: set.g(),
-                    min,
-                    max,
-                    tabulated: self.coverage(),
-                });
+                return Err(McError::Optics(
+                    scatterfit_optics::OpticsError::EtaNotTabulatedAtG {
+                        eta,
+                        g,
+                        node: set.g(),
+                        min,
+                        max,
+                        tabulated: self.coverage(),
+                    },
+                ));
             }
         }
         Ok(())
@@ -569,7 +571,7 @@ mod tests {
                 assert!(
                     matches!(
                         e,
-                        McError::EtaNotTabulatedAtG { node, max, .. } if node == 0.8 && max == 2.0
+                        McError::Optics(scatterfit_optics::OpticsError::EtaNotTabulatedAtG { node, max, .. }) if node == 0.8 && max == 2.0
                     ),
                     "{e}"
                 );
@@ -599,7 +601,9 @@ mod tests {
         for g in [-0.1, 0.96, f64::NAN] {
             assert!(matches!(
                 grid.place(g),
-                Err(McError::AnisotropyNotTabulated { .. })
+                Err(McError::Optics(
+                    scatterfit_optics::OpticsError::AnisotropyNotTabulated { .. }
+                ))
             ));
         }
         assert_eq!(grid.covered(), [(0.0, 0.95)]);

@@ -626,12 +626,14 @@ impl McTable {
             a
         };
         if !(a >= lo && a <= hi) {
-            return Err(McError::OutOfTable {
-                name: "albedo (σs/σt)",
-                value: a,
-                min: lo,
-                max: hi,
-            });
+            return Err(McError::Optics(
+                scatterfit_optics::OpticsError::OutOfTable {
+                    name: "albedo (σs/σt)",
+                    value: a,
+                    min: lo,
+                    max: hi,
+                },
+            ));
         }
         let x = |v: f64| -(1.0 - v).sqrt();
         let (i, w, dw_dx) = hermite_weights(al.len(), |k| x(al[k]), x(a), Ends::Parabola);
@@ -831,21 +833,25 @@ impl McTableSet {
             return if (eta - lo).abs() <= 1e-9 {
                 Ok((0, [0.0, 1.0, 0.0, 0.0]))
             } else {
-                Err(McError::OutOfTable {
+                Err(McError::Optics(
+                    scatterfit_optics::OpticsError::OutOfTable {
+                        name: "eta",
+                        value: eta,
+                        min: lo,
+                        max: hi,
+                    },
+                ))
+            };
+        }
+        if !(eta >= lo - ETA_EDGE_TOLERANCE && eta <= hi + ETA_EDGE_TOLERANCE) {
+            return Err(McError::Optics(
+                scatterfit_optics::OpticsError::OutOfTable {
                     name: "eta",
                     value: eta,
                     min: lo,
                     max: hi,
-                })
-            };
-        }
-        if !(eta >= lo - ETA_EDGE_TOLERANCE && eta <= hi + ETA_EDGE_TOLERANCE) {
-            return Err(McError::OutOfTable {
-                name: "eta",
-                value: eta,
-                min: lo,
-                max: hi,
-            });
+                },
+            ));
         }
         // Within the tolerance beyond an end, the end table (a measured η of 2.4002 for a material
         // of 2.4 must not fail).
@@ -1235,12 +1241,14 @@ pub(crate) fn invert_increasing_total(
 ) -> Result<f64> {
     let (r_lo, r_hi) = (total(lo)?, total(hi)?);
     if !(rd >= r_lo && rd <= r_hi) {
-        return Err(McError::OutOfTable {
-            name: "rd_total",
-            value: rd,
-            min: r_lo,
-            max: r_hi,
-        });
+        return Err(McError::Optics(
+            scatterfit_optics::OpticsError::OutOfTable {
+                name: "rd_total",
+                value: rd,
+                min: r_lo,
+                max: r_hi,
+            },
+        ));
     }
     let (mut u_lo, mut u_hi) = ((1.0 - hi).sqrt(), (1.0 - lo).sqrt());
     for _ in 0..200 {
@@ -1494,13 +1502,20 @@ mod tests {
         let e = McProfile::new(&set, &OpticalProperties::new(1.0, 10.0, 1.2).unwrap());
         assert!(matches!(
             e,
-            Err(McError::OutOfTable {
-                name: "albedo (σs/σt)",
-                ..
-            })
+            Err(McError::Optics(
+                scatterfit_optics::OpticsError::OutOfTable {
+                    name: "albedo (σs/σt)",
+                    ..
+                }
+            ))
         ));
         let e = McProfile::new(&set, &OpticalProperties::new(1.0, 0.1, 1.6).unwrap());
-        assert!(matches!(e, Err(McError::OutOfTable { name: "eta", .. })));
+        assert!(matches!(
+            e,
+            Err(McError::Optics(
+                scatterfit_optics::OpticsError::OutOfTable { name: "eta", .. }
+            ))
+        ));
         assert!(McProfile::new(&only, &OpticalProperties::new(1.0, 0.1, 1.41).unwrap()).is_err());
     }
 

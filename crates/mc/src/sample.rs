@@ -282,10 +282,10 @@ mod tests {
         assert!(
             matches!(
                 e,
-                McError::InvalidParameter {
+                McError::Optics(scatterfit_optics::OpticsError::InvalidParameter {
                     name: "sigma_t",
                     ..
-                }
+                })
             ),
             "{e:?}"
         );

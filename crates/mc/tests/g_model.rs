@@ -454,7 +454,9 @@ fn g_to_zero_and_refusals() {
     assert!((a.rd_total() / b.rd_total() - 1.0).abs() < 1e-5);
     assert!(matches!(
         McGridSet::new(vec![], 0.1),
-        Err(McError::InvalidParameter { .. })
+        Err(McError::Optics(
+            scatterfit_optics::OpticsError::InvalidParameter { .. }
+        ))
     ));
 }
 

@@ -5,7 +5,7 @@
 #[non_exhaustive]
 pub enum OpticsError {
     /// A physical quantity is outside its domain (negative coefficient, η < 1, NaN, …).
-    #[error("{name} = {value} is invalid: {reason}")]
+    #[error("{name} = {} is invalid: {reason}", short_number(*value))]
     InvalidParameter {
         /// The quantity's name as the user knows it (e.g. "sigma_a [mm^-1]").
         name: &'static str,
@@ -123,6 +123,16 @@ pub enum OpticsError {
     /// A spectrum that does not cover the range a colour computation needs.
     #[error("spectrum: {0}")]
     Spectrum(String),
+}
+
+/// A number for messages: as written for ordinary magnitudes, in scientific notation beyond them
+/// (Display writes 1e300 as 301 digits).
+fn short_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:.4e}")
+    }
 }
 
 /// Result with [`OpticsError`].
