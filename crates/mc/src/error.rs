@@ -87,3 +87,13 @@ pub(crate) fn check(ok: bool, name: &'static str, value: f64, reason: &'static s
         ))
     }
 }
+
+/// A query outside what a table covers (`OpticsError::OutOfTable`, as the crate returns it).
+pub(crate) fn out_of_table(name: &'static str, value: f64, min: f64, max: f64) -> McError {
+    McError::Optics(scatterfit_optics::OpticsError::OutOfTable {
+        name,
+        value,
+        min,
+        max,
+    })
+}

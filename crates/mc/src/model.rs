@@ -626,14 +626,7 @@ impl McTable {
             a
         };
         if !(a >= lo && a <= hi) {
-            return Err(McError::Optics(
-                scatterfit_optics::OpticsError::OutOfTable {
-                    name: "albedo (σs/σt)",
-                    value: a,
-                    min: lo,
-                    max: hi,
-                },
-            ));
+            return Err(crate::error::out_of_table("albedo (σs/σt)", a, lo, hi));
         }
         let x = |v: f64| -(1.0 - v).sqrt();
         let (i, w, dw_dx) = hermite_weights(al.len(), |k| x(al[k]), x(a), Ends::Parabola);
@@ -833,25 +826,11 @@ impl McTableSet {
             return if (eta - lo).abs() <= 1e-9 {
                 Ok((0, [0.0, 1.0, 0.0, 0.0]))
             } else {
-                Err(McError::Optics(
-                    scatterfit_optics::OpticsError::OutOfTable {
-                        name: "eta",
-                        value: eta,
-                        min: lo,
-                        max: hi,
-                    },
-                ))
+                Err(crate::error::out_of_table("eta", eta, lo, hi))
             };
         }
         if !(eta >= lo - ETA_EDGE_TOLERANCE && eta <= hi + ETA_EDGE_TOLERANCE) {
-            return Err(McError::Optics(
-                scatterfit_optics::OpticsError::OutOfTable {
-                    name: "eta",
-                    value: eta,
-                    min: lo,
-                    max: hi,
-                },
-            ));
+            return Err(crate::error::out_of_table("eta", eta, lo, hi));
         }
         // Within the tolerance beyond an end, the end table (a measured η of 2.4002 for a material
         // of 2.4 must not fail).
@@ -1241,14 +1220,7 @@ pub(crate) fn invert_increasing_total(
 ) -> Result<f64> {
     let (r_lo, r_hi) = (total(lo)?, total(hi)?);
     if !(rd >= r_lo && rd <= r_hi) {
-        return Err(McError::Optics(
-            scatterfit_optics::OpticsError::OutOfTable {
-                name: "rd_total",
-                value: rd,
-                min: r_lo,
-                max: r_hi,
-            },
-        ));
+        return Err(crate::error::out_of_table("rd_total", rd, r_lo, r_hi));
     }
     let (mut u_lo, mut u_hi) = ((1.0 - hi).sqrt(), (1.0 - lo).sqrt());
     for _ in 0..200 {

@@ -391,44 +391,10 @@ mod fixtures {
 
     fn channel(sp: f64, sa: f64, rd: f64) -> ChannelResult {
         ChannelResult {
-            status: ChannelStatus::Ok,
-            sigma_s_prime: Some(scatterfit_optics::Estimate {
-                value: sp,
-                fit: Some(0.01),
-                spectro: None,
-                g: None,
-                model: None,
-            }),
-            sigma_a: Some(scatterfit_optics::Estimate {
-                value: sa,
-                fit: Some(0.001),
-                spectro: None,
-                g: None,
-                model: None,
-            }),
-            albedo_prime: Some(scatterfit_optics::Estimate {
-                value: sp / (sp + sa),
-                fit: None,
-                spectro: None,
-                g: None,
-                model: None,
-            }),
             rd_total: Some(rd),
             scale: Some(1.0),
-            correlation: None,
-            unconstrained: vec![],
-            fit_time_s: 1e-5,
-            iterations: 7,
-            termination: scatterfit_optics::Termination::ConvergedResidual,
-            mse: Some(1e-6),
-            rms_log_residual: Some(0.01),
             chi2_reduced: Some(1.0),
-            rings_used: 250,
-            rings_inside_spot: 10,
-            rings_below_detection: 40,
-            rings_invalid: 0,
-            problem: None,
-            quality: None,
+            ..crate::result_json::tests::channel(sp, sa)
         }
     }
 

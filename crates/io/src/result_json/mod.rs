@@ -576,10 +576,12 @@ fn parse_result(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn channel(sp: f64, sa: f64) -> ChannelResult {
+    /// An ok channel of σ′s `sp` and σa `sa` with fit terms (the fixture of this module's tests
+    /// and of the exports').
+    pub(crate) fn channel(sp: f64, sa: f64) -> ChannelResult {
         ChannelResult {
             status: ChannelStatus::Ok,
             sigma_s_prime: Some(scatterfit_optics::Estimate {
