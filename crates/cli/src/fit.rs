@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use scatterfit_io::profile_csv::read_profile_csv;
 use scatterfit_io::result_json::write_result_json;
-use scatterfit_optics::{Method, Rgb};
+use scatterfit_optics::Rgb;
 use scatterfit_pipeline::profile::channel_from_table;
 use scatterfit_pipeline::profile_fit::{ProfileFitRequest, fit_profile};
 
@@ -78,50 +78,6 @@ pub struct Args {
 
 /// Runs `scatterfit fit`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    if !(args.eta.is_finite() && (1.0..=3.0).contains(&args.eta)) {
-        bail!(
-            "--eta {}: the relative refractive index must lie in [1, 3]",
-            crate::numeric::show(args.eta)
-        );
-    }
-    if !(args.spot_diameter_mm > 0.0 && args.spot_diameter_mm <= 20.0) {
-        bail!(
-            "--spot-diameter-mm {}: must lie in (0, 20] mm",
-            crate::numeric::show(args.spot_diameter_mm)
-        );
-    }
-    let method: Method = args.method.into();
-    if method == Method::Proposed && args.albedo.is_none() && args.rd.is_none() {
-        bail!(
-            "the proposed method needs the reduced albedo per channel: --albedo R,G,B (from \
-             `scatterfit spectro`), or the spectrophotometer's --rd R,G,B to invert it from, or \
-             use --method existing"
-        );
-    }
-    if let Some(a) = args.albedo
-        && let Some(bad) = a.iter().find(|v| !(**v > 0.0 && **v <= 1.0))
-    {
-        bail!(
-            "--albedo: {} is outside (0, 1] (a reduced albedo σ′s/σ′t)",
-            crate::numeric::show(*bad)
-        );
-    }
-    if let Some(rd) = args.rd
-        && let Some(bad) = rd.iter().find(|v| !(**v > 0.0 && **v <= 1.0))
-    {
-        bail!(
-            "--rd: {} is outside (0, 1] (a diffuse reflectance, a fraction)",
-            crate::numeric::show(*bad)
-        );
-    }
-    if let Some(r) = args.r_min_mm {
-        crate::numeric::ensure(
-            (0.0..1000.0).contains(&r),
-            "--r-min-mm",
-            r,
-            "the innermost fitted radius must lie in [0, 1000) mm",
-        )?;
-    }
     if let Some(out) = &args.output {
         crate::common::check_output_file(
             out,
@@ -147,7 +103,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eta: args.eta,
         albedo_prime: args.albedo.map(Rgb::from_array),
         rd: args.rd.map(Rgb::from_array),
-        method,
+        method: args.method.into(),
         model: args.model.into(),
         spot_diameter_mm: args.spot_diameter_mm,
         r_min_mm: args.r_min_mm,

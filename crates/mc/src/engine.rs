@@ -210,6 +210,19 @@ impl Simulation {
     /// Runs on the current rayon thread pool, calling `progress(photons_done)` after every wave of
     /// chunks (from the calling thread).
     pub fn run_with_progress(&self, progress: &(dyn Fn(u64) + Sync)) -> SimulationResult {
+        self.run_until(progress, &|| false)
+            .expect("a run that is never stopped finishes")
+    }
+
+    /// [`Simulation::run_with_progress`], stopped when `stop` answers true: it is asked after each
+    /// wave of photon chunks (about 10⁸ interactions apart, or one chunk per thread), and a
+    /// stopped run returns `None` (a partial tally is not a simulation of the photons asked for).
+    /// A caller that must stay responsive (a notebook's Ctrl-C, a scheduler's time limit) uses it.
+    pub fn run_until(
+        &self,
+        progress: &(dyn Fn(u64) + Sync),
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Option<SimulationResult> {
         let tracer = Tracer::new(self);
         let chunks = self.photons.div_ceil(CHUNK_PHOTONS);
         let mut total = Accum::new(self.grid.bins(), self.angle_bins);
@@ -243,8 +256,11 @@ impl Simulation {
             }
             first = last;
             progress((last * CHUNK_PHOTONS).min(self.photons));
+            if first < chunks && stop() {
+                return None;
+            }
         }
-        total.finish(self, tracer.specular)
+        Some(total.finish(self, tracer.specular))
     }
 }
 
@@ -674,6 +690,41 @@ pub(crate) fn spin_isotropic(rng: &mut PhotonRng) -> (f64, f64, f64) {
 mod tests {
     use super::*;
     use crate::phase::{hg_cdf_cos, hg_pdf_cos, sample_hg_cos};
+
+    /// A run stopped after its first wave returns nothing (no partial tally passes for the whole);
+    /// one never stopped gives the same tallies as `run`.
+    #[test]
+    fn a_stopped_run_returns_none() {
+        let layer = crate::Layer::from_reduced(1.0, 0.1, 0.0, 1.4, f64::INFINITY).unwrap();
+        let sim = Simulation::new(
+            crate::Sample::slab(layer, 1.0).unwrap(),
+            crate::Beam::pencil(),
+            RadialGrid::uniform(0.1, 10).unwrap(),
+            // Many waves: at least one chunk per thread and wave, far more chunks than threads.
+            CHUNK_PHOTONS * 64 * rayon::current_num_threads() as u64,
+            5,
+        )
+        .unwrap();
+        let waves = std::sync::atomic::AtomicU64::new(0);
+        let stopped = sim.run_until(
+            &|_| {
+                waves.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            },
+            &|| true,
+        );
+        assert!(stopped.is_none());
+        assert_eq!(waves.load(std::sync::atomic::Ordering::Relaxed), 1);
+        let small = Simulation::new(
+            sim.sample().clone(),
+            crate::Beam::pencil(),
+            RadialGrid::uniform(0.1, 10).unwrap(),
+            2_000,
+            5,
+        )
+        .unwrap();
+        let whole = small.run_until(&|_| {}, &|| false).expect("not stopped");
+        assert_eq!(whole.interactions, small.run().interactions);
+    }
 
     /// One scattering event as the tracer does it.
     fn spin(g: f64, u: [f64; 3], rng: &mut PhotonRng) -> [f64; 3] {

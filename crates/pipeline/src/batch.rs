@@ -26,11 +26,12 @@
 //! before any work (as the command-line tool does) reads them from [`BatchSample::inputs`].
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
-use crate::error::Result;
+use crate::error::{PipelineError, Result};
 use crate::measure::{Measurement, Overrides, measure_inputs};
 use crate::samples::{SampleInputs, sample_inputs};
 
@@ -78,6 +79,9 @@ pub struct BatchRequest {
     /// The memory the samples measured at once may take \[bytes\] (default:
     /// `scatterfit_io::budget::memory_budget_bytes`: half the machine's memory, or `$SCATTERFIT_MAX_MEMORY_MIB`).
     pub memory_budget: u64,
+    /// Once it reads true, the samples not yet started are not measured: their outcome is
+    /// [`PipelineError::Interrupted`] (the running ones finish). A caller's Ctrl-C.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl BatchRequest {
@@ -98,6 +102,16 @@ impl BatchRequest {
             samples,
             jobs: 0,
             memory_budget: scatterfit_io::budget::memory_budget_bytes(),
+            stop: None,
+        }
+    }
+
+    /// Stops starting samples once `flag` reads true ([`BatchRequest::stop`]).
+    #[must_use]
+    pub fn stop_when(self, flag: Arc<AtomicBool>) -> Self {
+        Self {
+            stop: Some(flag),
+            ..self
         }
     }
 
@@ -222,12 +236,18 @@ pub fn measure_batch_with<T: Send>(
     work: &(dyn Fn(&Path, Result<Measurement>) -> T + Sync),
     on_event: &(dyn Fn(BatchEvent<'_>) + Sync),
 ) -> std::result::Result<BatchOutcome<T>, BatchError> {
+    let stop = request.stop.clone();
+    let stopped = || stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed));
     for_each_sample(
         request,
         &|sample| {
-            let measured = sample
-                .inputs
-                .and_then(|inputs| measure_inputs(&inputs, &sample.overrides, &|_| {}));
+            let measured = if stopped() {
+                Err(PipelineError::Interrupted)
+            } else {
+                sample
+                    .inputs
+                    .and_then(|inputs| measure_inputs(&inputs, &sample.overrides, &|_| {}))
+            };
             work(&sample.dir, measured)
         },
         on_event,

@@ -69,6 +69,10 @@ pub enum PipelineError {
     /// An option or a combination of inputs the pipeline cannot use.
     #[error("{0}")]
     Input(String),
+    /// Not measured: the caller stopped the work before this sample started
+    /// ([`crate::BatchRequest::stop_when`]).
+    #[error("not measured: the batch was stopped before this sample started")]
+    Interrupted,
 }
 
 /// The forward-model factory's failure (the Monte Carlo tables shipped with scatterfit do not load)
@@ -88,6 +92,7 @@ impl PipelineError {
         match self {
             PipelineError::Imaging { source, .. } => source.is_failed_measurement(),
             PipelineError::Spectro { source, .. } => matches!(source, OpticsError::Specular { .. }),
+            PipelineError::Interrupted => true,
             _ => false,
         }
     }

@@ -50,6 +50,75 @@ pub struct ProfileFitRequest {
 /// them would be silently ignored.
 pub const MAX_RD_DISAGREEMENT: f64 = 0.01;
 
+impl ProfileFitRequest {
+    /// The request's own rules, checked before any fit: η in [1, 3], a spot diameter in
+    /// (0, 20] mm, α′ in (0, 1] and Rd in (0, 1] per channel, the innermost radius in [0, 1000) mm,
+    /// and α′ or Rd given for the proposed method (which holds α′ fixed).
+    ///
+    /// # Errors
+    /// [`crate::PipelineError::Input`] naming the value and the rule.
+    pub fn check(&self) -> Result<()> {
+        let bad = |what: &str, v: f64, rule: &str| {
+            Err(crate::PipelineError::Input(format!(
+                "{what} {}: {rule}",
+                scatterfit_io::escape::number(v)
+            )))
+        };
+        if !(self.eta.is_finite() && (1.0..=3.0).contains(&self.eta)) {
+            return bad(
+                "eta",
+                self.eta,
+                "the relative refractive index must lie in [1, 3]",
+            );
+        }
+        if !(self.spot_diameter_mm > 0.0 && self.spot_diameter_mm <= 20.0) {
+            return bad(
+                "spot diameter",
+                self.spot_diameter_mm,
+                "must lie in (0, 20] mm",
+            );
+        }
+        if self.method == Method::Proposed && self.albedo_prime.is_none() && self.rd.is_none() {
+            return Err(crate::PipelineError::Input(
+                "the proposed method needs the reduced albedo α′ per channel (from `scatterfit \
+                 spectro`), or the spectrophotometer's Rd per channel to invert it from; or fit \
+                 with the existing method"
+                    .into(),
+            ));
+        }
+        if let Some(a) = self.albedo_prime
+            && let Some(v) = a
+                .into_array()
+                .into_iter()
+                .find(|v| !(*v > 0.0 && *v <= 1.0))
+        {
+            return bad("albedo", v, "outside (0, 1] (a reduced albedo σ′s/σ′t)");
+        }
+        if let Some(rd) = self.rd
+            && let Some(v) = rd
+                .into_array()
+                .into_iter()
+                .find(|v| !(*v > 0.0 && *v <= 1.0))
+        {
+            return bad(
+                "rd",
+                v,
+                "outside (0, 1] (a diffuse reflectance, a fraction)",
+            );
+        }
+        if let Some(r) = self.r_min_mm
+            && !(0.0..1000.0).contains(&r)
+        {
+            return bad(
+                "r_min_mm",
+                r,
+                "the innermost fitted radius must lie in [0, 1000) mm",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// A given profile, fitted.
 #[derive(Debug, Clone)]
 pub struct ProfileFit {
@@ -69,6 +138,7 @@ pub struct ProfileFit {
 /// [`crate::PipelineError::Input`] when the model cannot be loaded. Channels that cannot be fitted
 /// are [`ChannelOutcome::NotFitted`].
 pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> Result<ProfileFit> {
+    request.check()?;
     request.g_prior.check()?;
     crate::measure::check_g_fit(&request.g_prior, request.model)?;
     let g = crate::measure::values_g(&request.g_prior)?;
