@@ -81,8 +81,9 @@ impl ProfileFitRequest {
         if self.method == Method::Proposed && self.albedo_prime.is_none() && self.rd.is_none() {
             return Err(crate::PipelineError::Input(
                 "the proposed method needs the reduced albedo α′ per channel (from `scatterfit \
-                 spectro`), or the spectrophotometer's Rd per channel to invert it from; or fit \
-                 with the existing method"
+                 spectro`; `--albedo R,G,B`, in Python `albedo=`), or the spectrophotometer's Rd \
+                 per channel to invert it from (`--rd R,G,B`, `rd=`); or fit with the existing \
+                 method (`--method existing`)"
                     .into(),
             ));
         }

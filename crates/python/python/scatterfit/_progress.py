@@ -42,8 +42,8 @@ class _Bar:
                 self._last_line = fraction
                 print(f"{self._description}: {done}/{total} {self._unit}", file=sys.stderr)
             return
-        self._bar.n = done
-        self._bar.refresh()
+        # update() (not refresh()) keeps tqdm's delay: quick work shows no bar.
+        self._bar.update(done - self._bar.n)
 
     def close(self) -> None:
         if self._bar:

@@ -165,6 +165,36 @@ class Result:
         """σa per channel R, G, B [mm⁻¹] (NaN where not fitted)."""
         return np.array([c.sigma_a.value if c.sigma_a else np.nan for c in self])
 
+    def model_profile(self, channel: str, r_mm: Any) -> np.ndarray:
+        """The fitted model of ``channel`` at radii ``r_mm`` [mm], in the profile's units (× the
+        fit's scale), the light spot taken as a uniform disk of the result's radius: the curve to
+        draw beside the measured profile (``fit.png``'s).
+
+        Raises
+        ------
+        InputError
+            The channel has no fitted σ′s and σa.
+        """
+        from . import models
+        from .errors import InputError
+
+        ch = self[channel]
+        scale = ch._d.get("scale")
+        if ch.sigma_s_prime is None or ch.sigma_a is None or scale is None:
+            raise InputError(f"channel {channel!r} was not fitted ({ch.status}): no model to draw")
+        inputs = self._d.get("inputs") or {}
+        options = inputs.get("options") or {}
+        radius = inputs.get("spot_radius_mm")
+        return scale * models.profile(
+            r_mm,
+            ch.sigma_s_prime.value,
+            ch.sigma_a.value,
+            self.eta,
+            options.get("g") or 0.0,
+            model=self.model or "mc",
+            spot_diameter_mm=2 * radius if radius else None,
+        )
+
     def to_dict(self) -> Dict[str, Any]:
         """The result as ``result.json`` holds it (a copy)."""
         return copy.deepcopy(dict(self._d))
