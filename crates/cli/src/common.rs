@@ -286,14 +286,12 @@ impl FitArgs {
     }
 }
 
-/// Parses `--g G|fit` into the manifest's `[fit] g` setting.
+/// Parses `--g G|fit` into the manifest's `[fit] g` setting (its `FromStr`; numbers as the
+/// other flags take them: `1_000`-style digits and exponents through [`crate::numeric::parse_finite`]).
 pub fn parse_g(text: &str) -> Result<GSetting, String> {
-    if text.trim() == "fit" {
-        return Ok(GSetting::Fit);
-    }
     crate::numeric::parse_finite(text)
         .map(GSetting::Value)
-        .map_err(|_| format!("`{text}` is neither a Henyey–Greenstein g in (−1, 1) nor `fit`"))
+        .or_else(|_| text.parse::<GSetting>())
 }
 
 /// Parses `--g-range LO,HI`: two finite numbers (the range's rule is checked with the other

@@ -30,13 +30,10 @@ pub(crate) fn g_setting(g: Option<&Bound<'_, PyAny>>) -> PyResult<Option<GSettin
         return Ok(None);
     }
     if let Ok(text) = g.extract::<String>() {
-        return if text.trim() == "fit" {
-            Ok(Some(GSetting::Fit))
-        } else {
-            Err(errors::input(format!(
-                "g={text:?}: neither a Henyey–Greenstein g in (−1, 1) nor \"fit\""
-            )))
-        };
+        return text
+            .parse::<GSetting>()
+            .map(Some)
+            .map_err(|e| errors::input(format!("g: {e}")));
     }
     let value: f64 = g.extract().map_err(|_| {
         errors::input(format!(

@@ -259,6 +259,24 @@ impl GSetting {
     }
 }
 
+/// `fit`, or a finite number (its range, (−1, 1), is checked where the setting is used, with
+/// the range of g beside it). The error says what was given and what is expected.
+impl std::str::FromStr for GSetting {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        let t = text.trim();
+        if t == "fit" {
+            return Ok(GSetting::Fit);
+        }
+        match t.parse::<f64>() {
+            Ok(g) if g.is_finite() => Ok(GSetting::Value(g)),
+            _ => Err(format!(
+                "`{text}` is neither a Henyey–Greenstein g in (−1, 1) nor `fit`"
+            )),
+        }
+    }
+}
+
 impl std::fmt::Display for GSetting {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
