@@ -4,8 +4,9 @@
 //! with SAMPLE_DIR a sample folder and RESULT_DIR the folder its result files were written to
 //! (its `profile.csv` and `result.json` give the profile and η, α′ of the fit).
 //!
-//! Prints the median wall time of `measure_sample` on the folder, and of `fit_profile` (proposed
-//! method, exact transport, 1 mm spot) on its profile, over repeated calls.
+//! Prints the median wall time of `measure_sample` on the folder (and of `to_result`, the
+//! measurement's result), and of `fit_profile` (proposed method, exact transport, 1 mm spot) on its
+//! profile, over repeated calls.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -66,5 +67,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         measure_sample(&sample, &overrides, &|_| {}).expect("measures");
     });
     println!("measure_sample: {:.1} ms (median of 11)", measure * 1e3);
+    // What a caller does next with a measurement: its result (what result.json holds).
+    let m = measure_sample(&sample, &overrides, &|_| {})?;
+    let result = median_s(11, || {
+        std::hint::black_box(m.to_result(Some("profile.csv")));
+    });
+    println!(
+        "Measurement::to_result: {:.2} ms (median of 11)",
+        result * 1e3
+    );
     Ok(())
 }

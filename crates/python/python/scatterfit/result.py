@@ -23,7 +23,25 @@ CHANNELS = ("r", "g", "b")
 
 @dataclass(frozen=True)
 class Value:
-    """One measured value and its uncertainty terms (``result.json``'s record)."""
+    """One measured value and its uncertainty terms (``result.json``'s record).
+
+    Attributes
+    ----------
+    value
+        The value (mm⁻¹ for σ′s and σa; α′ is a fraction).
+    fit
+        Standard error from the profile's noise (the fit's Jacobian).
+    spectro
+        Standard error from the spectrophotometer's reading (η and α′ at its repeatability).
+    g
+        How far the value moves over the range of the anisotropy g when g is not known (a bound).
+    model
+        An approximate model's distance from exact transport on the same data (a bound; ``None``
+        with the exact ``mc`` model).
+    total
+        The bar to quote: ``fit`` and ``spectro`` in quadrature, plus ``g`` and ``model``.
+    ``None`` marks a term that is unknown or does not apply.
+    """
 
     value: float
     fit: Optional[float] = None
