@@ -132,6 +132,14 @@ def test_load_reads_what_measure_writes(wood: Path, tmp_path: Path):
         sf.load(tmp_path / "missing.json")
 
 
+def test_notebook_table_escapes_the_name(wood: Path):
+    d = sf.measure(wood).to_dict()
+    d["name"] = "<script>alert(1)</script>"
+    page = sf.result.Result(d)._repr_html_()
+    assert "<script>" not in page and "&lt;script&gt;" in page
+    assert page.count("<tr>") == 4
+
+
 def test_help_is_useful():
     for f in (sf.measure, sf.batch, sf.fit_profile, sf.simulate, sf.spectro, sf.export, sf.models.profile):
         assert f.__doc__ and len(f.__doc__) > 200

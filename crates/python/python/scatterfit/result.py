@@ -221,6 +221,29 @@ class Result:
         """``result.json``'s text."""
         return json.dumps(self._d, ensure_ascii=False)
 
+    def _repr_html_(self) -> str:
+        """A table for notebooks: per channel σ′s and σa with their total bars, α′ and the verdict."""
+        import html
+
+        def cell(v: Optional[Value]) -> str:
+            if v is None:
+                return "—"
+            bar = "" if v.total is None else f" ± {v.total:.2g}"
+            return f"{v.value:.4g}{bar}"
+
+        rows = "".join(
+            f"<tr><td>{c.name.upper()}</td><td>{cell(c.sigma_s_prime)}</td><td>{cell(c.sigma_a)}</td>"
+            f"<td>{cell(c.albedo_prime)}</td><td>{html.escape(c.verdict)}"
+            + "".join(f"<br><small>{html.escape(r.kind)}: {html.escape(r.message)}</small>" for r in c.reasons)
+            + "</td></tr>"
+            for c in self
+        )
+        return (
+            f"<p><b>{html.escape(self.name)}</b>: η = {self.eta:.4g}, method {html.escape(self.method)}, "
+            f"model {html.escape(self.model)}</p><table><tr><th></th><th>σ′s [mm⁻¹]</th>"
+            f"<th>σa [mm⁻¹]</th><th>α′</th><th>verdict</th></tr>{rows}</table>"
+        )
+
     def __repr__(self) -> str:
         values = ", ".join(
             f"{c.name.upper()} σ′s={c.sigma_s_prime} σa={c.sigma_a}" for c in self
