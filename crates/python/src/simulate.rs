@@ -18,7 +18,8 @@ fn pair(m: McMean) -> (f64, f64) {
 /// Simulates `photons` photons (private: `scatterfit.simulate`).
 #[pyfunction]
 #[pyo3(signature = (sigma_s_prime, sigma_a, eta, *, g=0.0, thickness_mm=None, photons=100_000,
-    seed=1, r_max_mm=10.0, bins=100, beam_radius_mm=None, beam="pencil", progress=None))]
+    seed=1, r_max_mm=10.0, bins=100, beam_radius_mm=None, beam="pencil", max_interactions=1e12,
+    progress=None))]
 pub(crate) fn simulate<'py>(
     py: Python<'py>,
     sigma_s_prime: f64,
@@ -32,6 +33,7 @@ pub(crate) fn simulate<'py>(
     bins: usize,
     beam_radius_mm: Option<f64>,
     beam: &str,
+    max_interactions: f64,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     // Below a micrometre the bins' areas underflow and the tallies divide by them.
@@ -73,6 +75,17 @@ pub(crate) fn simulate<'py>(
             )));
         }
     };
+    // The tallies' memory, before they are allocated (the budget `scatterfit simulate` uses).
+    let budget = scatterfit_io::budget::memory_budget_bytes();
+    let needed = Simulation::tally_memory_bytes(bins, 0);
+    if needed > budget {
+        return Err(errors::input(format!(
+            "bins={bins}: the tallies need {} of memory, more than the budget of {} ({})",
+            scatterfit_io::budget::describe_bytes(needed),
+            scatterfit_io::budget::describe_bytes(budget),
+            scatterfit_io::budget::how_to_raise()
+        )));
+    }
     let layer = Layer::from_reduced(
         sigma_s_prime,
         sigma_a,
@@ -87,6 +100,22 @@ pub(crate) fn simulate<'py>(
         RadialGrid::uniform(r_max_mm / bins as f64, bins).map_err(|e| errors::bad_input(&e))?;
     let sim =
         Simulation::new(sample, beam, grid, photons, seed).map_err(|e| errors::bad_input(&e))?;
+    // Work that would not finish is refused before it starts, with the estimate (the same
+    // cost model and default budget as `scatterfit simulate --max-interactions`).
+    let cost = sim.cost_estimate();
+    if cost.interactions > max_interactions {
+        return Err(errors::input(format!(
+            "this simulation is expected to take about {:.1e} interactions ({:.3e} per photon × \
+             {photons} photons), about {} on {} threads, more than max_interactions={:.1e}; use \
+             fewer photons, a larger sigma_a, a g further from 1, a thinner slab, or raise \
+             max_interactions if you mean it",
+            cost.interactions,
+            cost.interactions_per_photon,
+            scatterfit_io::budget::describe_seconds(cost.seconds(rayon::current_num_threads())),
+            rayon::current_num_threads(),
+            max_interactions
+        )));
+    }
     let result = run(py, progress.as_ref(), photons, |control: &Control| {
         sim.run_until(&|done| control.set_done(done), &|| control.stopped())
     })?

@@ -56,6 +56,12 @@ def test_bad_parameters_raise_input_error():
         sf.simulate(-1.0, 0.1, 1.4)
     with pytest.raises(sf.InputError, match="beam"):
         sf.simulate(1.0, 0.1, 1.4, beam="laser")
+    # Work that would not finish, refused before it starts.
+    with pytest.raises(sf.InputError, match="max_interactions"):
+        sf.simulate(1.0, 1e-6, 1.4, photons=10**12)
+    # A count beyond 64 bits is not a number of photons.
+    with pytest.raises((OverflowError, sf.InputError)):
+        sf.simulate(1.0, 0.1, 1.4, photons=10**30)
 
 
 def test_ctrl_c_returns_control_during_a_long_simulation():

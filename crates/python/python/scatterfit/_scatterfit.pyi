@@ -90,6 +90,7 @@ def simulate(
     bins: int = 100,
     beam_radius_mm: Optional[float] = None,
     beam: str = "pencil",
+    max_interactions: float = 1e12,
     progress: _Progress = None,
 ) -> dict[str, Any]: ...
 def spectro_file(

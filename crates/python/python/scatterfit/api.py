@@ -273,6 +273,7 @@ def simulate(
     bins: int = 100,
     beam: str = "pencil",
     beam_radius_mm: Optional[float] = None,
+    max_interactions: float = 1e12,
     progress: ProgressArg = True,
 ) -> Dict[str, Any]:
     """Monte Carlo ground truth: photons through a half-space (or a slab of ``thickness_mm``)
@@ -285,10 +286,15 @@ def simulate(
         ``rd_total``, ``transmittance``, ``absorbed`` as (value, standard error) pairs;
         ``specular``, ``photons``, ``interactions``, ``seed``. The same seed gives the same numbers.
 
+    ``beam`` is ``"pencil"``, or ``"disk"`` / ``"gaussian"`` with ``beam_radius_mm``. A run
+    expected to take more than ``max_interactions`` photon interactions (about 10¹² is hours on
+    two cores) is refused before it starts, with its estimate.
+
     Raises
     ------
     InputError
-        A parameter out of range (the message says which and why).
+        A parameter out of range (the message says which and why), or more work than
+        ``max_interactions`` or tallies beyond the memory budget.
     KeyboardInterrupt
         Ctrl-C: the simulation stops within a wave of photons (about 10⁸ interactions).
     """
@@ -306,6 +312,7 @@ def simulate(
             bins=int(bins),
             beam=beam,
             beam_radius_mm=beam_radius_mm,
+            max_interactions=float(max_interactions),
             progress=callback,
         )
     finally:
