@@ -4,7 +4,8 @@
 # built into it by `maturin develop` with the workspace's dev profile (optimised; it reuses the
 # workspace's compiled crates, so only PyO3 and the module itself compile: ~20 s), then pytest runs
 # every test against the CLI that `cargo test` built (target/debug/scatterfit), the real Mitsuba
-# included (SCATTERFIT_REQUIRE_MITSUBA=1 makes its absence a failure, not a skip).
+# included (SCATTERFIT_REQUIRE_MITSUBA=1 makes its absence a failure, not a skip), and mypy on the
+# package's types (SCATTERFIT_REQUIRE_MYPY=1 likewise).
 #
 # Run it from the repository root after `cargo build -p scatterfit` (or `cargo test --workspace`):
 #   bash .ci/python-test.sh
@@ -15,12 +16,14 @@ VENV="$PWD/.ci/venv"
 MATURIN_VERSION=1.16.0
 PYTEST_VERSION=9.2.0
 NUMPY_VERSION=2.4.6
+MYPY_VERSION=2.4.1
 if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
 fi
-if ! "$VENV/bin/python" -c "import maturin, pytest, numpy, sys; sys.exit(pytest.__version__ != '${PYTEST_VERSION}')" 2>/dev/null; then
+if ! "$VENV/bin/python" -c "import maturin, pytest, numpy, mypy, sys; sys.exit(pytest.__version__ != '${PYTEST_VERSION}')" 2>/dev/null; then
   "$VENV/bin/pip" install --no-cache-dir --disable-pip-version-check --quiet \
-    "maturin==${MATURIN_VERSION}" "pytest==${PYTEST_VERSION}" "numpy==${NUMPY_VERSION}"
+    "maturin==${MATURIN_VERSION}" "pytest==${PYTEST_VERSION}" "numpy==${NUMPY_VERSION}" \
+    "mypy==${MYPY_VERSION}"
 fi
 
 echo "== maturin develop (the scatterfit Python package into .ci/venv)"

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import Callable, Optional, Union
+from typing import Any, Callable, Optional, Union
 
 ProgressArg = Union[bool, Callable[[int, int], None], None]
 
@@ -19,7 +19,7 @@ class _Bar:
     def __init__(self, description: str, unit: str) -> None:
         self._description = description
         self._unit = unit
-        self._bar = None
+        self._bar: Any = None
         self._last_line = -1.0
         self._start = time.monotonic()
 

@@ -158,6 +158,7 @@ def batch(
         if handle is not None:
             measured.append(Measurement(handle))
         else:
+            assert error is not None, "the compiled module returns a measurement or an error"
             kind, message = error
             failed.append(BatchFailure(os.fspath(folder), kind, message))
     return measured, failed
@@ -229,9 +230,7 @@ def fit_profile(
     if r.ndim != 1:
         raise InputError(f"r_mm: a 1-D array of radii, got shape {r.shape}")
 
-    def columns(what: str, a: Any) -> Optional[np.ndarray]:
-        if a is None:
-            return None
+    def columns(what: str, a: Any) -> np.ndarray:
         a = np.asarray(a, dtype=np.float64)
         if a.ndim == 1:
             a = np.repeat(a[:, None], 3, axis=1)
@@ -246,8 +245,8 @@ def fit_profile(
         eta=float(eta),
         albedo=_rgb("albedo", albedo),
         rd=_rgb("rd", rd),
-        count=columns("count", count),
-        limit=columns("limit", limit),
+        count=None if count is None else columns("count", count),
+        limit=None if limit is None else columns("limit", limit),
         method=method,
         model=model,
         g=g,
@@ -472,7 +471,7 @@ def mitsuba_dict(
     medium = scene.find("medium")
     if bsdf is None or medium is None:
         raise InputError("the Mitsuba export has no boundary or no medium")
-    d = dict(shape) if shape is not None else {"type": "sphere"}
+    d: Dict[str, Any] = dict(shape) if shape is not None else {"type": "sphere"}
     d["bsdf"] = _mitsuba_object(bsdf)
     d["interior"] = _mitsuba_object(medium)
     return d
