@@ -59,9 +59,12 @@ def test_bad_parameters_raise_input_error():
     # Work that would not finish, refused before it starts.
     with pytest.raises(sf.InputError, match="max_interactions"):
         sf.simulate(1.0, 1e-6, 1.4, photons=10**12)
-    # A count beyond 64 bits is not a number of photons.
-    with pytest.raises((OverflowError, sf.InputError)):
-        sf.simulate(1.0, 0.1, 1.4, photons=10**30)
+    # Counts that are not counts.
+    for photons in (10**30, -5, 2.5, True):
+        with pytest.raises(sf.InputError, match="photons"):
+            sf.simulate(1.0, 0.1, 1.4, photons=photons)
+    with pytest.raises(sf.InputError, match="seed"):
+        sf.simulate(1.0, 0.1, 1.4, seed=-1)
 
 
 def test_ctrl_c_returns_control_during_a_long_simulation():

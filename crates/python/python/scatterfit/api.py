@@ -90,7 +90,8 @@ def measure(
     MeasurementError
         The measurement ran and failed (e.g. every frame saturated).
     KeyboardInterrupt
-        Ctrl-C: the measurement stops after its current stage.
+        Ctrl-C: raised as soon as the measurement returns (one sample takes about a second; a
+        :func:`batch` stops starting samples at once).
     """
     callback, close = progress_callback(progress, "measuring", "stages")
     try:
@@ -297,6 +298,9 @@ def simulate(
     KeyboardInterrupt
         Ctrl-C: the simulation stops within a wave of photons (about 10⁸ interactions).
     """
+    for name, value, low in (("photons", photons, 1), ("seed", seed, 0), ("bins", bins, 1)):
+        if isinstance(value, bool) or int(value) != value or not low <= int(value) < 2**64:
+            raise InputError(f"{name}={value!r}: a whole number from {low} to 2**64 - 1")
     callback, close = progress_callback(progress, "simulating", "photons")
     try:
         return _scatterfit.simulate(
