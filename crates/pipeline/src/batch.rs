@@ -32,7 +32,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::error::{PipelineError, Result};
-use crate::measure::{Measurement, Overrides, measure_inputs};
+use crate::measure::{Measurement, Overrides, measure_inputs_until};
 use crate::samples::{SampleInputs, sample_inputs};
 
 /// Why a batch could not run at all (a sample that fails is an outcome, not this).
@@ -79,8 +79,8 @@ pub struct BatchRequest {
     /// The memory the samples measured at once may take \[bytes\] (default:
     /// `scatterfit_io::budget::memory_budget_bytes`: half the machine's memory, or `$SCATTERFIT_MAX_MEMORY_MIB`).
     pub memory_budget: u64,
-    /// Once it reads true, the samples not yet started are not measured: their outcome is
-    /// [`PipelineError::Interrupted`] (the running ones finish). A caller's Ctrl-C.
+    /// Once it reads true, the samples not yet started are not measured and the running ones stop
+    /// before their next stage: their outcome is [`PipelineError::Interrupted`]. A caller's Ctrl-C.
     pub stop: Option<Arc<AtomicBool>>,
 }
 
@@ -244,9 +244,10 @@ pub fn measure_batch_with<T: Send>(
             let measured = if stopped() {
                 Err(PipelineError::Interrupted)
             } else {
-                sample
-                    .inputs
-                    .and_then(|inputs| measure_inputs(&inputs, &sample.overrides, &|_| {}))
+                // A sample already running stops before its next stage.
+                sample.inputs.and_then(|inputs| {
+                    measure_inputs_until(&inputs, &sample.overrides, &|_| {}, &stopped)
+                })
             };
             work(&sample.dir, measured)
         },
@@ -308,6 +309,26 @@ mod tests {
 
     /// A batch keeps every sample's outcome in order, reports each finished sample once, and a
     /// sample that cannot be read is an outcome, not a failed batch.
+    #[test]
+    fn a_stopped_batch_starts_no_sample() {
+        let dir = tempfile::tempdir().unwrap();
+        let dirs: Vec<PathBuf> = (0..3).map(|k| dir.path().join(format!("s{k}"))).collect();
+        let stop = Arc::new(AtomicBool::new(true));
+        let outcome = measure_batch(
+            BatchRequest::new(dirs, Overrides::default()).stop_when(stop),
+            &|_| {},
+        )
+        .unwrap();
+        assert_eq!(outcome.samples.len(), 3);
+        // Not the missing folders' input error: nothing was started.
+        assert!(
+            outcome
+                .samples
+                .iter()
+                .all(|s| matches!(s.outcome, Err(PipelineError::Interrupted)))
+        );
+    }
+
     #[test]
     fn failures_are_outcomes_in_order() {
         let dir = tempfile::tempdir().unwrap();

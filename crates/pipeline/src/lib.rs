@@ -68,7 +68,8 @@ pub use compare::{Compared, compare_batch, compare_batch_with};
 pub use error::{PipelineError, Result};
 pub use fit::{ChannelFit, ChannelOutcome, FitSettings};
 pub use measure::{
-    Measurement, Overrides, Stage, Timings, fit_settings, measure_inputs, measure_sample,
+    Measurement, Overrides, Stage, Timings, fit_settings, measure_inputs, measure_inputs_until,
+    measure_sample, measure_sample_until,
 };
 pub use samples::{SampleDirs, SampleInputs, misspelt_manifest, sample_dirs, sample_inputs};
 /// What a result file holds, and where its named values come from.

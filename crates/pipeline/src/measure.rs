@@ -300,9 +300,24 @@ pub fn measure_sample(
     overrides: &Overrides,
     progress: &(dyn Fn(Stage) + Sync),
 ) -> Result<Measurement> {
+    measure_sample_until(dir, overrides, progress, &|| false)
+}
+
+/// [`measure_sample`], stopped when `stop` answers true: it is asked before each stage, and a
+/// stopped measurement is [`PipelineError::Interrupted`] (a caller's Ctrl-C: the Python package's
+/// `measure` returns within a stage).
+///
+/// # Errors
+/// As [`measure_sample`], and [`PipelineError::Interrupted`].
+pub fn measure_sample_until(
+    dir: &Path,
+    overrides: &Overrides,
+    progress: &(dyn Fn(Stage) + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Measurement> {
     let t0 = Instant::now();
     let inputs = sample_inputs(dir, overrides.allow_outside_paths)?;
-    measure_from(&inputs, overrides, progress, t0)
+    measure_from(&inputs, overrides, progress, stop, t0)
 }
 
 /// Measures a sample whose manifest and inputs [`sample_inputs`] already resolved (a caller that
@@ -315,20 +330,42 @@ pub fn measure_inputs(
     overrides: &Overrides,
     progress: &(dyn Fn(Stage) + Sync),
 ) -> Result<Measurement> {
-    measure_from(inputs, overrides, progress, Instant::now())
+    measure_inputs_until(inputs, overrides, progress, &|| false)
+}
+
+/// [`measure_inputs`], stopped before a stage when `stop` answers true ([`measure_sample_until`]).
+///
+/// # Errors
+/// As [`measure_inputs`], and [`PipelineError::Interrupted`].
+pub fn measure_inputs_until(
+    inputs: &SampleInputs,
+    overrides: &Overrides,
+    progress: &(dyn Fn(Stage) + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Measurement> {
+    measure_from(inputs, overrides, progress, stop, Instant::now())
 }
 
 fn measure_from(
     inputs: &SampleInputs,
     overrides: &Overrides,
     progress: &(dyn Fn(Stage) + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
     t0: Instant,
 ) -> Result<Measurement> {
+    // Each stage is announced, unless the caller asked to stop before it.
+    let begin = |stage: Stage| -> Result<()> {
+        if stop() {
+            return Err(PipelineError::Interrupted);
+        }
+        progress(stage);
+        Ok(())
+    };
     let manifest = inputs.manifest.clone();
     let settings = fit_settings(&manifest, overrides)?;
     let (model, albedo) = families(&settings)?;
     let (model, albedo) = (&model, &albedo);
-    progress(Stage::Spectro);
+    begin(Stage::Spectro)?;
     let spectro = spectro_stage(&manifest, overrides.eta, albedo)?;
     let spectro_s = t0.elapsed().as_secs_f64();
     let hdr = match &manifest.camera.hdr {
@@ -372,12 +409,12 @@ fn measure_from(
             // everywhere are masked out by the profile stage.
             inputs.clipped_fill = scatterfit_imaging::ClippedFill::LowerBound;
             let stage = read_and_merge(&inputs, &|_| progress(Stage::ReadFrame))?;
-            progress(Stage::Merge);
+            begin(Stage::Merge)?;
             stage
         }
     };
     let t_profile = Instant::now();
-    progress(Stage::Profile);
+    begin(Stage::Profile)?;
     let profile = profile_stage_with(
         &hdr.hdr.radiance,
         Some(&hdr.hdr.clipped),
@@ -402,7 +439,7 @@ fn measure_from(
     }
     let profile_s = t_profile.elapsed().as_secs_f64();
     let data = profile.rgb_data()?;
-    progress(Stage::Fit);
+    begin(Stage::Fit)?;
     let t_fit = Instant::now();
     let port = crate::port::port_of(
         manifest.spectro.aperture_mm,

@@ -13,7 +13,7 @@ use scatterfit_pipeline::outputs::{
 };
 use scatterfit_pipeline::{
     BatchEvent, BatchRequest, Measurement, PipelineError, Stage, measure_batch_with,
-    measure_sample, sample_inputs,
+    measure_sample_until, sample_inputs,
 };
 
 use crate::errors;
@@ -202,9 +202,12 @@ pub(crate) fn measure<'py>(
     }
     .overrides()?;
     let measured = run(py, progress.as_ref(), 5, |control: &Control| {
-        measure_sample(&folder, &overrides, &|stage| {
-            control.set_done(stage_number(stage) - 1);
-        })
+        measure_sample_until(
+            &folder,
+            &overrides,
+            &|stage| control.set_done(stage_number(stage) - 1),
+            &|| control.stopped(),
+        )
     })?;
     let m = measured.map_err(|e| errors::pipeline(&e))?;
     MeasurementHandle::new(m, allow_outside_paths)

@@ -140,6 +140,31 @@ def test_notebook_table_escapes_the_name(wood: Path):
     assert page.count("<tr>") == 4
 
 
+def test_ctrl_c_stops_a_measurement(wood: Path):
+    # SIGINT 50 ms into a measurement of ~0.4 s (in a child interpreter, as a notebook's kernel
+    # receives it): KeyboardInterrupt, before the measurement's end.
+    import subprocess
+    import sys
+    import textwrap
+
+    code = textwrap.dedent(
+        f"""
+        import os, signal, threading, time, scatterfit
+        threading.Timer(0.05, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+        t0 = time.monotonic()
+        try:
+            scatterfit.measure({str(wood)!r}, progress=False)
+        except KeyboardInterrupt:
+            print(f"interrupted after {{time.monotonic() - t0:.2f}} s")
+        else:
+            print("finished")
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("interrupted after"), done.stdout + done.stderr
+
+
 def test_help_is_useful():
     for f in (sf.measure, sf.batch, sf.fit_profile, sf.simulate, sf.spectro, sf.export, sf.models.profile):
         assert f.__doc__ and len(f.__doc__) > 200

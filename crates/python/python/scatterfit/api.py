@@ -90,8 +90,8 @@ def measure(
     MeasurementError
         The measurement ran and failed (e.g. every frame saturated).
     KeyboardInterrupt
-        Ctrl-C: raised as soon as the measurement returns (one sample takes about a second; a
-        :func:`batch` stops starting samples at once).
+        Ctrl-C: the measurement stops before its next stage (stages take up to a second or so on
+        a rig sample); a :func:`batch` stops starting samples, and its running ones stop likewise.
     """
     callback, close = progress_callback(progress, "measuring", "stages")
     try:
