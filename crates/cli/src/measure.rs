@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use scatterfit_pipeline::{Stage, measure_sample};
+use scatterfit_pipeline::{Stage, measure_inputs};
 
 use crate::common::{FitArgs, bar};
 use crate::output::{errln, out, outln};
@@ -53,7 +53,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         crate::common::check_destination(o, "-o")?;
     }
     let bar = bar(5, "{msg} {bar:30} {elapsed}", args.quiet || args.json);
-    let m = measure_sample(&args.dir, &overrides, &|stage| {
+    // The inputs resolved above are measured: the manifest is read once, and the one whose
+    // outputs were checked is the one measured.
+    let m = measure_inputs(&inputs, &overrides, &|stage| {
         let msg = match stage {
             Stage::Spectro => "spectrophotometer",
             Stage::ReadFrame => "reading frames",

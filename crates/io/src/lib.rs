@@ -9,6 +9,7 @@
 pub mod atomic;
 pub mod bracket;
 pub mod budget;
+pub mod digest;
 pub mod escape;
 pub mod export;
 pub mod image_files;

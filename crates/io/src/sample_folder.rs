@@ -393,6 +393,7 @@ pub fn write_sample_folder_with(
         },
         fit: s.fit.clone(),
         dir: dir.to_path_buf(),
+        read_from: None,
     };
     let mut comment = s.provenance.to_string();
     if let Some([l, a, b]) = s.lab10 {

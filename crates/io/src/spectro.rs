@@ -160,8 +160,26 @@ pub const MAX_SPECTRUM_ROWS: usize = 10_000;
 /// # Errors
 /// [`SpectroCsvError`] naming the file, line and column of the first problem.
 pub fn read_spectro_csv(path: &Path) -> Result<SpectroReading, SpectroCsvError> {
+    read_spectro_file(path).map(|(reading, _)| reading)
+}
+
+/// Reads a spectrophotometer CSV ([`read_spectro_csv`]) with the record of the file read: its path
+/// and the SHA-256 of the bytes parsed.
+///
+/// # Errors
+/// As [`read_spectro_csv`].
+pub fn read_spectro_file(
+    path: &Path,
+) -> Result<(SpectroReading, crate::digest::ReadFile), SpectroCsvError> {
     let text = read_text_file(path).map_err(text_error)?;
-    parse_spectro_csv(&text.text, path)
+    let reading = parse_spectro_csv(&text.text, path)?;
+    Ok((
+        reading,
+        crate::digest::ReadFile {
+            path: path.to_path_buf(),
+            sha256: text.sha256,
+        },
+    ))
 }
 
 /// Parses the bytes of a spectrophotometer CSV (any accepted encoding, [`crate::text`]); `path` is

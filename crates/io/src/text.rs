@@ -132,6 +132,9 @@ pub struct DecodedText {
     pub text: String,
     /// How the bytes were decoded.
     pub encoding: TextEncoding,
+    /// SHA-256 of the bytes decoded (the file as read, byte-order mark included), lower-case hex
+    /// ([`crate::digest::sha256_hex`]).
+    pub sha256: String,
 }
 
 /// Decodes the bytes of a text file (see the module documentation for what is accepted); `path`
@@ -141,6 +144,16 @@ pub struct DecodedText {
 /// [`TextError::NotText`] for UTF-16 without a BOM, UTF-32, invalid UTF-16, and binary data (a
 /// workbook, an image, …), each named.
 pub fn decode_text(bytes: &[u8], path: &Path) -> Result<DecodedText, TextError> {
+    let (text, encoding) = decode(bytes, path)?;
+    Ok(DecodedText {
+        text,
+        encoding,
+        sha256: crate::digest::sha256_hex(bytes),
+    })
+}
+
+/// The text of `bytes` and how it was decoded ([`decode_text`]).
+fn decode(bytes: &[u8], path: &Path) -> Result<(String, TextEncoding), TextError> {
     let not_text = |seen: String| TextError::NotText {
         path: path.to_path_buf(),
         seen,
@@ -151,10 +164,7 @@ pub fn decode_text(bytes: &[u8], path: &Path) -> Result<DecodedText, TextError> 
     }
     if let Some(rest) = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]) {
         return match std::str::from_utf8(rest) {
-            Ok(text) => Ok(DecodedText {
-                text: text.to_owned(),
-                encoding: TextEncoding::Utf8Bom,
-            }),
+            Ok(text) => Ok((text.to_owned(), TextEncoding::Utf8Bom)),
             Err(e) => Err(not_text(format!(
                 "the file starts with a UTF-8 byte-order mark but byte {} is not UTF-8",
                 e.valid_up_to() + 3
@@ -167,7 +177,7 @@ pub fn decode_text(bytes: &[u8], path: &Path) -> Result<DecodedText, TextError> 
     ] {
         if let Some(rest) = bytes.strip_prefix(&bom) {
             return decode_utf16(rest, little)
-                .map(|text| DecodedText { text, encoding })
+                .map(|text| (text, encoding))
                 .ok_or_else(|| {
                     not_text(format!(
                         "the file starts with a {} byte-order mark but is not valid UTF-16 (odd \
@@ -188,14 +198,11 @@ pub fn decode_text(bytes: &[u8], path: &Path) -> Result<DecodedText, TextError> 
         }));
     }
     match std::str::from_utf8(bytes) {
-        Ok(text) => Ok(DecodedText {
-            text: text.to_owned(),
-            encoding: TextEncoding::Utf8,
-        }),
-        Err(_) => Ok(DecodedText {
-            text: bytes.iter().map(|&b| windows_1252(b)).collect(),
-            encoding: TextEncoding::Windows1252,
-        }),
+        Ok(text) => Ok((text.to_owned(), TextEncoding::Utf8)),
+        Err(_) => Ok((
+            bytes.iter().map(|&b| windows_1252(b)).collect(),
+            TextEncoding::Windows1252,
+        )),
     }
 }
 

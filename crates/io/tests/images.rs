@@ -291,6 +291,12 @@ fn exposures_csv_resolves_paths_against_its_folder() {
     let bracket = read_bracket(&[], Some(&csv), &|_| {}).unwrap();
     assert_eq!(bracket.times_s(), vec![1e-3, 0.01, 0.04]);
     assert_eq!(bracket.frames()[0].path, sub.join("f2.png"));
+    // Each frame carries the hash of the bytes it was decoded from.
+    for f in bracket.frames() {
+        let bytes = std::fs::read(&f.path).unwrap();
+        assert_eq!(f.sha256, scatterfit_io::digest::sha256_hex(&bytes));
+    }
+    assert_ne!(bracket.frames()[0].sha256, bracket.frames()[1].sha256);
     // Images named on the command line (another spelling of the same files) take their times from the CSV.
     let given = vec![
         dir.path().join("shots/./f1.png"),

@@ -9,7 +9,6 @@ use scatterfit_io::result_json::{AlbedoSource, FileRef, Inputs, MeasurementResul
 use scatterfit_mc::{albedo_family, family};
 use scatterfit_optics::{AlbedoModel, AtG, Estimate, Method, ModelName, Rgb};
 use serde::Serialize;
-use sha2::{Digest, Sha256};
 
 use crate::anisotropy::{GPlan, GPrior, known_g_record};
 use crate::error::{PipelineError, Result};
@@ -609,30 +608,39 @@ impl Measurement {
     }
 
     /// The result file's content. `profile_file` is the profile CSV's name as written beside the
-    /// result (recorded in `inputs.profile`).
+    /// result (recorded in `inputs.profile`). The inputs' SHA-256 hashes are those the stages
+    /// recorded of the bytes they read and measured (the manifest, the spectrophotometer file, the
+    /// radiance map, each frame); no file is read here, so a file replaced after the measurement
+    /// is recorded as it was measured.
     pub fn to_result(&self, profile_file: Option<&str>) -> MeasurementResult {
         let m = &self.manifest;
-        let mut files = Vec::new();
-        let mut file_ref = |p: &Path| -> Option<FileRef> {
-            let full = m.resolve(p);
-            let r = hash_file(&full).map(|sha256| FileRef {
-                path: p.to_string_lossy().into_owned(),
-                sha256,
-            });
-            files.push(full);
-            r
+        let record = |path: &Path, sha256: Option<&String>| -> Option<FileRef> {
+            sha256.map(|sha256| FileRef {
+                path: path.to_string_lossy().into_owned(),
+                sha256: sha256.clone(),
+            })
         };
-        let manifest_ref = file_ref(Path::new(scatterfit_io::manifest::MANIFEST_NAME));
-        let spectro_ref = m.spectro.file.as_deref().and_then(&mut file_ref);
-        let hdr_ref = m.camera.hdr.as_deref().and_then(&mut file_ref);
+        // Paths relative to the sample folder, as the manifest names them.
+        let relative = |p: &Path| p.strip_prefix(&m.dir).unwrap_or(p).to_path_buf();
+        let manifest_ref = m
+            .read_from
+            .as_ref()
+            .and_then(|f| record(&relative(&f.path), Some(&f.sha256)));
+        let spectro_ref = m
+            .spectro
+            .file
+            .as_deref()
+            .and_then(|p| record(p, self.spectro.file_sha256.as_ref()));
+        let hdr_ref = m
+            .camera
+            .hdr
+            .as_deref()
+            .and_then(|p| record(p, self.hdr.radiance_file.as_ref().map(|f| &f.sha256)));
         let frames: Vec<FileRef> = self
             .hdr
             .frames
             .iter()
-            .filter_map(|f| {
-                let rel = f.file.strip_prefix(&m.dir).unwrap_or(&f.file).to_path_buf();
-                file_ref(&rel)
-            })
+            .filter_map(|f| record(&relative(&f.file), Some(&f.sha256)))
             .collect();
         let quality = crate::checks::quality(self);
         let channels = self.fits.as_ref().map_with_channel(|c, outcome| {
@@ -755,13 +763,14 @@ fn rd_spectrum(
 }
 
 /// SHA-256 of a file's bytes, lower-case hex (`None` when it cannot be read: missing, not a
-/// regular file, larger than the memory budget).
+/// regular file, larger than the memory budget): for a file that is not otherwise read, such as
+/// `batch`'s check of a sample's inputs against the hashes its `result.json` recorded. A
+/// measurement's own inputs are hashed as they are read (`Measurement::to_result`).
 pub fn hash_file(path: &Path) -> Option<String> {
     let bytes =
         scatterfit_safefs::read::read_limited(path, scatterfit_io::budget::memory_budget_bytes())
             .ok()?;
-    let digest = Sha256::digest(&bytes);
-    Some(digest.iter().map(|b| format!("{b:02x}")).collect())
+    Some(scatterfit_io::digest::sha256_hex(&bytes))
 }
 
 #[cfg(test)]

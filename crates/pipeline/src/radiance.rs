@@ -247,6 +247,7 @@ mod tests {
             response_kind: ResponseKind::Linear,
             rms: Vec::new(),
             frames: Vec::new(),
+            radiance_file: None,
             image: "2×2 RGB 16-bit".into(),
             detection_limit: Vec::new(),
             dropped_alpha: Vec::new(),

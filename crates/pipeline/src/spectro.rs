@@ -18,6 +18,10 @@ use crate::error::{PipelineError, Result};
 pub struct SpectroStage {
     /// The reading's file, when there is one.
     pub file: Option<PathBuf>,
+    /// SHA-256 of the reading file's bytes as [`spectro_stage`] read and parsed them (lower-case
+    /// hex); `None` without a file, or for a reading given in memory ([`from_reading`]).
+    #[serde(skip)]
+    pub file_sha256: Option<String>,
     /// The full analysis of the reading (η per wavelength, colour, …), when there is a reading.
     pub analysis: Option<SpectroAnalysis>,
     /// η used by the fit.
@@ -79,6 +83,7 @@ impl SpectroStage {
     pub fn given(eta: f64, rd: Rgb<f64>, albedo_prime: Rgb<Option<f64>>) -> SpectroStage {
         SpectroStage {
             file: None,
+            file_sha256: None,
             analysis: None,
             eta,
             eta_source: EtaSource::Given,
@@ -124,6 +129,7 @@ impl SpectroStage {
         from_rd(
             Reading {
                 file: self.file.clone(),
+                file_sha256: self.file_sha256.clone(),
                 analysis: self.analysis.clone(),
                 rd,
                 eta: self.eta,
@@ -167,6 +173,7 @@ impl SpectroStage {
 /// What the stage is computed from.
 struct Reading {
     file: Option<PathBuf>,
+    file_sha256: Option<String>,
     analysis: Option<SpectroAnalysis>,
     rd: Rgb<f64>,
     eta: f64,
@@ -220,8 +227,10 @@ pub fn spectro_stage(
     match &manifest.spectro.file {
         Some(file) => {
             let path = manifest.resolve(file);
-            let reading = scatterfit_io::spectro::read_spectro_csv(&path)?;
-            from_reading(&reading, &path, lab, eta, repeatability, albedo)
+            let (reading, read) = scatterfit_io::spectro::read_spectro_file(&path)?;
+            let mut stage = from_reading(&reading, &path, lab, eta, repeatability, albedo)?;
+            stage.file_sha256 = Some(read.sha256);
+            Ok(stage)
         }
         None => {
             let eta = eta.ok_or_else(|| {
@@ -234,6 +243,7 @@ pub fn spectro_stage(
             Ok(from_rd(
                 Reading {
                     file: None,
+                    file_sha256: None,
                     analysis: None,
                     rd,
                     eta,
@@ -283,6 +293,7 @@ pub fn from_reading(
     Ok(from_rd(
         Reading {
             file: Some(path.to_path_buf()),
+            file_sha256: None,
             analysis: Some(analysis),
             rd,
             eta,
@@ -329,6 +340,7 @@ fn beyond_the_totals(rd: f64, e: &scatterfit_optics::OpticsError) -> Option<Stri
 fn from_rd(reading: Reading, albedo: &dyn ModelFamily) -> SpectroStage {
     let Reading {
         file,
+        file_sha256,
         analysis,
         rd,
         eta,
@@ -363,6 +375,7 @@ fn from_rd(reading: Reading, albedo: &dyn ModelFamily) -> SpectroStage {
         (eta_source != EtaSource::Given).then_some(0.5 * (eta_pm[1] - eta_pm[0]).abs());
     SpectroStage {
         file,
+        file_sha256,
         analysis,
         eta,
         eta_source,

@@ -14,6 +14,7 @@ mod g_setting;
 mod g_term;
 mod hdr_stage;
 mod port;
+mod provenance;
 mod real_brackets;
 mod rig_twin;
 mod uncertainty;

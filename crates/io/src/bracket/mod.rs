@@ -190,6 +190,9 @@ pub struct BracketFrame {
     pub dropped_alpha: bool,
     /// A camera RAW file's metadata (levels, exposure time); `None` for other files.
     pub raw: Option<crate::image_files::RawInfo>,
+    /// SHA-256 of the file's bytes that were decoded into `frame`, lower-case hex
+    /// ([`crate::digest::sha256_hex`]).
+    pub sha256: String,
 }
 
 /// A validated exposure bracket: at least two frames of one shape and bit depth, with distinct
@@ -421,6 +424,7 @@ pub fn read_bracket_within(
                 (TimeOf::Exif, Some(t)) if t.is_finite() && t > 0.0 => t,
                 (TimeOf::Exif, _) => exif_exposure_time(&bytes, path)?,
             };
+            let sha256 = crate::digest::sha256_hex(&bytes);
             drop(bytes);
             on_frame_read(path);
             Ok(BracketFrame {
@@ -429,6 +433,7 @@ pub fn read_bracket_within(
                 frame: decoded.frame,
                 dropped_alpha: decoded.dropped_alpha,
                 raw: decoded.raw,
+                sha256,
             })
         })
         .collect();

@@ -388,6 +388,10 @@ pub struct SampleManifest {
     /// The folder the manifest was read from (not in the file).
     #[serde(skip)]
     pub dir: PathBuf,
+    /// The manifest file as [`read_manifest`] read it: its path and the SHA-256 of its bytes (not
+    /// in the file; `None` for a manifest made in memory or parsed from text).
+    #[serde(skip)]
+    pub read_from: Option<crate::digest::ReadFile>,
 }
 
 impl SampleManifest {
@@ -476,26 +480,29 @@ pub fn read_manifest(path_or_dir: &Path) -> Result<SampleManifest, ManifestError
     };
     // Through the text reader every text file uses: a regular file of at most 64 MiB, UTF-8 (with or
     // without BOM), UTF-16 with BOM, or Windows-1252.
-    let text = crate::text::read_text_file(&path)
-        .map_err(|e| match e {
-            crate::text::TextError::Io { path, source } => ManifestError::Read {
-                hint: if source.kind() == std::io::ErrorKind::NotFound {
-                    not_found_hint(&path)
-                } else {
-                    String::new()
-                },
-                path,
-                source,
+    let text = crate::text::read_text_file(&path).map_err(|e| match e {
+        crate::text::TextError::Io { path, source } => ManifestError::Read {
+            hint: if source.kind() == std::io::ErrorKind::NotFound {
+                not_found_hint(&path)
+            } else {
+                String::new()
             },
-            other => ManifestError::Text(other),
-        })?
-        .text;
+            path,
+            source,
+        },
+        other => ManifestError::Text(other),
+    })?;
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."))
         .to_path_buf();
-    parse_manifest(&text, &path, dir)
+    let mut manifest = parse_manifest(&text.text, &path, dir)?;
+    manifest.read_from = Some(crate::digest::ReadFile {
+        path,
+        sha256: text.sha256,
+    });
+    Ok(manifest)
 }
 
 /// What to say when the manifest is not there: a file that looks like a misspelt one
@@ -1072,6 +1079,10 @@ r_max_px = 300
             std::fs::write(dir.path().join(MANIFEST_NAME), &bytes).unwrap();
             let m = read_manifest(dir.path()).unwrap();
             assert_eq!(m.name.as_deref(), Some("Probe grün, 23 °C"));
+            // The record names the file read and the hash of its bytes as they were read.
+            let read = m.read_from.expect("read from a file");
+            assert_eq!(read.path, dir.path().join(MANIFEST_NAME));
+            assert_eq!(read.sha256, crate::digest::sha256_hex(&bytes));
         }
     }
 

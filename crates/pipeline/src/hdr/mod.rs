@@ -290,6 +290,10 @@ pub struct FrameInfo {
     pub file: PathBuf,
     /// Shutter time \[s\].
     pub time_s: f64,
+    /// SHA-256 of the file's bytes that were decoded and merged, lower-case hex (what
+    /// `result.json` records for the frame; not in `scatterfit merge --json`).
+    #[serde(skip)]
+    pub sha256: String,
 }
 
 /// The merged bracket.
@@ -305,6 +309,9 @@ pub struct HdrStage {
     pub rms: Vec<f64>,
     /// The frames, shortest first.
     pub frames: Vec<FrameInfo>,
+    /// The radiance map file read instead of a bracket (the manifest's `camera.hdr`), with the
+    /// SHA-256 of the bytes decoded; `None` for a merged bracket.
+    pub radiance_file: Option<scatterfit_io::digest::ReadFile>,
     /// e.g. `1024×1024 RGB 8-bit`.
     pub image: String,
     /// Detection limit per channel [relative radiance]; NaN when unknown.
@@ -531,6 +538,7 @@ pub fn read_frames(
         .map(|f| FrameInfo {
             file: f.path.clone(),
             time_s: f.time_s,
+            sha256: f.sha256.clone(),
         })
         .collect();
     let image = bracket.describe();
@@ -659,6 +667,7 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
         response_kind: merged.kind,
         rms: merged.rms,
         frames,
+        radiance_file: None,
         image,
         detection_limit: merged.detection_limit,
         dropped_alpha,
@@ -723,13 +732,18 @@ pub fn spot_kernel_from_image(
     crate::camera::spot_from_image(&buf, mm_per_pixel).map_err(bad)
 }
 
-/// A radiance map read from a file (the manifest's `camera.hdr`): no bracket, no detection limit.
+/// A radiance map read from a file (the manifest's `camera.hdr`): no bracket, no detection limit;
+/// the stage records the file with the hash of the bytes decoded ([`HdrStage::radiance_file`]).
 ///
 /// # Errors
 /// [`PipelineError::Image`].
 pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
     let t0 = Instant::now();
-    let radiance = scatterfit_io::image_files::read_radiance(path)?;
+    let budget = scatterfit_io::budget::memory_budget_bytes();
+    let bytes = scatterfit_io::image_files::read_image_bytes(path, budget)?;
+    let radiance = scatterfit_io::image_files::decode_radiance(&bytes, path, budget)?;
+    let radiance_file = scatterfit_io::digest::ReadFile::of(path, &bytes);
+    drop(bytes);
     let (w, h, ch) = (radiance.width(), radiance.height(), radiance.channels());
     let clipped = ImageBuf::filled(w, h, ch, 0u8).map_err(|e| {
         PipelineError::Input(format!("{}: inconsistent image size ({e})", path.display()))
@@ -744,6 +758,7 @@ pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
         response_kind: ResponseKind::Merged,
         rms: Vec::new(),
         frames: Vec::new(),
+        radiance_file: Some(radiance_file),
         image: format!("{w}×{h} {}", if ch == 1 { "grey" } else { "RGB" }),
         detection_limit: vec![f64::NAN; ch],
         dropped_alpha: Vec::new(),
