@@ -1,39 +1,47 @@
 #!/usr/bin/env bash
 # The Python package's tests (crates/python/tests, pytest), in the virtual environment that holds
-# Mitsuba (.ci/venv, made by .ci/run's provisioning, or here when missing): the compiled module is
-# built into it by `maturin develop` with the workspace's dev profile (optimised; it reuses the
-# workspace's compiled crates, so only PyO3 and the module itself compile: ~20 s), then pytest runs
-# every test against the CLI that `cargo test` built (target/debug/scatterfit), the real Mitsuba
-# included (SCATTERFIT_REQUIRE_MITSUBA=1 makes its absence a failure, not a skip), and mypy on the
-# package's types (SCATTERFIT_REQUIRE_MYPY=1 likewise).
+# Mitsuba (.ci/venv, made by .ci/run's provisioning, or here when missing), against the CLI that
+# `cargo test` built (target/debug/scatterfit): the real Mitsuba included
+# (SCATTERFIT_REQUIRE_MITSUBA=1 makes its absence a failure, not a skip), and mypy on the package's
+# types (SCATTERFIT_REQUIRE_MYPY=1 likewise).
 #
-# Run it from the repository root after `cargo build -p scatterfit` (or `cargo test --workspace`):
+# The compiled module is built by cargo with the workspace's own dependency features
+# (`cargo build --workspace --lib --tests`: after `cargo test --workspace` only PyO3, rust-numpy and
+# the module compile, ~30 s) and put beside the package's Python files in a temporary folder, as
+# `maturin develop` would put it in the source tree. maturin itself builds the crate alone, whose
+# dependencies resolve to other features than the workspace's, so that it recompiled some forty
+# crates (163 s in a CI run); the module it makes is the same code. `pip install ./crates/python`
+# (maturin, README.md "Using it from Python") is how a user installs it.
+#
+# Run it from the repository root (after `cargo test --workspace`, or it builds the tests first):
 #   bash .ci/python-test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 VENV="$PWD/.ci/venv"
-MATURIN_VERSION=1.16.0
 PYTEST_VERSION=9.2.0
 NUMPY_VERSION=2.4.6
 MYPY_VERSION=2.4.1
 if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
 fi
-if ! "$VENV/bin/python" -c "import maturin, pytest, numpy, mypy, sys; sys.exit(pytest.__version__ != '${PYTEST_VERSION}')" 2>/dev/null; then
+if ! "$VENV/bin/python" -c "import pytest, numpy, mypy, sys; sys.exit(pytest.__version__ != '${PYTEST_VERSION}')" 2>/dev/null; then
   "$VENV/bin/pip" install --no-cache-dir --disable-pip-version-check --quiet \
-    "maturin==${MATURIN_VERSION}" "pytest==${PYTEST_VERSION}" "numpy==${NUMPY_VERSION}" \
-    "mypy==${MYPY_VERSION}"
+    "pytest==${PYTEST_VERSION}" "numpy==${NUMPY_VERSION}" "mypy==${MYPY_VERSION}"
 fi
 
-echo "== maturin develop (the scatterfit Python package into .ci/venv)"
+echo "== the scatterfit Python package (compiled module: cargo, the workspace's features)"
 start=$(date +%s)
-VIRTUAL_ENV="$VENV" PATH="$VENV/bin:$PATH" "$VENV/bin/maturin" develop --quiet --profile dev \
-  --manifest-path crates/python/Cargo.toml
-echo "built and installed in $(( $(date +%s) - start )) s"
+cargo build --quiet --workspace --lib --tests
+package="$(mktemp -d)"
+trap 'rm -rf "$package"' EXIT
+cp -r crates/python/python/scatterfit "$package/"
+rm -f "$package"/scatterfit/*.so
+cp target/debug/lib_scatterfit.so "$package/scatterfit/_scatterfit.abi3.so"
+echo "built in $(( $(date +%s) - start )) s"
 
 echo "== pytest crates/python/tests"
 # (HOME inside the venv for the tests only: Dr.Jit makes a cache folder in $HOME when mitsuba is
-# imported; rustup and cargo above need the real one.)
-HOME="$VENV" SCATTERFIT_CLI="${SCATTERFIT_CLI:-$PWD/target/debug/scatterfit}" \
+# imported; cargo above needs the real one.)
+HOME="$VENV" PYTHONPATH="$package" SCATTERFIT_CLI="${SCATTERFIT_CLI:-$PWD/target/debug/scatterfit}" \
   "$VENV/bin/python" -m pytest -q -p no:cacheprovider crates/python/tests
