@@ -52,7 +52,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for o in &outputs {
         crate::common::check_destination(o, "-o")?;
     }
-    let bar = bar(5, "{msg} {bar:30} {elapsed}", args.quiet || args.json);
+    let bar = bar(6, "{msg} {bar:30} {elapsed}", args.quiet || args.json);
     // The inputs resolved above are measured: the manifest is read once, and the one whose
     // outputs were checked is the one measured.
     let m = measure_inputs(&inputs, &overrides, &|stage| {
@@ -62,6 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             Stage::Merge => "merging",
             Stage::Profile => "profile",
             Stage::Fit => "fitting",
+            Stage::Checks => "checks",
             _ => "",
         };
         bar.set_message(msg);
@@ -85,13 +86,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         out!("{}", scatterfit_report::summary_text(&result))?;
         let t = &m.timings;
         outln!(
-            "  time: {:.3} s (spectro {:.3}, read {:.3}, merge {:.3}, profile {:.3}, fits {:.4})",
+            "  time: {:.3} s (spectro {:.3}, read {:.3}, merge {:.3}, profile {:.3}, fits {:.4}, \
+             checks {:.3})",
             t.total_s,
             t.spectro_s,
             t.read_s,
             t.merge_s,
             t.profile_s,
-            t.fit_s
+            t.fit_s,
+            t.checks_s
         )?;
         outln!(
             "  wrote {} files in {}: {}",

@@ -1,12 +1,13 @@
 //! The library calls the Python package wraps, timed from Rust — the reference its overhead is
 //! measured against (`crates/python/examples/time_calls.py` times the same calls from Python):
-//! `cargo run --release -p scatterfit-pipeline --example library_calls -- SAMPLE_DIR RESULT_DIR`,
+//! `cargo run --release -p scatterfit-pipeline --example library_calls -- SAMPLE_DIR RESULT_DIR [N]`,
 //! with SAMPLE_DIR a sample folder and RESULT_DIR the folder its result files were written to
 //! (its `profile.csv` and `result.json` give the profile and η, α′ of the fit).
 //!
-//! Prints the median wall time of `measure_sample` on the folder, of `to_result` (the
-//! measurement's result with the checks' verdicts) and of the two together, and of `fit_profile` (proposed method, exact transport, 1 mm spot) on its
-//! profile, over repeated calls.
+//! Prints the median wall time of `measure_sample` on the folder (the measurement with its data
+//! checks, which it makes once), of `to_result` (the result file's content from it, with the
+//! verdicts) and of the two together, over N calls (default 11), and of `fit_profile` (proposed
+//! method, exact transport, 1 mm spot) on its profile over 51.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -34,7 +35,11 @@ fn median_s(n: usize, mut f: impl FnMut()) -> f64 {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1).map(PathBuf::from);
     let (Some(sample), Some(results)) = (args.next(), args.next()) else {
-        return Err("usage: library_calls SAMPLE_DIR RESULT_DIR".into());
+        return Err("usage: library_calls SAMPLE_DIR RESULT_DIR [N]".into());
+    };
+    let n: usize = match args.next() {
+        Some(n) => n.to_string_lossy().parse()?,
+        None => 11,
     };
     let result = read_result_json(&results.join("result.json"))?;
     let table = read_profile_csv(&results.join("profile.csv"))?;
@@ -63,27 +68,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("fit_profile: {:.3} ms (median of 51)", fit * 1e3);
     let overrides = Overrides::default();
     measure_sample(&sample, &overrides, &|_| {})?;
-    let measure = median_s(11, || {
+    let measure = median_s(n, || {
         measure_sample(&sample, &overrides, &|_| {}).expect("measures");
     });
-    println!("measure_sample: {:.1} ms (median of 11)", measure * 1e3);
+    println!("measure_sample: {:.1} ms (median of {n})", measure * 1e3);
     // What a caller does next with a measurement: its result with the checks' verdicts (what
     // result.json holds, and what the Python package's `measure` returns).
     let m = measure_sample(&sample, &overrides, &|_| {})?;
-    let result = median_s(11, || {
+    let result = median_s(n, || {
         std::hint::black_box(m.to_result(Some("profile.csv")));
     });
-    println!(
-        "Measurement::to_result: {:.2} ms (median of 11)",
-        result * 1e3
-    );
-    let both = median_s(11, || {
+    println!("Measurement::to_result: {:.2} ms (median of {n})", result * 1e3);
+    let both = median_s(n, || {
         let m = measure_sample(&sample, &overrides, &|_| {}).expect("measures");
         std::hint::black_box(m.to_result(Some("profile.csv")));
     });
-    println!(
-        "measure_sample + to_result: {:.1} ms (median of 11)",
-        both * 1e3
-    );
+    println!("measure_sample + to_result: {:.1} ms (median of {n})", both * 1e3);
     Ok(())
 }

@@ -122,6 +122,8 @@ pub enum Stage {
     Profile,
     /// Fitting the channels.
     Fit,
+    /// Checking the image and the bracket against the fits ([`crate::checks::image_checks`]).
+    Checks,
 }
 
 /// Everything a measurement produced.
@@ -148,6 +150,10 @@ pub struct Measurement {
     pub timings: Timings,
     /// What the data's redundancy says (the profile's own α′; [`crate::checks::evidence`]).
     pub evidence: crate::checks::evidence::Evidence,
+    /// The checks of the image, the bracket and the manifest that no fit enters
+    /// ([`crate::checks::image_checks`]): made once, when the measurement is made, and kept by
+    /// its refits; [`Measurement::quality`] adds the fits' own checks to them.
+    pub image_checks: crate::checks::SampleChecks,
 }
 
 /// Wall times per stage \[s\].
@@ -163,6 +169,9 @@ pub struct Timings {
     pub profile_s: f64,
     /// The three fits (start search + solver).
     pub fit_s: f64,
+    /// The checks of the image and the bracket ([`crate::checks::image_checks`]) and the spot's
+    /// scale against the fits ([`crate::checks::evidence::spot_scale`]).
+    pub checks_s: f64,
     /// The whole measurement.
     pub total_s: f64,
 }
@@ -496,9 +505,15 @@ fn measure_from(
         port,
         timings,
         evidence,
+        image_checks: crate::checks::SampleChecks::default(),
     }
     .with_model_term();
     m.timings.fit_s = t_fit.elapsed().as_secs_f64();
+    begin(Stage::Checks)?;
+    let t_checks = Instant::now();
+    m.image_checks = crate::checks::image_checks(&m);
+    m.evidence.spot_scale = crate::checks::evidence::spot_scale(&m);
+    m.timings.checks_s = t_checks.elapsed().as_secs_f64();
     m.timings.total_s = t0.elapsed().as_secs_f64();
     Ok(m)
 }
@@ -584,9 +599,11 @@ impl Measurement {
             port,
             timings: self.timings,
             evidence,
+            image_checks: self.image_checks.clone(),
         };
         if propagate {
             m = m.with_model_term();
+            m.evidence.spot_scale = crate::checks::evidence::spot_scale(&m);
         }
         m.timings.fit_s = t.elapsed().as_secs_f64();
         Ok(m)
@@ -602,7 +619,8 @@ impl Measurement {
         self.spectro.eta_estimate()
     }
 
-    /// The data checks' verdict per channel ([`crate::checks`]).
+    /// The data checks' verdict per channel ([`crate::checks::quality`]): the fits' checks and
+    /// the sample's, with the image checks made at measurement ([`Measurement::image_checks`]).
     pub fn quality(&self) -> Rgb<crate::checks::Quality> {
         crate::checks::quality(self)
     }

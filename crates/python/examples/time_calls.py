@@ -1,10 +1,10 @@
 """The package's calls timed from Python, beside the same library calls timed from Rust
 (`crates/pipeline/examples/library_calls.rs`): what the binding costs.
 
-    python crates/python/examples/time_calls.py SAMPLE_DIR RESULT_DIR
+    python crates/python/examples/time_calls.py SAMPLE_DIR RESULT_DIR [N]
 
 SAMPLE_DIR is a sample folder, RESULT_DIR the folder its result files were written to. Prints the
-median wall time of `measure` and of `fit_profile` (the same profile, η and α′ as the Rust
+median wall time of `measure` (over N calls, default 11) and of `fit_profile` (the same profile, η and α′ as the Rust
 example), and the forward model on 10⁶ radii in one vectorised call against a Python loop over
 one-radius calls (timed on 10⁴ radii, scaled).
 """
@@ -31,7 +31,7 @@ def median_s(n: int, f) -> float:
     return statistics.median(times)
 
 
-def main(sample: Path, results: Path) -> None:
+def main(sample: Path, results: Path, n: int) -> None:
     result = json.loads((results / "result.json").read_text())
     t = np.genfromtxt(results / "profile.csv", delimiter=",", names=True)
     cols = lambda what: np.stack([t[f"{what}_{c}"] for c in "rgb"], axis=1)  # noqa: E731
@@ -42,8 +42,8 @@ def main(sample: Path, results: Path) -> None:
     fit = median_s(51, lambda: sf.fit_profile(*args, **kwargs))
     print(f"fit_profile: {fit * 1e3:.3f} ms (median of 51)")
     sf.measure(sample, progress=False)
-    measure = median_s(11, lambda: sf.measure(sample, progress=False))
-    print(f"measure: {measure * 1e3:.1f} ms (median of 11)")
+    measure = median_s(n, lambda: sf.measure(sample, progress=False))
+    print(f"measure: {measure * 1e3:.1f} ms (median of {n})")
 
     r = np.linspace(0.01, 20.0, 1_000_000)
     sf.models.profile(r[:10], 1.0, 0.01, 1.4)
@@ -58,4 +58,4 @@ def main(sample: Path, results: Path) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]), Path(sys.argv[2]))
+    main(Path(sys.argv[1]), Path(sys.argv[2]), int(sys.argv[3]) if len(sys.argv) > 3 else 11)

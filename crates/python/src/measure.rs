@@ -97,6 +97,7 @@ impl MeasurementHandle {
             ("merge_s", t.merge_s),
             ("profile_s", t.profile_s),
             ("fit_s", t.fit_s),
+            ("checks_s", t.checks_s),
             ("total_s", t.total_s),
         ] {
             dict.set_item(k, v)?;
@@ -169,7 +170,8 @@ fn stage_number(stage: Stage) -> u64 {
         Stage::ReadFrame => 2,
         Stage::Merge => 3,
         Stage::Profile => 4,
-        _ => 5,
+        Stage::Fit => 5,
+        _ => 6,
     }
 }
 
@@ -201,7 +203,7 @@ pub(crate) fn measure<'py>(
         allow_outside_paths,
     }
     .overrides()?;
-    let measured = run(py, progress.as_ref(), 5, |control: &Control| {
+    let measured = run(py, progress.as_ref(), 6, |control: &Control| {
         measure_sample_until(
             &folder,
             &overrides,

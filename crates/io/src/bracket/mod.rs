@@ -193,6 +193,9 @@ pub struct BracketFrame {
     /// SHA-256 of the file's bytes that were decoded into `frame`, lower-case hex
     /// ([`crate::digest::sha256_hex`]).
     pub sha256: String,
+    /// The JPEG quality the file was saved at, from its header
+    /// ([`crate::image_files::jpeg_quality`]); `None` for other formats.
+    pub jpeg_quality: Option<f64>,
 }
 
 /// A validated exposure bracket: at least two frames of one shape and bit depth, with distinct
@@ -425,6 +428,7 @@ pub fn read_bracket_within(
                 (TimeOf::Exif, _) => exif_exposure_time(&bytes, path)?,
             };
             let sha256 = crate::digest::sha256_hex(&bytes);
+            let jpeg_quality = crate::image_files::jpeg_quality(&bytes);
             drop(bytes);
             on_frame_read(path);
             Ok(BracketFrame {
@@ -434,6 +438,7 @@ pub fn read_bracket_within(
                 dropped_alpha: decoded.dropped_alpha,
                 raw: decoded.raw,
                 sha256,
+                jpeg_quality,
             })
         })
         .collect();

@@ -11,7 +11,10 @@ use std::path::{Path, PathBuf};
 
 use scatterfit_imaging::ImageBuf;
 
+mod jpeg;
 mod radiance;
+
+pub use jpeg::jpeg_quality;
 
 pub use radiance::{
     RadianceFormat, decode_radiance, read_radiance, read_radiance_within, write_radiance,

@@ -46,6 +46,10 @@ pub struct Evidence {
     /// Per channel, the profile's α′ against the reading's (proposed method only; `None` where
     /// either fit is missing).
     pub albedo: Rgb<Option<AlbedoCheck>>,
+    /// The image's spot half width over the fitted model's at the stated scale ([`spot_scale`]),
+    /// made with the measurement (and its full refits) after the fits; `None` where it could not
+    /// be measured, and for a refit of values only.
+    pub spot_scale: Option<f64>,
 }
 
 /// Gathers the evidence of a measurement made with the proposed method: the two-parameter fit
@@ -71,7 +75,10 @@ pub fn gather(
         let free = profile_fits[c].report().filter(|r| r.converged)?;
         albedo_check(proposed, free, spectro.uncertainty.albedo_prime_stderr[c])
     });
-    Evidence { albedo }
+    Evidence {
+        albedo,
+        spot_scale: None,
+    }
 }
 
 /// The comparison of one channel's two fits ([`AlbedoCheck`]); `None` when the two-parameter fit

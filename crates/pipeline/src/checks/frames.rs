@@ -334,77 +334,13 @@ pub fn frame_agreement_reasons(m: &Measurement) -> Vec<Reason> {
 /// at 50 a quick twin's σ′s moved by up to +36 % with every other check passing.
 pub const MIN_JPEG_QUALITY: f64 = 75.0;
 
-/// The IJG quality of a baseline JPEG's first (luminance) quantisation table: the mean ratio S of
-/// its entries to the standard table of ITU-T T.81 Annex K (Table K.1) in percent, and quality
-/// (200 − S)/2 for S ≤ 100, 5000/S above (libjpeg's `jpeg_quality_scaling`, inverted). `None` for
-/// a file that is not a JPEG or whose table cannot be found in its first 64 KiB. Hand-written:
-/// the image crate decodes JPEGs but does not expose their quantisation tables.
-pub fn jpeg_quality(path: &std::path::Path) -> Option<f64> {
-    use std::io::Read;
-    // ITU-T T.81 Annex K, Table K.1 (luminance), in the zig-zag order a DQT segment stores.
-    const K1_ZIGZAG: [u16; 64] = [
-        16, 11, 12, 14, 12, 10, 16, 14, 13, 14, 18, 17, 16, 19, 24, 40, 26, 24, 22, 22, 24, 49, 35,
-        37, 29, 40, 58, 51, 61, 60, 57, 51, 56, 55, 64, 72, 92, 78, 64, 68, 87, 69, 55, 56, 80,
-        109, 81, 87, 95, 98, 103, 104, 103, 62, 77, 113, 121, 112, 100, 120, 92, 101, 103, 99,
-    ];
-    let mut head = Vec::new();
-    std::fs::File::open(path)
-        .ok()?
-        .take(64 * 1024)
-        .read_to_end(&mut head)
-        .ok()?;
-    if head.get(..2)? != [0xFF, 0xD8] {
-        return None;
-    }
-    let mut i = 2;
-    while i + 4 <= head.len() {
-        if head[i] != 0xFF {
-            return None;
-        }
-        let marker = head[i + 1];
-        let len = usize::from(u16::from_be_bytes([head[i + 2], head[i + 3]]));
-        if marker == 0xDB {
-            let seg = head.get(i + 4..i + 2 + len)?;
-            let (pq, tq) = (seg.first()? >> 4, seg.first()? & 0x0F);
-            if tq != 0 {
-                i += 2 + len;
-                continue;
-            }
-            let q: Vec<u16> = if pq == 0 {
-                seg.get(1..65)?.iter().map(|&v| u16::from(v)).collect()
-            } else {
-                seg.get(1..129)?
-                    .chunks(2)
-                    .map(|b| u16::from_be_bytes([b[0], b[1]]))
-                    .collect()
-            };
-            let s = 100.0
-                * q.iter()
-                    .zip(K1_ZIGZAG)
-                    .map(|(&a, b)| f64::from(a) / f64::from(b))
-                    .sum::<f64>()
-                / 64.0;
-            return Some(if s <= 100.0 {
-                (200.0 - s) / 2.0
-            } else {
-                5000.0 / s
-            });
-        }
-        if marker == 0xDA {
-            return None;
-        }
-        i += 2 + len;
-    }
-    None
-}
-
 /// JPEG frames compressed below [`MIN_JPEG_QUALITY`]: one reason naming the lowest.
 pub fn compression_reasons(m: &Measurement) -> Vec<Reason> {
     let worst = m
         .hdr
         .frames
         .iter()
-        .filter_map(|f| jpeg_quality(&f.file).map(|q| (q, f)))
+        .filter_map(|f| f.jpeg_quality.map(|q| (q, f)))
         .min_by(|a, b| a.0.total_cmp(&b.0));
     match worst {
         Some((q, f)) if q < MIN_JPEG_QUALITY => vec![suspect(
@@ -422,41 +358,5 @@ pub fn compression_reasons(m: &Measurement) -> Vec<Reason> {
             ),
         )],
         _ => Vec::new(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A JPEG header whose luminance table libjpeg's `jpeg_quality_scaling` made for quality q
-    /// (S = 5000/q below 50, 200 − 2q above; entries (K.1 · S + 50) / 100, at least 1) reads
-    /// back as q within the table's rounding; a PNG, or a JPEG without a table, reads as none.
-    #[test]
-    fn the_jpeg_quality_comes_back_from_the_quantisation_table() {
-        const K1_ZIGZAG: [u32; 64] = [
-            16, 11, 12, 14, 12, 10, 16, 14, 13, 14, 18, 17, 16, 19, 24, 40, 26, 24, 22, 22, 24, 49,
-            35, 37, 29, 40, 58, 51, 61, 60, 57, 51, 56, 55, 64, 72, 92, 78, 64, 68, 87, 69, 55, 56,
-            80, 109, 81, 87, 95, 98, 103, 104, 103, 62, 77, 113, 121, 112, 100, 120, 92, 101, 103,
-            99,
-        ];
-        let dir = tempfile::tempdir().unwrap();
-        for q in [30u32, 50, 75, 90, 95] {
-            let s = if q < 50 { 5000 / q } else { 200 - 2 * q };
-            let mut bytes = vec![0xFF, 0xD8, 0xFF, 0xE0, 0x00, 0x04, 0x00, 0x00];
-            bytes.extend([0xFF, 0xDB, 0x00, 67, 0x00]);
-            bytes.extend(K1_ZIGZAG.map(|k| ((k * s + 50) / 100).clamp(1, 255) as u8));
-            bytes.extend([0xFF, 0xDA, 0x00, 0x02]);
-            let path = dir.path().join(format!("q{q}.jpg"));
-            std::fs::write(&path, &bytes).unwrap();
-            let got = jpeg_quality(&path).unwrap();
-            assert!((got - f64::from(q)).abs() < 2.5, "quality {q}: read {got}");
-        }
-        let png = dir.path().join("f.png");
-        std::fs::write(&png, b"\x89PNG\r\n\x1a\n....").unwrap();
-        assert_eq!(jpeg_quality(&png), None);
-        let bare = dir.path().join("bare.jpg");
-        std::fs::write(&bare, [0xFF, 0xD8, 0xFF, 0xDA, 0x00, 0x02]).unwrap();
-        assert_eq!(jpeg_quality(&bare), None);
     }
 }

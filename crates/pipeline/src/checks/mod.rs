@@ -33,7 +33,7 @@ pub use frames::{
     AGREEMENT_CODES, AGREEMENT_MIN_SAMPLES, FrameAgreement, MAX_FRAME_OFFSET_LN,
     MAX_FRAME_SHIFT_PX, MAX_FRAME_SPREAD_LN, MAX_STEP_8BIT, MAX_STEP_LINEAR, MAX_STEP_RECOVERED,
     MIN_JPEG_QUALITY, black_level_reasons, bracket_reasons, code_reasons, compression_reasons,
-    frame_agreement, frame_agreement_reasons, jpeg_quality, registration_reasons,
+    frame_agreement, frame_agreement_reasons, registration_reasons,
 };
 
 /// A fit whose rms log residual exceeds this is suspect: the profile differs from the model by
@@ -112,15 +112,16 @@ fn suspect(kind: ReasonKind, message: String) -> Reason {
     }
 }
 
-/// The image-level checks: the spot inside the frame with its fitted rings complete (or cut
-/// symmetrically), a given centre on the spot, one spot, the spot's size against the manifest's
-/// scale.
+/// The sample's checks: the spot inside the frame with its fitted rings complete (or cut
+/// symmetrically), the measurement's image checks ([`Measurement::image_checks`], made once when
+/// the bracket was merged), and the spot's size in the image against the one the fitted model
+/// predicts at the manifest's scale ([`evidence::spot_scale`], made with the measurement:
+/// [`evidence::Evidence::spot_scale`]).
 pub fn sample_checks(m: &Measurement) -> SampleChecks {
     let mut reasons = Vec::new();
     let radiance = &m.hdr.hdr.radiance;
     let [cx, cy] = m.profile.center.xy();
     let mmpp = m.profile.profile.mm_per_pixel;
-    let a_px = m.settings.spot_radius_mm / mmpp;
     // (b) Rings complete to the fitted radius, or cut by the frame the same on both sides.
     let r_fit_px = m
         .fits
@@ -131,6 +132,40 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
     if let Some(msg) = incomplete_rings(radiance.width(), radiance.height(), [cx, cy], r_fit_px) {
         reasons.push(suspect(ReasonKind::IncompleteRings, msg));
     }
+    reasons.extend(m.image_checks.reasons.iter().cloned());
+    if let Some(factor) = m.evidence.spot_scale
+        && !(SPOT_FACTOR_RANGE.0..=SPOT_FACTOR_RANGE.1).contains(&factor)
+    {
+        reasons.push(suspect(
+            ReasonKind::SpotSize,
+            format!(
+                "the spot in the image is {factor:.3}× the size the fitted model predicts for a \
+                 {:.3} mm spot at {mmpp} mm per pixel (expected {}–{}): camera.mm_per_pixel or \
+                 camera.spot_diameter_mm is about {:.0} % off (the true scale is near {:.4} mm \
+                 per pixel if the diameter is right); σ′s and σa scale with it",
+                2.0 * m.settings.spot_radius_mm,
+                SPOT_FACTOR_RANGE.0,
+                SPOT_FACTOR_RANGE.1,
+                100.0 * (1.0 / factor - 1.0),
+                mmpp / factor,
+            ),
+        ));
+    }
+    SampleChecks { reasons }
+}
+
+/// The checks of the image, the bracket and the manifest that no fit enters: a given centre on
+/// the spot, the codes the frames use, the black level, the frames registered, the bracket's
+/// order and exposures, each frame against the merged radiance, the JPEG compression, the
+/// manifest's L\*a\*b\* against its spectrum, one spot, and the spot's half width against the
+/// manifest's scale. They read every frame's pixels, so a measurement makes them once
+/// ([`Measurement::image_checks`]) and every refit of the same bracket keeps them.
+pub fn image_checks(m: &Measurement) -> SampleChecks {
+    let mut reasons = Vec::new();
+    let radiance = &m.hdr.hdr.radiance;
+    let [cx, cy] = m.profile.center.xy();
+    let mmpp = m.profile.profile.mm_per_pixel;
+    let a_px = m.settings.spot_radius_mm / mmpp;
     // A given centre must lie on the spot the image shows.
     if m.profile.center_source == crate::profile::CenterSource::Given
         && let Ok(found) = find_spot_center(radiance, &CenterOptions::default())
@@ -158,24 +193,6 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
     reasons.extend(bracket_reasons(m));
     reasons.extend(frame_agreement_reasons(m));
     reasons.extend(compression_reasons(m));
-    if let Some(factor) = evidence::spot_scale(m)
-        && !(SPOT_FACTOR_RANGE.0..=SPOT_FACTOR_RANGE.1).contains(&factor)
-    {
-        reasons.push(suspect(
-            ReasonKind::SpotSize,
-            format!(
-                "the spot in the image is {factor:.3}× the size the fitted model predicts for a \
-                 {:.3} mm spot at {mmpp} mm per pixel (expected {}–{}): camera.mm_per_pixel or \
-                 camera.spot_diameter_mm is about {:.0} % off (the true scale is near {:.4} mm \
-                 per pixel if the diameter is right); σ′s and σa scale with it",
-                2.0 * m.settings.spot_radius_mm,
-                SPOT_FACTOR_RANGE.0,
-                SPOT_FACTOR_RANGE.1,
-                100.0 * (1.0 / factor - 1.0),
-                mmpp / factor,
-            ),
-        ));
-    }
     if let Some(msg) = lab_disagreement(m) {
         reasons.push(suspect(ReasonKind::LabDisagrees, msg));
     }

@@ -294,6 +294,10 @@ pub struct FrameInfo {
     /// `result.json` records for the frame; not in `scatterfit merge --json`).
     #[serde(skip)]
     pub sha256: String,
+    /// The JPEG quality the file was saved at, read from the header of the bytes decoded
+    /// (`scatterfit_io::image_files::jpeg_quality`); `None` for other formats.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jpeg_quality: Option<f64>,
 }
 
 /// The merged bracket.
@@ -539,6 +543,7 @@ pub fn read_frames(
             file: f.path.clone(),
             time_s: f.time_s,
             sha256: f.sha256.clone(),
+            jpeg_quality: f.jpeg_quality,
         })
         .collect();
     let image = bracket.describe();

@@ -274,7 +274,7 @@ class Measurement(Result):
     @property
     def timings(self) -> Dict[str, float]:
         """Wall time per stage [s]: ``spectro_s``, ``read_s``, ``merge_s``, ``profile_s``,
-        ``fit_s``, ``total_s``."""
+        ``fit_s``, ``checks_s`` (the image and bracket checks), ``total_s``."""
         return self._handle.timings()
 
     @property
