@@ -2,19 +2,18 @@
 //! every good one merges with the default settings, and one whose times truly disagree with its
 //! frames is still refused.
 //!
-//! Three places hold brackets, each folder `NAME/` with its frames, `exposures.csv` and (where it
-//! is a copy of someone's photographs) `SOURCE.md`:
-//! - `data/brackets/` in this repository: always merged (its README says what may be committed);
-//! - `shared/brackets/` beside the repository's folder (the steering repository's shared data,
-//!   where copies taken from public repositories are kept instead of being committed here): merged
-//!   when present;
-//! - the folder named by `SCATTERFIT_REAL_BRACKETS=DIR`: a corpus kept outside both, where the
-//!   sources give no licence to copy (BENCHMARKS.md, "Real brackets", names them); skipped without
-//!   the variable.
+//! Two places hold brackets, each folder `NAME/` with its frames and `exposures.csv`:
+//! - `data/brackets/` in this repository: always merged; each folder there has a `SOURCE.md` (where
+//!   the frames came from and the licence that allows the copy; a folder without one fails the
+//!   test). Its README says what may be committed;
+//! - the folder named by `SCATTERFIT_REAL_BRACKETS=DIR`: a corpus kept outside the repository
+//!   (sources that give no licence to copy, or copies that may not be committed; BENCHMARKS.md,
+//!   "Real brackets", names them); skipped without the variable.
 //!
 //! A folder holding a file `EXPECT_REFUSED` is a bracket whose listed times disagree with its
 //! frames (the shutter did not change): it must be refused, saying so. Every merge prints its
-//! self-consistency score (`imaging::self_consistency`, code values) and its time.
+//! self-consistency score (`imaging::self_consistency` over a regular pixel subsample, in code
+//! values, as `scatterfit merge` prints it) and its time.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -44,12 +43,6 @@ fn committed() -> Vec<PathBuf> {
     brackets_in(&workspace().join("data/brackets"))
 }
 
-/// `shared/brackets/` beside the repository's folder, where CI and every session find the
-/// steering repository's `shared/` (empty when there is none).
-fn shared() -> Vec<PathBuf> {
-    brackets_in(&workspace().join("../shared/brackets"))
-}
-
 fn corpus() -> Option<PathBuf> {
     std::env::var_os("SCATTERFIT_REAL_BRACKETS").map(PathBuf::from)
 }
@@ -69,23 +62,28 @@ fn merge(dir: &Path) -> Result<f64, String> {
 fn every_good_real_bracket_merges_and_a_wrong_one_is_refused() {
     let mut dirs = committed();
     let n_committed = dirs.len();
-    dirs.extend(shared());
-    let n_shared = dirs.len() - n_committed;
     if let Some(c) = corpus() {
         dirs.extend(brackets_in(&c));
     } else {
         eprintln!("SCATTERFIT_REAL_BRACKETS not set: the uncommitted corpus is skipped");
     }
     eprintln!(
-        "{} brackets: {n_committed} committed, {n_shared} in shared/brackets, {} outside",
+        "{} brackets: {n_committed} committed, {} outside",
         dirs.len(),
-        dirs.len() - n_committed - n_shared
+        dirs.len() - n_committed
     );
     let mut failures = Vec::new();
-    for dir in &dirs {
+    for (i, dir) in dirs.iter().enumerate() {
         let name = dir
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into());
+        // A copy committed with the project names its source and the licence that allows it.
+        if i < n_committed && !dir.join("SOURCE.md").is_file() {
+            failures.push(format!(
+                "{name}: no SOURCE.md (where the frames came from and the licence that allows \
+                 the copy)"
+            ));
+        }
         let expect_refused = dir.join("EXPECT_REFUSED").is_file();
         let start = Instant::now();
         let outcome = merge(dir);
