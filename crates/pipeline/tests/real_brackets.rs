@@ -2,14 +2,21 @@
 //! every good one merges with the default settings, and one whose times truly disagree with its
 //! frames is still refused.
 //!
-//! The brackets committed under `data/brackets/NAME/` (each with `exposures.csv` and `SOURCE.md`)
-//! are always merged. With `SCATTERFIT_REAL_BRACKETS=DIR` the folders of DIR are merged too (a
-//! corpus kept outside the repository where the sources give no licence to copy; BENCHMARKS.md,
-//! "Real brackets", names them). A folder holding a file `EXPECT_REFUSED` is a bracket whose listed
-//! times disagree with its frames (the shutter did not change): it must be refused, saying so.
-//! Without the variable the corpus part is skipped.
+//! Two places hold brackets, each folder `NAME/` with its frames and `exposures.csv`:
+//! - `data/brackets/` in this repository: always merged; each folder there has a `SOURCE.md` (where
+//!   the frames came from and the licence that allows the copy; a folder without one fails the
+//!   test). Its README says what may be committed;
+//! - the folder named by `SCATTERFIT_REAL_BRACKETS=DIR`: a corpus kept outside the repository
+//!   (sources that give no licence to copy, or copies that may not be committed; BENCHMARKS.md,
+//!   "Real brackets", names them); skipped without the variable.
+//!
+//! A folder holding a file `EXPECT_REFUSED` is a bracket whose listed times disagree with its
+//! frames (the shutter did not change): it must be refused, saying so. Every merge prints its
+//! self-consistency score (`imaging::self_consistency` over a regular pixel subsample, in code
+//! values, as `scatterfit merge` prints it) and its time.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use scatterfit_imaging::{ImageBuf, ImagingError, check_bracket_order};
 use scatterfit_io::image_files::{CameraFrame, read_camera_frame};
@@ -27,8 +34,13 @@ fn brackets_in(dir: &Path) -> Vec<PathBuf> {
     v
 }
 
+/// The repository's root.
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
 fn committed() -> Vec<PathBuf> {
-    brackets_in(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/brackets"))
+    brackets_in(&workspace().join("data/brackets"))
 }
 
 fn corpus() -> Option<PathBuf> {
@@ -49,21 +61,39 @@ fn merge(dir: &Path) -> Result<f64, String> {
 #[test]
 fn every_good_real_bracket_merges_and_a_wrong_one_is_refused() {
     let mut dirs = committed();
+    let n_committed = dirs.len();
     if let Some(c) = corpus() {
         dirs.extend(brackets_in(&c));
     } else {
         eprintln!("SCATTERFIT_REAL_BRACKETS not set: the uncommitted corpus is skipped");
     }
+    eprintln!(
+        "{} brackets: {n_committed} committed, {} outside",
+        dirs.len(),
+        dirs.len() - n_committed
+    );
     let mut failures = Vec::new();
-    for dir in &dirs {
+    for (i, dir) in dirs.iter().enumerate() {
         let name = dir
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into());
+        // A copy committed with the project names its source and the licence that allows it.
+        if i < n_committed && !dir.join("SOURCE.md").is_file() {
+            failures.push(format!(
+                "{name}: no SOURCE.md (where the frames came from and the licence that allows \
+                 the copy)"
+            ));
+        }
         let expect_refused = dir.join("EXPECT_REFUSED").is_file();
-        match (merge(dir), expect_refused) {
-            (Ok(rms), false) => eprintln!("{name}: merged, self-consistency {rms:.2} code values"),
+        let start = Instant::now();
+        let outcome = merge(dir);
+        let secs = start.elapsed().as_secs_f64();
+        match (outcome, expect_refused) {
+            (Ok(rms), false) => {
+                eprintln!("{name}: merged, self-consistency {rms:.2} code values ({secs:.2} s)");
+            }
             (Err(e), true) => {
-                eprintln!("{name}: refused as expected: {e}");
+                eprintln!("{name}: refused as expected ({secs:.2} s): {e}");
                 if !(e.contains("do not brighten") || e.contains("right file for that time")) {
                     failures.push(format!("{name}: refused for another reason: {e}"));
                 }
