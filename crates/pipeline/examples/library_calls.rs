@@ -78,11 +78,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let result = median_s(n, || {
         std::hint::black_box(m.to_result(Some("profile.csv")));
     });
-    println!("Measurement::to_result: {:.2} ms (median of {n})", result * 1e3);
+    println!(
+        "Measurement::to_result: {:.2} ms (median of {n})",
+        result * 1e3
+    );
     let both = median_s(n, || {
         let m = measure_sample(&sample, &overrides, &|_| {}).expect("measures");
         std::hint::black_box(m.to_result(Some("profile.csv")));
     });
-    println!("measure_sample + to_result: {:.1} ms (median of {n})", both * 1e3);
+    println!(
+        "measure_sample + to_result: {:.1} ms (median of {n})",
+        both * 1e3
+    );
     Ok(())
 }

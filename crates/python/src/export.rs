@@ -32,6 +32,44 @@ pub(crate) fn export(
                 Format::ALL.map(Format::name).join(", ")
             ))
         })?;
+    let (exported, untrusted) = exported(result_json, format, scale, mitsuba_variant, source)?;
+    Ok((exported.text, exported.warnings, untrusted))
+}
+
+/// The Mitsuba export's objects as `mitsuba.load_dict` dictionaries (private:
+/// `scatterfit.mitsuba_dict`, `mitsuba_integrator`): JSON text of `{"bsdf", "interior",
+/// "integrator"}` ([`scatterfit_io::export::MitsubaObject::to_dict`]), the export's warnings, and
+/// why the result is not trusted.
+#[pyfunction]
+#[pyo3(signature = (result_json, *, scale="mm", mitsuba_variant="rgb", source="the result"))]
+pub(crate) fn mitsuba_dict(
+    result_json: &str,
+    scale: &str,
+    mitsuba_variant: &str,
+    source: &str,
+) -> PyResult<(String, Vec<String>, Option<String>)> {
+    let (exported, untrusted) =
+        exported(result_json, Format::Mitsuba, scale, mitsuba_variant, source)?;
+    let material = exported
+        .mitsuba
+        .ok_or_else(|| errors::input(format!("{source}: the Mitsuba export has no objects")))?;
+    let dict = serde_json::json!({
+        "bsdf": material.boundary.to_dict(),
+        "interior": material.medium.to_dict(),
+        "integrator": material.integrator.to_dict(),
+    });
+    Ok((dict.to_string(), exported.warnings, untrusted))
+}
+
+/// The export of `result_json` in `format`, as `scatterfit export` makes it, with why the result
+/// is not trusted.
+fn exported(
+    result_json: &str,
+    format: Format,
+    scale: &str,
+    mitsuba_variant: &str,
+    source: &str,
+) -> PyResult<(scatterfit_io::export::Export, Option<String>)> {
     let unit = match scale {
         "mm" => SceneUnit::Millimetre,
         "m" => SceneUnit::Metre,
@@ -59,7 +97,7 @@ pub(crate) fn export(
         }
         other => errors::input(format!("{source}: {other}")),
     })?;
-    Ok((exported.text, exported.warnings, result.untrusted()))
+    Ok((exported, result.untrusted()))
 }
 
 /// A `result.json` file as the current schema's JSON text (private: `scatterfit.load`).

@@ -37,6 +37,7 @@ fn _scatterfit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(spectro::spectro_file, m)?)?;
     m.add_function(wrap_pyfunction!(spectro::spectro_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(export::export, m)?)?;
+    m.add_function(wrap_pyfunction!(export::mitsuba_dict, m)?)?;
     m.add_function(wrap_pyfunction!(export::read_result, m)?)?;
     Ok(())
 }

@@ -110,3 +110,29 @@ def test_mitsuba_dict_renders_with_scalar_rgb(wood: Path):
     # the channels in order, and the sphere under a white sky is neither black nor brighter than it.
     assert centre[0] > centre[1] > centre[2] > 0.02
     assert centre[0] < 1.05
+
+
+def test_mitsuba_dict_matches_the_export_and_loads_spectral(wood: Path):
+    try:
+        os.environ.setdefault("HOME", str(wood))
+        import mitsuba as mi
+    except ImportError:
+        if os.environ.get("SCATTERFIT_REQUIRE_MITSUBA") == "1":
+            raise
+        pytest.skip("no `mitsuba` package in this Python")
+    m = sf.measure(wood)
+    # The dict's numbers are the XML fragment's own.
+    xml = sf.export(m, "mitsuba")
+    d = sf.mitsuba_dict(m)
+    assert f'<float name="int_ior" value="{d["bsdf"]["int_ior"]!r}"/>' in xml
+    assert f'<float name="scale" value="{d["interior"]["scale"]!r}"/>' in xml
+    assert sf.mitsuba_integrator(m)["rr_depth"] >= 1
+    # The spectral medium: per-wavelength pairs that a spectral variant loads.
+    spectral = sf.mitsuba_dict(m, mitsuba_variant="spectral")
+    sigma_t = spectral["interior"]["sigma_t"]
+    assert sigma_t["type"] == "spectrum" and len(sigma_t["value"]) > 10
+    assert all(isinstance(p, tuple) and len(p) == 2 for p in sigma_t["value"])
+    mi.set_variant("scalar_spectral")
+    mi.load_dict(spectral)
+    with pytest.raises(sf.InputError, match="mitsuba_variant"):
+        sf.mitsuba_dict(m, mitsuba_variant="cmyk")

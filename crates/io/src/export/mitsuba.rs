@@ -40,10 +40,6 @@ pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant
     let id = &names.id;
     let u = params.unit.symbol();
     let chans = params.channels.as_array();
-    let scale = largest(chans.map(|c| c.sigma_t));
-    let rgb = |v: [f64; 3]| joined(v, num, ", ");
-    let sigma_t_rgb = rgb(chans.map(|c| c.sigma_t / scale));
-    let albedo_rgb = rgb(chans.map(|c| c.albedo));
     let rr = roulette_depth(largest(chans.map(|c| c.albedo)));
     let mfp = num(shortest_mfp(params));
     let offset_fraction = ray_offset_fraction(params);
@@ -125,64 +121,198 @@ pub fn mitsuba_fragment_for(params: &RendererParameters, variant: MitsubaVariant
         shift = MITSUBA_SPECTRAL_SHIFT,
     ), 100)));
     s.push_str("-->\n");
-    s.push_str(&format!(
-        "<scene version=\"3.0.0\">\n\
-         \x20   <bsdf type=\"dielectric\" id=\"{id}_boundary\">\n\
-         \x20       <float name=\"int_ior\" value=\"{eta}\"/>\n\
-         \x20       <float name=\"ext_ior\" value=\"1\"/>\n\
-         \x20   </bsdf>\n\
-         {medium}\
-         </scene>\n",
-        eta = num(params.eta),
-        medium = if spectral {
-            spectral_medium(params, id)
-        } else {
-            format!(
-                "\x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
-                 \x20       <rgb name=\"sigma_t\" value=\"{sigma_t_rgb}\"/>\n\
-                 \x20       <float name=\"scale\" value=\"{scale}\"/>\n\
-                 \x20       <rgb name=\"albedo\" value=\"{albedo_rgb}\"/>\n\
-                 \x20       <boolean name=\"sample_emitters\" value=\"false\"/>\n\
-                 \x20       <phase type=\"hg\">\n\
-                 \x20           <float name=\"g\" value=\"0\"/>\n\
-                 \x20       </phase>\n\
-                 \x20   </medium>\n",
-                scale = num(scale),
-            )
-        },
-    ));
+    let material = mitsuba_material(params, variant);
+    s.push_str("<scene version=\"3.0.0\">\n");
+    material.boundary.write_xml(&mut s, 1);
+    material.medium.write_xml(&mut s, 1);
+    s.push_str("</scene>\n");
     s
 }
 
-/// The `<id>_medium` element for spectral variants, when the parameters have a spectral medium: σt
-/// and albedo as wavelength:value spectra (σt normalised like the RGB one, its magnitude in `scale`).
-fn spectral_medium(params: &RendererParameters, id: &str) -> String {
-    let Some(m) = &params.spectral_medium else {
-        return String::new();
+/// The objects a Mitsuba 3 export describes: the boundary, the medium inside it, and the integrator
+/// its header recommends. The XML fragment ([`mitsuba_fragment_for`]) writes the first two as
+/// elements; [`MitsubaObject::to_dict`] gives each as the dictionary `mitsuba.load_dict` takes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MitsubaMaterial {
+    /// The `dielectric` BSDF `<id>_boundary`: `int_ior` = η, `ext_ior` = 1.
+    pub boundary: MitsubaObject,
+    /// The `homogeneous` medium `<id>_medium` (RGB, or per wavelength for spectral variants).
+    pub medium: MitsubaObject,
+    /// `volpathmis` with unbounded depth and the Russian-roulette depth the albedo needs
+    /// ([`roulette_depth`]).
+    pub integrator: MitsubaObject,
+}
+
+/// One Mitsuba 3 scene object: a plugin instance with its properties, as an XML element and as a
+/// `load_dict` dictionary describe it (Mitsuba 3 documentation, "File format" and
+/// `mitsuba.load_dict`). Numbers are written as the export writes them (`num`), so the dictionary
+/// holds exactly the XML's values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MitsubaObject {
+    /// The element's tag: `bsdf`, `medium`, `phase` or `integrator`.
+    pub tag: &'static str,
+    /// The plugin (the element's `type`).
+    pub plugin: &'static str,
+    /// The id a scene refers to it by.
+    pub id: Option<String>,
+    /// The properties, in the order they are written; a nested object's name is its tag.
+    pub properties: Vec<(&'static str, MitsubaProperty)>,
+}
+
+/// A property of a [`MitsubaObject`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum MitsubaProperty {
+    /// `<float>`.
+    Float(f64),
+    /// `<integer>`.
+    Integer(i64),
+    /// `<boolean>`.
+    Boolean(bool),
+    /// `<rgb>`: linear sRGB.
+    Rgb([f64; 3]),
+    /// `<spectrum>`: (wavelength \[nm\], value) pairs.
+    Spectrum(Vec<(f64, f64)>),
+    /// A nested object (the medium's phase function).
+    Object(MitsubaObject),
+}
+
+impl MitsubaObject {
+    fn new(tag: &'static str, plugin: &'static str, id: Option<String>) -> Self {
+        Self {
+            tag,
+            plugin,
+            id,
+            properties: Vec::new(),
+        }
+    }
+
+    fn with(mut self, name: &'static str, value: MitsubaProperty) -> Self {
+        self.properties.push((name, value));
+        self
+    }
+
+    /// Appends the element to `out`, indented by `depth` × 4 spaces.
+    fn write_xml(&self, out: &mut String, depth: usize) {
+        let pad = "    ".repeat(depth);
+        let id = self
+            .id
+            .as_ref()
+            .map_or_else(String::new, |id| format!(" id=\"{id}\""));
+        out.push_str(&format!(
+            "{pad}<{} type=\"{}\"{id}>\n",
+            self.tag, self.plugin
+        ));
+        let inner = "    ".repeat(depth + 1);
+        for (name, value) in &self.properties {
+            let (tag, text) = match value {
+                MitsubaProperty::Float(x) => ("float", num(*x)),
+                MitsubaProperty::Integer(n) => ("integer", n.to_string()),
+                MitsubaProperty::Boolean(b) => ("boolean", b.to_string()),
+                MitsubaProperty::Rgb(v) => ("rgb", joined(*v, num, ", ")),
+                MitsubaProperty::Spectrum(pairs) => (
+                    "spectrum",
+                    pairs
+                        .iter()
+                        .map(|(l, x)| format!("{}:{}", num(*l), num(*x)))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                ),
+                MitsubaProperty::Object(o) => {
+                    o.write_xml(out, depth + 1);
+                    continue;
+                }
+            };
+            out.push_str(&format!(
+                "{inner}<{tag} name=\"{name}\" value=\"{text}\"/>\n"
+            ));
+        }
+        out.push_str(&format!("{pad}</{}>\n", self.tag));
+    }
+
+    /// The object as the dictionary `mitsuba.load_dict` takes: `{"type": plugin, name: value,
+    /// …}`, an RGB as `{"type": "rgb", "value": [r, g, b]}`, a spectrum as `{"type": "spectrum",
+    /// "value": [[λ, v], …]}`, a nested object under its tag. The id is left out (a dictionary
+    /// nests the object where it is used).
+    #[must_use]
+    pub fn to_dict(&self) -> serde_json::Value {
+        use serde_json::{Value, json};
+        // The number as the XML writes it.
+        let n = |x: f64| -> Value {
+            num(x)
+                .parse::<f64>()
+                .ok()
+                .and_then(serde_json::Number::from_f64)
+                .map_or(Value::Null, Value::Number)
+        };
+        let mut d = serde_json::Map::new();
+        d.insert("type".into(), json!(self.plugin));
+        for (name, value) in &self.properties {
+            let v = match value {
+                MitsubaProperty::Float(x) => n(*x),
+                MitsubaProperty::Integer(i) => json!(i),
+                MitsubaProperty::Boolean(b) => json!(b),
+                MitsubaProperty::Rgb(v) => json!({"type": "rgb", "value": v.map(n)}),
+                MitsubaProperty::Spectrum(pairs) => json!({
+                    "type": "spectrum",
+                    "value": pairs.iter().map(|(l, x)| json!([n(*l), n(*x)])).collect::<Vec<_>>(),
+                }),
+                MitsubaProperty::Object(o) => o.to_dict(),
+            };
+            d.insert((*name).into(), v);
+        }
+        Value::Object(d)
+    }
+}
+
+/// The boundary, the medium and the integrator of the export for `variant`
+/// ([`mitsuba_fragment_for`] writes the first two).
+#[must_use]
+pub fn mitsuba_material(params: &RendererParameters, variant: MitsubaVariant) -> MitsubaMaterial {
+    use MitsubaProperty::{Boolean, Float, Integer, Object, Rgb, Spectrum};
+    let spectral = variant == MitsubaVariant::Spectral && params.spectral_medium.is_some();
+    let id = MaterialNames::new(&params.name).id;
+    let chans = params.channels.as_array();
+    let boundary = MitsubaObject::new("bsdf", "dielectric", Some(format!("{id}_boundary")))
+        .with("int_ior", Float(params.eta))
+        .with("ext_ior", Float(1.0));
+    let mut medium = MitsubaObject::new("medium", "homogeneous", Some(format!("{id}_medium")));
+    medium = match (&params.spectral_medium, spectral) {
+        (Some(m), true) => {
+            // σt normalised like the RGB one, its magnitude in `scale`.
+            let scale = m.sigma_t.iter().copied().fold(0.0_f64, f64::max);
+            let pairs = |v: &[f64], k: f64| -> Vec<(f64, f64)> {
+                m.wavelength_nm
+                    .iter()
+                    .zip(v)
+                    .map(|(l, x)| (*l, x / k))
+                    .collect()
+            };
+            medium
+                .with("sigma_t", Spectrum(pairs(&m.sigma_t, scale)))
+                .with("scale", Float(scale))
+                .with("albedo", Spectrum(pairs(&m.albedo, 1.0)))
+        }
+        _ => {
+            let scale = largest(chans.map(|c| c.sigma_t));
+            medium
+                .with("sigma_t", Rgb(chans.map(|c| c.sigma_t / scale)))
+                .with("scale", Float(scale))
+                .with("albedo", Rgb(chans.map(|c| c.albedo)))
+        }
     };
-    let scale = m.sigma_t.iter().copied().fold(0.0_f64, f64::max);
-    let pairs = |v: &[f64], k: f64| -> String {
-        m.wavelength_nm
-            .iter()
-            .zip(v)
-            .map(|(l, x)| format!("{}:{}", num(*l), num(x / k)))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    format!(
-        "\x20   <medium type=\"homogeneous\" id=\"{id}_medium\">\n\
-         \x20       <spectrum name=\"sigma_t\" value=\"{}\"/>\n\
-         \x20       <float name=\"scale\" value=\"{}\"/>\n\
-         \x20       <spectrum name=\"albedo\" value=\"{}\"/>\n\
-         \x20       <boolean name=\"sample_emitters\" value=\"false\"/>\n\
-         \x20       <phase type=\"hg\">\n\
-         \x20           <float name=\"g\" value=\"0\"/>\n\
-         \x20       </phase>\n\
-         \x20   </medium>\n",
-        pairs(&m.sigma_t, scale),
-        num(scale),
-        pairs(&m.albedo, 1.0),
-    )
+    let medium = medium.with("sample_emitters", Boolean(false)).with(
+        "phase",
+        Object(MitsubaObject::new("phase", "hg", None).with("g", Float(0.0))),
+    );
+    let rr = roulette_depth(largest(chans.map(|c| c.albedo)));
+    let integrator = MitsubaObject::new("integrator", "volpathmis", None)
+        .with("max_depth", Integer(-1))
+        .with("rr_depth", Integer(i64::try_from(rr).unwrap_or(i64::MAX)));
+    MitsubaMaterial {
+        boundary,
+        medium,
+        integrator,
+    }
 }
 
 /// The shortest mean free path 1/σt of the channels [scene units].
@@ -255,6 +385,67 @@ pub fn roulette_depth(albedo: f64) -> u64 {
 mod tests {
     use super::super::fixtures::{SA, SP, close, marble};
     use super::super::{Format, SceneUnit, export};
+
+    /// The dictionaries `load_dict` takes hold every property the XML fragment writes, with the
+    /// same values (read back from the XML text), and the integrator the header recommends.
+    #[test]
+    fn the_dictionaries_hold_the_fragments_values() {
+        let r = marble();
+        for unit in [SceneUnit::Millimetre, SceneUnit::Metre] {
+            let exported = export(&r, Format::Mitsuba, unit).unwrap();
+            let material = exported.mitsuba.expect("the Mitsuba objects");
+            let doc = roxmltree::Document::parse(&exported.text).expect("well-formed XML");
+            for (tag, object) in [("bsdf", &material.boundary), ("medium", &material.medium)] {
+                let element = doc.descendants().find(|n| n.has_tag_name(tag)).unwrap();
+                let dict = object.to_dict();
+                assert_eq!(dict["type"].as_str(), element.attribute("type"));
+                let mut compared = 0;
+                for child in element
+                    .descendants()
+                    .filter(|n| n.attribute("name").is_some())
+                {
+                    let name = child.attribute("name").unwrap();
+                    let text = child.attribute("value").unwrap();
+                    // The phase function's properties sit in its own dictionary.
+                    let value = if child.parent().is_some_and(|p| p.has_tag_name("phase")) {
+                        &dict["phase"][name]
+                    } else {
+                        &dict[name]
+                    };
+                    match child.tag_name().name() {
+                        "float" => assert_eq!(value.as_f64(), text.parse().ok(), "{name}"),
+                        "boolean" => assert_eq!(value.as_bool(), text.parse().ok(), "{name}"),
+                        "rgb" => {
+                            let xml: Vec<f64> =
+                                text.split(',').map(|t| t.trim().parse().unwrap()).collect();
+                            let got: Vec<f64> = value["value"]
+                                .as_array()
+                                .unwrap()
+                                .iter()
+                                .map(|v| v.as_f64().unwrap())
+                                .collect();
+                            assert_eq!(value["type"], "rgb");
+                            assert_eq!(got, xml, "{name}");
+                        }
+                        other => panic!("unexpected property <{other}>"),
+                    }
+                    compared += 1;
+                }
+                assert!(compared >= 2, "{tag}: {compared} properties compared");
+            }
+            assert_eq!(material.medium.to_dict()["phase"]["type"], "hg");
+            let integrator = material.integrator.to_dict();
+            assert_eq!(integrator["type"], "volpathmis");
+            assert_eq!(integrator["max_depth"], -1);
+            let rr = integrator["rr_depth"].as_i64().unwrap();
+            assert!(
+                exported
+                    .text
+                    .contains(&format!("<integer name=\"rr_depth\" value=\"{rr}\"/>")),
+                "the header recommends rr_depth {rr}"
+            );
+        }
+    }
 
     /// The Mitsuba medium must give back σt = σa + σ′s and α = σ′s/σt per channel through
     /// `scale · rgb(sigma_t)`, with the RGB within [0, 1].

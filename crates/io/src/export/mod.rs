@@ -81,8 +81,8 @@ use params::*;
 pub use blender::{BLENDER_MAX_ALBEDO, BlenderValues, blender_script};
 pub use json::{JSON_FORMAT_TAG, JSON_FORMAT_VERSION, json};
 pub use mitsuba::{
-    MitsubaVariant, RAY_EPSILON, mitsuba_fragment, mitsuba_fragment_for, ray_offset_fraction,
-    roulette_depth,
+    MitsubaMaterial, MitsubaObject, MitsubaProperty, MitsubaVariant, RAY_EPSILON, mitsuba_fragment,
+    mitsuba_fragment_for, mitsuba_material, ray_offset_fraction, roulette_depth,
 };
 pub use names::{
     BLENDER_NAME_BYTES, MaterialNames, identifier, name_hash, num, one_line, python_docstring_text,
@@ -238,6 +238,9 @@ pub struct Export {
     pub text: String,
     /// Warnings for the user (unconstrained channels, model mismatch, fallbacks), one sentence each.
     pub warnings: Vec<String>,
+    /// For [`Format::Mitsuba`], the objects the fragment describes, with the integrator its
+    /// header recommends ([`MitsubaObject::to_dict`] gives `mitsuba.load_dict`'s dictionaries).
+    pub mitsuba: Option<MitsubaMaterial>,
 }
 
 /// What the caller knows beyond the result: the scene unit, and exact transport's total Rd.
@@ -316,6 +319,7 @@ pub fn export_with(
             warnings.push(note.warning());
         }
     }
+    let mut mitsuba = None;
     let text = match format {
         Format::Pbrt => pbrt_material(&params),
         Format::Mitsuba => {
@@ -335,6 +339,7 @@ pub fn export_with(
                      shifted in colour"
                 ));
             }
+            mitsuba = Some(mitsuba_material(&params, options.mitsuba_variant));
             mitsuba_fragment_for(&params, options.mitsuba_variant)
         }
         Format::Blender => {
@@ -343,7 +348,11 @@ pub fn export_with(
         }
         Format::Json => json(&params),
     };
-    Ok(Export { text, warnings })
+    Ok(Export {
+        text,
+        warnings,
+        mitsuba,
+    })
 }
 
 /// What a target renders a material with: the light transport its numbers meet.

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import warnings
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -424,36 +422,37 @@ def export(
     return out
 
 
-def _mitsuba_value(e: ET.Element) -> Any:
-    """One Mitsuba XML property as ``load_dict`` takes it."""
-    tag, value = e.tag, e.get("value", "")
-    if tag == "float":
-        return float(value)
-    if tag == "integer":
-        return int(value)
-    if tag == "boolean":
-        return value == "true"
-    if tag == "string":
-        return value
-    if tag == "rgb":
-        return {"type": "rgb", "value": [float(v) for v in value.replace(",", " ").split()]}
-    if tag == "spectrum":
-        pairs = [p.split(":") for p in value.replace(",", " ").split()]
-        if all(len(p) == 2 for p in pairs):
-            return {
-                "type": "spectrum",
-                "value": [(float(w), float(v)) for w, v in pairs],
-            }
-        return {"type": "spectrum", "value": float(value)}
-    return _mitsuba_object(e)
+def _mitsuba_objects(
+    result: Union[Result, Mapping[str, Any], PathLike],
+    allow_suspect: bool,
+    mitsuba_variant: str = "rgb",
+) -> Dict[str, Any]:
+    """The Mitsuba export's boundary, medium and integrator as ``load_dict`` dicts."""
+    text, source = _result_json(result)
+    out, notes, untrusted = _scatterfit.mitsuba_dict(
+        text, mitsuba_variant=mitsuba_variant, source=source
+    )
+    for note in notes:
+        warnings.warn(note, UserWarning, stacklevel=3)
+    if untrusted and not allow_suspect:
+        warnings.warn(
+            f"{source}: not every channel passed the measurement's data checks ({untrusted}); "
+            "the numbers are not trusted (allow_suspect=True to use them anyway)",
+            SuspectResultWarning,
+            stacklevel=3,
+        )
+    objects: Dict[str, Any] = json.loads(out)
+    return objects
 
 
-def _mitsuba_object(e: ET.Element) -> Dict[str, Any]:
-    d: Dict[str, Any] = {"type": e.get("type")}
-    for k, child in enumerate(e):
-        # A nested object without a name (the medium's phase function) is keyed by its tag.
-        name = child.get("name") or (child.tag if child.tag not in d else f"{child.tag}_{k}")
-        d[name] = _mitsuba_value(child)
+def _spectra_as_pairs(d: Dict[str, Any]) -> Dict[str, Any]:
+    """A spectrum's (wavelength, value) pairs as tuples, as ``load_dict`` documents them."""
+    for v in d.values():
+        if isinstance(v, dict):
+            if v.get("type") == "spectrum" and isinstance(v.get("value"), list):
+                v["value"] = [tuple(p) for p in v["value"]]
+            else:
+                _spectra_as_pairs(v)
     return d
 
 
@@ -461,35 +460,27 @@ def mitsuba_dict(
     result: Union[Result, Mapping[str, Any], PathLike],
     *,
     shape: Optional[Mapping[str, Any]] = None,
+    mitsuba_variant: str = "rgb",
     allow_suspect: bool = False,
 ) -> Dict[str, Any]:
     """The material as a Mitsuba 3 shape dict that ``mitsuba.load_dict`` accepts as it is: the
     shape (default ``{"type": "sphere"}``; pass your own, e.g. with a ``to_world``) with the
     export's dielectric boundary as its ``bsdf`` and its homogeneous medium as its
-    ``interior``, in millimetres. The same numbers as ``export(result, "mitsuba")``.
-    Render it with :func:`mitsuba_integrator`'s integrator (``volpathmis``).
+    ``interior``, in millimetres. The same objects and numbers as ``export(result, "mitsuba")``
+    (the library gives both). Render it with :func:`mitsuba_integrator`'s integrator
+    (``volpathmis``). ``mitsuba_variant="spectral"`` gives the medium per wavelength from the
+    measured spectrum, for Mitsuba's spectral variants (as ``export``'s option).
     """
-    xml = export(result, "mitsuba", allow_suspect=allow_suspect)
-    scene = ET.fromstring(xml.split("?>", 1)[1] if xml.startswith("<?xml") else xml)
-    bsdf = scene.find("bsdf")
-    medium = scene.find("medium")
-    if bsdf is None or medium is None:
-        raise InputError("the Mitsuba export has no boundary or no medium")
+    objects = _mitsuba_objects(result, allow_suspect, mitsuba_variant)
     d: Dict[str, Any] = dict(shape) if shape is not None else {"type": "sphere"}
-    d["bsdf"] = _mitsuba_object(bsdf)
-    d["interior"] = _mitsuba_object(medium)
+    d["bsdf"] = _spectra_as_pairs(objects["bsdf"])
+    d["interior"] = _spectra_as_pairs(objects["interior"])
     return d
 
 
 def mitsuba_integrator(result: Union[Result, Mapping[str, Any], PathLike]) -> Dict[str, Any]:
     """The integrator the Mitsuba export recommends for this material (its header), as a dict:
     ``volpathmis`` with unbounded depth and the Russian-roulette depth the medium needs."""
-    xml = export(result, "mitsuba", allow_suspect=True)
-    m = re.search(
-        r'<integrator type="(\w+)"><integer name="max_depth" value="(-?\d+)"/>\s*'
-        r'<integer name="rr_depth" value="(\d+)"/>',
-        xml,
-    )
-    if m is None:
-        return {"type": "volpathmis", "max_depth": -1}
-    return {"type": m.group(1), "max_depth": int(m.group(2)), "rr_depth": int(m.group(3))}
+    integrator: Dict[str, Any] = _mitsuba_objects(result, True)["integrator"]
+    return integrator
+
