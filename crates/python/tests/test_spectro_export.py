@@ -6,6 +6,7 @@ import json
 import os
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -74,14 +75,20 @@ def test_export_of_a_suspect_result_warns(wood: Path):
         sf.export(d, "maya")
 
 
-def test_mitsuba_dict_renders_with_scalar_rgb(wood: Path):
+def _mitsuba(home: Path) -> Any:
+    """The `mitsuba` module, or the test skipped (failed with SCATTERFIT_REQUIRE_MITSUBA=1)."""
     try:
-        os.environ.setdefault("HOME", str(wood))
+        os.environ.setdefault("HOME", str(home))
         import mitsuba as mi
     except ImportError:
         if os.environ.get("SCATTERFIT_REQUIRE_MITSUBA") == "1":
             raise
         pytest.skip("no `mitsuba` package in this Python")
+    return mi
+
+
+def test_mitsuba_dict_renders_with_scalar_rgb(wood: Path):
+    mi = _mitsuba(wood)
     mi.set_variant("scalar_rgb")
     m = sf.measure(wood)
     shape = sf.mitsuba_dict(m, shape={"type": "sphere", "radius": 20.0})
@@ -113,13 +120,7 @@ def test_mitsuba_dict_renders_with_scalar_rgb(wood: Path):
 
 
 def test_mitsuba_dict_matches_the_export_and_loads_spectral(wood: Path):
-    try:
-        os.environ.setdefault("HOME", str(wood))
-        import mitsuba as mi
-    except ImportError:
-        if os.environ.get("SCATTERFIT_REQUIRE_MITSUBA") == "1":
-            raise
-        pytest.skip("no `mitsuba` package in this Python")
+    mi = _mitsuba(wood)
     m = sf.measure(wood)
     # The dict's numbers are the XML fragment's own.
     xml = sf.export(m, "mitsuba")

@@ -410,16 +410,25 @@ def export(
     out, notes, untrusted = _scatterfit.export(
         text, to=to, scale=scale, mitsuba_variant=mitsuba_variant, source=source
     )
+    _warn_exported(source, notes, untrusted, allow_suspect)
+    return out
+
+
+def _warn_exported(
+    source: str, notes: List[str], untrusted: Optional[str], allow_suspect: bool
+) -> None:
+    """The export's notes as warnings, and a :class:`SuspectResultWarning` for a result whose
+    channels did not all pass the data checks (unless ``allow_suspect``); at the caller's
+    caller."""
     for note in notes:
-        warnings.warn(note, UserWarning, stacklevel=2)
+        warnings.warn(note, UserWarning, stacklevel=3)
     if untrusted and not allow_suspect:
         warnings.warn(
             f"{source}: not every channel passed the measurement's data checks ({untrusted}); "
             "the numbers are not trusted (allow_suspect=True to use them anyway)",
             SuspectResultWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
-    return out
 
 
 def _mitsuba_objects(
@@ -432,15 +441,7 @@ def _mitsuba_objects(
     out, notes, untrusted = _scatterfit.mitsuba_dict(
         text, mitsuba_variant=mitsuba_variant, source=source
     )
-    for note in notes:
-        warnings.warn(note, UserWarning, stacklevel=3)
-    if untrusted and not allow_suspect:
-        warnings.warn(
-            f"{source}: not every channel passed the measurement's data checks ({untrusted}); "
-            "the numbers are not trusted (allow_suspect=True to use them anyway)",
-            SuspectResultWarning,
-            stacklevel=3,
-        )
+    _warn_exported(source, notes, untrusted, allow_suspect)
     objects: Dict[str, Any] = json.loads(out)
     return objects
 
