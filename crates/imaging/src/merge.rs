@@ -431,19 +431,46 @@ fn refine_by_expected_signal(
     let h = pass.radiance.len() / stride.max(1);
     let r = EXPECTED_SIGNAL_RADIUS;
     let t_max = times_s.iter().copied().fold(0.0f64, f64::max);
+    // Per frame and code, Δt·u(z) and Δt²·u(z) (the products the sums below are made of, formed
+    // once), and per frame, channel and code Δt·u(z)·X_c(z), the numerator's term without a
+    // dark frame.
+    let u: [f64; LEVELS] = std::array::from_fn(|z| f64::from(tables.w[z]));
+    let tu: Vec<[f64; LEVELS]> = times_s
+        .iter()
+        .map(|&t| std::array::from_fn(|z| t * u[z]))
+        .collect();
+    let ttu: Vec<[f64; LEVELS]> = times_s
+        .iter()
+        .map(|&t| std::array::from_fn(|z| t * t * u[z]))
+        .collect();
+    let tux: Vec<Vec<[f64; LEVELS]>> = tu
+        .iter()
+        .map(|tu_j| {
+            (0..ch)
+                .map(|c| std::array::from_fn(|z| tu_j[z] * tables.x[c][z]))
+                .collect()
+        })
+        .collect();
     let mut out = pass.radiance.to_vec();
     out.par_chunks_mut(stride)
         .enumerate()
         .for_each(|(y, row_out)| {
+            let row = y * stride..(y + 1) * stride;
+            let rows: Vec<&[u8]> = frames.iter().map(|f| &f.data()[row.clone()]).collect();
+            let dark_row = dark.map(|d| &d.data()[row.clone()]);
             // Window sums of the valid first-pass radiance: rows y − r ..= y + r, then along x.
             let (y0, y1) = (y.saturating_sub(r), (y + r).min(h - 1));
             let mut col_sum = vec![0.0f64; stride];
             let mut col_n = vec![0u32; stride];
             for yy in y0..=y1 {
                 let base = yy * stride;
+                let (m, v) = (
+                    &pass.mask[base..base + stride],
+                    &pass.radiance[base..base + stride],
+                );
                 for k in 0..stride {
-                    if pass.mask[base + k] == 0 {
-                        let v = f64::from(pass.radiance[base + k]);
+                    if m[k] == 0 {
+                        let v = f64::from(v[k]);
                         if v.is_finite() {
                             col_sum[k] += v;
                             col_n[k] += 1;
@@ -451,11 +478,12 @@ fn refine_by_expected_signal(
                     }
                 }
             }
+            let mask_row = &pass.mask[row.clone()];
             for x in 0..w {
                 let (x0, x1) = (x.saturating_sub(r), (x + r).min(w - 1));
                 for c in 0..ch {
                     let k = x * ch + c;
-                    if pass.mask[y * stride + k] != 0 {
+                    if mask_row[k] != 0 {
                         continue;
                     }
                     let (mut s, mut n) = (0.0f64, 0u32);
@@ -467,17 +495,29 @@ fn refine_by_expected_signal(
                         continue;
                     }
                     let e_hat = s / f64::from(n);
-                    let i = y * stride + k;
-                    let xd = dark.map_or(0.0, |d| tables.x[c][usize::from(d.data()[i])]);
                     let (mut nu, mut de) = (0.0f64, 0.0f64);
-                    for (f, &t) in frames.iter().zip(times_s) {
-                        if e_hat * t + xd < x_floor[c] && t < t_max {
-                            continue;
+                    match dark_row {
+                        None => {
+                            for (j, (zs, &t)) in rows.iter().zip(times_s).enumerate() {
+                                if e_hat * t < x_floor[c] && t < t_max {
+                                    continue;
+                                }
+                                let z = usize::from(zs[k]);
+                                nu += tux[j][c][z];
+                                de += ttu[j][z];
+                            }
                         }
-                        let z = usize::from(f.data()[i]);
-                        let u = f64::from(tables.w[z]);
-                        nu += t * u * (tables.x[c][z] - xd);
-                        de += t * t * u;
+                        Some(d) => {
+                            let xd = tables.x[c][usize::from(d[k])];
+                            for (j, (zs, &t)) in rows.iter().zip(times_s).enumerate() {
+                                if e_hat * t + xd < x_floor[c] && t < t_max {
+                                    continue;
+                                }
+                                let z = usize::from(zs[k]);
+                                nu += tu[j][z] * (tables.x[c][z] - xd);
+                                de += ttu[j][z];
+                            }
+                        }
                     }
                     if nu > 0.0 && de > 0.0 {
                         row_out[k] = (nu / de) as f32;
