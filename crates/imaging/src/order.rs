@@ -116,11 +116,17 @@ where
             // Every key (the others' sum) is a whole number; when they are small (8-bit codes:
             // at most 255 · P) the darkest are found by counting keys, otherwise by selection.
             let max_key = total.iter().copied().fold(0.0f64, f64::max);
+            let whole = max_key <= COUNTED_KEYS as f64 && total.iter().all(|t| t.fract() == 0.0);
+            let total_u32: Vec<u32> = if whole {
+                total.iter().map(|&t| t as u32).collect()
+            } else {
+                Vec::new()
+            };
             frames
                 .par_iter()
                 .map(|f| {
-                    let v = if max_key <= COUNTED_KEYS as f64 {
-                        darkest_by_counting(f.data(), &idx, &total, take)
+                    let v = if whole {
+                        darkest_by_counting(f.data(), &idx, &total_u32, max_key as usize, take)
                     } else {
                         darkest_by_selection(f.data(), &idx, &total, take)
                     };
@@ -196,23 +202,29 @@ fn darkest_by_selection<T: Copy + Into<f64>>(
         .collect()
 }
 
-/// [`darkest_by_selection`]'s values (the same set) by counting the keys, all at most
-/// [`COUNTED_KEYS`]: the key K at which the count reaches `take`, then every candidate below K and
-/// the first in raster order at K.
+/// [`darkest_by_selection`]'s values (the same set) by counting the keys, all at most `max_key`
+/// (≤ [`COUNTED_KEYS`]; the codes whole numbers, so the key is the others' sum in integers): the
+/// key K at which the count reaches `take`, then every candidate below K and the first in raster
+/// order at K.
 fn darkest_by_counting<T: Copy + Into<f64>>(
     data: &[T],
     idx: &[usize],
-    total: &[f64],
+    total: &[u32],
+    max_key: usize,
     take: usize,
 ) -> Vec<f64> {
-    let mut count = vec![0u32; COUNTED_KEYS + 1];
+    let key = |pos: usize| -> u32 {
+        let own: f64 = data[idx[pos]].into();
+        total[pos].saturating_sub(own as u32)
+    };
+    let mut count = vec![0u32; max_key + 1];
     for pos in 0..idx.len() {
-        count[others_key(data, idx, total, pos) as usize] += 1;
+        count[key(pos) as usize] += 1;
     }
-    let (mut below, mut cut) = (0usize, 0u64);
-    for (key, &n) in count.iter().enumerate() {
+    let (mut below, mut cut) = (0usize, 0u32);
+    for (k, &n) in count.iter().enumerate() {
         if below + n as usize >= take {
-            cut = key as u64;
+            cut = k as u32;
             break;
         }
         below += n as usize;
@@ -220,9 +232,9 @@ fn darkest_by_counting<T: Copy + Into<f64>>(
     let mut at_cut = take - below;
     let mut v = Vec::with_capacity(take);
     for pos in 0..idx.len() {
-        let key = others_key(data, idx, total, pos);
-        if key < cut || (key == cut && at_cut > 0) {
-            if key == cut {
+        let k = key(pos);
+        if k < cut || (k == cut && at_cut > 0) {
+            if k == cut {
                 at_cut -= 1;
             }
             v.push(data[idx[pos]].into());
