@@ -479,6 +479,9 @@ fn refine_by_expected_signal(
                 }
             }
             let mask_row = &pass.mask[row.clone()];
+            // ê per pixel-channel of the row: the window's mean valid radiance, or −1 where the
+            // pixel-channel keeps its first-pass value (flagged, or no positive mean around it).
+            let mut e_hat = vec![-1.0f64; stride];
             for x in 0..w {
                 let (x0, x1) = (x.saturating_sub(r), (x + r).min(w - 1));
                 for c in 0..ch {
@@ -494,38 +497,88 @@ fn refine_by_expected_signal(
                     if n == 0 || s <= 0.0 {
                         continue;
                     }
-                    let e_hat = s / f64::from(n);
-                    let (mut nu, mut de) = (0.0f64, 0.0f64);
-                    match dark_row {
-                        None => {
-                            for (j, (zs, &t)) in rows.iter().zip(times_s).enumerate() {
-                                if e_hat * t < x_floor[c] && t < t_max {
-                                    continue;
-                                }
-                                let z = usize::from(zs[k]);
-                                nu += tux[j][c][z];
-                                de += ttu[j][z];
-                            }
+                    e_hat[k] = s / f64::from(n);
+                }
+            }
+            match (dark_row, ch) {
+                (None, 1) => {
+                    refine_pixels::<1>(&rows, times_s, t_max, &tux, &ttu, x_floor, &e_hat, row_out)
+                }
+                (None, 3) => {
+                    refine_pixels::<3>(&rows, times_s, t_max, &tux, &ttu, x_floor, &e_hat, row_out)
+                }
+                (None, 4) => {
+                    refine_pixels::<4>(&rows, times_s, t_max, &tux, &ttu, x_floor, &e_hat, row_out)
+                }
+                _ => {
+                    for (k, &e) in e_hat.iter().enumerate() {
+                        if e <= 0.0 {
+                            continue;
                         }
-                        Some(d) => {
-                            let xd = tables.x[c][usize::from(d[k])];
-                            for (j, (zs, &t)) in rows.iter().zip(times_s).enumerate() {
-                                if e_hat * t + xd < x_floor[c] && t < t_max {
-                                    continue;
-                                }
-                                let z = usize::from(zs[k]);
-                                nu += tu[j][z] * (tables.x[c][z] - xd);
-                                de += ttu[j][z];
+                        let c = k % ch;
+                        let xd = dark_row.map_or(0.0, |d| tables.x[c][usize::from(d[k])]);
+                        let (mut nu, mut de) = (0.0f64, 0.0f64);
+                        for (j, (zs, &t)) in rows.iter().zip(times_s).enumerate() {
+                            if e * t + xd < x_floor[c] && t < t_max {
+                                continue;
                             }
+                            let z = usize::from(zs[k]);
+                            nu += tu[j][z] * (tables.x[c][z] - xd);
+                            de += ttu[j][z];
                         }
-                    }
-                    if nu > 0.0 && de > 0.0 {
-                        row_out[k] = (nu / de) as f32;
+                        if nu > 0.0 && de > 0.0 {
+                            row_out[k] = (nu / de) as f32;
+                        }
                     }
                 }
             }
         });
     out
+}
+
+/// One row of [`refine_by_expected_signal`] without a dark frame, `N` channels: a pixel's channels
+/// summed together frame by frame (independent sums, each in the order of the frames, so each
+/// value is the one a channel-by-channel loop gives: Σ Δt·u·X over the frames kept, over
+/// Σ Δt²·u). `e_hat` is −1 where a pixel-channel keeps its first-pass value.
+fn refine_pixels<const N: usize>(
+    rows: &[&[u8]],
+    times_s: &[f64],
+    t_max: f64,
+    tux: &[Vec<[f64; LEVELS]>],
+    ttu: &[[f64; LEVELS]],
+    x_floor: &[f64],
+    e_hat: &[f64],
+    row_out: &mut [f32],
+) {
+    let floor: [f64; N] = std::array::from_fn(|c| x_floor[c]);
+    for (x, (e, out)) in e_hat
+        .chunks_exact(N)
+        .zip(row_out.chunks_exact_mut(N))
+        .enumerate()
+    {
+        let active: [bool; N] = std::array::from_fn(|c| e[c] > 0.0);
+        if !active.iter().any(|&a| a) {
+            continue;
+        }
+        let (mut nu, mut de) = ([0.0f64; N], [0.0f64; N]);
+        for ((zs, &t), (tx, tt)) in rows.iter().zip(times_s).zip(tux.iter().zip(ttu)) {
+            let z = &zs[x * N..(x + 1) * N];
+            let longest = !(t < t_max);
+            for c in 0..N {
+                // Left out: expected below the floor, unless the longest exposure.
+                if active[c] && (longest || !(e[c] * t < floor[c])) {
+                    let zi = usize::from(z[c]);
+                    nu[c] += tx[c][zi];
+                    de[c] += tt[zi];
+                }
+            }
+        }
+        for c in 0..N {
+            if active[c] && nu[c] > 0.0 && de[c] > 0.0 {
+                out[c] = (nu[c] / de[c]) as f32;
+            }
+        }
+    }
 }
 
 /// The paper's hat over the code range above a dark frame's code `zd`: w = min(z − zd, 255 − z) for
