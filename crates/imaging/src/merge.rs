@@ -563,10 +563,11 @@ fn refine_pixels<const N: usize>(
         let (mut nu, mut de) = ([0.0f64; N], [0.0f64; N]);
         for ((zs, &t), (tx, tt)) in rows.iter().zip(times_s).zip(tux.iter().zip(ttu)) {
             let z = &zs[x * N..(x + 1) * N];
-            let longest = !(t < t_max);
+            let shorter = t < t_max;
             for c in 0..N {
                 // Left out: expected below the floor, unless the longest exposure.
-                if active[c] && (longest || !(e[c] * t < floor[c])) {
+                let left_out = e[c] * t < floor[c] && shorter;
+                if active[c] && !left_out {
                     let zi = usize::from(z[c]);
                     nu[c] += tx[c][zi];
                     de[c] += tt[zi];
