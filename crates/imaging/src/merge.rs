@@ -431,19 +431,46 @@ fn refine_by_expected_signal(
     let h = pass.radiance.len() / stride.max(1);
     let r = EXPECTED_SIGNAL_RADIUS;
     let t_max = times_s.iter().copied().fold(0.0f64, f64::max);
+    // Per frame and code, Δt·u(z) and Δt²·u(z) (the products the sums below are made of, formed
+    // once), and per frame, channel and code Δt·u(z)·X_c(z), the numerator's term without a
+    // dark frame.
+    let u: [f64; LEVELS] = std::array::from_fn(|z| f64::from(tables.w[z]));
+    let tu: Vec<[f64; LEVELS]> = times_s
+        .iter()
+        .map(|&t| std::array::from_fn(|z| t * u[z]))
+        .collect();
+    let ttu: Vec<[f64; LEVELS]> = times_s
+        .iter()
+        .map(|&t| std::array::from_fn(|z| t * t * u[z]))
+        .collect();
+    let tux: Vec<Vec<[f64; LEVELS]>> = tu
+        .iter()
+        .map(|tu_j| {
+            (0..ch)
+                .map(|c| std::array::from_fn(|z| tu_j[z] * tables.x[c][z]))
+                .collect()
+        })
+        .collect();
     let mut out = pass.radiance.to_vec();
     out.par_chunks_mut(stride)
         .enumerate()
         .for_each(|(y, row_out)| {
+            let row = y * stride..(y + 1) * stride;
+            let rows: Vec<&[u8]> = frames.iter().map(|f| &f.data()[row.clone()]).collect();
+            let dark_row = dark.map(|d| &d.data()[row.clone()]);
             // Window sums of the valid first-pass radiance: rows y − r ..= y + r, then along x.
             let (y0, y1) = (y.saturating_sub(r), (y + r).min(h - 1));
             let mut col_sum = vec![0.0f64; stride];
             let mut col_n = vec![0u32; stride];
             for yy in y0..=y1 {
                 let base = yy * stride;
+                let (m, v) = (
+                    &pass.mask[base..base + stride],
+                    &pass.radiance[base..base + stride],
+                );
                 for k in 0..stride {
-                    if pass.mask[base + k] == 0 {
-                        let v = f64::from(pass.radiance[base + k]);
+                    if m[k] == 0 {
+                        let v = f64::from(v[k]);
                         if v.is_finite() {
                             col_sum[k] += v;
                             col_n[k] += 1;
@@ -451,11 +478,15 @@ fn refine_by_expected_signal(
                     }
                 }
             }
+            let mask_row = &pass.mask[row.clone()];
+            // ê per pixel-channel of the row: the window's mean valid radiance, or −1 where the
+            // pixel-channel keeps its first-pass value (flagged, or no positive mean around it).
+            let mut e_hat = vec![-1.0f64; stride];
             for x in 0..w {
                 let (x0, x1) = (x.saturating_sub(r), (x + r).min(w - 1));
                 for c in 0..ch {
                     let k = x * ch + c;
-                    if pass.mask[y * stride + k] != 0 {
+                    if mask_row[k] != 0 {
                         continue;
                     }
                     let (mut s, mut n) = (0.0f64, 0u32);
@@ -466,26 +497,89 @@ fn refine_by_expected_signal(
                     if n == 0 || s <= 0.0 {
                         continue;
                     }
-                    let e_hat = s / f64::from(n);
-                    let i = y * stride + k;
-                    let xd = dark.map_or(0.0, |d| tables.x[c][usize::from(d.data()[i])]);
-                    let (mut nu, mut de) = (0.0f64, 0.0f64);
-                    for (f, &t) in frames.iter().zip(times_s) {
-                        if e_hat * t + xd < x_floor[c] && t < t_max {
+                    e_hat[k] = s / f64::from(n);
+                }
+            }
+            match (dark_row, ch) {
+                (None, 1) => {
+                    refine_pixels::<1>(&rows, times_s, t_max, &tux, &ttu, x_floor, &e_hat, row_out)
+                }
+                (None, 3) => {
+                    refine_pixels::<3>(&rows, times_s, t_max, &tux, &ttu, x_floor, &e_hat, row_out)
+                }
+                (None, 4) => {
+                    refine_pixels::<4>(&rows, times_s, t_max, &tux, &ttu, x_floor, &e_hat, row_out)
+                }
+                _ => {
+                    for (k, &e) in e_hat.iter().enumerate() {
+                        if e <= 0.0 {
                             continue;
                         }
-                        let z = usize::from(f.data()[i]);
-                        let u = f64::from(tables.w[z]);
-                        nu += t * u * (tables.x[c][z] - xd);
-                        de += t * t * u;
-                    }
-                    if nu > 0.0 && de > 0.0 {
-                        row_out[k] = (nu / de) as f32;
+                        let c = k % ch;
+                        let xd = dark_row.map_or(0.0, |d| tables.x[c][usize::from(d[k])]);
+                        let (mut nu, mut de) = (0.0f64, 0.0f64);
+                        for (j, (zs, &t)) in rows.iter().zip(times_s).enumerate() {
+                            if e * t + xd < x_floor[c] && t < t_max {
+                                continue;
+                            }
+                            let z = usize::from(zs[k]);
+                            nu += tu[j][z] * (tables.x[c][z] - xd);
+                            de += ttu[j][z];
+                        }
+                        if nu > 0.0 && de > 0.0 {
+                            row_out[k] = (nu / de) as f32;
+                        }
                     }
                 }
             }
         });
     out
+}
+
+/// One row of [`refine_by_expected_signal`] without a dark frame, `N` channels: a pixel's channels
+/// summed together frame by frame (independent sums, each in the order of the frames, so each
+/// value is the one a channel-by-channel loop gives: Σ Δt·u·X over the frames kept, over
+/// Σ Δt²·u). `e_hat` is −1 where a pixel-channel keeps its first-pass value.
+fn refine_pixels<const N: usize>(
+    rows: &[&[u8]],
+    times_s: &[f64],
+    t_max: f64,
+    tux: &[Vec<[f64; LEVELS]>],
+    ttu: &[[f64; LEVELS]],
+    x_floor: &[f64],
+    e_hat: &[f64],
+    row_out: &mut [f32],
+) {
+    let floor: [f64; N] = std::array::from_fn(|c| x_floor[c]);
+    for (x, (e, out)) in e_hat
+        .chunks_exact(N)
+        .zip(row_out.chunks_exact_mut(N))
+        .enumerate()
+    {
+        let active: [bool; N] = std::array::from_fn(|c| e[c] > 0.0);
+        if !active.iter().any(|&a| a) {
+            continue;
+        }
+        let (mut nu, mut de) = ([0.0f64; N], [0.0f64; N]);
+        for ((zs, &t), (tx, tt)) in rows.iter().zip(times_s).zip(tux.iter().zip(ttu)) {
+            let z = &zs[x * N..(x + 1) * N];
+            let shorter = t < t_max;
+            for c in 0..N {
+                // Left out: expected below the floor, unless the longest exposure.
+                let left_out = e[c] * t < floor[c] && shorter;
+                if active[c] && !left_out {
+                    let zi = usize::from(z[c]);
+                    nu[c] += tx[c][zi];
+                    de[c] += tt[zi];
+                }
+            }
+        }
+        for c in 0..N {
+            if active[c] && nu[c] > 0.0 && de[c] > 0.0 {
+                out[c] = (nu[c] / de[c]) as f32;
+            }
+        }
+    }
 }
 
 /// The paper's hat over the code range above a dark frame's code `zd`: w = min(z − zd, 255 − z) for

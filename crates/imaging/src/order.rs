@@ -70,6 +70,31 @@ where
     let step = subsample(n_px);
     let p = frames.len();
     let zero = T::default();
+    // The values the checks read (every `step`-th pixel's samples), and per value its codes summed
+    // over the bracket and whether any frame holds it above the low clip: one pass per frame
+    // (frames in order, so each sum is formed as a pixel-by-pixel loop over the frames forms it).
+    let sampled: Vec<usize> = (0..n_px)
+        .step_by(step)
+        .flat_map(|i| i * ch..(i + 1) * ch)
+        .collect();
+    let (sums, lit) = {
+        let mut sums = vec![0.0f64; sampled.len()];
+        let mut lit = vec![false; sampled.len()];
+        for f in frames {
+            let data = f.data();
+            sums.par_chunks_mut(16_384)
+                .zip(lit.par_chunks_mut(16_384))
+                .zip(sampled.par_chunks(16_384))
+                .for_each(|((s, l), ks)| {
+                    for ((s, l), &k) in s.iter_mut().zip(l.iter_mut()).zip(ks) {
+                        let v = data[k];
+                        *l |= v > zero;
+                        *s += v.into();
+                    }
+                });
+        }
+        (sums, lit)
+    };
     // Per channel, per frame (in parallel: every frame's floor is a selection over the channel's
     // pixels).
     let by_channel: Vec<Vec<f64>> = (0..ch)
@@ -77,17 +102,10 @@ where
         .map(|c| {
             // Pixels with some value above the low clip, and their summed codes.
             let (mut idx, mut total) = (Vec::new(), Vec::new());
-            for i in (0..n_px).step_by(step) {
-                let k = i * ch + c;
-                let (mut key, mut any) = (0.0, false);
-                for f in frames {
-                    let v = f.data()[k];
-                    any |= v > zero;
-                    key += v.into();
-                }
-                if any {
-                    idx.push(k);
-                    total.push(key);
+            for pos in (c..sampled.len()).step_by(ch) {
+                if lit[pos] {
+                    idx.push(sampled[pos]);
+                    total.push(sums[pos]);
                 }
             }
             if idx.is_empty() {
@@ -95,31 +113,24 @@ where
             }
             let take =
                 ((FLOOR_DARKEST_FRACTION * idx.len() as f64).ceil() as usize).clamp(1, idx.len());
+            // Every key (the others' sum) is a whole number; when they are small (8-bit codes:
+            // at most 255 · P) the darkest are found by counting keys, otherwise by selection.
+            let max_key = total.iter().copied().fold(0.0f64, f64::max);
+            let whole = max_key <= COUNTED_KEYS as f64 && total.iter().all(|t| t.fract() == 0.0);
+            let total_u32: Vec<u32> = if whole {
+                total.iter().map(|&t| t as u32).collect()
+            } else {
+                Vec::new()
+            };
             frames
                 .par_iter()
                 .map(|f| {
-                    // The darkest pixels by the *other* frames' codes, so that frame j's own noise does
-                    // not choose them (which would pull its floor low). The codes are whole numbers:
-                    // the key (the others' sum) and the pixel's position packed into one integer,
-                    // so that equal sums are taken in raster order.
-                    let mut keyed: Vec<u64> = idx
-                        .iter()
-                        .zip(&total)
-                        .enumerate()
-                        .map(|(pos, (&k, &t))| {
-                            let others = (t - f.data()[k].into()).max(0.0) as u64;
-                            (others.min(u64::from(u32::MAX)) << 32) | pos as u64
-                        })
-                        .collect();
-                    keyed.select_nth_unstable(take - 1);
-                    let mut v: Vec<f64> = keyed[..take]
-                        .iter()
-                        .map(|&key| f.data()[idx[(key & u64::from(u32::MAX)) as usize]].into())
-                        .collect();
-                    v.sort_by(f64::total_cmp);
-                    let q =
-                        ((FLOOR_QUANTILE * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
-                    v[q]
+                    let v = if whole {
+                        darkest_by_counting(f.data(), &idx, &total_u32, max_key as usize, take)
+                    } else {
+                        darkest_by_selection(f.data(), &idx, &total, take)
+                    };
+                    quantile_of(v)
                 })
                 .collect()
         })
@@ -158,6 +169,85 @@ where
         signal_fraction,
         has_signal,
     })
+}
+
+/// Keys (sums of a pixel's codes over the bracket's other frames) up to this value are selected by
+/// counting ([`darkest_by_counting`]): every 8-bit bracket of up to 257 frames.
+const COUNTED_KEYS: usize = 1 << 16;
+
+/// The key of the candidate at `pos` for frame `data`: the sum of its codes over the *other*
+/// frames (`total` less this frame's code), so that the frame's own noise does not choose the
+/// darkest pixels (which would pull its floor low).
+#[inline]
+fn others_key<T: Copy + Into<f64>>(data: &[T], idx: &[usize], total: &[f64], pos: usize) -> u64 {
+    let own: f64 = data[idx[pos]].into();
+    ((total[pos] - own).max(0.0) as u64).min(u64::from(u32::MAX))
+}
+
+/// Frame `data`'s values at the `take` darkest candidates by [`others_key`], equal keys taken in
+/// raster order, found by selection on the key and the position packed into one integer.
+fn darkest_by_selection<T: Copy + Into<f64>>(
+    data: &[T],
+    idx: &[usize],
+    total: &[f64],
+    take: usize,
+) -> Vec<f64> {
+    let mut keyed: Vec<u64> = (0..idx.len())
+        .map(|pos| (others_key(data, idx, total, pos) << 32) | pos as u64)
+        .collect();
+    keyed.select_nth_unstable(take - 1);
+    keyed[..take]
+        .iter()
+        .map(|&key| data[idx[(key & u64::from(u32::MAX)) as usize]].into())
+        .collect()
+}
+
+/// [`darkest_by_selection`]'s values (the same set) by counting the keys, all at most `max_key`
+/// (≤ [`COUNTED_KEYS`]; the codes whole numbers, so the key is the others' sum in integers): the
+/// key K at which the count reaches `take`, then every candidate below K and the first in raster
+/// order at K.
+fn darkest_by_counting<T: Copy + Into<f64>>(
+    data: &[T],
+    idx: &[usize],
+    total: &[u32],
+    max_key: usize,
+    take: usize,
+) -> Vec<f64> {
+    let key = |pos: usize| -> u32 {
+        let own: f64 = data[idx[pos]].into();
+        total[pos].saturating_sub(own as u32)
+    };
+    let mut count = vec![0u32; max_key + 1];
+    for pos in 0..idx.len() {
+        count[key(pos) as usize] += 1;
+    }
+    let (mut below, mut cut) = (0usize, 0u32);
+    for (k, &n) in count.iter().enumerate() {
+        if below + n as usize >= take {
+            cut = k as u32;
+            break;
+        }
+        below += n as usize;
+    }
+    let mut at_cut = take - below;
+    let mut v = Vec::with_capacity(take);
+    for pos in 0..idx.len() {
+        let k = key(pos);
+        if k < cut || (k == cut && at_cut > 0) {
+            if k == cut {
+                at_cut -= 1;
+            }
+            v.push(data[idx[pos]].into());
+        }
+    }
+    v
+}
+
+/// The [`FLOOR_QUANTILE`] of `v` (the value at rank round(q · (n − 1)) in ascending order), `v`
+/// not empty.
+fn quantile_of(mut v: Vec<f64>) -> f64 {
+    let q = ((FLOOR_QUANTILE * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
+    *v.select_nth_unstable_by(q, f64::total_cmp).1
 }
 
 /// Checks that the frames of a bracket brighten with their exposure times: for each pair of frames

@@ -1168,50 +1168,88 @@ fn forward_toe_both(
         return None;
     }
     let bins = ((hi - lo) / width).ceil() as usize + 1;
-    let (mut sum, mut sum2, mut cnt) = (vec![0.0f64; bins], vec![0.0f64; bins], vec![0.0f64; bins]);
     let ln_t: Vec<f64> = times_s.iter().map(|t| t.ln()).collect();
-    for i in (0..n).step_by(step) {
-        let k = i * ch + c;
-        let (mut num, mut den) = (0.0f64, 0.0f64);
-        for (f, &t) in frames.iter().zip(times_s) {
-            let z = f.data()[k];
-            if trusted(z) {
-                num += t * x[usize::from(z)];
-                den += t * t;
-            }
-        }
-        if den == 0.0 {
-            continue;
-        }
-        // A frame that is not among the trusted ones leaves num/den as it is: its ln once.
-        let ln_all = if num > 0.0 {
-            (num / den).ln()
-        } else {
-            f64::NAN
-        };
-        for ((f, &t), &ln_tj) in frames.iter().zip(times_s).zip(&ln_t) {
-            let z = f.data()[k];
-            let u = if trusted(z) {
-                let (nj, dj) = (num - t * x[usize::from(z)], den - t * t);
-                if dj <= 0.0 || nj <= 0.0 {
-                    continue;
+    // Per frame, Δt·X(z) for every code (the products the pixel loop would form).
+    let tx: Vec<[f64; LEVELS]> = times_s
+        .iter()
+        .map(|&t| std::array::from_fn(|z| t * x[z]))
+        .collect();
+    // A leave-one-out exposure X̂ clearly outside [e^lo, e^hi) has its ln outside [lo, hi): it
+    // is passed over without taking the logarithm (the margin, 10⁻⁶ relative, is far beyond
+    // the logarithm's rounding, so every reading binned is binned as before).
+    let (x_lo, x_hi) = (lo.exp() * (1.0 - 1e-6), hi.exp() * (1.0 + 1e-6));
+    // The pixels in parallel, each chunk's bins added: the bins hold sums of whole codes, their
+    // squares and counts, exact in f64 whatever the order.
+    let pixels: Vec<usize> = (0..n).step_by(step).collect();
+    let zero = || (vec![0.0f64; bins], vec![0.0f64; bins], vec![0.0f64; bins]);
+    let (sum, sum2, cnt) = {
+        use rayon::prelude::*;
+        pixels
+            .par_chunks(8192)
+            .fold(zero, |(mut sum, mut sum2, mut cnt), chunk| {
+                for &i in chunk {
+                    let k = i * ch + c;
+                    let (mut num, mut den) = (0.0f64, 0.0f64);
+                    for (j, (f, &t)) in frames.iter().zip(times_s).enumerate() {
+                        let z = f.data()[k];
+                        if trusted(z) {
+                            num += tx[j][usize::from(z)];
+                            den += t * t;
+                        }
+                    }
+                    if den == 0.0 {
+                        continue;
+                    }
+                    // A frame that is not among the trusted ones leaves num/den as it is: its ln
+                    // once.
+                    let ln_all = if num > 0.0 {
+                        (num / den).ln()
+                    } else {
+                        f64::NAN
+                    };
+                    for (j, ((f, &t), &ln_tj)) in frames.iter().zip(times_s).zip(&ln_t).enumerate()
+                    {
+                        let z = f.data()[k];
+                        let u = if trusted(z) {
+                            let (nj, dj) = (num - tx[j][usize::from(z)], den - t * t);
+                            if dj <= 0.0 || nj <= 0.0 {
+                                continue;
+                            }
+                            let xj = t * nj / dj;
+                            if xj < x_lo || xj >= x_hi {
+                                continue;
+                            }
+                            xj.ln()
+                        } else {
+                            if ln_all.is_nan() {
+                                continue;
+                            }
+                            ln_tj + ln_all
+                        };
+                        if u < lo || u >= hi {
+                            continue;
+                        }
+                        let b = ((u - lo) / width) as usize;
+                        sum[b] += f64::from(z);
+                        sum2[b] += f64::from(z) * f64::from(z);
+                        cnt[b] += 1.0;
+                    }
                 }
-                (t * nj / dj).ln()
-            } else {
-                if ln_all.is_nan() {
-                    continue;
+                (sum, sum2, cnt)
+            })
+            .reduce(zero, |mut a, b| {
+                for (x, y) in a.0.iter_mut().zip(&b.0) {
+                    *x += y;
                 }
-                ln_tj + ln_all
-            };
-            if u < lo || u >= hi {
-                continue;
-            }
-            let b = ((u - lo) / width) as usize;
-            sum[b] += f64::from(z);
-            sum2[b] += f64::from(z) * f64::from(z);
-            cnt[b] += 1.0;
-        }
-    }
+                for (x, y) in a.1.iter_mut().zip(&b.1) {
+                    *x += y;
+                }
+                for (x, y) in a.2.iter_mut().zip(&b.2) {
+                    *x += y;
+                }
+                a
+            })
+    };
     if cnt.iter().sum::<f64>() < 2_000.0 {
         return None;
     }

@@ -100,6 +100,39 @@ pub fn registration(
     ch: usize,
     level: &(dyn Fn(usize, usize) -> f64 + Sync),
 ) -> Registration {
+    let mean_level = |j: usize, i: usize| (0..ch).map(|c| level(j, i + c)).sum::<f64>() / ch as f64;
+    registration_where(frames, w, h, ch, |j, i| mean_level(j, i) >= 0.5)
+}
+
+/// [`registration`] of 8-bit frames (saturation 255), the half-saturation test in whole codes:
+/// 2 Σ_c z_c against 255 · channels, the fractions' mean taken only at equality (where rounding
+/// could tip it), so each pixel is judged as [`registration`] judges it.
+pub fn registration_8bit(frames: &[scatterfit_imaging::ImageBuf<u8>]) -> Registration {
+    let Some(f0) = frames.first() else {
+        return registration_where(0, 0, 0, 1, |_, _| false);
+    };
+    let (w, h, ch) = (f0.width(), f0.height(), f0.channels());
+    let full = 255 * ch as u32;
+    registration_where(frames.len(), w, h, ch, |j, i| {
+        let px = &frames[j].data()[i..i + ch];
+        let twice = 2 * px.iter().map(|&z| u32::from(z)).sum::<u32>();
+        if twice == full {
+            px.iter().map(|&z| f64::from(z) / 255.0).sum::<f64>() / ch as f64 >= 0.5
+        } else {
+            twice > full
+        }
+    })
+}
+
+/// The centroids of the pixels for which `bright(j, i)` holds (frame `j`, the pixel's first
+/// sample at `i`), frame by frame in parallel, and their largest shift ([`Registration`]).
+fn registration_where(
+    frames: usize,
+    w: usize,
+    h: usize,
+    ch: usize,
+    bright: impl Fn(usize, usize) -> bool + Sync,
+) -> Registration {
     use rayon::prelude::*;
     // The frames in parallel.
     let centroids: Vec<Option<[f64; 2]>> = (0..frames)
@@ -109,9 +142,7 @@ pub fn registration(
             let mut edge = false;
             for y in 0..h {
                 for x in 0..w {
-                    let i = (y * w + x) * ch;
-                    let v = (0..ch).map(|c| level(j, i + c)).sum::<f64>() / ch as f64;
-                    if v >= 0.5 {
+                    if bright(j, (y * w + x) * ch) {
                         n += 1;
                         sx += x as f64;
                         sy += y as f64;

@@ -48,15 +48,8 @@ pub(super) fn merge_8bit(
             check_order(&bufs, stated, u8::MAX, signal.as_ref())
         })
         .map_err(imaging(&(cx.order)()))?;
-    corrections.registration = Some(corrections.timed("registration", || {
-        super::frames::registration(
-            bufs.len(),
-            bufs[0].width(),
-            bufs[0].height(),
-            bufs[0].channels(),
-            &|j, i| f64::from(bufs[j].data()[i]) / 255.0,
-        )
-    }));
+    corrections.registration =
+        Some(corrections.timed("registration", || super::frames::registration_8bit(&bufs)));
     let samples = cx
         .inputs
         .samples
@@ -84,6 +77,8 @@ pub(super) fn merge_8bit(
             (r, m, ResponseKind::Recovered, rms)
         }
     };
+    // The code pairs the noise-aware detection codes are measured on (below), counted once.
+    let pair_counts = corrections.timed("detection codes", || PairCounts::new(&bufs));
     // Exposure times from the frames: ratios of linearised codes in the well-exposed range.
     let mut times_used = stated.to_vec();
     if cx.inputs.exposure_correction != ExposureCorrection::Never {
@@ -100,7 +95,7 @@ pub(super) fn merge_8bit(
             let p = bufs.len();
             // The noise-aware detection code per channel: the expected exposure a pixel must have.
             let t = Instant::now();
-            let det = detection_codes(&bufs, &times_used, &response);
+            let det = detection_codes(&pair_counts, &times_used, &response);
             corrections.time("detection codes", t.elapsed().as_secs_f64());
             let t = Instant::now();
             let est = estimate_exposures(
@@ -186,7 +181,7 @@ pub(super) fn merge_8bit(
     // floor: a frame counts at a pixel only where the radiance around it predicts at least that,
     // so that readings censored at code 0 do not lift faint pixels (imaging::merge's second pass).
     let codes = corrections.timed("detection codes", || {
-        detection_codes(&bufs, &times_used, &response)
+        detection_codes(&pair_counts, &times_used, &response)
     });
     let mut floor = [DETECTION_CODE; 4];
     for (c, (f, &det)) in floor.iter_mut().zip(&codes).enumerate() {
@@ -736,6 +731,53 @@ pub(super) fn divide_flat(
     Ok((path.to_path_buf(), lo, hi))
 }
 
+/// The code pairs of consecutive frames that [`detection_codes`] reads, counted once for the
+/// bracket: per channel and pair of frames (j, j + 1), how many pixels read (z_j, z_{j+1}), both
+/// unclipped (neither 0 nor 255); at most about 2.6·10⁵ pixels per frame pair are read (a 24-MP
+/// frame is subsampled). The counts depend on the codes alone, so the response's rounds reuse
+/// them.
+pub(super) struct PairCounts {
+    /// Per channel, per pair: the code pairs met and how often, (z_j, z_{j+1}, count), z_j
+    /// ascending.
+    cells: Vec<Vec<Vec<(u8, u8, u32)>>>,
+}
+
+impl PairCounts {
+    pub(super) fn new(bufs: &[ImageBuf<u8>]) -> Self {
+        use rayon::prelude::*;
+        let ch = bufs[0].channels();
+        let pairs = bufs.len().saturating_sub(1);
+        let flat: Vec<Vec<(u8, u8, u32)>> = (0..ch * pairs)
+            .into_par_iter()
+            .map(|task| {
+                let (c, j) = (task / pairs.max(1), task % pairs.max(1));
+                let (a, b) = (bufs[j].data(), bufs[j + 1].data());
+                // At most ~2.6·10⁵ pixels per pair: plenty for the per-code scatter.
+                let step = (a.len() / ch / 262_144).max(1);
+                let mut count = vec![0u32; 256 * 256];
+                for i in (c..a.len()).step_by(ch * step) {
+                    let (z1, z2) = (a[i], b[i]);
+                    if z1 == 0 || z2 == u8::MAX || z1 == u8::MAX || z2 == 0 {
+                        continue;
+                    }
+                    count[usize::from(z1) * 256 + usize::from(z2)] += 1;
+                }
+                count
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, n)| **n > 0)
+                    .map(|(cell, &n)| ((cell / 256) as u8, (cell % 256) as u8, n))
+                    .collect()
+            })
+            .collect();
+        let mut cells: Vec<Vec<Vec<(u8, u8, u32)>>> = vec![Vec::with_capacity(pairs); ch];
+        for (task, v) in flat.into_iter().enumerate() {
+            cells[task / pairs.max(1)].push(v);
+        }
+        Self { cells }
+    }
+}
+
 /// Per channel, the lowest code from [`DETECTION_CODE`] up from which the linearised signal's
 /// relative noise stays within 1/[`DETECTION_SNR`] (codes 30–200 checked), measured on the bracket
 /// itself in the manner of the photon-transfer method, which reads a sensor's noise from pairs of
@@ -745,37 +787,32 @@ pub(super) fn divide_flat(
 /// is σ²(z) + σ²(z_{j+1}) ≈ σ²(z)(1 + 1/k) for shot noise (the brighter reading's relative
 /// variance a factor k smaller; for read noise it is 1 + 1/k², so σ is then overestimated by
 /// ≤ 8 % for k ≈ 1.9), so σ²(z) = var(q | z)/(1 + 1/k). Codes with fewer than 50 pairs are
-/// skipped; at most about 2.6·10⁵ pixels per frame pair are read (a 24-MP frame is subsampled).
-fn detection_codes(bufs: &[ImageBuf<u8>], times: &[f64], response: &ResponseCurve) -> Vec<u8> {
+/// skipped; the pixels read are those of [`PairCounts`] (q depends on the two codes only, so
+/// each code pair's q is weighted by its count).
+fn detection_codes(counts: &PairCounts, times: &[f64], response: &ResponseCurve) -> Vec<u8> {
     use rayon::prelude::*;
-    let ch = bufs[0].channels();
-    (0..ch)
-        .into_par_iter()
-        .map(|c| {
+    counts
+        .cells
+        .par_iter()
+        .enumerate()
+        .map(|(c, pairs)| {
             let g = &response.tables()[if response.channels() == 1 { 0 } else { c }];
             let (mut n, mut s1, mut s2) = ([0f64; 256], [0f64; 256], [0f64; 256]);
             let mut kk = 0.0f64;
-            let mut pairs = 0.0f64;
-            for j in 0..bufs.len().saturating_sub(1) {
+            let mut n_pairs = 0.0f64;
+            for (j, cells) in pairs.iter().enumerate() {
                 let ln_k = (times[j + 1] / times[j]).ln();
                 kk += ln_k;
-                pairs += 1.0;
-                let (a, b) = (bufs[j].data(), bufs[j + 1].data());
-                // At most ~2.6·10⁵ pixels per pair: plenty for the per-code scatter.
-                let step = (a.len() / ch / 262_144).max(1);
-                for i in (c..a.len()).step_by(ch * step) {
-                    let (z1, z2) = (a[i], b[i]);
-                    if z1 == 0 || z2 == u8::MAX || z1 == u8::MAX || z2 == 0 {
-                        continue;
-                    }
+                n_pairs += 1.0;
+                for &(z1, z2, m) in cells {
                     let q = g[usize::from(z2)] - g[usize::from(z1)] - ln_k;
-                    let z = usize::from(z1);
-                    n[z] += 1.0;
-                    s1[z] += q;
-                    s2[z] += q * q;
+                    let (z, m) = (usize::from(z1), f64::from(m));
+                    n[z] += m;
+                    s1[z] += m * q;
+                    s2[z] += m * q * q;
                 }
             }
-            let k = (kk / pairs.max(1.0)).exp();
+            let k = (kk / n_pairs.max(1.0)).exp();
             let limit = 1.0 / (DETECTION_SNR * DETECTION_SNR);
             let ok = |z: usize| {
                 if n[z] < 50.0 {

@@ -565,19 +565,18 @@ pub fn read_frames(
 fn linearise_u8(frame: &ImageBuf<u8>, response: &ResponseCurve) -> Vec<f32> {
     let tables = response.tables();
     let ch = frame.channels();
-    frame
-        .data()
-        .iter()
-        .enumerate()
-        .map(|(i, &z)| {
-            let g = &tables[if tables.len() == 1 { 0 } else { i % ch }];
-            if z == 0 {
-                0.0
-            } else {
-                g[usize::from(z)].exp() as f32
-            }
+    // exp g(z) per channel and code, once (the same values as per sample).
+    let lin: Vec<[f32; LEVELS]> = (0..ch)
+        .map(|c| {
+            let g = &tables[if tables.len() == 1 { 0 } else { c }];
+            std::array::from_fn(|z| if z == 0 { 0.0 } else { g[z].exp() as f32 })
         })
-        .collect()
+        .collect();
+    let mut out = Vec::with_capacity(frame.data().len());
+    for px in frame.data().chunks_exact(ch) {
+        out.extend(px.iter().zip(&lin).map(|(&z, l)| l[usize::from(z)]));
+    }
+    out
 }
 
 /// Merges a bracket read by [`read_frames`]: 8-bit frames through the given response
