@@ -94,7 +94,7 @@ impl GPrior {
             GSource::Fit => self.range.or_else(|| {
                 scatterfit_mc::bundled_grid()
                     .ok()
-                    .and_then(crate::anisotropy_fit::default_search_range)
+                    .and_then(default_search_range)
             }),
             GSource::Given => None,
             GSource::Range => self.range,
@@ -559,6 +559,16 @@ pub(crate) fn warm_start<E: std::fmt::Display>(
     })
 }
 
+/// The default search range for `g = "fit"` without a `g_range`: the widest interval of g the
+/// grid covers (0–0.95 since the g 0.3/0.5/0.7 tables); `None` when it covers single nodes only.
+pub fn default_search_range(grid: &McGridSet) -> Option<[f64; 2]> {
+    grid.covered()
+        .into_iter()
+        .filter(|(a, b)| b > a)
+        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+        .map(|(a, b)| [a, b])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -628,10 +638,7 @@ mod tests {
         };
         assert_eq!(fit.source(), GSource::Fit);
         let grid = scatterfit_mc::bundled_grid().unwrap();
-        assert_eq!(
-            fit.propagated_range(),
-            crate::anisotropy_fit::default_search_range(grid)
-        );
+        assert_eq!(fit.propagated_range(), default_search_range(grid));
         assert!(fit.is_centred() && fit.check().is_ok());
         for bad in [
             GPrior {

@@ -51,6 +51,7 @@ use scatterfit_mc::McGridSet;
 use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
 use serde::Serialize;
 
+pub use crate::anisotropy::default_search_range;
 use crate::anisotropy::{AlbedoAtG, warm_start};
 use crate::fit::{ChannelOutcome, FitSettings};
 use crate::spectro::SpectroStage;
@@ -141,16 +142,6 @@ impl GFit {
             reason: self.reason.clone(),
         }
     }
-}
-
-/// The default search range for `g = "fit"` without a `g_range`: the widest interval of g the
-/// grid covers (0–0.95 since the g 0.3/0.5/0.7 tables); `None` when it covers single nodes only.
-pub fn default_search_range(grid: &McGridSet) -> Option<[f64; 2]> {
-    grid.covered()
-        .into_iter()
-        .filter(|(a, b)| b > a)
-        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
-        .map(|(a, b)| [a, b])
 }
 
 /// The scan's points in `range`: steps of [`SCAN_STEP_COARSE`] below [`SCAN_FINE_FROM`] and of
