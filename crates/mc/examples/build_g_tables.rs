@@ -9,6 +9,11 @@
 //! cargo run --release -p scatterfit-mc --example build_g_tables -- --out DIR \
 //!     [--photons P] [--seed S] [--g G,G,…] [--eta E,E,…] [--spacing reduced]
 //! ```
+//! Each table also gets low-albedo nodes down to α′ 0.01 from a short run of their own
+//! (`scatterfit_mc::LowAlbedoRun`, 160 P photons). `--add-low-albedos` instead gives every table
+//! already in OUT (of the `--g` listed, if given) that lacks them its low-albedo nodes (the shipped tables: seconds each), leaving
+//! the rest of each file as it was.
+//!
 //! `--spacing reduced` spaces the albedo nodes equally in √(1 − α′) instead of √(1 − a)
 //! (`scatterfit_mc::AlbedoSpacing`), halving the last interval toward α′ → 1 at g = 0.9.
 //! Defaults: P = 1e6 full-length photons (16 P and 4 P in the shorter strata), seed 1, and the
@@ -62,6 +67,10 @@ fn main() {
         list,
     );
     std::fs::create_dir_all(&out).expect("output folder");
+    if args.iter().any(|a| a == "--add-low-albedos") {
+        add_low_albedos(&out, photons, value("--g").map(list));
+        return;
+    }
     for &g in &gs {
         for &eta in &etas {
             let path = out.join(format!("mc-white-eta{eta:.2}-g{g:.2}.json"));
@@ -73,6 +82,8 @@ fn main() {
             if reduced {
                 spec.albedo_spacing = scatterfit_mc::AlbedoSpacing::SqrtOneMinusReducedAlbedo;
             }
+            let spec =
+                layout::with_low_albedos(spec, layout::LOW_ALBEDO_PHOTONS_PER_PHOTON * photons);
             let t0 = std::time::Instant::now();
             let tally = simulate(&spec.white().expect("white spec"), &|_| {}).expect("simulate");
             let secs = t0.elapsed().as_secs_f64();
@@ -98,5 +109,51 @@ fn main() {
                 std::fs::metadata(&path).map_or(0, |m| m.len())
             );
         }
+    }
+}
+
+/// Gives every table in `dir` (of the g in `gs`, if given) without low-albedo nodes its nodes down
+/// to α′ 0.01, with `LOW_ALBEDO_PHOTONS_PER_PHOTON` × `photons` in their run, and writes it back in compact form (one line of log per table).
+fn add_low_albedos(dir: &std::path::Path, photons: u64, gs: Option<Vec<f64>>) {
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .expect("table folder")
+        .map(|e| e.expect("folder entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let table = McTable::load(&path).expect("a table");
+        let g = table.spec().g;
+        if table.spec().low_albedos.is_some()
+            || g == 0.0
+            || gs
+                .as_ref()
+                .is_some_and(|gs| !gs.iter().any(|&x| (x - g).abs() < 1e-9))
+        {
+            continue;
+        }
+        let t0 = std::time::Instant::now();
+        let spec = layout::with_low_albedos(
+            table.spec().clone(),
+            layout::LOW_ALBEDO_PHOTONS_PER_PHOTON * photons,
+        );
+        let low = spec.low_albedos.clone().expect("just set");
+        let nodes = low.albedo_count;
+        let table = match table.with_low_albedos(low) {
+            Ok(t) => t.compact(),
+            Err(e) => {
+                println!("FAILED {}: {e}", path.display());
+                continue;
+            }
+        };
+        table.save(&path).expect("write");
+        let chi = &table.chi2_per_bin()[..nodes];
+        println!(
+            "{}: {nodes} low-albedo nodes in {:.1} s, χ²/bin {:.2}–{:.2}",
+            path.display(),
+            t0.elapsed().as_secs_f64(),
+            chi.iter().cloned().fold(f64::INFINITY, f64::min),
+            chi.iter().cloned().fold(0.0, f64::max),
+        );
     }
 }

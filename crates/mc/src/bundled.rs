@@ -62,8 +62,10 @@ macro_rules! g_table {
 /// (g 0.95 had η 1.0, 1.4, 1.8, 2.4 until 2026-11-27: Catmull-Rom over 0.4–0.6 in η was up to 4.6 %
 /// off in shape and 6.7·10⁻³ in the total, CHANGELOG.md "The g 0.95 node's η layout filled in");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
-/// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)).
-/// About 45 KB each, 4.2 MB in all (the g = 0 set: 0.75 MB).
+/// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)),
+/// and below them nodes down to α′ 0.01 from a short run of their own (1.6·10⁷ photons stopped
+/// after a few dozen interactions; [`crate::LowAlbedoRun`], added 2026-11-29: 8 nodes, 79 at
+/// g = 0.95 where √(1 − a) spreads that range).
 #[rustfmt::skip]
 pub const BUNDLED_G: [(f64, f64, &str); 94] = [
     g_table!(1.0, 0.15, "1.00", "0.15"),

@@ -47,6 +47,7 @@ mod rng;
 mod sample;
 pub mod shard;
 pub mod smooth;
+pub mod spec;
 pub mod white;
 
 pub use beam::{Beam, BeamProfile};
@@ -59,8 +60,9 @@ pub use family::{albedo_family, bundled_grid, bundled_tables, family};
 pub use fresnel::{FresnelSample, fresnel_mcml};
 pub use grid::RadialGrid;
 pub use grid_g::{McGridProfile, McGridSet};
-pub use model::{AlbedoSpacing, McProfile, McTable, McTableSet, McTableSpec};
+pub use model::{McProfile, McTable, McTableSet};
 pub use phase::{hg_cdf_cos, hg_pdf_cos, sample_hg_cos};
 pub use report::{SimulationReport, TableSummary};
 pub use sample::{Layer, Sample};
 pub use shard::{Shard, ShardError};
+pub use spec::{AlbedoSpacing, LowAlbedoRun, McTableSpec};

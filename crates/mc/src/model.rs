@@ -14,8 +14,14 @@
 //! Similarity (pbrt's `TabulatedBSSRDF::Sr`, docs/physics.md §2.3): with σs = σ′s/(1 − g), σt = σa + σs and
 //! a = σs/σt, Rd(r) = σt² R̂(σt r; a) exactly (same η, g). For g = 0, σt = σ′t and a = α′.
 //!
-//! Interpolation: between albedos, cubic Hermite in x = −√(1 − a) on the spline coefficients (so on
-//! S, after the analytic κ₀(a)ρ is taken out: C¹ in a) and on ln Rd for the totals — Catmull-Rom
+//! Interpolation: between albedos, cubic Hermite in x = −√(1 − a) on the spline coefficients less
+//! ln a (so on S − ln a, after the analytic κ₀(a)ρ is taken out: C¹ in a) and on ln(Rd/a) for the
+//! totals, ln a added back after. At low albedo light leaves mostly after one scattering, so R̂ ∝ a
+//! to first order (the single-scattering term of the collision expansion Rd = Σₙ aⁿRₙ) and ln R̂
+//! bends like ln a, which a cubic in √(1 − a) cannot follow across the first nodes: on ln Rd itself
+//! the totals between the g ≠ 0 tables' first two nodes (α′ 0.01 and 0.035) were 7–10 % below
+//! adding-doubling's at α′ 0.02 and 1–2 % above at 0.05; toward a → 1, ln a ≈ −(1 − a) is smooth in
+//! √(1 − a) and changes little (BENCHMARKS.md, "Low albedo at g ≠ 0") — Catmull-Rom
 //! derivatives inside (pbrt's `CatmullRomWeights`), the parabola through the three end nodes at the
 //! first and last node (`Ends`); between η nodes,
 //! Catmull-Rom in η on the same coefficients (linear with two tables); in ρ, the cubic B-spline itself
@@ -31,274 +37,14 @@ use scatterfit_optics::{OpticalProperties, ProfileModel, ProfileSample};
 use crate::cache::CacheStatus;
 use crate::error::{McError, Result, check};
 use crate::shard::Shard;
-use crate::smooth::{Knots, SmoothParams, fit_row, kappa0};
-use crate::white::{WhitePartial, WhiteSpec, WhiteTally, simulate_shard};
+use crate::smooth::{Knots, fit_row, kappa0};
+use crate::white::{WhitePartial, WhiteSpec, WhiteTally, simulate, simulate_shard};
+
+pub use crate::spec::{AlbedoSpacing, LowAlbedoRun, McTableSpec};
 
 /// Version of the `McTable` file format; files of another version are rebuilt.
 pub const MC_TABLE_VERSION: u32 = 1;
 const MC_TABLE_TAG: &str = "scatterfit-mc-white-table";
-
-/// How an [`McTable`] is made: the Monte Carlo run and the smoother.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct McTableSpec {
-    /// Relative refractive index η (outside index 1).
-    pub eta: f64,
-    /// Henyey–Greenstein asymmetry g.
-    pub g: f64,
-    /// Number of albedo nodes, from `albedo_min` to `albedo_max`, spaced as `albedo_spacing` says.
-    pub albedo_count: usize,
-    /// How the albedo nodes are spaced (default: equally in √(1 − a); absent from the files of
-    /// tables built that way, so their specs and cache names are unchanged).
-    #[serde(default, skip_serializing_if = "AlbedoSpacing::is_default")]
-    pub albedo_spacing: AlbedoSpacing,
-    /// Smallest single-scattering albedo.
-    pub albedo_min: f64,
-    /// Largest single-scattering albedo.
-    pub albedo_max: f64,
-    /// Inner radius of the log-spaced bins [mean free paths]; below it one bin [0, ρ₀).
-    pub rho_min: f64,
-    /// Outer radius of the last bin [mean free paths].
-    pub rho_max: f64,
-    /// Log-spaced radial bins between `rho_min` and `rho_max`.
-    pub radial_bins: usize,
-    /// Photons traced in each path-length stratum ([`crate::white`]).
-    pub photons: Vec<u64>,
-    /// Interaction counts separating the strata (one fewer than `photons`).
-    pub stratum_bounds: Vec<u64>,
-    /// Seed of the random streams.
-    pub seed: u64,
-    /// The smoother.
-    pub smooth: SmoothParams,
-}
-
-/// How a table's albedo nodes are spaced between its smallest and largest single-scattering
-/// albedo a.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum AlbedoSpacing {
-    /// Equally in √(1 − a) (the g = 0 tables, and the g ≠ 0 tables shipped first).
-    #[default]
-    SqrtOneMinusA,
-    /// Equally in √(1 − α′), α′ = a(1 − g)/(1 − ag) the reduced albedo. At g ≠ 0 the first spacing
-    /// crowds the nodes toward α′ → 1 less than at g = 0 (1 − a ≈ (1 − g)(1 − α′) there): at
-    /// g = 0.9 only two of 64 nodes lie above α′ 0.998, and the far field between them is 1–5 %
-    /// off (BENCHMARKS.md, "Weak absorption"). This spacing gives a g ≠ 0 table the g = 0 table's
-    /// node density in α′, where the profile's shape is set.
-    SqrtOneMinusReducedAlbedo,
-}
-
-impl AlbedoSpacing {
-    /// Whether this is the default spacing (serde: omitted from files).
-    pub fn is_default(&self) -> bool {
-        *self == Self::default()
-    }
-}
-
-impl McTableSpec {
-    /// The default layout for η and g: 64 albedos from 0.02 to 0.9999 (√(1 − a) spacing 0.0156),
-    /// 216 radial bins (Δ ln ρ = 0.05) from 0.01 to 500 mean free paths, seed 1, and three
-    /// path-length strata: `photons` full-length photons, 4× as many stopped at 1024 interactions and
-    /// 16× as many stopped at 64 (module [`crate::white`]).
-    ///
-    /// # Errors
-    /// `InvalidParameter` for η < 1, g outside (−1, 1) or no photons.
-    pub fn new(eta: f64, g: f64, photons: u64) -> Result<Self> {
-        Self::with_strata(
-            eta,
-            g,
-            vec![16 * photons, 4 * photons, photons],
-            vec![64, 1024],
-        )
-    }
-
-    /// The layout of the g = 0 tables shipped with the crate (`crates/mc/tables/`, rebuilt
-    /// 2026-11-27): the default one with 128 albedo nodes instead of 64 (√(1 − a) spacing 0.0078),
-    /// 4·10⁶ full-length photons, 1.6·10⁷ stopped at 1024 interactions and 3.2·10⁷ at 64, and the
-    /// seed 1000 + round(100 η), so that the tables' Monte Carlo noise is independent from one η to
-    /// the next. Why (CHANGELOG.md, "The g = 0 tables rebuilt"): between the 64 nodes' last two
-    /// (α′ 0.99935–0.9999) Catmull-Rom put the far field 1–2 % low beyond 30 mean free paths — the
-    /// light a spectrophotometer's port loses, and the g ≠ 0 model's continuation past its join
-    /// ([`crate::model::McProfile::far_field_join`]) — and the full-length stratum's 2·10⁶ photons,
-    /// one seed for every η, left the totals near α′ = 1 a few 10⁻⁴ off together.
-    ///
-    /// # Errors
-    /// `InvalidParameter` for η < 1.
-    pub fn shipped(eta: f64) -> Result<Self> {
-        let mut spec = Self::with_strata(
-            eta,
-            0.0,
-            vec![32_000_000, 16_000_000, 4_000_000],
-            vec![64, 1024],
-        )?;
-        spec.albedo_count = 128;
-        spec.seed = 1000 + (100.0 * eta).round() as u64;
-        spec.white()?;
-        Ok(spec)
-    }
-
-    /// The default layout with explicit strata (`photons[k]` photons, separated at `bounds`).
-    ///
-    /// # Errors
-    /// `InvalidParameter` for a bad field.
-    pub fn with_strata(eta: f64, g: f64, photons: Vec<u64>, bounds: Vec<u64>) -> Result<Self> {
-        let spec = Self {
-            eta,
-            g,
-            albedo_count: 64,
-            albedo_spacing: AlbedoSpacing::SqrtOneMinusA,
-            albedo_min: 0.02,
-            albedo_max: 0.9999,
-            rho_min: 0.01,
-            rho_max: 500.0,
-            radial_bins: 216,
-            photons,
-            stratum_bounds: bounds,
-            seed: 1,
-            smooth: SmoothParams::default(),
-        };
-        spec.white()?;
-        Ok(spec)
-    }
-
-    /// The albedo nodes (single-scattering albedos a, increasing), spaced as `albedo_spacing` says.
-    pub fn albedos(&self) -> Vec<f64> {
-        let g = self.g;
-        // To and from the variable the nodes are equally spaced in (a or α′, docs on
-        // `AlbedoSpacing`; α′ = a(1 − g)/(1 − ag) ⇔ a = α′/(1 − g + gα′)).
-        let reduced = self.albedo_spacing == AlbedoSpacing::SqrtOneMinusReducedAlbedo;
-        let to = |a: f64| {
-            if reduced {
-                a * (1.0 - g) / (1.0 - a * g)
-            } else {
-                a
-            }
-        };
-        let from = |v: f64| if reduced { v / (1.0 - g + g * v) } else { v };
-        let (x0, x1) = (
-            (1.0 - to(self.albedo_max)).sqrt(),
-            (1.0 - to(self.albedo_min)).sqrt(),
-        );
-        let n = self.albedo_count.max(2);
-        (0..n)
-            .rev()
-            .map(|i| {
-                let x = x0 + (x1 - x0) * i as f64 / (n - 1) as f64;
-                from(1.0 - x * x)
-            })
-            .collect()
-    }
-
-    /// The radial bin edges [mean free paths].
-    pub fn radial_edges(&self) -> Vec<f64> {
-        let mut e = vec![0.0];
-        let q = (self.rho_max / self.rho_min).ln() / self.radial_bins.max(1) as f64;
-        e.extend((0..=self.radial_bins).map(|i| self.rho_min * (q * i as f64).exp()));
-        e
-    }
-
-    /// The white Monte Carlo run this spec asks for.
-    ///
-    /// # Errors
-    /// `InvalidParameter` for a bad field.
-    pub fn white(&self) -> Result<WhiteSpec> {
-        check(
-            self.albedo_count >= 4,
-            "albedo_count",
-            self.albedo_count as f64,
-            "need at least 4 albedos (Catmull-Rom)",
-        )?;
-        check(
-            self.albedo_min > 0.0 && self.albedo_max < 1.0 && self.albedo_min < self.albedo_max,
-            "albedo_max",
-            self.albedo_max,
-            "need 0 < albedo_min < albedo_max < 1",
-        )?;
-        check(
-            self.rho_min > 0.0 && self.rho_max > self.rho_min && self.radial_bins >= 8,
-            "rho_max",
-            self.rho_max,
-            "need 0 < rho_min < rho_max and at least 8 radial bins",
-        )?;
-        WhiteSpec::new(
-            self.eta,
-            self.g,
-            self.albedos(),
-            self.radial_edges(),
-            &self.photons,
-            &self.stratum_bounds,
-            self.seed,
-        )
-    }
-
-    /// A short stable hash of the spec (FNV-1a 64 of its JSON), used in the cache file name.
-    pub fn fingerprint(&self) -> String {
-        let json = serde_json::to_string(self).expect("a spec of numbers always serialises");
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        for b in json.bytes() {
-            h ^= u64::from(b);
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        format!("{h:016x}")
-    }
-
-    /// The cache file name for this spec.
-    pub fn file_name(&self) -> String {
-        format!(
-            "mc-white-v{MC_TABLE_VERSION}-eta{:.4}-g{:.3}-{}.json",
-            self.eta,
-            self.g,
-            self.fingerprint()
-        )
-    }
-
-    /// The default layout with few photons (20 000 full-length, 80 000 and 320 000 in the shorter
-    /// strata): a table that builds in a few seconds (1–4 s on two cores for η = 1–2.5, g = 0), at
-    /// about ten times the default table's noise.
-    ///
-    /// # Errors
-    /// As [`McTableSpec::new`].
-    pub fn coarse(eta: f64, g: f64) -> Result<Self> {
-        Self::new(eta, g, 20_000)
-    }
-
-    /// The expected cost of [`McTable::build`], before it runs: interactions, from a fit to measured
-    /// counts of white runs (η 1–2.5, g 0–0.9, stratum caps 64 to 120 000; within a factor 2 of
-    /// them, `cost_estimate_matches_measured_work`), and the tallies' memory.
-    ///
-    /// Per photon of a stratum that stops at N interactions, with the roulette at R < N keeping ¼:
-    /// I = φ(R) + ¼(φ(N) − φ(R)) (else φ(N)), φ(n) = min(n, 3.5 √n η²/√(1 − g)) — a non-absorbing
-    /// half-space returns a photon after n interactions with probability ∝ n^{−3/2}, so the mean of
-    /// min(n, N) grows like √N; total internal reflection (η²) and forward scattering (1/(1 − g)
-    /// interactions per transport mean free path) lengthen the walks. Bounded by N whatever g is.
-    ///
-    /// # Errors
-    /// `InvalidParameter` for a bad field.
-    pub fn cost_estimate(&self) -> Result<crate::CostEstimate> {
-        let white = self.white()?;
-        let x = |n: f64| (3.5 * n.sqrt() * self.eta * self.eta / (1.0 - self.g).sqrt()).min(n);
-        let roulette = white.roulette_interactions as f64;
-        let mut interactions = 0.0;
-        for s in &white.strata {
-            let cap = s.max_interactions as f64;
-            let per_photon = if roulette > 0.0 && roulette < cap {
-                x(roulette) + crate::white::ROULETTE_SURVIVAL * (x(cap) - x(roulette))
-            } else {
-                x(cap)
-            };
-            interactions += per_photon * s.photons as f64;
-        }
-        // Tallies: a sum and a sum of squares per (albedo, bin) and per albedo, for each of the 32
-        // chunks of a wave, the running total and the result; then the table with its raw profiles.
-        let cells = (self.albedo_count * (self.radial_bins + 2) + self.albedo_count) as u64;
-        let memory_bytes = 2 * cells * 8 * (32 + 2 + 2);
-        let photons = white.photons();
-        Ok(crate::CostEstimate {
-            interactions_per_photon: interactions / photons.max(1) as f64,
-            interactions,
-            memory_bytes,
-        })
-    }
-}
 
 /// The raw Monte Carlo profiles behind a table (kept in cache files for diagnostics; dropped by
 /// [`McTable::without_raw`] for shipping).
@@ -310,6 +56,64 @@ pub struct RawProfiles {
     pub rd: Vec<f64>,
     /// Standard errors of `rd`.
     pub rd_stderr: Vec<f64>,
+}
+
+/// The smoothed rows of one white run, in the table's layout.
+struct Rows {
+    knots: Knots,
+    coefs: Vec<f64>,
+    rho_data_min: Vec<f64>,
+    rho_data_max: Vec<f64>,
+    chi2_per_bin: Vec<f64>,
+}
+
+impl Rows {
+    /// Each albedo row of `tally` (made from `white`) smoothed by [`fit_row`] with `spec`'s knots
+    /// and smoother; the totals checked to increase with the albedo.
+    fn smooth(spec: &McTableSpec, white: &WhiteSpec, tally: &WhiteTally) -> Result<Self> {
+        let edges = &white.radial_edges;
+        let bins = tally.bins();
+        let knots = Knots::covering(
+            edges[1].ln(),
+            edges[edges.len() - 1].ln(),
+            spec.smooth.knot_spacing,
+        );
+        let mut rows = Self {
+            coefs: Vec::with_capacity(white.albedos.len() * knots.len()),
+            knots,
+            rho_data_min: Vec::new(),
+            rho_data_max: Vec::new(),
+            chi2_per_bin: Vec::new(),
+        };
+        for (k, &a) in white.albedos.iter().enumerate() {
+            let row = k * bins..(k + 1) * bins;
+            let fit = fit_row(
+                edges,
+                &tally.rd[row.clone()],
+                &tally.rd_stderr[row],
+                kappa0(a, spec.g).0,
+                &rows.knots,
+                &spec.smooth,
+            )
+            .ok_or(McError::Smoothing {
+                albedo: a,
+                reason: "fewer than 4 radial bins with data: trace more photons",
+            })?;
+            rows.coefs.extend_from_slice(&fit.coefs);
+            rows.rho_data_min.push(fit.rho_data_min);
+            rows.rho_data_max.push(fit.rho_data_max);
+            rows.chi2_per_bin.push(fit.chi2 / fit.bins_used as f64);
+        }
+        for (k, w) in tally.rd_total.windows(2).enumerate() {
+            if w[1] <= w[0] {
+                return Err(McError::Smoothing {
+                    albedo: white.albedos[k + 1],
+                    reason: "total Rd does not increase with the albedo: trace more photons",
+                });
+            }
+        }
+        Ok(rows)
+    }
 }
 
 /// A smoothed Monte Carlo profile table for one η and g (module docs).
@@ -356,7 +160,7 @@ struct RawTable {
 impl TryFrom<RawTable> for McTable {
     type Error = String;
     fn try_from(t: RawTable) -> std::result::Result<Self, String> {
-        let k = t.spec.albedo_count;
+        let k = t.spec.node_count();
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let checks: [(bool, &str); 10] = [
             (
@@ -472,7 +276,10 @@ impl McTable {
         Self::from_tally(spec, &tally)
     }
 
-    /// Smooths an existing white tally made from `spec.white()`.
+    /// Smooths an existing white tally made from `spec.white()` (the main run). A spec with
+    /// low-albedo nodes ([`LowAlbedoRun`]) has their short run simulated and smoothed here too
+    /// ([`McTable::with_low_albedos`]: seconds), so that every way to a table — one machine, or N
+    /// shards combined — goes through this one function.
     ///
     /// # Errors
     /// `InvalidParameter` when the tally was not made from this spec; `Smoothing` if a row has too
@@ -485,59 +292,91 @@ impl McTable {
             0.0,
             "the tally was made from another spec",
         )?;
-        let edges = &white.radial_edges;
-        let bins = tally.bins();
-        let knots = Knots::covering(
-            edges[1].ln(),
-            edges[edges.len() - 1].ln(),
-            spec.smooth.knot_spacing,
-        );
-        let mut coefs = Vec::with_capacity(white.albedos.len() * knots.len());
-        let (mut rho_data_min, mut rho_data_max, mut chi2) = (Vec::new(), Vec::new(), Vec::new());
-        for (k, &a) in white.albedos.iter().enumerate() {
-            let row = k * bins..(k + 1) * bins;
-            let fit = fit_row(
-                edges,
-                &tally.rd[row.clone()],
-                &tally.rd_stderr[row],
-                kappa0(a, spec.g).0,
-                &knots,
-                &spec.smooth,
-            )
-            .ok_or(McError::Smoothing {
-                albedo: a,
-                reason: "fewer than 4 radial bins with data: trace more photons",
-            })?;
-            coefs.extend_from_slice(&fit.coefs);
-            rho_data_min.push(fit.rho_data_min);
-            rho_data_max.push(fit.rho_data_max);
-            chi2.push(fit.chi2 / fit.bins_used as f64);
-        }
-        for (k, w) in tally.rd_total.windows(2).enumerate() {
-            if w[1] <= w[0] {
-                return Err(McError::Smoothing {
-                    albedo: white.albedos[k + 1],
-                    reason: "total Rd does not increase with the albedo: trace more photons",
-                });
-            }
-        }
-        Ok(Self {
+        let main = McTableSpec {
+            low_albedos: None,
+            ..spec.clone()
+        };
+        let rows = Rows::smooth(&main, &white, tally)?;
+        let table = Self {
             format: MC_TABLE_TAG.to_owned(),
             version: MC_TABLE_VERSION,
-            spec: spec.clone(),
+            spec: main,
             albedos: white.albedos.clone(),
-            knots,
-            coefs,
-            rho_data_min,
-            rho_data_max,
+            knots: rows.knots,
+            coefs: rows.coefs,
+            rho_data_min: rows.rho_data_min,
+            rho_data_max: rows.rho_data_max,
             rd_total: tally.rd_total.clone(),
             rd_total_stderr: tally.rd_total_stderr.clone(),
-            chi2_per_bin: chi2,
+            chi2_per_bin: rows.chi2_per_bin,
             raw: Some(RawProfiles {
-                edges: edges.clone(),
+                edges: white.radial_edges.clone(),
                 rd: tally.rd.clone(),
                 rd_stderr: tally.rd_stderr.clone(),
             }),
+        };
+        match &spec.low_albedos {
+            None => Ok(table),
+            Some(low) => table.with_low_albedos(low.clone()),
+        }
+    }
+
+    /// This table with low-albedo nodes below its first ([`LowAlbedoRun`]): their white run
+    /// ([`McTableSpec::low_albedo_white`]) simulated on the current rayon pool, smoothed as the
+    /// table's own rows, and put in front of them; the spec records the run. Raw profiles are kept
+    /// only if the table kept its own. A table shipped without low nodes gains them this way, equal
+    /// to the table built from the extended spec (its rows are the same numbers; compacting is per
+    /// value).
+    ///
+    /// # Errors
+    /// `InvalidParameter` when the table has low-albedo nodes already or `low` is not below its
+    /// first node; `Smoothing` as [`McTable::from_tally`], or when the low run's totals do not rise
+    /// to the table's first.
+    pub fn with_low_albedos(self, low: LowAlbedoRun) -> Result<Self> {
+        check(
+            self.spec.low_albedos.is_none(),
+            "low_albedos",
+            0.0,
+            "the table has low-albedo nodes already",
+        )?;
+        let spec = McTableSpec {
+            low_albedos: Some(low),
+            ..self.spec.clone()
+        };
+        let white = spec
+            .low_albedo_white()?
+            .expect("a spec with low albedos has their run");
+        let tally = simulate(&white, &|_| {})?;
+        let rows = Rows::smooth(&spec, &white, &tally)?;
+        check(
+            rows.knots == self.knots,
+            "knots",
+            rows.knots.len() as f64,
+            "the low-albedo rows have other knots than the table's (a defect)",
+        )?;
+        let last = tally.rd_total[tally.rd_total.len() - 1];
+        if last >= self.rd_total[0] {
+            return Err(McError::Smoothing {
+                albedo: self.albedos[0],
+                reason: "the low-albedo run's largest total is not below the table's first: trace more photons",
+            });
+        }
+        let front = |low: &[f64], own: &[f64]| [low, own].concat();
+        Ok(Self {
+            albedos: front(&white.albedos, &self.albedos),
+            coefs: front(&rows.coefs, &self.coefs),
+            rho_data_min: front(&rows.rho_data_min, &self.rho_data_min),
+            rho_data_max: front(&rows.rho_data_max, &self.rho_data_max),
+            rd_total: front(&tally.rd_total, &self.rd_total),
+            rd_total_stderr: front(&tally.rd_total_stderr, &self.rd_total_stderr),
+            chi2_per_bin: front(&rows.chi2_per_bin, &self.chi2_per_bin),
+            raw: self.raw.map(|r| RawProfiles {
+                rd: front(&tally.rd, &r.rd),
+                rd_stderr: front(&tally.rd_stderr, &r.rd_stderr),
+                edges: r.edges,
+            }),
+            spec,
+            ..self
         })
     }
 
@@ -635,7 +474,8 @@ impl McTable {
     }
 
     /// Total diffuse reflectance Rd(a) (excluding R_sp): cubic Hermite in √(1 − a) with parabolic
-    /// ends (`Ends::Parabola`) on ln Rd between the Monte Carlo totals of the nodes. On ln Rd, as
+    /// ends (`Ends::Parabola`) on ln(Rd/a) between the Monte Carlo totals of the nodes (module docs,
+    /// "Interpolation": then × a). On ln Rd, as
     /// the profile's coefficients are: toward a → 1 at η = 2 Rd itself bends so much within the last
     /// interval that its interpolant was 1.5–2.3·10⁻³ high at α′ 0.9993–0.9998 (g 0.8–0.9) against
     /// adding-doubling, ln Rd 4–6·10⁻⁴ (6·10⁻³ with the chord ends; BENCHMARKS.md).
@@ -644,7 +484,11 @@ impl McTable {
     /// `OutOfTable` for a outside the tabulated albedos.
     pub fn rd_total(&self, a: f64) -> Result<f64> {
         let (i, w, _) = self.albedo_weights(a)?;
-        Ok(dot4(&w, |k| self.rd_total[i + k - 1].ln()).exp())
+        let al = &self.albedos;
+        // An end reached through a round trip is that end (as in the weights), so that the
+        // totals at the ends are the nodes' own, bit for bit.
+        let a = a.clamp(al[0], al[al.len() - 1]);
+        Ok(a * dot4(&w, |k| (self.rd_total[i + k - 1] / al[i + k - 1]).ln()).exp())
     }
 }
 
@@ -1019,13 +863,27 @@ impl McProfile {
                     continue;
                 }
                 let row = t.row(i + k - 1);
+                // The row's S less ln a of its node (module docs, "Interpolation"): a constant on every
+                // coefficient, since the B-splines sum to 1.
+                let ln_node = t0.albedos[i + k - 1].ln();
                 let (w, dw) = (w_eta * wa[k], w_eta * dwa[k]);
                 for ((c, d), &b) in coefs.iter_mut().zip(dcoefs.iter_mut()).zip(row) {
-                    *c += w * b;
-                    *d += dw * b;
+                    *c += w * (b - ln_node);
+                    *d += dw * (b - ln_node);
                 }
                 rho_data += w * t.rho_data_max[i + k - 1];
             }
+        }
+        // ln a back (the η and albedo weights sum to 1, their a-derivatives to 0); held at the
+        // last node above it, as the shape is.
+        let (ln_a, dln_a) = if beyond_top && a > top {
+            (top.ln(), 0.0)
+        } else {
+            (a.ln(), 1.0 / a)
+        };
+        for (c, d) in coefs.iter_mut().zip(dcoefs.iter_mut()) {
+            *c += ln_a;
+            *d += dln_a;
         }
         let (kappa, dkappa) = kappa0(a, g);
         let st2 = sigma_t * sigma_t;
@@ -1260,58 +1118,32 @@ mod tests {
         spec
     }
 
-    /// `AlbedoSpacing::SqrtOneMinusReducedAlbedo`: at g = 0.9 the nodes' reduced albedos
-    /// (α′ = a(1 − g)/(1 − ag), computed here from each node) are equally spaced in √(1 − α′) and
-    /// the end nodes are the spec's own ends; at g = 0 the two spacings coincide; the default is
-    /// left out of the spec's JSON (so the shipped tables' specs and cache names do not change)
-    /// and the other one round-trips.
+    /// Low-albedo nodes ([`LowAlbedoRun`]) built with the table or added to it afterwards (what the
+    /// shipped g ≠ 0 tables went through) give the same table bit for bit, compacted too; the nodes
+    /// are the spec's, the totals rise across the join, the file reads back through the format's
+    /// checks, and a second set of low nodes is refused.
     #[test]
-    fn reduced_albedo_spacing_is_even_in_sqrt_one_minus_albedo_prime() {
-        let mut spec = McTableSpec::new(1.4, 0.9, 1000).unwrap();
-        spec.albedo_min = 0.2 / (0.1 + 0.9 * 0.2);
-        spec.albedo_max = 0.99995 / (0.1 + 0.9 * 0.99995);
-        let plain = spec.albedos();
-        spec.albedo_spacing = AlbedoSpacing::SqrtOneMinusReducedAlbedo;
-        let nodes = spec.albedos();
-        assert_eq!(nodes.len(), 64);
-        assert!((nodes[0] - spec.albedo_min).abs() < 1e-12);
-        assert!((nodes[63] - spec.albedo_max).abs() < 1e-12);
-        let x: Vec<f64> = nodes
-            .iter()
-            .map(|&a| (1.0 - a * 0.1 / (1.0 - 0.9 * a)).sqrt())
-            .collect();
-        let step = x[0] - x[1];
-        for w in x.windows(2) {
-            assert!(((w[0] - w[1]) / step - 1.0).abs() < 1e-9, "{w:?} vs {step}");
-        }
-        // Toward α′ → 1 the last interval, in √(1 − α′), is about half the old spacing's (whose
-        // nodes above α′ 0.998 are two: 0.99995 and 0.99886).
-        let top = |v: &[f64]| {
-            let x = |a: f64| (1.0 - a * 0.1 / (1.0 - 0.9 * a)).sqrt();
-            x(v[62]) - x(v[63])
-        };
-        assert!(
-            top(&nodes) < 0.55 * top(&plain),
-            "{} vs {}",
-            top(&nodes),
-            top(&plain)
-        );
-        let json = serde_json::to_string(&spec).unwrap();
-        assert!(json.contains("sqrt_one_minus_reduced_albedo"), "{json}");
-        assert_eq!(serde_json::from_str::<McTableSpec>(&json).unwrap(), spec);
-        let g0 = McTableSpec::new(1.4, 0.0, 1000).unwrap();
-        assert!(
-            !serde_json::to_string(&g0)
-                .unwrap()
-                .contains("albedo_spacing")
-        );
-        let reduced = McTableSpec {
-            albedo_spacing: AlbedoSpacing::SqrtOneMinusReducedAlbedo,
-            ..g0.clone()
-        };
-        for (a, b) in reduced.albedos().iter().zip(g0.albedos()) {
-            assert!((a - b).abs() < 1e-15, "{a} vs {b}");
-        }
+    fn low_albedo_nodes_built_or_added_are_the_same_table() {
+        let spec = small_spec_g(1.3, 0.5);
+        let extended = spec.clone().with_low_albedos_to(0.3, 400_000).unwrap();
+        let low = extended.low_albedos.clone().unwrap();
+        let built = McTable::build(&extended, &|_, _| {}).unwrap();
+        let added = McTable::build(&spec, &|_, _| {})
+            .unwrap()
+            .with_low_albedos(low.clone())
+            .unwrap();
+        let bytes = |t: &McTable| serde_json::to_vec(t).unwrap();
+        assert_eq!(bytes(&built), bytes(&added));
+        assert_eq!(bytes(&built.clone().compact()), bytes(&added.compact()));
+        assert_eq!(built.albedos(), extended.albedos().as_slice());
+        assert_eq!(built.albedos().len(), 8 + low.albedo_count);
+        let (totals, _) = built.totals();
+        assert!(totals.windows(2).all(|w| w[1] > w[0]), "{totals:?}");
+        let text = serde_json::to_string(&built.clone().compact()).unwrap();
+        let back = McTable::from_json(&text).unwrap();
+        assert_eq!(back.spec(), &extended);
+        assert!((back.rd_total(0.3).unwrap() / totals[0] - 1.0).abs() < 1e-6);
+        assert!(built.with_low_albedos(low).is_err());
     }
 
     fn small_set(etas: &[f64]) -> McTableSet {

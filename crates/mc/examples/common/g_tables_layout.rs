@@ -8,6 +8,26 @@ use scatterfit_mc::model::McTableSpec;
 /// margin so that Catmull-Rom has a node on each side).
 pub const ALBEDO_PRIME_RANGE: (f64, f64) = (0.2, 0.99995);
 
+/// Smallest reduced albedo α′ of the low-albedo nodes ([`scatterfit_mc::LowAlbedoRun`]) below
+/// [`ALBEDO_PRIME_RANGE`]: every channel the g = 0 tables answer (from α′ 0.02; a food's green and
+/// blue, such as ketchup's 0.07 and 0.02) then has its g ≠ 0 tables too.
+pub const LOW_ALBEDO_PRIME: f64 = 0.01;
+
+/// Photons of the low-albedo run per full-length photon of the main run (1.6·10⁸ for 10⁶): the
+/// run stops its photons after a few dozen interactions (about 100 CPU-s at g 0.9), and its rows'
+/// data reach farther with each photon. With 16 per photon (the main run's shortest stratum) the
+/// far field at α′ 0.07, g 0.9 was 4.5–6.6 % high beyond 5 mean free paths, and the twin's blue
+/// channel there +1.5 % in σ′s; with 160, 0.0 % (BENCHMARKS.md, "Low albedo at g ≠ 0").
+pub const LOW_ALBEDO_PHOTONS_PER_PHOTON: u64 = 160;
+
+/// `spec` with its low-albedo nodes down to α′ = [`LOW_ALBEDO_PRIME`]
+/// ([`scatterfit_mc::McTableSpec::with_low_albedos_to`]), `photons` in their run.
+pub fn with_low_albedos(spec: McTableSpec, photons: u64) -> McTableSpec {
+    let a = albedo_from_reduced(LOW_ALBEDO_PRIME, spec.g);
+    spec.with_low_albedos_to(a, photons)
+        .expect("valid low-albedo run")
+}
+
 /// Single-scattering albedo a with reduced albedo α′ at asymmetry g: α′ = a(1 − g)/(1 − ag) ⇔
 /// a = α′/(1 − g + gα′) (σ′s = σs(1 − g), σ′t = σa + σ′s).
 pub fn albedo_from_reduced(albedo_prime: f64, g: f64) -> f64 {

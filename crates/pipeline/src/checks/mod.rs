@@ -572,7 +572,9 @@ pub fn model_reasons(outcome: &ChannelOutcome, model: scatterfit_optics::ModelNa
 
 /// The profile's own α′ against the spectrophotometer's, per channel ([`ALBEDO_Z`],
 /// [`ALBEDO_CHI2_RATIO`]); when two channels disagree the reading is likely not this sample's,
-/// and the third is suspect too.
+/// and the third is suspect too. With g not known, both α′ are taken at the assumed g (0), and a
+/// forward-scattering material opens the same gap (at g 0.9 and α′ 0.07–0.3 the profile's shape
+/// at g = 0 reads α′ 0.8–0.97): the advice then names g first.
 pub fn albedo_reasons(m: &Measurement) -> Rgb<Vec<Reason>> {
     let flagged = m.evidence.albedo.as_ref().map(|check| {
         check.filter(|a| {
@@ -580,23 +582,34 @@ pub fn albedo_reasons(m: &Measurement) -> Rgb<Vec<Reason>> {
         })
     });
     let count = flagged.iter().filter(|f| f.is_some()).count();
+    let advice = match m.settings.g_prior.propagated_range() {
+        Some([lo, hi]) => format!(
+            "g is not known and was taken as {}, and a material that scatters forward (g up to \
+             {hi}; the range is {lo}–{hi}) shows such a gap: give [fit] g (or --g) if it is \
+             known; otherwise check that the spectro file is this sample's (and the port, \
+             spectro.aperture_mm)",
+            m.settings.g
+        ),
+        None => "check that the spectro file is this sample's (and the port, \
+                 spectro.aperture_mm), or measure with --method existing"
+            .to_owned(),
+    };
     flagged.as_ref().map(|f| match f {
         Some(a) => vec![suspect(
             ReasonKind::AlbedoDisagrees,
             format!(
                 "the profile's own shape gives α′ {:.4} (σ′s and σa both fitted), the \
                  spectrophotometer α′ {:.4}: {:.0} standard errors apart, and the fit with the \
-                 reading's α′ has χ²/dof {:.1} against {:.1} — check that the spectro file is \
-                 this sample's (and the port, spectro.aperture_mm), or measure with \
-                 --method existing",
+                 reading's α′ has χ²/dof {:.1} against {:.1} — {advice}",
                 a.profile, a.spectro, a.z, a.chi2_proposed, a.chi2_profile
             ),
         )],
         None if count >= 2 => vec![suspect(
             ReasonKind::AlbedoDisagrees,
-            "two other channels' α′ from the profile disagree with the spectrophotometer's: \
-             the reading is likely not this sample's, so this channel's α′ is in doubt too"
-                .into(),
+            format!(
+                "two other channels' α′ from the profile disagree with the spectrophotometer's, \
+                 so this channel's α′ is in doubt too — {advice}"
+            ),
         )],
         None => Vec::new(),
     })
