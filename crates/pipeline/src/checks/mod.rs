@@ -90,6 +90,15 @@ pub const MAX_LAB_DELTA_E: f64 = 3.0;
 /// and the camera sweep 0.97–1.03 (RELIABILITY.md, "The evidence behind ok").
 pub const SPOT_FACTOR_RANGE: (f64, f64) = (0.94, 1.06);
 
+/// The spot-size check ([`SPOT_FACTOR_RANGE`]) also needs every channel, measured alone, beyond
+/// 1 by this much on the same side as the channel sum: a scale is common to the channels. Alone,
+/// the demo's channels give 0.972–1.004, the quick demo's 0.944–1.008 (the quick pink-plastic
+/// twin's PNG bracket R 1.008, G 1.003, B 0.966); `mm_per_pixel` × 1.1 gives R 1.088, G 1.085,
+/// B 1.044 (sum 1.082), × 0.9 0.900, 0.898, 0.864. Pillow's JPEG quality 75 with 4:2:0 chroma
+/// moves the quick twin's 10-pixel spot by R +5, G +10, B −2 % (sum 1.073, σ′s within 1.6 %),
+/// `jpeg-encoder`'s by +4, +10, −6 % (sum 1.074).
+pub const SPOT_CHANNEL_MARGIN: f64 = 0.01;
+
 /// The profile's own α′ and the spectrophotometer's further apart than this many standard
 /// errors (in ln(1 − α′), [`evidence::AlbedoCheck`]) …
 pub const ALBEDO_Z: f64 = 5.0;
@@ -144,19 +153,28 @@ pub fn sample_checks(m: &Measurement) -> SampleChecks {
         reasons.push(suspect(ReasonKind::IncompleteRings, msg));
     }
     reasons.extend(m.image_checks.reasons.iter().cloned());
-    if let Some(factor) = m.evidence.spot_scale
-        && !(SPOT_FACTOR_RANGE.0..=SPOT_FACTOR_RANGE.1).contains(&factor)
+    if let Some(scale) = m.evidence.spot_scale
+        && !(SPOT_FACTOR_RANGE.0..=SPOT_FACTOR_RANGE.1).contains(&scale.factor)
+        && scale.every_channel_agrees(scale.factor > 1.0)
     {
+        let factor = scale.factor;
         reasons.push(suspect(
             ReasonKind::SpotSize,
             format!(
                 "the spot in the image is {factor:.3}× the size the fitted model predicts for a \
-                 {:.3} mm spot at {mmpp} mm per pixel (expected {}–{}): camera.mm_per_pixel or \
-                 camera.spot_diameter_mm is about {:.0} % off (the true scale is near {:.4} mm \
-                 per pixel if the diameter is right); σ′s and σa scale with it",
+                 {:.3} mm spot at {mmpp} mm per pixel (expected {}–{}; each channel alone: {}): \
+                 camera.mm_per_pixel or camera.spot_diameter_mm is about {:.0} % off (the true \
+                 scale is near {:.4} mm per pixel if the diameter is right); σ′s and σa scale \
+                 with it",
                 2.0 * m.settings.spot_radius_mm,
                 SPOT_FACTOR_RANGE.0,
                 SPOT_FACTOR_RANGE.1,
+                scale
+                    .channels
+                    .iter()
+                    .map(|c| c.map_or("–".into(), |f| format!("{f:.3}")))
+                    .collect::<Vec<_>>()
+                    .join(", "),
                 100.0 * (1.0 / factor - 1.0),
                 mmpp / factor,
             ),
