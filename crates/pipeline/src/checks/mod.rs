@@ -31,7 +31,7 @@ pub use crate::hdr::frames::{
     code_range, registration,
 };
 pub use ambient::{
-    FAR_FIELD_FRACTION, FAR_FIELD_MIN_SAMPLES, FarField, MAX_FAR_FIELD_CODES,
+    FAR_FIELD_FRACTION, FAR_FIELD_MIN_SAMPLES, FarField, MAX_FAR_FIELD_CODES, MIN_FAR_FIELD_RATIO,
     ambient_light_reasons, far_field_agreement, far_field_agreement_in,
 };
 pub use frames::{
