@@ -157,6 +157,9 @@ pub struct FittedRing {
     pub model: f64,
     /// Standard deviation of ln(measured) used as the weight.
     pub sigma_ln: f64,
+    /// Pixels the ring averages (0 in a report written before it was recorded).
+    #[serde(default)]
+    pub count: u64,
 }
 
 /// The outcome of one channel's fit.
@@ -197,6 +200,12 @@ pub struct FitReport {
     pub mse: f64,
     /// Root mean square of ln(measured/(k·model)) over the fitted rings.
     pub rms_log_residual: f64,
+    /// The same over the fitted rings' pixels: each ring's squared log residual weighted by the
+    /// pixels it averages, √(Σ nᵢ eᵢ² / Σ nᵢ). A ring of one pixel at the frame's corner counts
+    /// once, a ring of 700 pixels 700 times, so how far the profile lies from the model is judged
+    /// by what the rings hold, not by how many rings there are. NaN when not recorded.
+    #[serde(default = "not_recorded")]
+    pub pixel_rms_log_residual: f64,
     /// χ² of the weighted log residuals per degree of freedom.
     pub chi2_reduced: f64,
     /// Rings fitted.
@@ -209,6 +218,10 @@ pub struct FitReport {
     pub rings_invalid: usize,
     /// The fitted rings with the model at the solution.
     pub fitted: Vec<FittedRing>,
+}
+
+fn not_recorded() -> f64 {
+    f64::NAN
 }
 
 impl FitReport {
@@ -485,13 +498,21 @@ impl<'a> PreparedFit<'a> {
                 measured: y,
                 model: k * model,
                 sigma_ln: self.selected.sigma_ln[i],
+                count: self.selected.count[i],
             });
         }
         // ln(k m) − ln y = eᵢ/wᵢ, the residual without its weight (no logarithms to take again).
-        let msl = if problem.valid && res.len() == n {
-            res.iter().zip(&self.w).map(|(e, w)| (e / w).powi(2)).sum()
+        let (msl, pixel_msl) = if problem.valid && res.len() == n {
+            let (mut sum, mut weighted, mut pixels) = (0.0, 0.0, 0.0);
+            for ((e, w), &count) in res.iter().zip(&self.w).zip(&self.selected.count) {
+                let e2 = (e / w).powi(2);
+                sum += e2;
+                weighted += count as f64 * e2;
+                pixels += count as f64;
+            }
+            (sum, weighted / pixels)
         } else {
-            f64::NAN
+            (f64::NAN, f64::NAN)
         };
         let converged = termination.was_successful() && problem.valid;
         FitReport {
@@ -527,6 +548,7 @@ impl<'a> PreparedFit<'a> {
             prepare_time_s: self.prepare_time_s,
             mse: mse / n as f64,
             rms_log_residual: (msl / n as f64).sqrt(),
+            pixel_rms_log_residual: pixel_msl.sqrt(),
             chi2_reduced,
             rings_used: n,
             rings_inside_spot: self.selected.inside_spot,

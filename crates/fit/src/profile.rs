@@ -259,6 +259,8 @@ pub struct Selected {
     pub value: Vec<f64>,
     /// Standard deviation of ln(value) per ring (relative error, floored).
     pub sigma_ln: Vec<f64>,
+    /// Pixels each ring averages.
+    pub count: Vec<u64>,
     /// Indices of the fitted rings in the profile.
     pub index: Vec<usize>,
     /// Rings left out because r < r_min (inside the spot).
@@ -278,6 +280,7 @@ pub fn select_rings(profile: &ProfileData, sel: &RingSelection) -> Result<Select
         r_mm: Vec::new(),
         value: Vec::new(),
         sigma_ln: Vec::new(),
+        count: Vec::new(),
         index: Vec::new(),
         inside_spot: 0,
         below_detection: 0,
@@ -316,6 +319,7 @@ pub fn select_rings(profile: &ProfileData, sel: &RingSelection) -> Result<Select
         s.r_mm.push(ring.r_mm);
         s.value.push(ring.value);
         s.sigma_ln.push(rel);
+        s.count.push(ring.count);
         s.index.push(i);
     }
     Ok(s)

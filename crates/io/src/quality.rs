@@ -96,6 +96,10 @@ pub enum ReasonKind {
     /// The black level subtracted from linear frames (given, from the RAW metadata, or a dark
     /// frame) disagrees with the level the bracket's far corners show at zero exposure time.
     BlackLevel,
+    /// Light other than the spot's reached the sample in some frames and not in others: a
+    /// frame's far corners read far from the codes the merged radiance predicts (room light
+    /// switched on or off during the bracket).
+    AmbientLight,
 }
 
 /// One finding of a check.

@@ -138,6 +138,13 @@ fn shape_errors(
         inputs.response = Some(path);
     }
     let stage = read_and_merge(&inputs, &|_| {}).map_err(|e| format!("{e:#}"))?;
+    // Only the spot's light: every frame's far field agrees with the next longer frame's (no false
+    // alarm of the ambient-light check on any tone curve or noise level).
+    if let Some(f) = scatterfit_pipeline::checks::far_field_agreement_in(&stage, b.center_px)
+        .and_then(|v| v.into_iter().find(|f| f.disagrees()))
+    {
+        return Err(format!("the far field disagrees between frames: {f:?}"));
+    }
     if std::env::var("CAMERA_DEBUG_G").is_ok()
         && let Some(r) = &stage.response
     {

@@ -51,6 +51,21 @@ fn corpus() -> Option<PathBuf> {
 fn merge(dir: &Path) -> Result<f64, String> {
     let inputs = HdrInputs::new(Some(dir.join("exposures.csv")), Vec::new());
     let stage = read_and_merge(&inputs, &|_| {}).map_err(|e| format!("{e:#}"))?;
+    // Any static scene keeps Debevec & Malik's relation between two frames, so the far corners'
+    // frame-against-frame check (made for the spot's far field) finds no light switched on here.
+    let r = &stage.hdr.radiance;
+    let centre = [0.5 * r.width() as f64, 0.5 * r.height() as f64];
+    if let Some(fields) = scatterfit_pipeline::checks::far_field_agreement_in(&stage, centre) {
+        let darkest = fields
+            .iter()
+            .min_by(|a, b| a.difference.total_cmp(&b.difference));
+        eprintln!("  far corners, frame against frame: most below the prediction {darkest:?}");
+        if let Some(f) = fields.iter().find(|f| f.disagrees()) {
+            return Err(format!(
+                "the far corners' check finds light switched on during the bracket: {f:?}"
+            ));
+        }
+    }
     Ok(stage
         .corrections
         .self_consistency

@@ -1,6 +1,6 @@
 //! A careless session at the rig, made from a good twin's bracket: the spot near the frame's edge
 //! or half outside it, a second spot (a reflection off the rig, a second light), the camera bumped
-//! in the middle of the bracket, linear data of fewer bits stored in 16-bit files. Each function
+//! in the middle of the bracket, room light, hot pixels, linear data of fewer bits stored in 16-bit files. Each function
 //! takes the frames of a [`crate::Bracket`] (the twin's 8-bit output) and returns what the rig would
 //! have recorded had that gone wrong, so that a test can build the bad case from a good twin and
 //! check that the tool notices (RELIABILITY.md, "Numbers that look right and are not").
@@ -174,6 +174,38 @@ pub fn room_light(
         out.extend(relight(std::slice::from_ref(f), camera, 0, |e| e + add));
     }
     out
+}
+
+/// Hot pixels: each pixel of `pixels` (x, y) gains `electrons_per_s` × the frame's exposure time
+/// `times_s[j]` in every channel of every frame (a sensor's dark current at a defect grows with the
+/// exposure, as a lamp's glow does), toned and quantised again through `camera`. Isolated pixels
+/// far from the spot lift the ring means they fall in, the more the fewer pixels the ring holds.
+pub fn hot_pixels(
+    frames: &[ImageBuf<u8>],
+    camera: &CameraModel,
+    times_s: &[f64],
+    pixels: &[(usize, usize)],
+    electrons_per_s: f64,
+) -> Vec<ImageBuf<u8>> {
+    frames
+        .iter()
+        .zip(times_s)
+        .map(|(f, &t)| {
+            let (w, ch) = (f.width(), f.channels());
+            let mut data = f.data().to_vec();
+            for &(x, y) in pixels {
+                if x >= w || y >= f.height() {
+                    continue;
+                }
+                for z in &mut data[(y * w + x) * ch..(y * w + x + 1) * ch] {
+                    if *z != u8::MAX {
+                        *z = camera.code(electrons(camera, *z) + electrons_per_s * t);
+                    }
+                }
+            }
+            ImageBuf::new(w, f.height(), ch, data).expect("same shape")
+        })
+        .collect()
 }
 
 fn relight(

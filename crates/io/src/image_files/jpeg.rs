@@ -8,7 +8,9 @@ const K1_ZIGZAG: [u16; 64] = [
     87, 95, 98, 103, 104, 103, 62, 77, 113, 121, 112, 100, 120, 92, 101, 103, 99,
 ];
 
-/// The IJG quality of a baseline JPEG's first (luminance) quantisation table: the mean ratio S of
+/// The IJG quality of a baseline JPEG's first (luminance) quantisation table: the integer quality
+/// whose libjpeg table it is, entry for entry (libjpeg, Pillow and most encoders write those); for
+/// any other table the mean ratio S of
 /// its entries to the standard table of ITU-T T.81 Annex K (Table K.1) in percent, and quality
 /// (200 − S)/2 for S ≤ 100, 5000/S above (libjpeg's `jpeg_quality_scaling`, inverted). `None` for
 /// bytes that are not a JPEG or whose table is not among the segments before the scan.
@@ -40,6 +42,21 @@ pub fn jpeg_quality(bytes: &[u8]) -> Option<f64> {
                     .map(|b| u16::from_be_bytes([b[0], b[1]]))
                     .collect()
             };
+            // libjpeg's own tables (`jpeg_set_quality`, baseline) at an integer quality: read
+            // exactly (the mean ratio below puts its quality 75 at 74.7: each odd entry of K.1
+            // rounds up).
+            if let Some(exact) = (1..=100u32).find(|&quality| {
+                let scale = if quality < 50 {
+                    5000 / quality
+                } else {
+                    200 - 2 * quality
+                };
+                q.iter().zip(K1_ZIGZAG).all(|(&a, b)| {
+                    u32::from(a) == ((u32::from(b) * scale + 50) / 100).clamp(1, 255)
+                })
+            }) {
+                return Some(f64::from(exact));
+            }
             let s = 100.0
                 * q.iter()
                     .zip(K1_ZIGZAG)
@@ -66,7 +83,7 @@ mod tests {
 
     /// A JPEG header whose luminance table libjpeg's `jpeg_quality_scaling` made for quality q
     /// (S = 5000/q below 50, 200 − 2q above; entries (K.1 · S + 50) / 100, at least 1) reads
-    /// back as q within the table's rounding; a PNG, or a JPEG without a table, reads as none.
+    /// back as q exactly; a PNG, or a JPEG without a table, reads as none.
     #[test]
     fn the_jpeg_quality_comes_back_from_the_quantisation_table() {
         for q in [30u32, 50, 75, 90, 95] {
@@ -75,8 +92,15 @@ mod tests {
             bytes.extend([0xFF, 0xDB, 0x00, 67, 0x00]);
             bytes.extend(K1_ZIGZAG.map(|k| ((u32::from(k) * s + 50) / 100).clamp(1, 255) as u8));
             bytes.extend([0xFF, 0xDA, 0x00, 0x02]);
+            assert_eq!(jpeg_quality(&bytes), Some(f64::from(q)));
+            // A table of no libjpeg quality (every entry one step coarser) reads by its mean
+            // ratio, within the table's rounding.
+            let at = bytes.len() - 4 - 64;
+            for b in &mut bytes[at..at + 64] {
+                *b = b.saturating_add(1);
+            }
             let got = jpeg_quality(&bytes).unwrap();
-            assert!((got - f64::from(q)).abs() < 2.5, "quality {q}: read {got}");
+            assert!((got - f64::from(q)).abs() < 5.0, "quality {q}: read {got}");
         }
         assert_eq!(jpeg_quality(b"\x89PNG\r\n\x1a\n...."), None);
         assert_eq!(jpeg_quality(&[0xFF, 0xD8, 0xFF, 0xDA, 0x00, 0x02]), None);

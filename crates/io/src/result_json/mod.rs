@@ -168,6 +168,11 @@ pub struct ChannelResult {
     /// between samples).
     #[serde(default)]
     pub rms_log_residual: Option<f64>,
+    /// The same over the fitted rings' pixels (each ring weighted by the pixels it averages): the
+    /// number the fit-quality check judges, so a ring of one corner pixel counts once, not like a
+    /// ring of hundreds. Absent in files written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pixel_rms_log_residual: Option<f64>,
     /// χ² per degree of freedom of the weighted log residuals (1 when the model fits to the noise).
     #[serde(default)]
     pub chi2_reduced: Option<f64>,
@@ -614,6 +619,7 @@ pub(crate) mod tests {
             termination: scatterfit_optics::Termination::ConvergedResidual,
             mse: Some(1e-6),
             rms_log_residual: Some(0.01),
+            pixel_rms_log_residual: Some(0.01),
             chi2_reduced: Some(1.1),
             rings_used: 250,
             rings_inside_spot: 10,

@@ -49,7 +49,7 @@ pub struct Evidence {
     /// The image's spot half width over the fitted model's at the stated scale ([`spot_scale`]),
     /// made with the measurement (and its full refits) after the fits; `None` where it could not
     /// be measured, and for a refit of values only.
-    pub spot_scale: Option<f64>,
+    pub spot_scale: Option<SpotScale>,
 }
 
 /// Gathers the evidence of a measurement made with the proposed method: the two-parameter fit
@@ -131,17 +131,40 @@ fn albedo_check(
     })
 }
 
+/// The image's spot half width against the fitted model's at the stated scale: for the channel
+/// sum and for each channel alone ([`spot_scale`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpotScale {
+    /// The channel sum's ratio (image over model).
+    pub factor: f64,
+    /// Each channel's own ratio (R, G, B); `None` where a channel has no half width.
+    pub channels: [Option<f64>; 3],
+}
+
+impl SpotScale {
+    /// True when every channel, measured alone, finds the spot too large (`above`) or too small
+    /// by more than [`crate::checks::SPOT_CHANNEL_MARGIN`]. A wrong scale (or spot diameter) is
+    /// common to the channels and moves each of them alike; a JPEG's 8 × 8 blocks and chroma
+    /// subsampling move the edge of a small spot differently in each (Pillow's quality 75 on the
+    /// quick twin's 10-pixel spot: R 1.05, G 1.10, B 0.98).
+    pub fn every_channel_agrees(&self, above: bool) -> bool {
+        let m = crate::checks::SPOT_CHANNEL_MARGIN;
+        self.channels
+            .iter()
+            .all(|c| c.is_some_and(|f| if above { f > 1.0 + m } else { f < 1.0 - m }))
+    }
+}
+
 /// The ratio of the image's spot half width to the one the fitted model predicts at the stated
 /// scale and spot ([`crate::checks::SPOT_FACTOR_RANGE`]): each fitted channel's model (convolved
 /// with the spot, × its fitted scale) averaged over the same rings as the image (8 radii per
 /// ring, equal areas), the channels summed as the image's half width is measured
-/// ([`crate::checks::spot_hwhm_px`]). About mm_per_pixel(stated) / mm_per_pixel(true): 0.91 for
-/// a scale stated 10 % too large. With an approximate model the exact fit of the same data
-/// ([`crate::model_term::ExactFit`]) predicts the spot instead: a diffusion model's near field,
-/// inside the spot, is its least accurate part (the dipole's spot on red aluminium is 2.6× too
-/// wide). `None` without three fitted channels or a half width.
-pub fn spot_scale(m: &Measurement) -> Option<f64> {
-    let data_hwhm = crate::checks::spot_hwhm_px(m)?;
+/// ([`crate::checks::spot_hwhm_px`]), and each channel alone. About mm_per_pixel(stated) /
+/// mm_per_pixel(true): 0.91 for a scale stated 10 % too large. With an approximate model the
+/// exact fit of the same data ([`crate::model_term::ExactFit`]) predicts the spot instead: a
+/// diffusion model's near field, inside the spot, is its least accurate part (the dipole's spot
+/// on red aluminium is 2.6× too wide). `None` without three fitted channels or a half width.
+pub fn spot_scale(m: &Measurement) -> Option<SpotScale> {
     let rings = &m.profile.profile.rings;
     let mmpp = m.profile.profile.mm_per_pixel;
     if !(mmpp.is_finite() && mmpp > 0.0) {
@@ -159,7 +182,8 @@ pub fn spot_scale(m: &Measurement) -> Option<f64> {
             (0..SUB).map(move |j| mmpp * (a2 + (j as f64 + 0.5) / SUB as f64 * (b2 - a2)).sqrt())
         })
         .collect();
-    let mut sum = vec![0.0; rings.len()];
+    let r_px: Vec<f64> = rings.iter().map(|r| r.r_px).collect();
+    let mut per_channel: Vec<Vec<f64>> = Vec::with_capacity(3);
     for c in Channel::ALL {
         let f = m.fits[c].fit().filter(|f| f.report.converged)?;
         let (s, a, scale) = if exact {
@@ -171,12 +195,25 @@ pub fn spot_scale(m: &Measurement) -> Option<f64> {
         };
         let props = OpticalProperties::new(s, a, m.spectro.eta).ok()?;
         let values = scatterfit_fit::model_profile(&model, &props, spot, &radii).ok()?;
-        for (k, chunk) in values.chunks(SUB).enumerate() {
-            sum[k] += scale * chunk.iter().sum::<f64>() / SUB as f64;
-        }
+        per_channel.push(
+            values
+                .chunks(SUB)
+                .map(|chunk| scale * chunk.iter().sum::<f64>() / SUB as f64)
+                .collect(),
+        );
     }
-    let model_hwhm = hwhm_of(&sum, &rings.iter().map(|r| r.r_px).collect::<Vec<_>>())?;
-    Some(data_hwhm / model_hwhm)
+    let sum: Vec<f64> = (0..rings.len())
+        .map(|k| per_channel.iter().map(|v| v[k]).sum())
+        .collect();
+    let factor = crate::checks::spot_hwhm_px(m)? / hwhm_of(&sum, &r_px)?;
+    let channels = std::array::from_fn(|c| {
+        let data: Vec<f64> = rings
+            .iter()
+            .map(|r| r.channels.get(c).map_or(f64::NAN, |x| x.mean))
+            .collect();
+        Some(hwhm_of(&data, &r_px)? / hwhm_of(&per_channel[c], &r_px)?)
+    });
+    Some(SpotScale { factor, channels })
 }
 
 /// The half width at half maximum of ring values `v` at radii `r` \[px\], as
