@@ -80,7 +80,7 @@ fn reusable(dir: &Path, o: &Overrides) -> Option<MeasurementResult> {
         .chain(inputs.hdr.as_ref())
         .chain(&inputs.frames);
     for f in refs {
-        if scatterfit_pipeline::measure::hash_file(&dir.join(&f.path)).as_deref() != Some(&f.sha256)
+        if scatterfit_pipeline::samples::hash_file(&dir.join(&f.path)).as_deref() != Some(&f.sha256)
         {
             return None;
         }
