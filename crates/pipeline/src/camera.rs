@@ -287,18 +287,9 @@ fn box_blur(data: &[f32], w: usize, h: usize, ch: usize, r: usize) -> Vec<f32> {
 }
 
 /// The veiling glare (stray light) of a channel: a constant background under the profile,
-/// estimated on the rings beyond the profile's near field.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Background {
-    /// The level [relative radiance].
-    pub level: f64,
-    /// Its standard error.
-    pub stderr: f64,
-    /// The level over the profile's peak (the glare's size as a lens maker gives it).
-    pub relative_to_peak: f64,
-    /// True when it was subtracted (significant: above 3 standard errors and the detection limit).
-    pub subtracted: bool,
-}
+/// estimated on the rings beyond the profile's near field — the record `result.json` keeps
+/// (`inputs.options.camera.background`).
+pub use scatterfit_io::result_json::BackgroundLevel as Background;
 
 /// Fits y(r) = b + A e^{−s r}/r^p to rings (r \[mm\], value, standard error) — a diffusion profile's
 /// far field over a constant background — by least squares in (b, A) for each s on a log grid in

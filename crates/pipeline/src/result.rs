@@ -4,13 +4,17 @@
 
 use std::path::Path;
 
-use scatterfit_io::result_json::{AlbedoSource, FileRef, Inputs, MeasurementResult, RunOptions};
+use scatterfit_io::result_json::{
+    AlbedoSource, CameraCorrections, CameraRecord, ExposureRecord, FileRef, Inputs,
+    MeasurementResult, RunOptions,
+};
 use scatterfit_optics::Rgb;
 
 use crate::anisotropy::plan::{GPlan, known_g_record};
 use crate::anisotropy::record::GFit;
 use crate::fit::channel_result;
 use crate::fit::outcome::ChannelOutcome;
+use crate::hdr::Corrections;
 use crate::measurement::Measurement;
 use crate::settings::FitSettings;
 
@@ -96,10 +100,10 @@ impl Measurement {
                             .map(|v| v.is_finite().then_some(*v))
                             .collect(),
                     ),
-                    camera: Some(serde_json::json!({
-                        "corrections": self.hdr.corrections,
-                        "background": self.profile.background,
-                    })),
+                    camera: Some(CameraRecord {
+                        background: self.profile.background.clone(),
+                        corrections: corrections_record(&self.hdr.corrections),
+                    }),
                 },
             },
             version: env!("CARGO_PKG_VERSION").into(),
@@ -167,4 +171,26 @@ fn rd_spectrum(
             rd: a.spectral.iter().map(|p| p.sce).collect(),
         }
     })
+}
+
+/// What the HDR stage corrected, as the result records it (the parts a reader of the file needs;
+/// the checks' working values stay in the measurement).
+fn corrections_record(c: &Corrections) -> CameraCorrections {
+    CameraCorrections {
+        black_level: c
+            .black_level
+            .as_ref()
+            .map(|(dn, source)| (dn.clone(), (*source).to_string())),
+        exposure: c.exposure.as_ref().map(|e| ExposureRecord {
+            factor: e.factor.clone(),
+            max_correction: e.max_correction,
+            pairs: e.pairs.clone(),
+        }),
+        exposure_applied: c.exposure_applied,
+        flat: c
+            .flat
+            .as_ref()
+            .map(|(path, lo, hi)| (path.to_string_lossy().into_owned(), *lo, *hi)),
+        no_signal: c.no_signal.clone(),
+    }
 }
