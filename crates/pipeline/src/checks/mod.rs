@@ -32,8 +32,9 @@ pub use crate::hdr::frames::{
     code_range, registration,
 };
 pub use ambient::{
-    FAR_FIELD_FRACTION, FAR_FIELD_MIN_SAMPLES, FarField, MAX_FAR_FIELD_CODES, MIN_FAR_FIELD_RATIO,
-    ambient_light_reasons, far_field_agreement, far_field_agreement_in,
+    FAR_FIELD_FRACTION, FAR_FIELD_MIN_SAMPLES, FarField, MAX_CORNER_Z, MAX_FAR_FIELD_CODES,
+    MIN_CORNER_RELATIVE, MIN_FAR_FIELD_RATIO, ambient_light_reasons, far_field_agreement,
+    far_field_agreement_in,
 };
 pub use findings::SampleChecks;
 pub use frames::{
