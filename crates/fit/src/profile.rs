@@ -307,14 +307,8 @@ pub fn select_rings(profile: &ProfileData, sel: &RingSelection) -> Result<Select
         let rel = if ring.stderr.is_finite() && ring.stderr >= 0.0 {
             ring.stderr / ring.value
         } else {
-            // One pixel (or an unknown error): as uncertain as the error floor allows, no better.
-            f64::INFINITY
-        };
-        let rel = if rel.is_finite() {
-            rel.max(sel.relative_error_floor)
-        } else {
-            // Unknown error: weight like a ring at ten times the floor.
-            10.0 * sel.relative_error_floor
+            // One pixel: no scatter of its own (the thin rings are given their neighbours' below).
+            f64::NAN
         };
         s.r_mm.push(ring.r_mm);
         s.value.push(ring.value);
@@ -322,5 +316,99 @@ pub fn select_rings(profile: &ProfileData, sel: &RingSelection) -> Result<Select
         s.count.push(ring.count);
         s.index.push(i);
     }
+    thin_rings_from_neighbours(&mut s.sigma_ln, &s.count);
+    for rel in &mut s.sigma_ln {
+        *rel = if rel.is_finite() {
+            rel.max(sel.relative_error_floor)
+        } else {
+            // No ring to learn the pixels' scatter from: weight like a ring at ten times the floor.
+            10.0 * sel.relative_error_floor
+        };
+    }
     Ok(s)
+}
+
+/// A ring of fewer pixels than this has its error from its neighbours' pixels
+/// ([`thin_rings_from_neighbours`]).
+pub const THIN_RING_PIXELS: u64 = 8;
+
+/// The relative error of the rings with fewer than [`THIN_RING_PIXELS`] pixels (the frame's
+/// corners, the centre): a sample standard deviation of one to seven values says little (of two
+/// nearly equal pixels it is nearly 0, and the ring would weigh as much as the floor allows; of one
+/// it does not exist), so such a ring gets at least the per-pixel relative scatter of the nearest
+/// ring with enough pixels, s·√n there, over its own √n — the standard error of a mean of n
+/// values whose scatter is the neighbours' (the profile changes slowly from ring to ring). Rings
+/// with enough pixels keep their own.
+fn thin_rings_from_neighbours(rel: &mut [f64], count: &[u64]) {
+    let per_pixel: Vec<Option<f64>> = rel
+        .iter()
+        .zip(count)
+        .map(|(&r, &n)| (n >= THIN_RING_PIXELS && r.is_finite()).then(|| r * (n as f64).sqrt()))
+        .collect();
+    for i in 0..rel.len() {
+        if count[i] >= THIN_RING_PIXELS && rel[i].is_finite() {
+            continue;
+        }
+        // The nearest ring with enough pixels, on either side (the inner one on a tie).
+        let nearest = (1..rel.len()).find_map(|d| {
+            i.checked_sub(d)
+                .and_then(|j| per_pixel[j])
+                .or_else(|| per_pixel.get(i + d).copied().flatten())
+        });
+        if let Some(p) = nearest {
+            let own = rel[i];
+            let pooled = p / (count[i].max(1) as f64).sqrt();
+            rel[i] = if own.is_finite() {
+                own.max(pooled)
+            } else {
+                pooled
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ring(r_mm: f64, value: f64, stderr: f64, count: u64) -> Ring {
+        Ring {
+            r_mm,
+            value,
+            stderr,
+            count,
+            detection_limit: 0.0,
+        }
+    }
+
+    /// Rings of one, two and three pixels take their error from the nearest ring of enough pixels:
+    /// its per-pixel relative scatter (1 % × √100 = 10 %) over their own √n, never less than their
+    /// own; rings of enough pixels keep theirs, and with no such ring the old rule (ten times the
+    /// floor for an unknown error, the floor otherwise) holds.
+    #[test]
+    fn thin_rings_take_their_neighbours_pixel_scatter() {
+        let data = ProfileData::new(vec![
+            ring(1.0, 10.0, 0.1, 100),
+            ring(2.0, 5.0, 0.0005, 2),
+            ring(3.0, 4.0, f64::NAN, 1),
+            ring(4.0, 3.0, 0.9, 3),
+            ring(5.0, 2.0, 0.04, 400),
+        ])
+        .unwrap();
+        let sel = RingSelection::new(0.5, 10.0, 0.0, RingSelection::DEFAULT_ERROR_FLOOR).unwrap();
+        let s = select_rings(&data, &sel).unwrap();
+        let expected = [0.01, 0.1 / 2f64.sqrt(), 0.1, 0.3, 0.02];
+        for (got, want) in s.sigma_ln.iter().zip(expected) {
+            assert!(
+                (got - want).abs() < 1e-12,
+                "{:?} against {expected:?}",
+                s.sigma_ln
+            );
+        }
+        let alone =
+            ProfileData::new(vec![ring(1.0, 1.0, f64::NAN, 1), ring(2.0, 1.0, 0.0, 2)]).unwrap();
+        let s = select_rings(&alone, &sel).unwrap();
+        let floor = RingSelection::DEFAULT_ERROR_FLOOR;
+        assert_eq!(s.sigma_ln, [10.0 * floor, floor]);
+    }
 }
