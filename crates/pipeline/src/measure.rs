@@ -24,7 +24,7 @@ use crate::model_term;
 use crate::port::{correct_port, port_of, propagate_fit_through_port};
 use crate::profile::{ProfileSettings, profile_stage_with};
 use crate::samples::{SampleInputs, sample_inputs};
-use crate::settings::{FitSettings, Overrides, SpotShape, families, fit_settings};
+use crate::settings::{FitSettings, Overrides, SpotShape, families, resolve};
 use crate::spectro::spectro_stage;
 
 /// Measures the sample in folder `dir` (its `sample.toml`): [`sample_inputs`], then
@@ -101,8 +101,7 @@ fn measure_from(
         Ok(())
     };
     let manifest = inputs.manifest.clone();
-    let settings = fit_settings(&manifest, overrides)?;
-    let (model, albedo) = families(&settings)?;
+    let (settings, (model, albedo)) = resolve(&manifest, overrides)?;
     let (model, albedo) = (&model, &albedo);
     begin(Stage::Spectro)?;
     let spectro = spectro_stage(&manifest, overrides.eta, albedo)?;

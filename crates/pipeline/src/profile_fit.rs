@@ -193,7 +193,11 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
     } else {
         AlbedoAtG::Fixed
     };
-    let mut fits = with_g_term(profile, &spectro, &settings, fits, albedo_at_g);
+    // Options the rings refuse leave every channel not fitted (fit_stage says why): no g term.
+    let mut fits = match settings.options() {
+        Ok(opts) => with_g_term(profile, &spectro, &settings, &opts, fits, albedo_at_g),
+        Err(_) => fits,
+    };
     // An approximate model's error: the same rings fitted again with exact transport (α′ as
     // given, or inverted from the given Rd through the `mc` total), |approximate − exact| the
     // `model` term of each estimate (crate::model_term).

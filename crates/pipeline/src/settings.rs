@@ -173,6 +173,15 @@ impl FitSettings {
 /// [`PipelineError::Input`] for a model that is not available or normalisation with the existing
 /// method.
 pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSettings> {
+    resolve(manifest, o).map(|(settings, _)| settings)
+}
+
+/// [`fit_settings`] with the profile model and the albedo model they name, both at their g
+/// ([`families`]).
+///
+/// # Errors
+/// As [`fit_settings`].
+pub(crate) fn resolve(manifest: &SampleManifest, o: &Overrides) -> Result<(FitSettings, Families)> {
     let method = o.method.or(manifest.fit.method).unwrap_or_default();
     let model = o.model.or(manifest.fit.model).unwrap_or_default();
     family(model)?;
@@ -216,9 +225,12 @@ pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSetti
         g: values_g(&g_prior)?,
         g_prior,
     };
-    families(&settings)?;
-    Ok(settings)
+    let models = families(&settings)?;
+    Ok((settings, models))
 }
+
+/// The profile model and the albedo model of a [`FitSettings`], at its g.
+pub(crate) type Families = (AtG<'static>, AtG<'static>);
 
 /// `g = "fit"` needs the g-aware `mc` model (the diffusion dipoles do not depend on g, and
 /// photon beam diffusion's g enters only its near field).
@@ -273,7 +285,7 @@ pub fn values_g_on(grid: &scatterfit_mc::McGridSet, prior: &GPrior) -> Result<f6
 ///
 /// # Errors
 /// [`PipelineError::Input`] for a g the Monte Carlo tables do not cover when either model is `mc`.
-pub(crate) fn families(settings: &FitSettings) -> Result<(AtG<'static>, AtG<'static>)> {
+pub(crate) fn families(settings: &FitSettings) -> Result<Families> {
     let at = |f| AtG::new(f, settings.g).map_err(|e| PipelineError::Input(format!("fit.g: {e}")));
     let (model, albedo) = (
         at(family(settings.model)?)?,

@@ -399,20 +399,17 @@ pub fn fit_g_channels(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
     settings: &FitSettings,
+    opts: &FitOptions,
     fits: &Rgb<ChannelOutcome>,
     range: [f64; 2],
     albedo_at_g: AlbedoAtG,
 ) -> Rgb<Option<Result<GFit, String>>> {
-    let opts = settings.options();
     let grid = scatterfit_mc::bundled_grid();
     fits.as_ref()
         .zip(profiles.as_ref())
         .map_with_channel(|c, (outcome, data)| {
             let report = outcome.report().filter(|r| r.converged)?;
-            let opts = match warm_start(&opts, report) {
-                Ok(o) => o,
-                Err(e) => return Some(Err(e)),
-            };
+            let opts = warm_start(opts, report);
             let grid = match &grid {
                 Ok(g) => *g,
                 Err(e) => return Some(Err(e.to_string())),

@@ -39,28 +39,26 @@ fn estimate_at(
     Ok([r.sigma_s_prime.value, r.sigma_a.value, r.albedo_prime])
 }
 
-/// The g term of every fitted channel ([module docs](self)): `None` for a channel not fitted,
-/// `Err` (why) where no term could be computed — the g the values are at could not be evaluated, or
-/// no point could.
+/// The g term of every fitted channel ([module docs](self)), each refit with `opts` (the
+/// settings' [`FitSettings::options`]) started from the channel's own fit: `None` for a channel not
+/// fitted, `Err` (why) where no term could be computed — the g the values are at could not be
+/// evaluated, or no point could.
 pub fn propagate_g(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
     settings: &FitSettings,
+    opts: &FitOptions,
     fits: &Rgb<ChannelOutcome>,
     plan: &GPlan,
     albedo_at_g: AlbedoAtG,
 ) -> Rgb<Option<std::result::Result<GTerm, String>>> {
-    let opts = settings.options();
     let proposed = settings.method == Method::Proposed;
     let value_is_mc = settings.model == ModelName::Mc && settings.albedo_model == AlbedoModel::Mc;
     fits.as_ref()
         .zip(profiles.as_ref())
         .map_with_channel(|c, (outcome, data)| {
             let report = outcome.report().filter(|r| r.converged)?;
-            let opts = match warm_start(&opts, report) {
-                Ok(o) => o,
-                Err(e) => return Some(Err(e)),
-            };
+            let opts = warm_start(opts, report);
             let input = ChannelInput {
                 eta: spectro.eta,
                 albedo_prime: spectro.albedo_prime[c],
@@ -242,17 +240,13 @@ fn list(v: &[f64]) -> String {
 
 /// The fit's options started from a converged fit's solution (σ′s, σa; the scale refitted): the
 /// refits at other g begin where the main fit ended.
-pub(crate) fn warm_start<E: std::fmt::Display>(
-    opts: &std::result::Result<FitOptions, E>,
-    report: &FitReport,
-) -> std::result::Result<FitOptions, String> {
-    let o = opts.as_ref().map_err(|e| e.to_string())?;
-    Ok(FitOptions {
+pub(crate) fn warm_start(opts: &FitOptions, report: &FitReport) -> FitOptions {
+    FitOptions {
         start: Some(Start {
             sigma_s_prime: report.sigma_s_prime.value,
             sigma_a: Some(report.sigma_a.value),
             scale: None,
         }),
-        ..*o
-    })
+        ..*opts
+    }
 }

@@ -40,14 +40,27 @@ pub fn fit_stage(
     settings: &FitSettings,
     model: &dyn ModelFamily,
 ) -> Rgb<ChannelOutcome> {
-    let opts = match settings.options() {
-        Ok(o) => o,
-        Err(e) => {
-            return Rgb::from_fn(|_| ChannelOutcome::NotFitted {
-                problem: e.to_string(),
-            });
-        }
-    };
+    match settings.options() {
+        Ok(opts) => fit_with(profiles, spectro, settings, &opts, model),
+        Err(e) => not_fitted(&e),
+    }
+}
+
+/// Every channel not fitted, for why.
+fn not_fitted(why: &dyn std::fmt::Display) -> Rgb<ChannelOutcome> {
+    Rgb::from_fn(|_| ChannelOutcome::NotFitted {
+        problem: why.to_string(),
+    })
+}
+
+/// [`fit_stage`] with the settings' options made.
+fn fit_with(
+    profiles: &Rgb<ProfileData>,
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    opts: &FitOptions,
+    model: &dyn ModelFamily,
+) -> Rgb<ChannelOutcome> {
     profiles.as_ref().map_with_channel(|c, data| {
         let albedo = spectro.albedo_prime[c];
         if settings.method == Method::Proposed && albedo.is_none() {
@@ -62,7 +75,7 @@ pub fn fit_stage(
             albedo_prime: albedo,
             rd_total: Some(spectro.rd[c]),
         };
-        match scatterfit_fit::fit_channel(data, &input, model, &opts) {
+        match scatterfit_fit::fit_channel(data, &input, model, opts) {
             Ok(r) => ChannelOutcome::Fitted(Box::new(ChannelFit::new(
                 r,
                 spectro.uncertainty.albedo_prime_stderr[c],
@@ -82,30 +95,38 @@ pub fn fit_and_propagate(
     settings: &FitSettings,
     model: &dyn ModelFamily,
 ) -> Rgb<ChannelOutcome> {
-    let fits = fit_stage(profiles, spectro, settings, model);
-    let errors = propagate_spectro(profiles, spectro, settings, model, &fits);
+    // The options once, for the fit and every refit after it.
+    let opts = match settings.options() {
+        Ok(o) => o,
+        Err(e) => return not_fitted(&e),
+    };
+    let fits = fit_with(profiles, spectro, settings, &opts, model);
+    let errors = spectro_errors(profiles, spectro, settings, &opts, model, &fits);
     let fits = fits.zip(errors).map(|(f, e)| f.with_spectro(e));
-    with_g_term(profiles, spectro, settings, fits, AlbedoAtG::FromRd)
+    with_g_term(profiles, spectro, settings, &opts, fits, AlbedoAtG::FromRd)
 }
 
 /// The outcomes with the g term of `settings.g_prior` ([`crate::anisotropy`]; 0 when g is
-/// known). A plan that cannot be made (the tables cover no g of the range) leaves the terms
-/// unknown, with the reason in each channel's note.
+/// known), its refits made with `opts` (the settings' [`FitSettings::options`]). A plan that cannot
+/// be made (the tables cover no g of the range) leaves the terms unknown, with the reason in each
+/// channel's note.
 pub fn with_g_term(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
     settings: &FitSettings,
+    opts: &FitOptions,
     fits: Rgb<ChannelOutcome>,
     albedo_at_g: AlbedoAtG,
 ) -> Rgb<ChannelOutcome> {
     match GPlan::new(&settings.g_prior, settings.g) {
         Ok(None) => fits.map(|f| f.with_g(None)),
         Ok(Some(plan)) if settings.g_prior.fit => {
-            let terms = propagate_g(profiles, spectro, settings, &fits, &plan, albedo_at_g);
+            let terms = propagate_g(profiles, spectro, settings, opts, &fits, &plan, albedo_at_g);
             let fitted = crate::anisotropy::fit::fit_g_channels(
                 profiles,
                 spectro,
                 settings,
+                opts,
                 &fits,
                 plan.range,
                 albedo_at_g,
@@ -115,7 +136,7 @@ pub fn with_g_term(
                 .map(|((f, g), t)| f.with_g_fit(g, t))
         }
         Ok(Some(plan)) => {
-            let terms = propagate_g(profiles, spectro, settings, &fits, &plan, albedo_at_g);
+            let terms = propagate_g(profiles, spectro, settings, opts, &fits, &plan, albedo_at_g);
             fits.zip(terms).map(|(f, t)| f.with_g(t))
         }
         Err(e) => fits.map(|f| f.with_g(Some(Err(e.to_string())))),
@@ -137,9 +158,21 @@ pub fn propagate_spectro(
     model: &dyn ModelFamily,
     fits: &Rgb<ChannelOutcome>,
 ) -> Rgb<Option<SpectroErrors>> {
-    let Ok(opts) = settings.options() else {
-        return Rgb::default();
-    };
+    match settings.options() {
+        Ok(opts) => spectro_errors(profiles, spectro, settings, &opts, model, fits),
+        Err(_) => Rgb::default(),
+    }
+}
+
+/// [`propagate_spectro`] with the settings' options made.
+fn spectro_errors(
+    profiles: &Rgb<ProfileData>,
+    spectro: &SpectroStage,
+    settings: &FitSettings,
+    opts: &FitOptions,
+    model: &dyn ModelFamily,
+    fits: &Rgb<ChannelOutcome>,
+) -> Rgb<Option<SpectroErrors>> {
     let u = &spectro.uncertainty;
     let proposed = settings.method == Method::Proposed;
     fits.as_ref()
@@ -174,7 +207,7 @@ pub fn propagate_spectro(
             };
             // One preparation (rings, spot kernel) for both refits.
             let lo_fit =
-                PreparedFit::new(data, &input(0)?, model, &FitOptions { start, ..opts }).ok()?;
+                PreparedFit::new(data, &input(0)?, model, &FitOptions { start, ..*opts }).ok()?;
             let hi = values(lo_fit.with_input(&input(1)?, start).ok()?.solve())?;
             let lo = values(lo_fit.solve())?;
             Some(SpectroErrors {
