@@ -30,7 +30,7 @@ use crate::response::ResponseCurve;
 /// Bracket errors (fewer than 2 frames, one time per frame, positive distinct times, equal shapes),
 /// a dark frame of another shape, [`ImagingError::ChannelMismatch`];
 /// [`ImagingError::DarkFrameAboveSignal`] (checked before merging) and
-/// [`ImagingError::NoValidRadiance`] when fewer than [`MIN_VALID_FRACTION`] of a channel's pixels
+/// [`ImagingError::NoValidRadiance`] when fewer than [`MIN_VALID_FRACTION`](crate::merge::MIN_VALID_FRACTION) of a channel's pixels
 /// have an estimate.
 pub fn merge(
     frames: &[ImageBuf<u8>],

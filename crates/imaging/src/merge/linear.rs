@@ -19,7 +19,7 @@ use crate::error::{ImagingError, Result, check_bracket, check_shape};
 ///
 /// # Errors
 /// Bracket errors, a dark frame of another shape,
-/// [`ImagingError::DarkFrameAboveSignal`], [`ImagingError::NoValidRadiance`] (as [`merge`]).
+/// [`ImagingError::DarkFrameAboveSignal`], [`ImagingError::NoValidRadiance`] (as [`merge`](crate::merge::merge)).
 pub fn merge_linear_u16(
     frames: &[ImageBuf<u16>],
     times_s: &[f64],
@@ -96,7 +96,7 @@ pub fn merge_linear_u16(
 }
 
 /// Merges a linear bracket whose values carry a black level (raw files, linear 16-bit frames of a
-/// camera that does not subtract it): the noise-aware linear-domain estimate of [`merge`]'s
+/// camera that does not subtract it): the noise-aware linear-domain estimate of [`merge`](crate::merge::merge)'s
 /// default, E = Σ_j u_j Δt_j (v_j − b)/Σ_j u_j Δt_j² (Robertson et al. 2003; Granados et al.
 /// 2010, with a noise constant in the signal), per channel with its own black level `black[c]`
 /// \[DN\]. Values below the black level are kept as the negative readings they are (read noise

@@ -4,7 +4,7 @@
 use super::image::ClippedFill;
 use crate::error::{ImagingError, Result};
 
-/// How [`merge`] weights the samples of a pixel-channel across the bracket.
+/// How [`merge`](crate::merge::merge) weights the samples of a pixel-channel across the bracket.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Weighting {
@@ -29,7 +29,7 @@ pub enum Weighting {
     DebevecHat,
 }
 
-/// Options of [`merge`]. Its fields are public: two enums, every combination valid (nothing to
+/// Options of [`merge`](crate::merge::merge). Its fields are public: two enums, every combination valid (nothing to
 /// check, unlike [`LinearMergeOptions`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MergeOptions {
@@ -40,11 +40,11 @@ pub struct MergeOptions {
     /// The expected-signal floor of [`Weighting::NoiseOptimal`] (default `None`: every frame
     /// counts): per channel (channel c uses entry min(c, 3)) a code below which a frame's reading
     /// of a pixel is left out of the merge *because of the signal it is expected to have*, not the
-    /// code it shows. See [`merge`]'s second pass.
+    /// code it shows. See [`merge`](crate::merge::merge)'s second pass.
     pub expected_floor: Option<[u8; 4]>,
 }
 
-/// Options of [`merge_linear_u16`]; built through [`LinearMergeOptions::new`], so always valid.
+/// Options of [`merge_linear_u16`](crate::merge::merge_linear_u16); built through [`LinearMergeOptions::new`], so always valid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearMergeOptions {
     pub(super) saturation: u16,

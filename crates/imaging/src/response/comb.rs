@@ -10,7 +10,7 @@ use super::solve::solve_least_squares;
 
 /// Knot spacing of the response's final smoothing, in units of ln k (k: the bracket's median ratio
 /// of consecutive exposure times): knots 1.2 ln k apart in log exposure barely follow a ripple of
-/// period ln k, which the bracket's data cannot see (see [`recover_response`]). Measured on the twin's camera sweep
+/// period ln k, which the bracket's data cannot see (see [`recover_response`](crate::response::recover_response)). Measured on the twin's camera sweep
 /// (BENCHMARKS.md): 1.2 and 1.5 remove most of the ripple; 2 bends the S-curve; 1.2 keeps the
 /// S-curve's toe within 0.5 % from code 30 up, where 1.5 bends it by 0.9 %.
 pub const AMBIGUITY_KNOT_STEP: f64 = 1.2;

@@ -92,7 +92,7 @@ pub struct Calibration {
     /// The recovered response, gauge g(128) = 0 per channel: X(z) unbiased for the mean of the
     /// readings at one exposure (what the merge averages).
     pub response: ResponseCurve,
-    /// The same response with the toe to first order only ([`forward_toe`]): unbiased for the
+    /// The same response with the toe to first order only ([`forward_toe`](crate::response::forward_toe)): unbiased for the
     /// *median* of the readings at one exposure, for statistics of medians (the pipeline's
     /// exposure estimate takes the median of pixel ratios). Equal to `response` above the toe.
     pub median_response: ResponseCurve,

@@ -4,7 +4,7 @@ use super::curve::LEVELS;
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result, check_bracket};
 
-/// Most sample pixels per channel [`recover_response`] and [`gsolve`] accept: 10× the default. The
+/// Most sample pixels per channel [`recover_response`](crate::response::recover_response) and [`gsolve`](crate::response::gsolve) accept: 10× the default. The
 /// dense system has N·P + 255 rows of 256 doubles (1000 samples × 13 frames: 27 MB, well under a
 /// second to solve); more samples add nothing that 1000 do not already give.
 pub const MAX_RESPONSE_SAMPLES: usize = 1000;

@@ -5,7 +5,7 @@ use super::curve::LEVELS;
 use crate::ImageBuf;
 
 /// Codes at and above this (up to [`TOE_TRUST_HI`]) are trusted as Debevec & Malik's least squares
-/// gives them; below it [`recover_response`] replaces g by the inverse of the mean code at known
+/// gives them; below it [`recover_response`](crate::response::recover_response) replaces g by the inverse of the mean code at known
 /// exposure ([`forward_toe`]). Chosen so that the trusted codes' noise is small against their
 /// signal for every camera of the twin's camera sweep (at code 120, 15 e⁻ read noise is < 0.5 % of the
 /// exposure through sRGB or gamma 2.2 and ~1.3 % through the log curve), and low enough that every
