@@ -21,22 +21,15 @@
 //! θ has a square-root end point (s = |r − a| and s = r + a) the interval is mapped by s = s₀ ± Δv²,
 //! which makes the integrand smooth.
 
+use scatterfit_optics::numerics::quadrature::{GL8_AS_W, GL8_AS_X};
+
 use crate::error::{Result, check};
 
-/// Gauss–Legendre nodes and weights on [0, 1], 8 points (Abramowitz & Stegun, Table 25.4).
+/// Gauss–Legendre nodes and weights on [0, 1], 8 points: Abramowitz & Stegun's table 25.4
+/// (`scatterfit_optics::numerics::quadrature`) mapped from [−1, 1].
 const GL8: [(f64, f64); 8] = {
-    const X: [f64; 4] = [
-        0.183_434_642_495_649_8,
-        0.525_532_409_916_329,
-        0.796_666_477_413_626_7,
-        0.960_289_856_497_536_3,
-    ];
-    const W: [f64; 4] = [
-        0.362_683_783_378_362,
-        0.313_706_645_877_887_3,
-        0.222_381_034_453_374_5,
-        0.101_228_536_290_376_3,
-    ];
+    const X: [f64; 4] = GL8_AS_X;
+    const W: [f64; 4] = GL8_AS_W;
     let mut out = [(0.0, 0.0); 8];
     let mut i = 0;
     while i < 4 {

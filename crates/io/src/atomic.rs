@@ -26,13 +26,13 @@ use std::path::Path;
 
 use scatterfit_safefs::{ledger, write};
 
+use crate::result_set::set_file;
+
 /// True when an older run listed `name` among the result files of `dir` (its set manifest,
 /// [`crate::result_set`]): results written before the ledger existed are scatterfit's too.
 fn listed_by_a_result_set(dir: &Path, name: &str) -> bool {
-    match crate::result_set::read(dir) {
-        Ok(Some(set)) => {
-            name == crate::result_set::SET_FILE || set.files.iter().any(|f| f.name == name)
-        }
+    match set_file::read(dir) {
+        Ok(Some(set)) => name == set_file::SET_FILE || set.files.iter().any(|f| f.name == name),
         _ => false,
     }
 }

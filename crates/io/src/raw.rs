@@ -14,7 +14,7 @@ use std::path::Path;
 
 use scatterfit_imaging::ImageBuf;
 
-use crate::image_files::ImageFileError;
+use crate::image_files::error::ImageFileError;
 
 /// File extensions read as camera RAW (lower case).
 pub const RAW_EXTENSIONS: [&str; 20] = [

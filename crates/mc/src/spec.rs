@@ -400,6 +400,7 @@ impl McTableSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::white::simulate;
 
     /// `AlbedoSpacing::SqrtOneMinusReducedAlbedo`: at g = 0.9 the nodes' reduced albedos
     /// (α′ = a(1 − g)/(1 − ag), computed here from each node) are equally spaced in √(1 − α′) and
@@ -514,5 +515,43 @@ mod tests {
             );
         }
         assert!(main.clone().with_low_albedos_to(0.05, 0).is_err());
+    }
+
+    /// The cost model against measured interaction counts of white runs: within a factor 2 over
+    /// η 1–2.5, g 0–0.9 and the default strata (the run's own count, `WhiteTally::interactions`).
+    /// Fixed seeds; 4 000 full-length photons keep the heavy-tailed counts' noise to a few per cent.
+    #[test]
+    fn cost_estimate_matches_measured_work() {
+        for (eta, g) in [
+            (1.0, 0.0),
+            (1.4, 0.0),
+            (2.5, 0.0),
+            (1.4, 0.5),
+            (1.4, 0.9),
+            (2.0, 0.9),
+        ] {
+            let mut spec = McTableSpec::new(eta, g, 4_000).unwrap();
+            spec.radial_bins = 40;
+            let est = spec.cost_estimate().unwrap();
+            let tally = simulate(&spec.white().unwrap(), &|_| {}).unwrap();
+            let ratio = est.interactions / tally.interactions as f64;
+            assert!(
+                (0.5..=2.0).contains(&ratio),
+                "η {eta} g {g}: estimate {:.3e} vs measured {:.3e}",
+                est.interactions,
+                tally.interactions as f64
+            );
+            assert!(est.memory_bytes > 0);
+        }
+        // Bounded by the interaction caps whatever g is.
+        let spec = McTableSpec::new(1.4, 0.999_99, 1_000).unwrap();
+        let bound: f64 = spec
+            .white()
+            .unwrap()
+            .strata
+            .iter()
+            .map(|s| s.photons as f64 * s.max_interactions as f64)
+            .sum();
+        assert!(spec.cost_estimate().unwrap().interactions <= bound);
     }
 }

@@ -208,35 +208,6 @@ impl PairTerm for Dual {
     }
 }
 
-/// Nodes and weights of 8-point Gauss–Legendre quadrature on [−1, 1] (numpy 2.4
-/// `polynomial.legendre.leggauss(8)`, printed to 17 digits; Abramowitz & Stegun table 25.4 to 15).
-const GL8: [(f64, f64); 8] = [
-    (-9.602_898_564_975_362e-1, 1.012_285_362_903_770_6e-1),
-    (-7.966_664_774_136_267e-1, 2.223_810_344_533_744_3e-1),
-    (-5.255_324_099_163_29e-1, 3.137_066_458_778_869e-1),
-    (-1.834_346_424_956_498e-1, 3.626_837_833_783_616_6e-1),
-    (1.834_346_424_956_498e-1, 3.626_837_833_783_616_6e-1),
-    (5.255_324_099_163_29e-1, 3.137_066_458_778_869e-1),
-    (7.966_664_774_136_267e-1, 2.223_810_344_533_744_3e-1),
-    (9.602_898_564_975_362e-1, 1.012_285_362_903_770_6e-1),
-];
-
-/// ∫₀^{L·2^{p−1}} f(r) dr by 8-point Gauss–Legendre on the panels [0, L], [L, 2L], [2L, 4L], …
-/// (`panels` panels, first width `first`): doubling panels resolve a radial integrand whose
-/// features scale with the distance from the source, and an exponential tail. f is called
-/// 8·`panels` times.
-pub(crate) fn integrate_doubling(first: f64, panels: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
-    let mut sum = 0.0;
-    let (mut a, mut b) = (0.0, first);
-    for _ in 0..panels {
-        let (h, m) = (0.5 * (b - a), 0.5 * (a + b));
-        sum += h * GL8.iter().map(|&(x, w)| w * f(m + h * x)).sum::<f64>();
-        a = b;
-        b *= 2.0;
-    }
-    sum
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -311,17 +282,5 @@ mod tests {
         let s = 0.7;
         let want = ((-s * 1.0f64).exp() - (-s * 3.0f64).exp()) / s;
         assert!((exp_diff_over_sigma(s, 1.0, 3.0) - want).abs() < 1e-15);
-    }
-
-    /// ∫₀^∞ r e^{−r} dr = 1 and ∫₀^∞ 2πr e^{−√(r² + 1)}/√(r² + 1) dr = 2π e^{−1} (substitute d).
-    #[test]
-    fn doubling_quadrature_integrates_known_integrals() {
-        let i1 = integrate_doubling(1.0 / 1024.0, 17, |r| r * (-r).exp());
-        assert!((i1 - 1.0).abs() < 1e-11, "{i1}");
-        let i2 = integrate_doubling(1.0 / 1024.0, 17, |r| {
-            let d = (r * r + 1.0).sqrt();
-            2.0 * std::f64::consts::PI * r * (-d).exp() / d
-        });
-        assert!((i2 - 2.0 * std::f64::consts::PI * (-1.0f64).exp()).abs() < 1e-11);
     }
 }

@@ -45,8 +45,11 @@ pub mod termination;
 mod diffusion;
 mod dual;
 mod error;
+pub mod numerics;
 mod properties;
-pub mod roots;
+
+/// The root finder's old path.
+pub use numerics::roots;
 
 pub use error::{OpticsError, Result};
 pub use estimate::Estimate;

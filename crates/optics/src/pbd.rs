@@ -39,12 +39,11 @@
 
 use std::f64::consts::PI;
 
-use crate::diffusion::{
-    Boundary, Pair, PairTerm, check_albedo, exp_diff_over_sigma, integrate_doubling, invert_total,
-};
+use crate::diffusion::{Boundary, Pair, PairTerm, check_albedo, exp_diff_over_sigma, invert_total};
 use crate::dual::{Dual, Real};
 use crate::error::Result;
 use crate::family::{ProfileModel, ProfileSample};
+use crate::numerics::quadrature::integrate_doubling;
 use crate::properties::OpticalProperties;
 
 /// Depth samples per sum, pbrt's `nSamples` in both `BeamDiffusionMS` and `BeamDiffusionSS`.

@@ -183,19 +183,7 @@ pub fn disc_intersection_area(a: f64, b: f64, d: f64) -> f64 {
 
 /// ∫ f over [lo, hi] with `panels` Gauss–Legendre panels whose edges are lo + (hi − lo)(i/panels)².
 fn integrate_sqrt_panels(f: &dyn Fn(f64) -> f64, lo: f64, hi: f64, panels: usize) -> f64 {
-    // 8-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun, table 25.4).
-    const X: [f64; 4] = [
-        0.183_434_642_495_649_8,
-        0.525_532_409_916_329,
-        0.796_666_477_413_626_7,
-        0.960_289_856_497_536_3,
-    ];
-    const W: [f64; 4] = [
-        0.362_683_783_378_362,
-        0.313_706_645_877_887_3,
-        0.222_381_034_453_374_5,
-        0.101_228_536_290_376_3,
-    ];
+    use crate::numerics::quadrature::{GL8_AS_W as W, GL8_AS_X as X};
     let edge = |i: usize| lo + (hi - lo) * (i as f64 / panels as f64).powi(2);
     let mut sum = 0.0;
     for i in 0..panels {

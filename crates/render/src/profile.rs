@@ -3,6 +3,7 @@
 //! the better dipole, photon beam diffusion, the Monte Carlo tables: the caller chooses, e.g. with
 //! `scatterfit_mc::family`), without touching the renderer.
 
+use scatterfit_optics::numerics::roots::bisect;
 use scatterfit_optics::{
     Channel, DiffusionModel, ModelFamily, ModelName, OpticalProperties, ProfileModel, Rgb,
 };
@@ -151,26 +152,10 @@ impl RdTable {
         while hi < 1000.0 && rd(hi) > floor {
             hi *= 2.0;
         }
-        let mut lo = 0.5 * hi;
-        for _ in 0..40 {
-            let mid = 0.5 * (lo + hi);
-            if rd(mid) > floor {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
+        let (_, hi) = bisect(0.5 * hi, hi, 40, |r| rd(r) > floor);
         let r_cut = hi.min(1000.0).min(r_limit.max(1e-3));
         // Half-width: where Rd falls to half its peak (peaked at 0 for the dipole; bisection).
-        let (mut lo_h, mut hi_h) = (0.0, r_cut);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo_h + hi_h);
-            if rd(mid) > 0.5 * peak {
-                lo_h = mid;
-            } else {
-                hi_h = mid;
-            }
-        }
+        let (_, hi_h) = bisect(0.0, r_cut, 60, |r| rd(r) > 0.5 * peak);
         let half_width = hi_h.max(1e-6);
         let q_max = r_cut.sqrt();
         let nodes = ((q_max / MAX_DQ).ceil() as usize).clamp(4096, 16384);

@@ -7,6 +7,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::axis::{Axis, figure_axes};
+use super::palette::{GREY, INK};
 use super::series::draw_series;
 use super::{Figure, PANEL_WIDTH, Panel};
 use crate::error::{ReportError, Result, draw_error};
@@ -25,9 +26,6 @@ const LEGEND_SIZE: f64 = 14.0;
 const NOTE_LINE_HEIGHT: u32 = 18;
 /// At most this many note lines per panel (the rest is cut with "…").
 const NOTE_MAX_LINES: usize = 3;
-
-const INK: RGBColor = RGBColor(20, 20, 20);
-pub(super) const GREY: RGBColor = RGBColor(140, 140, 140);
 
 fn font(size: f64) -> TextStyle<'static> {
     (FONT, size).into_font().color(&INK)

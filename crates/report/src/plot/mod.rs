@@ -11,8 +11,8 @@
 //! The module by concept: the figure's data (this file); `axis` (plot-space axes, decade and
 //! linear ticks, the figure's shared ranges); `series` (how each [`SeriesStyle`] is drawn,
 //! clipping, legend samples); `layout` (title strip, panel headers with wrapped notes, the chart
-//! frame and legend); `backend` (SVG and PNG backends, the embedded font, the PNG's text through
-//! `scatterfit_imaging::text`).
+//! frame and legend); `palette` (the neutral colours layout and series share); `backend` (SVG and
+//! PNG backends, the embedded font, the PNG's text through `scatterfit_imaging::text`).
 //!
 //! Text: `plotters` runs without font-kit (no FreeType or fontconfig, which a fresh machine may lack);
 //! the DejaVu Sans embedded in `scatterfit_imaging::text` is registered with plotters' `ab_glyph`
@@ -30,6 +30,7 @@ use crate::error::{ReportError, Result};
 mod axis;
 mod backend;
 mod layout;
+mod palette;
 mod series;
 #[cfg(test)]
 mod tests;

@@ -6,7 +6,7 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::axis::Axis;
-use super::layout::GREY;
+use super::palette::GREY;
 use super::{Figure, Series, SeriesStyle};
 use crate::error::{Result, draw_error};
 

@@ -1,6 +1,8 @@
 //! The rig twin's camera: sensor (full well, read noise, gain), tone curve and output bit depth
 //! (`CameraModel`, `ToneCurve`, `SensorOutput`).
 
+use scatterfit_optics::numerics::roots::bisect;
+
 use super::*;
 
 /// The camera of the twin: a linear sensor counted in electrons, then a tone curve and 8 bits.
@@ -148,15 +150,7 @@ impl CameraModel {
     /// Debevec & Malik's g(Z) recovers, for tests that separate response errors from the merge's.
     pub fn true_log_response(&self) -> [f64; 256] {
         let inv = |v: f64| {
-            let (mut lo, mut hi) = (0.0, 1.0);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if self.tone(mid) < v {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
+            let (lo, hi) = bisect(0.0, 1.0, 60, |s| self.tone(s) < v);
             0.5 * (lo + hi)
         };
         std::array::from_fn(|z| {

@@ -1,4 +1,5 @@
-//! A bracketed scalar root finder for the few one-dimensional inversions in this crate.
+//! A bracketed scalar root finder for the few one-dimensional inversions of the physics crates,
+//! and the plain bisection that tabulation and tone-curve inversions use.
 //!
 //! Written by hand rather than taken from a crate: the inversions here are monotone, smooth and
 //! called in hot loops (one per pixel channel in batch work), so we want an allocation-free,
@@ -47,6 +48,27 @@ pub fn bracketed_root<F: Fn(f64) -> f64>(f: F, lo: f64, hi: f64, x_tol: f64) -> 
         }
     }
     Some(0.5 * (a + b))
+}
+
+/// Bisection with a fixed number of steps: halves [lo, hi] `steps` times, keeping the half where
+/// `below` turns from true (at lo) to false (at hi), and returns the last bracket. For a
+/// monotone predicate such as "f(x) is still above the level"; 60 steps shrink a bracket of 1 by
+/// 2⁻⁶⁰, below the spacing of doubles near 1.
+pub fn bisect(
+    mut lo: f64,
+    mut hi: f64,
+    steps: usize,
+    mut below: impl FnMut(f64) -> bool,
+) -> (f64, f64) {
+    for _ in 0..steps {
+        let mid = 0.5 * (lo + hi);
+        if below(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (lo, hi)
 }
 
 #[cfg(test)]
