@@ -6,13 +6,15 @@
 //! - [`study`]: the bias study over α′, η and g (`scatterfit study`), its rows and tables, and
 //!   [`study_figure`], its figure;
 //! - [`accuracy`]: the demo's table of each measured value against the twin's truth, and
-//!   [`accuracy_markdown()`], its Markdown.
+//!   [`accuracy_markdown()`], its Markdown;
+//! - [`slurm`]: the Slurm script of a sharded run (`scatterfit slurm`).
 //!
 //! The layers below ([`scatterfit_pipeline`], [`scatterfit_report`], `scatterfit-render`) know
 //! nothing of the twin; this crate joins the two (ARCHITECTURE.md, "Workspace layout").
 
 pub mod accuracy;
 pub mod accuracy_markdown;
+pub mod slurm;
 pub mod study;
 pub mod study_figure;
 pub mod twin;
