@@ -52,6 +52,7 @@ pub mod fit;
 pub mod hdr;
 pub mod measure;
 pub mod model_term;
+pub mod monte_carlo;
 pub mod outputs;
 pub mod port;
 pub mod profile;
