@@ -2,7 +2,8 @@
 //! a lab needs to measure a sample.
 //!
 //! - [`twin`]: a rig twin (a [`scatterfit_synth::SyntheticSample`]) written as a sample folder, the
-//!   one writer `scatterfit synth`, the demo, the study and the tests share;
+//!   one writer `scatterfit synth`, the demo, the study and the tests share, and
+//!   [`twin_settings`], what a twin is made of (material, rig, port) from a user's settings;
 //! - [`study`]: the bias study over α′, η and g (`scatterfit study`), its rows and tables, and
 //!   [`study_figure`], its figure;
 //! - [`accuracy`]: the demo's table of each measured value against the twin's truth, and
@@ -18,5 +19,6 @@ pub mod slurm;
 pub mod study;
 pub mod study_figure;
 pub mod twin;
+pub mod twin_settings;
 
 pub use accuracy_markdown::accuracy_markdown;
