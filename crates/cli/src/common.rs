@@ -342,16 +342,6 @@ pub struct PhotonScaleArgs {
     pub photon_scale: f64,
 }
 
-impl PhotonScaleArgs {
-    /// `rig` with the photons scaled (the factor was checked when parsed).
-    pub fn apply(
-        &self,
-        rig: scatterfit_synth::RigSpec,
-    ) -> anyhow::Result<scatterfit_synth::RigSpec> {
-        Ok(rig.with_photon_scale(self.photon_scale)?)
-    }
-}
-
 /// Parses `--photon-scale`: a finite number in [`scatterfit_synth::rig::PHOTON_SCALE_RANGE`].
 ///
 /// # Errors

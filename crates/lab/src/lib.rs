@@ -5,7 +5,8 @@
 //!   one writer `scatterfit synth`, the demo, the study and the tests share, and
 //!   [`twin_settings`], what a twin is made of (material, rig, port) from a user's settings;
 //! - [`study`]: the bias study over α′, η and g (`scatterfit study`), its rows and tables, and
-//!   [`study_figure`], its figure;
+//!   [`study_figure`], its figure, and [`study_run`], the study as a run (its settings, fits,
+//!   shards' parts and files);
 //! - [`accuracy`]: the demo's table of each measured value against the twin's truth, and
 //!   [`accuracy_markdown()`], its Markdown;
 //! - [`slurm`]: the Slurm script of a sharded run (`scatterfit slurm`).
@@ -18,6 +19,7 @@ pub mod accuracy_markdown;
 pub mod slurm;
 pub mod study;
 pub mod study_figure;
+pub mod study_run;
 pub mod twin;
 pub mod twin_settings;
 
