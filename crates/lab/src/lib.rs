@@ -8,7 +8,7 @@
 //!   [`study_figure`], its figure, and [`study_run`], the study as a run (its settings, fits,
 //!   shards' parts and files);
 //! - [`accuracy`]: the demo's table of each measured value against the twin's truth, and
-//!   [`accuracy_markdown()`], its Markdown;
+//!   [`accuracy_markdown()`], its Markdown, and [`demo`], the demo's materials and files;
 //! - [`slurm`]: the Slurm script of a sharded run (`scatterfit slurm`).
 //!
 //! The layers below ([`scatterfit_pipeline`], [`scatterfit_report`], `scatterfit-render`) know
@@ -16,6 +16,7 @@
 
 pub mod accuracy;
 pub mod accuracy_markdown;
+pub mod demo;
 pub mod slurm;
 pub mod study;
 pub mod study_figure;
