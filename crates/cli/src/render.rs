@@ -27,44 +27,6 @@ use scatterfit_render::{
     RenderOptions, Shape, StudioScene, Summary,
 };
 
-/// The built-in models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ShapeArg {
-    /// Sphere, 10 mm radius.
-    Sphere,
-    /// 30 × 30 × 4 mm slab.
-    Slab,
-    /// Goblet-shaped statue 40 mm tall: thick base and stem, bowl wall under 1 mm.
-    Statue,
-}
-
-/// Which method(s).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    /// Subsurface colour method (§4.1, eqs. 3–5).
-    Color,
-    /// Texture-space dipole method (§4.2, eq. 6).
-    Dipole,
-    /// Both, side by side.
-    Both,
-}
-
-/// Lighting.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum LightArg {
-    /// Key light from the upper front left (irradiance 1) and a back light from behind (0.8).
-    Studio,
-    /// The key light alone.
-    Key,
-    /// The back light alone (irradiance 1): light through thin parts.
-    Back,
-    /// A point light above the front left, giving irradiance 1 at the model's centre.
-    Point,
-    /// A collimated spot of 2 mm radius from the key light's direction, aimed at the model's
-    /// centre (irradiance 1), like the measurement rig's: light spreading under the surface.
-    Spot,
-}
-
 /// Arguments of `scatterfit render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -84,18 +46,18 @@ pub struct Args {
     #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub mesh_scale: f64,
     /// A built-in model (used when no --mesh is given).
-    #[arg(long, value_enum, default_value_t = ShapeArg::Statue)]
-    pub shape: ShapeArg,
+    #[arg(long, value_enum, default_value_t = Shape::Statue)]
+    pub shape: Shape,
     /// Triangles of the built-in sphere or statue (about): a count, 1000 to 1e7.
     #[arg(long, default_value = "100000", value_parser = crate::numeric::parse_size, value_name = "N")]
     pub triangles: usize,
     /// Which of the paper's rendering methods.
-    #[arg(long, value_enum, default_value_t = MethodArg::Both)]
-    pub method: MethodArg,
+    #[arg(long, value_enum, default_value_t = Methods::Both)]
+    pub method: Methods,
     /// The profile model of the texture-space method: dipole, better-dipole, pbd or mc (default: the
     /// model the result was fitted with; dipole for published parameters).
     #[arg(long, value_enum)]
-    pub model: Option<crate::common::ModelArg>,
+    pub model: Option<ModelName>,
     /// Write the luminance (grey) instead of colour, like the paper's Figure 5.
     #[arg(long)]
     pub gray: bool,
@@ -111,8 +73,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Lighting.
-    #[arg(long, value_enum, default_value_t = LightArg::Studio)]
-    pub light: LightArg,
+    #[arg(long, value_enum, default_value_t = LightRig::Studio)]
+    pub light: LightRig,
     /// Rays each light shoots to sample the irradiance (texture-space method): a count, 1e3 to 1e8
     /// (default: a spacing of a third of the profile's half-width over the model, 65 536–2 097 152).
     #[arg(long, value_parser = crate::numeric::parse_size, value_name = "N")]
@@ -322,11 +284,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     inputs.extend(args.mesh.iter().cloned());
     inputs.extend(args.measured_profile.iter().cloned());
     check_outputs(&args, &inputs)?;
-    let methods = match args.method {
-        MethodArg::Color => Methods::Colour,
-        MethodArg::Dipole => Methods::Dipole,
-        MethodArg::Both => Methods::Both,
-    };
+    let methods = args.method;
     let panels = if args.profile {
         1
     } else {
@@ -341,7 +299,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     {
         bail!("--light-rays {n} must lie in 1e3–1e8");
     }
-    let model = args.model.map(ModelName::from);
+    let model = args.model;
     let mut params: Vec<ParameterSet> = specs
         .iter()
         .map(|s| ParameterSet::load(s, model).map_err(cli_error))
@@ -403,11 +361,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             scale: args.mesh_scale,
         },
         None => MeshSource::Builtin {
-            shape: match args.shape {
-                ShapeArg::Sphere => Shape::Sphere,
-                ShapeArg::Slab => Shape::Slab,
-                ShapeArg::Statue => Shape::Statue,
-            },
+            shape: args.shape,
             triangles: args.triangles,
         },
     };
@@ -417,11 +371,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             errln!("{note}");
         }
     }
-    let studio = StudioScene::new(loaded, light_rig(args.light), t0)?;
+    let studio = StudioScene::new(loaded, args.light, t0)?;
     let request = FigureRequest {
         params,
         mesh,
-        lights: light_rig(args.light),
+        lights: args.light,
         methods,
         model,
         options,
@@ -452,16 +406,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     print_summary(&args, &summary)?;
     Ok(code)
-}
-
-fn light_rig(light: LightArg) -> LightRig {
-    match light {
-        LightArg::Studio => LightRig::Studio,
-        LightArg::Key => LightRig::Key,
-        LightArg::Back => LightRig::Back,
-        LightArg::Point => LightRig::Point,
-        LightArg::Spot => LightRig::Spot,
-    }
 }
 
 /// `--profile`: the measurement's slab and spot rendered by the texture-space method, compared ring

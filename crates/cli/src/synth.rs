@@ -46,10 +46,10 @@ pub struct Args {
     /// The forward model written into the manifest's `[fit]` (how `measure` will fit this sample;
     /// the sample itself is always made by Monte Carlo).
     #[arg(long, value_enum)]
-    pub model: Option<crate::common::ModelArg>,
+    pub model: Option<scatterfit_optics::ModelName>,
     /// The albedo model written into the manifest's `[fit]`.
     #[arg(long, value_enum)]
-    pub albedo_model: Option<crate::common::AlbedoModelArg>,
+    pub albedo_model: Option<scatterfit_optics::AlbedoModel>,
     /// A small fast sample (256 × 256 px at 0.1 mm/px, a tenth of the photons) for trying the tool
     /// and for tests; not for accuracy studies.
     #[arg(long)]
@@ -208,8 +208,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &args.output_dir,
         &sample,
         scatterfit_io::manifest::FitSection {
-            model: args.model.map(Into::into),
-            albedo_model: args.albedo_model.map(Into::into),
+            model: args.model,
+            albedo_model: args.albedo_model,
             ..Default::default()
         },
     )?;
