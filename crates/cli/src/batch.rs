@@ -223,7 +223,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     entries.sort_by_key(|e| e.index);
     if let Some((shard, job)) = job {
-        job.write(&entries)?;
+        job.write(&entries, std::env::args().collect())?;
         if !quiet {
             errln!(
                 "shard {shard}: {} sample(s), {} failed, incomplete or suspect; {} (the summary: \

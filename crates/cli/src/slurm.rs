@@ -8,7 +8,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
-use scatterfit_lab::slurm::{ShardedCommand, SlurmJob};
+use scatterfit_lab::partial::Kind;
+use scatterfit_lab::slurm::SlurmJob;
 
 use crate::output::{errln, outln};
 
@@ -161,7 +162,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )?;
             let spec = crate::table::spec_for_shards(args, slurm.array)?;
             (
-                ShardedCommand::Table,
+                Kind::Table,
                 slurm,
                 &args.shard,
                 args.shard.partial_dir.clone(),
@@ -170,7 +171,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )
         }
         What::Batch { slurm, args } => (
-            ShardedCommand::Batch,
+            Kind::Batch,
             slurm,
             &args.shard,
             args.shard.partial_dir.clone(),
@@ -179,7 +180,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ),
         // The shards need -o (their samples go there): it stays in their command line too.
         What::Study { slurm, args } => (
-            ShardedCommand::Study,
+            Kind::Study,
             slurm,
             &args.shard,
             args.shard.partial_dir.clone(),

@@ -214,12 +214,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if let Some((shard, job)) = job {
         let n = samples.len();
-        job.write(StudyPart {
-            rows: rows.clone(),
-            failed: failed.clone(),
-            synth_s,
-            fit_s: t0.elapsed().as_secs_f64() - synth_s,
-        })?;
+        job.write(
+            StudyPart {
+                rows: rows.clone(),
+                failed: failed.clone(),
+                synth_s,
+                fit_s: t0.elapsed().as_secs_f64() - synth_s,
+            },
+            std::env::args().collect(),
+        )?;
         if !quiet {
             errln!(
                 "shard {shard}: {n} sample(s), {} failed; {} (the tables and the figure: \

@@ -179,7 +179,7 @@ fn run_shard(
     })?;
     bar.finish_and_clear();
     let photons = white.shard_photons(shard);
-    job.write(&part)?;
+    job.write(&part, std::env::args().collect())?;
     if !args.quiet {
         errln!(
             "shard {shard}: {photons} of {} photons in {:.1} s; {}",

@@ -9,7 +9,8 @@
 //!   shards' parts and files);
 //! - [`accuracy`]: the demo's table of each measured value against the twin's truth, and
 //!   [`accuracy_markdown()`], its Markdown, and [`demo`], the demo's materials and files;
-//! - [`slurm`]: the Slurm script of a sharded run (`scatterfit slurm`).
+//! - [`partial`]: the partial files of a sharded run (`--shard K/N`) and their checks, and
+//!   [`slurm`], the Slurm script of such a run (`scatterfit slurm`).
 //!
 //! The layers below ([`scatterfit_pipeline`], [`scatterfit_report`], `scatterfit-render`) know
 //! nothing of the twin; this crate joins the two (ARCHITECTURE.md, "Workspace layout").
@@ -17,6 +18,7 @@
 pub mod accuracy;
 pub mod accuracy_markdown;
 pub mod demo;
+pub mod partial;
 pub mod slurm;
 pub mod study;
 pub mod study_figure;

@@ -6,34 +6,14 @@
 
 use std::path::PathBuf;
 
-/// The commands a script can shard.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ShardedCommand {
-    /// A Monte Carlo table (`scatterfit table`).
-    Table,
-    /// A batch of samples (`scatterfit batch`).
-    Batch,
-    /// A bias study (`scatterfit study`).
-    Study,
-}
+use crate::partial::Kind;
 
-impl ShardedCommand {
-    /// The subcommand's name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Table => "table",
-            Self::Batch => "batch",
-            Self::Study => "study",
-        }
-    }
-
-    /// How the combined result equals the one-machine run's (said in the script's header).
-    fn same(self) -> &'static str {
-        match self {
-            Self::Table => "byte for byte",
-            Self::Batch => "the same summary.csv, summary.md and index.html",
-            Self::Study => "the same rows in study.csv and study.md",
-        }
+/// How the combined result equals the one-machine run's (said in the script's header).
+fn same(command: Kind) -> &'static str {
+    match command {
+        Kind::Table => "byte for byte",
+        Kind::Batch => "the same summary.csv, summary.md and index.html",
+        Kind::Study => "the same rows in study.csv and study.md",
     }
 }
 
@@ -42,7 +22,7 @@ impl ShardedCommand {
 #[derive(Debug, Clone)]
 pub struct SlurmJob {
     /// What is sharded.
-    pub command: ShardedCommand,
+    pub command: Kind,
     /// The command's own arguments, without `--shard` (each array task adds its own).
     pub args: Vec<String>,
     /// Shards: the job array's size (tasks 1…N).
@@ -174,7 +154,7 @@ echo "logs: {logs}; squeue -j $array,$combine shows them"
             version = env!("CARGO_PKG_VERSION"),
             script = q(&self.script),
             partials = self.partial_dir.display(),
-            same = self.command.same(),
+            same = same(self.command),
             cwd = self.cwd.display(),
             cache_note = self.cache_dir.as_deref().map_or(String::new(), |c| format!(
                 ", and the table cache ({})",
@@ -191,7 +171,7 @@ mod tests {
 
     fn job() -> SlurmJob {
         SlurmJob {
-            command: ShardedCommand::Table,
+            command: Kind::Table,
             args: vec![
                 "--eta".into(),
                 "1.3".into(),
@@ -263,7 +243,7 @@ mod tests {
     #[test]
     fn without_an_output_or_fingerprint_the_combine_job_takes_any_run_into_the_folder() {
         let s = SlurmJob {
-            command: ShardedCommand::Batch,
+            command: Kind::Batch,
             output: None,
             fingerprint: None,
             cache_dir: None,
