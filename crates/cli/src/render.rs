@@ -13,14 +13,14 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use crate::output::errln;
-use anyhow::{Context, bail};
+use anyhow::bail;
 use scatterfit_optics::ModelName;
 use scatterfit_render::colour::ColourParams;
 use scatterfit_render::measured::{profile_path, read_measured};
 use scatterfit_render::request::{
     MeshSummary, RenderEvent, RenderSummary, render_figure, write_figure,
 };
-use scatterfit_render::texture_space::{DipoleParams, Evaluation};
+use scatterfit_render::settings::RenderSettings;
 use scatterfit_render::tonemap::ToneMap;
 use scatterfit_render::{
     FigureRequest, LightRig, MeshSource, Methods, ParameterSet, ProfileRequest, RenderError,
@@ -163,49 +163,33 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Checks the numbers that no library checks, then the memory the flags size, before any work.
-fn check_numbers(args: &Args, panels: usize) -> anyhow::Result<()> {
-    use crate::numeric::ensure;
-    ensure(
-        (1..=4096).contains(&args.spp),
-        "--spp",
-        args.spp,
-        "the samples per pixel must lie in 1–4096",
-    )?;
-    ensure(
-        args.mesh_scale > 0.0 && args.mesh_scale <= 1e6,
-        "--mesh-scale",
-        args.mesh_scale,
-        "the mesh scale must lie in (0, 1e6] mm per file unit",
-    )?;
-    if let Some(ev) = args.exposure {
-        ensure(
-            (-60.0..=60.0).contains(&ev),
-            "--exposure",
-            ev,
-            "the exposure must lie in [−60, 60] EV",
-        )?;
+/// The render's settings from the flags (checked by [`RenderSettings::check`]).
+fn settings(args: &Args) -> RenderSettings {
+    RenderSettings {
+        size: args.size,
+        spp: args.spp,
+        seed: args.seed,
+        colour: ColourParams {
+            rho_d: args.rho_d,
+            rho_ts: args.rho_ts,
+            rho_s: args.rho_s,
+            alpha: args.alpha,
+            beta: args.beta,
+            gamma: args.gamma,
+            alpha_x: args.alpha_x,
+            alpha_y: args.alpha_y,
+            g: args.g,
+        },
+        light_rays: args.light_rays,
+        max_angle: args.max_angle,
+        direct: args.direct,
+        interpolate: !args.no_interpolation,
+        mesh_scale: args.mesh_scale,
+        triangles: args.triangles,
+        exposure: args.exposure,
+        white: args.white,
+        spot_radius_mm: args.spot_radius_mm,
     }
-    ensure(
-        (1.0..=1e6).contains(&args.white),
-        "--white",
-        args.white,
-        "the tone-curve white must lie in [1, 1e6]",
-    )?;
-    if let Some(r) = args.spot_radius_mm {
-        ensure(
-            r > 0.0 && r <= 10.0,
-            "--spot-radius-mm",
-            r,
-            "the light spot's radius must lie in (0, 10] mm",
-        )?;
-    }
-    let (w, h) = args.size;
-    crate::numeric::check_memory(
-        &format!("rendering {panels} panel(s) of {w}×{h} px"),
-        scatterfit_render::request::memory_bytes(w, h, panels, args.triangles, args.light_rays),
-        args.memory.budget(),
-    )
 }
 
 fn parse_size(text: &str) -> Result<(usize, usize), String> {
@@ -290,15 +274,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         specs.len() * methods.list().len()
     };
-    check_numbers(&args, panels)?;
-    if !(1000..=10_000_000).contains(&args.triangles) {
-        bail!("--triangles {} must lie in 1000–1e7", args.triangles);
-    }
-    if let Some(n) = args.light_rays
-        && !(1000..=100_000_000).contains(&n)
-    {
-        bail!("--light-rays {n} must lie in 1e3–1e8");
-    }
+    let settings = settings(&args);
+    settings.check(panels, args.memory.budget())?;
     let model = args.model;
     let mut params: Vec<ParameterSet> = specs
         .iter()
@@ -313,41 +290,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             code = c;
         }
     }
-    let options = RenderOptions {
-        width: args.size.0,
-        height: args.size.1,
-        spp: args.spp,
-        seed: args.seed,
-        colour: ColourParams {
-            rho_d: args.rho_d,
-            rho_ts: args.rho_ts,
-            rho_s: args.rho_s,
-            alpha: args.alpha,
-            beta: args.beta,
-            gamma: args.gamma,
-            alpha_x: args.alpha_x,
-            alpha_y: args.alpha_y,
-            g: args.g,
-        },
-        dipole: DipoleParams {
-            light_rays: args.light_rays,
-            evaluation: if args.direct {
-                Evaluation::Direct
-            } else {
-                Evaluation::Hierarchical {
-                    max_angle: args.max_angle,
-                }
-            },
-            specular: true,
-            interpolate: !args.no_interpolation,
-        },
-    };
-    options.colour.validate().context("shading coefficients")?;
-    options.dipole.validate().context("texture-space options")?;
-    let tone = ToneMap {
-        exposure_ev: args.exposure.unwrap_or(0.0),
-        white: args.white,
-    };
+    let options = settings.options()?;
+    let tone = settings.tone();
     if args.profile {
         return run_profile(&args, params.remove(0), model, options, &tone)
             .map(|c| if c == ExitCode::SUCCESS { code } else { c });
