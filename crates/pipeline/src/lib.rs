@@ -58,6 +58,7 @@ pub mod port;
 pub mod profile;
 pub mod profile_fit;
 pub mod radiance;
+pub mod reuse;
 pub mod samples;
 pub mod spectro;
 
