@@ -264,7 +264,7 @@ pub fn radial_profile(
 mod tests {
     use super::*;
 
-    /// Issue 10: `--ring-width-px 1e-300` panicked with "capacity overflow" and `--r-max-px 1e13`
+    /// `--ring-width-px 1e-300` once panicked with "capacity overflow" and `--r-max-px 1e13`
     /// asked for 160 TB; both are now an `InvalidOption` before anything is allocated.
     #[test]
     fn ring_count_is_bounded() {

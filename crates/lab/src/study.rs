@@ -26,8 +26,8 @@ use scatterfit_optics::{AlbedoModel, Method, ModelName};
 use scatterfit_synth::Truth;
 use serde::{Deserialize, Serialize};
 
+use scatterfit_pipeline::FitSettings;
 use scatterfit_pipeline::anisotropy::GPrior;
-use scatterfit_pipeline::fit::FitSettings;
 use scatterfit_pipeline::{Measurement, Overrides, PipelineError, measure_sample};
 
 /// How a row's fit ended: the channel's status, or not run where the `mc` tables do not cover the

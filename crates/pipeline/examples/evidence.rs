@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p scatterfit-pipeline --example evidence -- DIR...`
 
-use scatterfit_pipeline::checks::{evidence, frame_agreement};
+use scatterfit_pipeline::checks::{frame_agreement, spot_scale};
 use scatterfit_pipeline::{Channel, Overrides, measure_sample};
 
 fn main() {
@@ -18,7 +18,7 @@ fn main() {
         let q = m.quality();
         println!(
             "{dir}: spot factor {:?}; verdicts {} {} {}",
-            evidence::spot_scale(&m),
+            spot_scale(&m),
             q.r.verdict,
             q.g.verdict,
             q.b.verdict

@@ -18,8 +18,8 @@ use scatterfit_io::result_json::ChannelResult;
 use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
 use scatterfit_optics::materials::by_name;
 use scatterfit_optics::{AlbedoModel, Channel, Estimate, ModelName};
+use scatterfit_pipeline::FitSettings;
 use scatterfit_pipeline::anisotropy::GPrior;
-use scatterfit_pipeline::fit::FitSettings;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::{RigSpec, synthesize};
 

@@ -24,7 +24,7 @@ use scatterfit_io::manifest::FitSection;
 use scatterfit_io::sample_folder::{SampleFiles, write_sample_folder};
 use scatterfit_optics::materials::by_name;
 use scatterfit_optics::{AlbedoModel, Channel, ModelName};
-use scatterfit_pipeline::fit::FitSettings;
+use scatterfit_pipeline::FitSettings;
 use scatterfit_pipeline::{Overrides, measure_sample};
 use scatterfit_synth::{RigSpec, synthesize};
 

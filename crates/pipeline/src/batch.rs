@@ -32,8 +32,10 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::error::{PipelineError, Result};
-use crate::measure::{Measurement, Overrides, measure_inputs_until};
+use crate::measure::measure_inputs_until;
+use crate::measurement::Measurement;
 use crate::samples::{SampleInputs, sample_inputs};
+use crate::settings::Overrides;
 
 /// Why a batch could not run at all (a sample that fails is an outcome, not this).
 #[derive(Debug, thiserror::Error)]

@@ -46,6 +46,30 @@ pub struct BlackLevelEstimate {
     /// Fraction of the shortest frame's corner samples at 0: a camera that clips its data at 0 has
     /// no pedestal (level then 0).
     pub zero_fraction: f64,
+    /// Per channel, the frame whose corner mean lies farthest from the straight line, in its own
+    /// standard errors ([`CornerDeparture`]); `None` with fewer than three usable frames.
+    pub departure: Vec<Option<CornerDeparture>>,
+}
+
+/// The frame whose far-corner mean departs most from the straight line m = level + rate·Δt that
+/// the corner means of a static scene follow (a constant pedestal, plus the light that reaches the
+/// corners — the profile's tail, veiling glare, dark current, a lamp that stays on — in proportion
+/// to the exposure time). Light that changed during the bracket (room light switched on or off)
+/// reaches some frames and not others and bends the line; the straight-line fit then also moves
+/// the intercept, the black level read from the corners.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CornerDeparture {
+    /// The frame, by its index in the bracket as given.
+    pub frame: usize,
+    /// Its exposure time \[s\].
+    pub time_s: f64,
+    /// Its corner mean less the line's value there \[DN\].
+    pub residual_dn: f64,
+    /// The residual in the corner mean's standard errors.
+    pub z: f64,
+    /// The residual over the line's time-proportional part at that frame, |rate·Δt| (at least
+    /// 1 DN): what a shutter's error of that fraction would leave.
+    pub relative: f64,
 }
 
 /// Estimates the black level of a linear bracket from the far corners ([`corner_pixels`]): per
@@ -72,13 +96,15 @@ pub fn estimate_black_level(
     let mut level = vec![0.0; ch];
     let mut rate = vec![0.0; ch];
     let mut level_stderr = vec![f64::NAN; ch];
+    let mut departure = vec![None; ch];
     let count = corners.len().max(1) as f64;
     for c in 0..ch {
-        // (time, corner mean, the mean's variance) per frame.
-        let pts: Vec<(f64, f64, f64)> = frames
+        // (time, corner mean, the mean's variance, frame) per frame.
+        let pts: Vec<(f64, f64, f64, usize)> = frames
             .iter()
             .zip(times_s)
-            .filter_map(|(f, &t)| {
+            .enumerate()
+            .filter_map(|(j, (f, &t))| {
                 let (mut sum, mut sum2) = (0.0, 0.0);
                 for &p in &corners {
                     let v = f.data()[p * ch + c];
@@ -91,7 +117,7 @@ pub fn estimate_black_level(
                 }
                 let mean = sum / count;
                 let var = (sum2 / count - mean * mean).max(0.0) / (count - 1.0).max(1.0);
-                Some((t, mean, var))
+                Some((t, mean, var, j))
             })
             .collect();
         if pts.len() < 2 {
@@ -118,6 +144,23 @@ pub fn estimate_black_level(
             .sum::<f64>()
             .sqrt();
         rate[c] = slope;
+        let intercept = mm - slope * mt;
+        departure[c] = (pts.len() >= 3)
+            .then(|| {
+                pts.iter()
+                    .map(|&(t, m, var, frame)| {
+                        let residual_dn = m - (intercept + slope * t);
+                        CornerDeparture {
+                            frame,
+                            time_s: t,
+                            residual_dn,
+                            z: residual_dn / var.sqrt().max(1e-9),
+                            relative: residual_dn / (slope * t).abs().max(1.0),
+                        }
+                    })
+                    .max_by(|a, b| a.z.abs().total_cmp(&b.z.abs()))
+            })
+            .flatten();
         level[c] = if zero_fraction > 0.01 {
             0.0
         } else {
@@ -129,6 +172,7 @@ pub fn estimate_black_level(
         rate,
         level_stderr,
         zero_fraction,
+        departure,
     }
 }
 
@@ -287,18 +331,9 @@ fn box_blur(data: &[f32], w: usize, h: usize, ch: usize, r: usize) -> Vec<f32> {
 }
 
 /// The veiling glare (stray light) of a channel: a constant background under the profile,
-/// estimated on the rings beyond the profile's near field.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Background {
-    /// The level [relative radiance].
-    pub level: f64,
-    /// Its standard error.
-    pub stderr: f64,
-    /// The level over the profile's peak (the glare's size as a lens maker gives it).
-    pub relative_to_peak: f64,
-    /// True when it was subtracted (significant: above 3 standard errors and the detection limit).
-    pub subtracted: bool,
-}
+/// estimated on the rings beyond the profile's near field — the record `result.json` keeps
+/// (`inputs.options.camera.background`).
+pub use scatterfit_io::result_json::BackgroundLevel as Background;
 
 /// Fits y(r) = b + A e^{−s r}/r^p to rings (r \[mm\], value, standard error) — a diffusion profile's
 /// far field over a constant background — by least squares in (b, A) for each s on a log grid in

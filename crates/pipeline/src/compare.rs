@@ -10,9 +10,11 @@ use scatterfit_optics::{AlbedoModel, Method, ModelName};
 
 use crate::batch::{BatchError, BatchEvent, BatchOutcome, BatchRequest, for_each_sample};
 use crate::error::Result;
-use crate::fit::FitSettings;
-use crate::measure::{Measurement, Overrides, measure_inputs};
+use crate::measure::measure_inputs;
+use crate::measurement::Measurement;
 use crate::samples::SampleInputs;
+use crate::settings::FitSettings;
+use crate::settings::Overrides;
 
 /// One sample fitted both ways (and, when asked, with the paper's model).
 #[derive(Debug)]

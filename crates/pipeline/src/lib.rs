@@ -41,7 +41,6 @@
 #![forbid(unsafe_code)]
 
 pub mod anisotropy;
-pub mod anisotropy_fit;
 pub mod batch;
 pub mod camera;
 pub mod checks;
@@ -51,6 +50,7 @@ pub mod export;
 pub mod fit;
 pub mod hdr;
 pub mod measure;
+pub mod measurement;
 pub mod model_term;
 pub mod monte_carlo;
 pub mod outputs;
@@ -58,8 +58,10 @@ pub mod port;
 pub mod profile;
 pub mod profile_fit;
 pub mod radiance;
+mod result;
 pub mod reuse;
 pub mod samples;
+pub mod settings;
 pub mod spectro;
 
 pub use batch::{
@@ -68,11 +70,10 @@ pub use batch::{
 };
 pub use compare::{Compared, compare_batch, compare_batch_with};
 pub use error::{PipelineError, Result};
-pub use fit::{ChannelFit, ChannelOutcome, FitSettings};
-pub use measure::{
-    Measurement, Overrides, Stage, Timings, fit_settings, measure_inputs, measure_inputs_until,
-    measure_sample, measure_sample_until,
-};
+pub use fit::{ChannelFit, ChannelOutcome};
+pub use measure::{measure_inputs, measure_inputs_until, measure_sample, measure_sample_until};
+pub use measurement::{Measurement, Stage, Timings};
+pub use result::g_record;
 pub use samples::{SampleDirs, SampleInputs, misspelt_manifest, sample_dirs, sample_inputs};
 /// What a result file holds, and where its named values come from.
 pub use scatterfit_io::result_json::{
@@ -83,3 +84,4 @@ pub use scatterfit_mc::{albedo_family, family};
 /// The vocabulary a program using the pipeline needs: what to fit with, per-channel values, and
 /// a value with its uncertainty terms.
 pub use scatterfit_optics::{AlbedoModel, Channel, Estimate, Method, ModelFamily, ModelName, Rgb};
+pub use settings::{FitSettings, Overrides, SpotShape, fit_settings};

@@ -1,300 +1,31 @@
-//! `measure_sample`: a sample folder in, the paper's Table 1 row out — spectro → η, α′; bracket →
-//! HDR → profile; the fit per channel.
+//! `measure_sample`: a sample folder in, the paper's Table 1 row out — the one place the stages
+//! are assembled: [`crate::settings`] (what to fit with) → [`crate::spectro`] (η, α′) →
+//! [`crate::hdr`] (the bracket merged) → [`crate::profile`] (the spot and its rings) →
+//! [`crate::port`] (the spectrophotometer port's edge loss) → [`crate::fit`] (σ′s, σa per channel,
+//! with the spectrophotometer's and the g terms) → [`crate::model_term`] (an approximate model's
+//! error) → [`crate::checks`] (the image checks and the data's cross-checks). The refits
+//! ([`Measurement::refit_with`]) rerun the stages after the profile with other settings.
 
 use std::path::Path;
 use std::time::Instant;
 
-use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting, SampleManifest};
-use scatterfit_io::result_json::{AlbedoSource, FileRef, Inputs, MeasurementResult, RunOptions};
-use scatterfit_mc::{albedo_family, family};
-use scatterfit_optics::{AlbedoModel, AtG, Estimate, Method, ModelName, Rgb};
-use serde::Serialize;
+use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting};
+use scatterfit_optics::Method;
+use scatterfit_optics::port::Port;
 
-use crate::anisotropy::{GPlan, GPrior, known_g_record};
+use crate::checks::evidence::{Evidence, gather};
+use crate::checks::findings::SampleChecks;
+use crate::checks::{image_checks, spot_scale};
 use crate::error::{PipelineError, Result};
-use crate::fit::{
-    ChannelOutcome, FitSettings, SpotShape, channel_result, fit_and_propagate, fit_stage,
-};
-use crate::hdr::BlackLevel;
-use crate::hdr::{HdrInputs, HdrStage, read_and_merge, read_radiance_map};
-use crate::profile::{ProfileSettings, ProfileStage, profile_stage_with};
+use crate::fit::{fit_and_propagate, fit_stage};
+use crate::hdr::{BlackLevel, HdrInputs, read_and_merge, read_radiance_map};
+use crate::measurement::{Measurement, Stage, Timings};
+use crate::model_term;
+use crate::port::{correct_port, port_of, propagate_fit_through_port};
+use crate::profile::{ProfileSettings, profile_stage_with};
 use crate::samples::{SampleInputs, sample_inputs};
-use crate::spectro::{SpectroStage, spectro_stage};
-
-/// Options that override the manifest's `[fit]` (from the command line, or a program). Every
-/// option unset means "as the manifest says"; choose with the setters:
-///
-/// ```
-/// use scatterfit_pipeline::{Method, ModelName, Overrides};
-///
-/// let exact = Overrides::default().model(ModelName::Mc);
-/// let existing = Overrides::default().method(Method::Existing).eta(1.45);
-/// assert_eq!(exact.model, Some(ModelName::Mc));
-/// assert_eq!(existing.eta, Some(1.45));
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Overrides {
-    /// proposed | existing.
-    pub method: Option<Method>,
-    /// The forward model.
-    pub model: Option<ModelName>,
-    /// How α′ comes from the spectrophotometer.
-    pub albedo_model: Option<AlbedoModel>,
-    /// η instead of the measured one.
-    pub eta: Option<f64>,
-    /// Fix the scale by the spectrophotometer.
-    pub normalise_with_spectro: Option<bool>,
-    /// What is known about g instead of the manifest's `[fit] g` and `[fit] g_range` (both
-    /// replaced; `--g`, `--g-range`).
-    pub g: Option<GPrior>,
-    /// Allow the manifest to name files outside the sample folder (the input path policy,
-    /// `scatterfit_io::inputs`; `--allow-outside-paths`).
-    pub allow_outside_paths: bool,
-}
-
-impl Overrides {
-    /// The fitting method (proposed | existing).
-    #[must_use]
-    pub fn method(self, method: Method) -> Self {
-        Self {
-            method: Some(method),
-            ..self
-        }
-    }
-
-    /// The forward model.
-    #[must_use]
-    pub fn model(self, model: ModelName) -> Self {
-        Self {
-            model: Some(model),
-            ..self
-        }
-    }
-
-    /// How α′ comes from the spectrophotometer (default: the model's own, [`AlbedoModel::default_for`]).
-    #[must_use]
-    pub fn albedo_model(self, albedo_model: AlbedoModel) -> Self {
-        Self {
-            albedo_model: Some(albedo_model),
-            ..self
-        }
-    }
-
-    /// A known η instead of the measured one.
-    #[must_use]
-    pub fn eta(self, eta: f64) -> Self {
-        Self {
-            eta: Some(eta),
-            ..self
-        }
-    }
-
-    /// Fix the profile's scale by the spectrophotometer's Rd (proposed method only).
-    #[must_use]
-    pub fn normalise_with_spectro(self, normalise: bool) -> Self {
-        Self {
-            normalise_with_spectro: Some(normalise),
-            ..self
-        }
-    }
-
-    /// Let the manifest name files outside the sample folder (`scatterfit_io::inputs`).
-    #[must_use]
-    pub fn allow_outside_paths(self, allow: bool) -> Self {
-        Self {
-            allow_outside_paths: allow,
-            ..self
-        }
-    }
-}
-
-/// A stage of [`measure_sample`], for progress reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum Stage {
-    /// Reading and analysing the spectrophotometer file.
-    Spectro,
-    /// Reading the frames (called per frame).
-    ReadFrame,
-    /// Recovering the response and merging.
-    Merge,
-    /// Spot and rings.
-    Profile,
-    /// Fitting the channels.
-    Fit,
-    /// Checking the image and the bracket against the fits ([`crate::checks::image_checks`]).
-    Checks,
-}
-
-/// Everything a measurement produced.
-#[derive(Debug, Clone)]
-pub struct Measurement {
-    /// The manifest.
-    pub manifest: SampleManifest,
-    /// Fit settings used.
-    pub settings: FitSettings,
-    /// Spectrophotometer stage.
-    pub spectro: SpectroStage,
-    /// The merged bracket.
-    pub hdr: HdrStage,
-    /// Spot and rings.
-    pub profile: ProfileStage,
-    /// Per channel: σ′s, σa and α′ with their uncertainty terms, the solver's report, or why the
-    /// channel was not fitted.
-    pub fits: Rgb<ChannelOutcome>,
-    /// The port's edge-loss correction (`spectro.aperture_mm` given; `spectro` is then the
-    /// corrected stage and the correction keeps the reading), or `None`: the reading was taken as
-    /// loss-free.
-    pub port: Option<crate::port::PortCorrection>,
-    /// Wall times per stage \[s\].
-    pub timings: Timings,
-    /// What the data's redundancy says (the profile's own α′; [`crate::checks::evidence`]).
-    pub evidence: crate::checks::evidence::Evidence,
-    /// The checks of the image, the bracket and the manifest that no fit enters
-    /// ([`crate::checks::image_checks`]): made once, when the measurement is made, and kept by
-    /// its refits; [`Measurement::quality`] adds the fits' own checks to them.
-    pub image_checks: crate::checks::SampleChecks,
-}
-
-/// Wall times per stage \[s\].
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub struct Timings {
-    /// Spectro stage.
-    pub spectro_s: f64,
-    /// Reading frames.
-    pub read_s: f64,
-    /// Response recovery and merge.
-    pub merge_s: f64,
-    /// Spot centre and profile.
-    pub profile_s: f64,
-    /// The three fits (start search + solver).
-    pub fit_s: f64,
-    /// The checks of the image and the bracket ([`crate::checks::image_checks`]) and the spot's
-    /// scale against the fits ([`crate::checks::evidence::spot_scale`]).
-    pub checks_s: f64,
-    /// The whole measurement.
-    pub total_s: f64,
-}
-
-/// Resolves the fit settings from the manifest and the overrides.
-///
-/// # Errors
-/// [`PipelineError::Input`] for a model that is not available or normalisation with the existing
-/// method.
-pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSettings> {
-    let method = o.method.or(manifest.fit.method).unwrap_or_default();
-    let model = o.model.or(manifest.fit.model).unwrap_or_default();
-    family(model)?;
-    let albedo_model = o
-        .albedo_model
-        .or(manifest.fit.albedo_model)
-        .unwrap_or(AlbedoModel::default_for(model));
-    let normalise = o
-        .normalise_with_spectro
-        .or(manifest.fit.normalise_with_spectro)
-        .unwrap_or(false);
-    if normalise && method == Method::Existing {
-        return Err(PipelineError::Input(
-            "normalising with the spectrophotometer applies to the proposed method only".into(),
-        ));
-    }
-    // The spot: a disk (the paper's), or a Gaussian of that 1/e² diameter; a spot
-    // image replaces this once the bracket is merged (measure_sample).
-    let diameter = manifest.camera.spot_diameter_mm.unwrap_or(1.0);
-    let (spot, spot_radius_mm) = match manifest.camera.spot_profile {
-        Some(scatterfit_io::manifest::SpotProfileName::Gaussian) => {
-            let s = scatterfit_fit::RadialSpot::gaussian(0.5 * diameter)
-                .map_err(|e| PipelineError::Input(format!("camera.spot_profile: {e}")))?;
-            (SpotShape::Radial(s), s.radius_enclosing(0.99))
-        }
-        _ => (SpotShape::Disk, 0.5 * diameter),
-    };
-    // What is known about g: an override replaces both manifest keys.
-    let g_prior =
-        o.g.unwrap_or_else(|| GPrior::from_setting(manifest.fit.g, manifest.fit.g_range));
-    g_prior.check()?;
-    check_g_fit(&g_prior, model)?;
-    let settings = FitSettings {
-        method,
-        model,
-        albedo_model,
-        spot,
-        spot_radius_mm,
-        r_min_mm: manifest.fit.r_min_mm,
-        normalise_with_spectro: normalise,
-        g: values_g(&g_prior)?,
-        g_prior,
-    };
-    families(&settings)?;
-    Ok(settings)
-}
-
-/// `g = "fit"` needs the g-aware `mc` model (the diffusion dipoles do not depend on g, and
-/// photon beam diffusion's g enters only its near field).
-///
-/// # Errors
-/// [`PipelineError::Input`] naming `fit.g` and what to do.
-pub fn check_g_fit(prior: &GPrior, model: ModelName) -> Result<()> {
-    if prior.fit && model != ModelName::Mc {
-        return Err(PipelineError::Input(format!(
-            "fit.g = \"fit\": fitting g needs the g-aware Monte Carlo model, not {model}; set \
-             fit.model = \"mc\" (or --model mc), or give g as a number or a fit.g_range"
-        )));
-    }
-    Ok(())
-}
-
-/// The g the values are computed at: the given g; for a range without a g (or `g = "fit"`: the
-/// range searched) the covered g nearest its middle ([`GPlan::nominal_g`]); else 0.
-///
-/// # Errors
-/// [`PipelineError::Input`] for a range the `mc` tables cover nowhere.
-pub fn values_g(prior: &GPrior) -> Result<f64> {
-    values_g_on(scatterfit_mc::bundled_grid()?, prior)
-}
-
-/// [`values_g`] on another grid of tables.
-///
-/// # Errors
-/// As [`values_g`].
-pub fn values_g_on(grid: &scatterfit_mc::McGridSet, prior: &GPrior) -> Result<f64> {
-    match (
-        prior.g,
-        prior
-            .range
-            .or(prior.propagated_range().filter(|_| prior.fit)),
-    ) {
-        (Some(g), _) => Ok(g),
-        (None, Some(range)) => GPlan::nominal_g(grid, range).ok_or_else(|| {
-            PipelineError::Input(format!(
-                "fit.g_range = [{}, {}]: the `mc` tables cover no g in it ({}); give a range \
-                     that reaches one of them (or a g)",
-                range[0],
-                range[1],
-                grid.coverage()
-            ))
-        }),
-        (None, None) => Ok(0.0),
-    }
-}
-
-/// The profile model and the albedo model of `settings`, both at its g.
-///
-/// # Errors
-/// [`PipelineError::Input`] for a g the Monte Carlo tables do not cover when either model is `mc`.
-pub(crate) fn families(settings: &FitSettings) -> Result<(AtG<'static>, AtG<'static>)> {
-    let at = |f| AtG::new(f, settings.g).map_err(|e| PipelineError::Input(format!("fit.g: {e}")));
-    let (model, albedo) = (
-        at(family(settings.model)?)?,
-        at(albedo_family(settings.albedo_model, settings.model)?)?,
-    );
-    if settings.model == ModelName::Mc || settings.albedo_model == AlbedoModel::Mc {
-        scatterfit_mc::bundled_grid()?
-            .albedo_prime_range(settings.g)
-            .map_err(|e| PipelineError::Input(format!("fit.g: {e}")))?;
-    }
-    Ok((model, albedo))
-}
+use crate::settings::{FitSettings, Overrides, SpotShape, families, fit_settings};
+use crate::spectro::spectro_stage;
 
 /// Measures the sample in folder `dir` (its `sample.toml`): [`sample_inputs`], then
 /// [`measure_inputs`].
@@ -449,14 +180,13 @@ fn measure_from(
     let data = profile.rgb_data()?;
     begin(Stage::Fit)?;
     let t_fit = Instant::now();
-    let port = crate::port::port_of(
+    let port = port_of(
         manifest.spectro.aperture_mm,
         manifest.spectro.illuminated_mm,
     )?;
     let (spectro, port) = match port {
         Some(p) => {
-            let (mut s, c) =
-                crate::port::correct_port(&data, &spectro, &settings, model, albedo, p);
+            let (mut s, c) = correct_port(&data, &spectro, &settings, model, albedo, p);
             if let Some([lo, hi]) = settings.g_prior.propagated_range() {
                 // The g term refits at each g from the Rd corrected here, at the values' g; the
                 // port's F is not recomputed at each g (BENCHMARKS.md, "The port's
@@ -475,17 +205,15 @@ fn measure_from(
     };
     let fits = fit_and_propagate(&data, &spectro, &settings, model);
     let fits = match &port {
-        Some(c) => crate::port::propagate_fit_through_port(
-            &data, &spectro, &settings, model, albedo, c, fits,
-        ),
+        Some(c) => propagate_fit_through_port(&data, &spectro, &settings, model, albedo, c, fits),
         None => fits,
     };
     // With an approximate model the evidence comes from exact transport's fits
     // (`Measurement::with_model_term`): the model's own error would confound it.
-    let evidence = if crate::model_term::is_approximate(&settings) {
-        crate::checks::evidence::Evidence::default()
+    let evidence = if settings.is_approximate() {
+        Evidence::default()
     } else {
-        crate::checks::evidence::gather(&data, &spectro, &settings, model, &fits)
+        gather(&data, &spectro, &settings, model, &fits)
     };
     let timings = Timings {
         spectro_s,
@@ -505,14 +233,14 @@ fn measure_from(
         port,
         timings,
         evidence,
-        image_checks: crate::checks::SampleChecks::default(),
+        image_checks: SampleChecks::default(),
     }
     .with_model_term();
     m.timings.fit_s = t_fit.elapsed().as_secs_f64();
     begin(Stage::Checks)?;
     let t_checks = Instant::now();
-    m.image_checks = crate::checks::image_checks(&m);
-    m.evidence.spot_scale = crate::checks::evidence::spot_scale(&m);
+    m.image_checks = image_checks(&m);
+    m.evidence.spot_scale = spot_scale(&m);
     m.timings.checks_s = t_checks.elapsed().as_secs_f64();
     m.timings.total_s = t0.elapsed().as_secs_f64();
     Ok(m)
@@ -562,13 +290,11 @@ impl Measurement {
         // The port correction depends on the model: start again from the reading.
         let (spectro, port) = match &self.port {
             Some(p) => {
-                let port = scatterfit_optics::port::Port::new(p.illuminated_mm, p.aperture_mm)
-                    .map_err(|e| {
-                        PipelineError::Input(format!("the spectrophotometer port: {e}"))
-                    })?;
+                let port = Port::new(p.illuminated_mm, p.aperture_mm).map_err(|e| {
+                    PipelineError::Input(format!("the spectrophotometer port: {e}"))
+                })?;
                 let read = p.read.with_albedo_model(albedo);
-                let (s, c) =
-                    crate::port::correct_port(&data, &read, &settings, model, albedo, port);
+                let (s, c) = correct_port(&data, &read, &settings, model, albedo, port);
                 (s, Some(c))
             }
             None => (self.spectro.with_albedo_model(albedo), None),
@@ -576,18 +302,18 @@ impl Measurement {
         let fits = if propagate {
             let fits = fit_and_propagate(&data, &spectro, &settings, model);
             match &port {
-                Some(c) => crate::port::propagate_fit_through_port(
-                    &data, &spectro, &settings, model, albedo, c, fits,
-                ),
+                Some(c) => {
+                    propagate_fit_through_port(&data, &spectro, &settings, model, albedo, c, fits)
+                }
                 None => fits,
             }
         } else {
             fit_stage(&data, &spectro, &settings, model)
         };
-        let evidence = if propagate && !crate::model_term::is_approximate(&settings) {
-            crate::checks::evidence::gather(&data, &spectro, &settings, model, &fits)
+        let evidence = if propagate && !settings.is_approximate() {
+            gather(&data, &spectro, &settings, model, &fits)
         } else {
-            crate::checks::evidence::Evidence::default()
+            Evidence::default()
         };
         let mut m = Measurement {
             manifest: self.manifest.clone(),
@@ -603,224 +329,33 @@ impl Measurement {
         };
         if propagate {
             m = m.with_model_term();
-            m.evidence.spot_scale = crate::checks::evidence::spot_scale(&m);
+            m.evidence.spot_scale = spot_scale(&m);
         }
         m.timings.fit_s = t.elapsed().as_secs_f64();
         Ok(m)
     }
 
-    /// True when every channel gave constrained parameters.
-    pub fn complete(&self) -> bool {
-        self.fits.iter().all(ChannelOutcome::is_measurement)
-    }
-
-    /// η with the spectrophotometer's standard error (none when η was given).
-    pub fn eta(&self) -> Estimate {
-        self.spectro.eta_estimate()
-    }
-
-    /// The data checks' verdict per channel ([`crate::checks::quality`]): the fits' checks and
-    /// the sample's, with the image checks made at measurement ([`Measurement::image_checks`]).
-    pub fn quality(&self) -> Rgb<crate::checks::Quality> {
-        crate::checks::quality(self)
-    }
-
-    /// The result file's content. `profile_file` is the profile CSV's name as written beside the
-    /// result (recorded in `inputs.profile`). The inputs' SHA-256 hashes are those the stages
-    /// recorded of the bytes they read and measured (the manifest, the spectrophotometer file, the
-    /// radiance map, each frame); no file is read here, so a file replaced after the measurement
-    /// is recorded as it was measured.
-    pub fn to_result(&self, profile_file: Option<&str>) -> MeasurementResult {
-        let m = &self.manifest;
-        let record = |path: &Path, sha256: Option<&String>| -> Option<FileRef> {
-            sha256.map(|sha256| FileRef {
-                path: path.to_string_lossy().into_owned(),
-                sha256: sha256.clone(),
-            })
-        };
-        // Paths relative to the sample folder, as the manifest names them.
-        let relative = |p: &Path| p.strip_prefix(&m.dir).unwrap_or(p).to_path_buf();
-        let manifest_ref = m
-            .read_from
-            .as_ref()
-            .and_then(|f| record(&relative(&f.path), Some(&f.sha256)));
-        let spectro_ref = m
-            .spectro
-            .file
-            .as_deref()
-            .and_then(|p| record(p, self.spectro.file_sha256.as_ref()));
-        let hdr_ref = m
-            .camera
-            .hdr
-            .as_deref()
-            .and_then(|p| record(p, self.hdr.radiance_file.as_ref().map(|f| &f.sha256)));
-        let frames: Vec<FileRef> = self
-            .hdr
-            .frames
-            .iter()
-            .filter_map(|f| record(&relative(&f.file), Some(&f.sha256)))
-            .collect();
-        let quality = crate::checks::quality(self);
-        let channels = self.fits.as_ref().map_with_channel(|c, outcome| {
-            let mut r = channel_result(outcome, &self.spectro, c);
-            r.quality = Some(quality[c].clone());
-            r
-        });
-        let s = &self.settings;
-        MeasurementResult {
-            schema_version: scatterfit_io::result_json::SCHEMA_VERSION,
-            name: m.display_name(),
-            eta: self.spectro.eta,
-            eta_source: Some(self.spectro.eta_source),
-            eta_stderr: self.spectro.uncertainty.eta_stderr,
-            spectro_repeatability: Some(self.spectro.uncertainty.repeatability),
-            method: s.method,
-            model: s.model,
-            albedo_model: Some(AlbedoSource::Model(s.albedo_model)),
-            channels,
-            inputs: Inputs {
-                sample_dir: m.dir.to_string_lossy().into_owned(),
-                manifest: manifest_ref,
-                spectro: spectro_ref,
-                frames,
-                hdr: hdr_ref,
-                profile: profile_file.map(str::to_string),
-                mm_per_pixel: m.camera.mm_per_pixel,
-                spot_radius_mm: Some(self.settings.spot_radius_mm),
-                center_px: Some(self.profile.center.xy()),
-                options: RunOptions {
-                    method: Some(s.method),
-                    model: Some(s.model),
-                    albedo_model: Some(s.albedo_model),
-                    normalise_with_spectro: Some(s.normalise_with_spectro),
-                    g: Some(s.g),
-                    r_min_mm: Some(s.r_min_mm()),
-                    r_max_px: Some(m.fit.r_max_px.unwrap_or(300.0)),
-                    spot_radius_mm: Some(s.spot_radius_mm),
-                    response: Some(self.hdr.response_kind),
-                    // JSON has no NaN: an unknown limit is null.
-                    detection_limit: Some(
-                        self.profile
-                            .detection_limit
-                            .iter()
-                            .map(|v| v.is_finite().then_some(*v))
-                            .collect(),
-                    ),
-                    camera: Some(serde_json::json!({
-                        "corrections": self.hdr.corrections,
-                        "background": self.profile.background,
-                    })),
-                },
-            },
-            version: env!("CARGO_PKG_VERSION").into(),
-            // The spectrum as the port let the instrument read it, corrected like the channels.
-            rd_spectrum: rd_spectrum(self.spectro.analysis.as_ref()).map(|s| {
-                self.port
-                    .as_ref()
-                    .and_then(|p| crate::port::correct_spectrum(&s, &p.reading_fraction))
-                    .unwrap_or(s)
-            }),
-            g_uncertainty: Some(g_record(s, &self.fits)),
-            spectro_port: self
-                .port
-                .as_ref()
-                .map(|p| scatterfit_io::result_json::PortResult {
-                    aperture_mm: p.aperture_mm,
-                    illuminated_mm: p.illuminated_mm,
-                    rd_read: p.read.rd,
-                    reading_fraction: p.reading_fraction,
-                    problems: p.problems.clone(),
-                }),
+    /// The measurement with every fitted channel's `model` term (module docs): nothing changes
+    /// with exact transport itself; with an approximate model the same data are fitted again
+    /// with the `mc` tables (values only) and |approximate − exact| is the term of σ′s, σa and α′.
+    /// Where exact transport cannot be evaluated (outside the tables' η or α′, a refit that does
+    /// not converge) the channel keeps no term and a note that says why.
+    #[must_use]
+    pub fn with_model_term(mut self) -> Self {
+        if !self.settings.is_approximate() {
+            return self;
         }
-    }
-}
-
-/// The result's record of how g entered ([`scatterfit_io::result_json::GUncertainty`]), with
-/// each channel's fit of g for `g = "fit"` (from `fits`).
-pub fn g_record(
-    settings: &FitSettings,
-    fits: &Rgb<ChannelOutcome>,
-) -> scatterfit_io::result_json::GUncertainty {
-    match GPlan::new(&settings.g_prior, settings.g) {
-        Ok(Some(plan)) => {
-            let mut record = plan.record(&settings.g_prior);
-            if settings.g_prior.fit {
-                record.fitted = Some(fits.as_ref().map(|f| {
-                    f.fit()
-                        .and_then(|f| f.g_fit.as_ref())
-                        .map(crate::anisotropy_fit::GFit::record)
-                }));
-            }
-            record
+        let exact = self.refit_values_only(self.settings.exact());
+        // The data's cross-checks from exact transport's fits (an approximate model's own error
+        // would read as a disagreement between the profile and the reading).
+        if let Ok(x) = &exact
+            && let Ok(data) = x.profile.rgb_data()
+            && let Ok((model, _)) = families(&x.settings)
+        {
+            self.evidence = gather(&data, &x.spectro, &x.settings, &model, &x.fits);
         }
-        Ok(None) => known_g_record(settings.g),
-        // No plan: the range, nothing evaluated (the channels' notes say why).
-        Err(e) => scatterfit_io::result_json::GUncertainty {
-            source: settings.g_prior.source(),
-            g: Some(settings.g),
-            range: settings.g_prior.propagated_range(),
-            evaluated: Vec::new(),
-            not_covered: Some(e.to_string()),
-            fitted: None,
-        },
-    }
-}
-
-/// The SCE spectrum the channels' Rd came from (spectral renderers need it), when the
-/// colour came from the spectrum rather than a measured L*a*b*.
-fn rd_spectrum(
-    analysis: Option<&scatterfit_optics::spectro::SpectroAnalysis>,
-) -> Option<scatterfit_io::result_json::RdSpectrum> {
-    let a = analysis?;
-    (a.colour_source == scatterfit_optics::spectro::ColourSource::SceSpectrum).then(|| {
-        scatterfit_io::result_json::RdSpectrum {
-            wavelength_nm: a.spectral.iter().map(|p| p.wavelength_nm).collect(),
-            rd: a.spectral.iter().map(|p| p.sce).collect(),
-        }
-    })
-}
-
-/// SHA-256 of a file's bytes, lower-case hex (`None` when it cannot be read: missing, not a
-/// regular file, larger than the memory budget): for a file that is not otherwise read, such as
-/// `batch`'s check of a sample's inputs against the hashes its `result.json` recorded. A
-/// measurement's own inputs are hashed as they are read (`Measurement::to_result`).
-pub fn hash_file(path: &Path) -> Option<String> {
-    let bytes =
-        scatterfit_safefs::read::read_limited(path, scatterfit_io::budget::memory_budget_bytes())
-            .ok()?;
-    Some(scatterfit_io::digest::sha256_hex(&bytes))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A range in a grid's gap is refused naming what the tables cover (the grid's own
-    /// description, so it follows new tables), not a list written into the message. The shipped
-    /// grid has no gap in 0–0.95 since the g 0.3/0.5/0.7 tables (2026-11-27), so the grid here is
-    /// the shipped one without them: g = 0 and 0.8–0.95.
-    #[test]
-    fn a_range_the_tables_miss_names_what_they_cover() {
-        let grid = scatterfit_mc::bundled_grid()
-            .unwrap()
-            .with_nodes(|g| g == 0.0 || g >= 0.8)
-            .unwrap();
-        let prior = GPrior {
-            g: None,
-            range: Some([0.3, 0.6]),
-            fit: false,
-        };
-        let message = values_g_on(&grid, &prior).unwrap_err().to_string();
-        assert!(message.contains("[0.3, 0.6]"), "{message}");
-        assert!(message.contains(&grid.coverage()), "{message}");
-        assert!(message.contains("0.95"), "{message}");
-        // The shipped grid answers it; a range reaching a covered g is accepted on both.
-        assert!(values_g(&prior).is_ok());
-        let reaching = GPrior {
-            g: None,
-            range: Some([0.3, 0.85]),
-            fit: false,
-        };
-        assert!(values_g_on(&grid, &reaching).is_ok());
+        let exact = exact.as_ref().map(|m| &m.fits).map_err(ToString::to_string);
+        model_term::apply(&mut self.fits, exact, self.settings.model);
+        self
     }
 }

@@ -13,54 +13,9 @@
 //! ([`crate::checks::model_reasons`]): a model whose residuals are many times exact transport's
 //! does not describe the profile.
 
-use scatterfit_optics::{AlbedoModel, ModelName};
+use scatterfit_optics::ModelName;
 
-use crate::fit::{ChannelOutcome, FitSettings};
-use crate::measure::Measurement;
-
-pub use crate::fit::ExactFit;
-
-/// Whether `settings` use an approximate model for the profile or for α′.
-pub fn is_approximate(settings: &FitSettings) -> bool {
-    settings.model != ModelName::Mc || settings.albedo_model != AlbedoModel::Mc
-}
-
-/// `settings` with exact transport for the profile and for α′ (method, g, spot and rings as
-/// chosen).
-pub fn exact_settings(settings: &FitSettings) -> FitSettings {
-    FitSettings {
-        model: ModelName::Mc,
-        albedo_model: AlbedoModel::Mc,
-        ..*settings
-    }
-}
-
-impl Measurement {
-    /// The measurement with every fitted channel's `model` term (module docs): nothing changes
-    /// with exact transport itself; with an approximate model the same data are fitted again
-    /// with the `mc` tables (values only) and |approximate − exact| is the term of σ′s, σa and α′.
-    /// Where exact transport cannot be evaluated (outside the tables' η or α′, a refit that does
-    /// not converge) the channel keeps no term and a note that says why.
-    #[must_use]
-    pub fn with_model_term(mut self) -> Self {
-        if !is_approximate(&self.settings) {
-            return self;
-        }
-        let exact = self.refit_values_only(exact_settings(&self.settings));
-        // The data's cross-checks from exact transport's fits (an approximate model's own error
-        // would read as a disagreement between the profile and the reading).
-        if let Ok(x) = &exact
-            && let Ok(data) = x.profile.rgb_data()
-            && let Ok((model, _)) = crate::measure::families(&x.settings)
-        {
-            self.evidence =
-                crate::checks::evidence::gather(&data, &x.spectro, &x.settings, &model, &x.fits);
-        }
-        let exact = exact.as_ref().map(|m| &m.fits).map_err(ToString::to_string);
-        apply(&mut self.fits, exact, self.settings.model);
-        self
-    }
-}
+use crate::fit::outcome::{ChannelOutcome, ExactFit};
 
 /// Each fitted channel of `fits` with its `model` term from exact transport's fits of the same
 /// data (`exact`, or why they could not be made): |approximate − exact| of σ′s, σa and α′ and

@@ -17,7 +17,7 @@ use scatterfit_optics::port::Port;
 use scatterfit_optics::{Channel, ModelFamily, OpticalProperties, Rgb};
 use serde::Serialize;
 
-use crate::fit::FitSettings;
+use crate::settings::FitSettings;
 use crate::spectro::SpectroStage;
 
 /// Rounds before giving up on a channel (it converges in 3–10 on the rig twin).
@@ -430,9 +430,9 @@ pub fn propagate_fit_through_port(
     model: &dyn ModelFamily,
     albedo: &dyn ModelFamily,
     correction: &PortCorrection,
-    fits: Rgb<crate::fit::ChannelOutcome>,
-) -> Rgb<crate::fit::ChannelOutcome> {
-    use crate::fit::ChannelOutcome;
+    fits: Rgb<crate::fit::outcome::ChannelOutcome>,
+) -> Rgb<crate::fit::outcome::ChannelOutcome> {
+    use crate::fit::outcome::ChannelOutcome;
     use scatterfit_fit::{FitOptions, PreparedFit, Start};
     if settings.method != scatterfit_optics::Method::Proposed {
         return fits;

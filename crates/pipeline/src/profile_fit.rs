@@ -6,9 +6,11 @@ use scatterfit_fit::ProfileData;
 use scatterfit_io::result_json::{AlbedoSource, Inputs, MeasurementResult, RunOptions};
 use scatterfit_optics::{AlbedoModel, Method, ModelFamily, ModelName, Rgb};
 
-use crate::anisotropy::AlbedoAtG;
+use crate::anisotropy::record::AlbedoAtG;
 use crate::error::Result;
-use crate::fit::{ChannelOutcome, FitSettings, channel_result, fit_stage, with_g_term};
+use crate::fit::outcome::ChannelOutcome;
+use crate::fit::{channel_result, fit_stage, with_g_term};
+use crate::settings::FitSettings;
 use crate::spectro::SpectroStage;
 
 /// What to fit a given profile with.
@@ -40,7 +42,7 @@ pub struct ProfileFitRequest {
     /// What is known about g (`--g`, `--g-range`): the values' g and the g term, as for
     /// a measurement ([`crate::anisotropy`]). With `rd` the term's α′ is inverted from it at each
     /// g; without, α′ is held at the given value and the term is the profile's part only.
-    pub g_prior: crate::anisotropy::GPrior,
+    pub g_prior: crate::anisotropy::plan::GPrior,
 }
 
 /// How far (absolute, in Rd) a given Rd may lie from the fit model's total Rd of the given α′
@@ -141,8 +143,8 @@ pub struct ProfileFit {
 pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> Result<ProfileFit> {
     request.check()?;
     request.g_prior.check()?;
-    crate::measure::check_g_fit(&request.g_prior, request.model)?;
-    let g = crate::measure::values_g(&request.g_prior)?;
+    crate::settings::check_g_fit(&request.g_prior, request.model)?;
+    let g = crate::settings::values_g(&request.g_prior)?;
     // A g — or an η at that g — the Monte Carlo tables do not cover is refused here, before any
     // fit, as a manifest's g is (the family itself would only answer NaN, and every channel's fit
     // would fail obscurely). η is probed with a model at a mid albedo: the tables' η range does
@@ -179,7 +181,7 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
         model: request.model,
         albedo_model: AlbedoModel::Diffusion,
         spot_radius_mm: 0.5 * request.spot_diameter_mm,
-        spot: crate::fit::SpotShape::Disk,
+        spot: crate::settings::SpotShape::Disk,
         r_min_mm: request.r_min_mm,
         normalise_with_spectro: request.normalise_with_spectro,
         g,
@@ -236,7 +238,7 @@ fn exact_fits(
         })
     });
     let spectro = SpectroStage::given(request.eta, rd, albedo);
-    let settings = crate::model_term::exact_settings(settings);
+    let settings = settings.exact();
     Ok(fit_stage(profile, &spectro, &settings, &model))
 }
 
@@ -328,7 +330,7 @@ impl ProfileFit {
             version: env!("CARGO_PKG_VERSION").into(),
             rd_spectrum: None,
             spectro_port: None,
-            g_uncertainty: Some(crate::measure::g_record(s, &self.fits)),
+            g_uncertainty: Some(crate::result::g_record(s, &self.fits)),
         }
     }
 }

@@ -32,7 +32,7 @@ pub fn reusable_result(dir: &Path, o: &Overrides) -> Option<MeasurementResult> {
         .chain(inputs.hdr.as_ref())
         .chain(&inputs.frames);
     for f in refs {
-        if crate::measure::hash_file(&dir.join(&f.path)).as_deref() != Some(&f.sha256) {
+        if crate::samples::hash_file(&dir.join(&f.path)).as_deref() != Some(&f.sha256) {
             return None;
         }
     }

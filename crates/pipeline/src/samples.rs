@@ -220,6 +220,17 @@ pub fn sample_dirs(paths: &[PathBuf]) -> SampleDirs {
     out
 }
 
+/// SHA-256 of a file's bytes, lower-case hex (`None` when it cannot be read: missing, not a
+/// regular file, larger than the memory budget): for a file that is not otherwise read, such as
+/// `batch`'s check of a sample's inputs against the hashes its `result.json` recorded. A
+/// measurement's own inputs are hashed as they are read (`Measurement::to_result`).
+pub fn hash_file(path: &Path) -> Option<String> {
+    let bytes =
+        scatterfit_safefs::read::read_limited(path, scatterfit_io::budget::memory_budget_bytes())
+            .ok()?;
+    Some(scatterfit_io::digest::sha256_hex(&bytes))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

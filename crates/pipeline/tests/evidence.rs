@@ -604,6 +604,61 @@ fn room_light_switched_on_during_the_bracket_is_suspect() {
     }
 }
 
+/// Room light switched on for the last three frames of a linear 16-bit bracket (the quick twin on
+/// the `linear16` camera, its black level 1024 DN read off the far corners): the corners' means no
+/// longer grow in a straight line with the exposure time, and the line's intercept — the black
+/// level subtracted from every pixel — moves with them. Every channel is suspect for ambient
+/// light, the message naming the frame; the clean bracket and one with the light on in every
+/// frame (a straight line: it reads as glare) are not.
+#[test]
+fn room_light_switched_on_during_a_linear_bracket_is_suspect() {
+    use scatterfit_io::manifest::FitSection;
+    use scatterfit_lab::twin::{TwinFolder, write_twin_folder};
+    use scatterfit_synth::{CameraModel, mishaps};
+    let root = tempfile::tempdir().unwrap();
+    let mut rig = RigSpec::quick();
+    rig.camera = CameraModel::named("linear16").unwrap();
+    let s = common::twin(MATERIAL, &rig, 1);
+    let (f, t) = (&s.bracket.frames_u16, &s.bracket.times_s);
+    let n = f.len();
+    assert!(n >= 6, "a linear bracket");
+    for (label, from, rate, flagged) in [
+        ("linear, clean", n, 0.0, false),
+        ("linear, room light 2000 DN/s, last 3", n - 3, 2000.0, true),
+        ("linear, room light 200 DN/s, last 3", n - 3, 200.0, true),
+        ("linear, room light 200 DN/s, every frame", 0, 200.0, false),
+    ] {
+        let mut lit = s.clone();
+        lit.bracket.frames_u16 = mishaps::room_light_linear(f, t, from, rate);
+        let d = root.path().join(label.replace([' ', ',', '/'], "_"));
+        write_twin_folder(&d, &lit, &TwinFolder::new(FitSection::default(), "test")).unwrap();
+        let (m, q) = measure(label, &d, &Overrides::default());
+        let corners = m
+            .hdr
+            .corrections
+            .corners
+            .as_ref()
+            .expect("a linear merge's corners");
+        println!(
+            "   black level {:?}, departures {:?}",
+            corners.level, corners.departure
+        );
+        if flagged {
+            assert!(all_have(&q, ReasonKind::AmbientLight), "{label}: {q:?}");
+            assert!(
+                q[0].reasons
+                    .iter()
+                    .any(|r| r.kind == ReasonKind::AmbientLight
+                        && r.message.contains("frame_")
+                        && r.message.contains("room light")),
+                "{label}: {q:?}"
+            );
+        } else {
+            assert!(none_has(&q, ReasonKind::AmbientLight), "{label}: {q:?}");
+        }
+    }
+}
+
 /// A bracket saved as JPEG at libjpeg's default, quality 75 with 4:2:0 chroma (Pillow's and
 /// libjpeg's defaults): the 8 × 8 blocks and the half-resolution, coarsely quantised chroma move
 /// the edge of the quick twin's 10-pixel spot differently in each channel (R +4, G +10, B −6 %

@@ -132,7 +132,7 @@ fn fitting_g_needs_the_mc_model() {
     let mut m = scatterfit_io::manifest::SampleManifest::default();
     m.fit.g = Some(GSetting::Fit);
     m.fit.model = Some(ModelName::Dipole);
-    let e = scatterfit_pipeline::measure::fit_settings(&m, &Overrides::default())
+    let e = scatterfit_pipeline::fit_settings(&m, &Overrides::default())
         .unwrap_err()
         .to_string();
     assert!(e.contains("fit.g") && e.contains("mc"), "{e}");

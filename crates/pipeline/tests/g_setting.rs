@@ -3,8 +3,8 @@
 //! albedo inversion are then evaluated at that g (`scatterfit_optics::AtG`).
 
 use scatterfit_io::manifest::SampleManifest;
-use scatterfit_pipeline::measure::{Overrides, fit_settings};
 use scatterfit_pipeline::{AlbedoModel, ModelFamily, ModelName, PipelineError};
+use scatterfit_pipeline::{Overrides, fit_settings};
 
 fn manifest(model: ModelName, g: Option<f64>) -> SampleManifest {
     let mut m = SampleManifest::default();

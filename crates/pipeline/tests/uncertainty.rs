@@ -15,7 +15,8 @@ use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
 use scatterfit_optics::spectro::SpectroReading;
 use scatterfit_optics::{AlbedoModel, Channel, DiffusionModel, Method, ModelName, Rgb};
-use scatterfit_pipeline::fit::{FitSettings, fit_stage, propagate_spectro};
+use scatterfit_pipeline::FitSettings;
+use scatterfit_pipeline::fit::{fit_stage, propagate_spectro};
 use scatterfit_pipeline::spectro::{SpectroStage, from_reading};
 
 const EPS: f64 = 0.005;
@@ -133,7 +134,7 @@ fn sigma_errors_match_refits_of_repeated_readings() {
         model: ModelName::Dipole,
         albedo_model: AlbedoModel::Diffusion,
         spot_radius_mm: 0.5,
-        spot: scatterfit_pipeline::fit::SpotShape::Disk,
+        spot: scatterfit_pipeline::SpotShape::Disk,
         r_min_mm: Some(1.0),
         normalise_with_spectro: false,
         g: 0.0,

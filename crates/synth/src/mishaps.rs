@@ -176,6 +176,32 @@ pub fn room_light(
     out
 }
 
+/// Room light switched on before frame `from` of a linear 16-bit bracket: every value of the frames
+/// from there on gains `dn_per_s` × the frame's exposure time `times_s[j]` (a uniform glow, in the
+/// camera's numbers), rounded and clipped at 65535. The glow's own shot noise is left out: the
+/// change in the frames' means is what a check sees.
+pub fn room_light_linear(
+    frames: &[ImageBuf<u16>],
+    times_s: &[f64],
+    from: usize,
+    dn_per_s: f64,
+) -> Vec<ImageBuf<u16>> {
+    frames
+        .iter()
+        .enumerate()
+        .map(|(j, f)| {
+            let mut f = f.clone();
+            if j >= from {
+                let add = dn_per_s * times_s[j];
+                for v in f.data_mut() {
+                    *v = (f64::from(*v) + add).round().clamp(0.0, 65535.0) as u16;
+                }
+            }
+            f
+        })
+        .collect()
+}
+
 /// Hot pixels: each pixel of `pixels` (x, y) gains `electrons_per_s` × the frame's exposure time
 /// `times_s[j]` in every channel of every frame (a sensor's dark current at a defect grows with the
 /// exposure, as a lamp's glow does), toned and quantised again through `camera`. Isolated pixels

@@ -34,9 +34,11 @@ mod names;
 use names::lenient;
 pub use names::{AlbedoSource, EtaSource, ResponseKind};
 
+mod camera;
 mod records;
 mod schema;
 
+pub use camera::{BackgroundLevel, CameraCorrections, CameraRecord, ExposureRecord};
 pub use records::{GFitRecord, GSource, GUncertainty, PortResult, RdSpectrum};
 pub use schema::SCHEMA_VERSION;
 
@@ -246,9 +248,13 @@ pub struct RunOptions {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub albedo_model: Option<AlbedoModel>,
     /// What the HDR and profile stages found and corrected of a real camera (black level,
-    /// exposure times, flat frame, background), as they serialise.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub camera: Option<serde_json::Value>,
+    /// exposure times, flat frame, frames without signal, the level under the profile); `None`
+    /// in a file without it, or with a record this reader does not know.
+    #[serde(
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "camera::lenient_camera"
+    )]
+    pub camera: Option<CameraRecord>,
     /// The bracket's detection limit per channel (R, G, B) [relative radiance]; `null` where
     /// unknown.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -693,7 +699,18 @@ pub(crate) mod tests {
             method: Some(Method::Existing),
             model: Some(ModelName::BetterDipole),
             albedo_model: Some(AlbedoModel::Mc),
-            camera: Some(serde_json::json!({"background": "none"})),
+            camera: Some(CameraRecord {
+                background: vec![BackgroundLevel {
+                    level: 0.5,
+                    relative_to_peak: 1e-4,
+                    stderr: 0.01,
+                    subtracted: true,
+                }],
+                corrections: CameraCorrections {
+                    exposure_applied: true,
+                    ..CameraCorrections::default()
+                },
+            }),
             normalise_with_spectro: Some(false),
             r_min_mm: Some(1.0),
             r_max_px: Some(300.0),
@@ -710,7 +727,7 @@ pub(crate) mod tests {
         let options = serde_json::to_string(&r.inputs.options).unwrap();
         assert_eq!(
             options,
-            r#"{"albedo_model":"mc","camera":{"background":"none"},"detection_limit":[0.25,null,1.0],"g":0.85,"method":"existing","model":"better-dipole","normalise_with_spectro":false,"r_max_px":300.0,"r_min_mm":1.0,"response":"recovered","spot_radius_mm":0.5}"#
+            r#"{"albedo_model":"mc","camera":{"background":[{"level":0.5,"relative_to_peak":0.0001,"stderr":0.01,"subtracted":true}],"corrections":{"black_level":null,"exposure":null,"exposure_applied":true,"flat":null}},"detection_limit":[0.25,null,1.0],"g":0.85,"method":"existing","model":"better-dipole","normalise_with_spectro":false,"r_max_px":300.0,"r_min_mm":1.0,"response":"recovered","spot_radius_mm":0.5}"#
         );
         let back = parse_result_json(&v.to_string(), Path::new("r.json")).unwrap();
         assert_eq!(back, r);

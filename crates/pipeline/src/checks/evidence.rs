@@ -13,11 +13,11 @@
 //!   the material. The image's half width against it ([`spot_scale`]) measures the scale (or the
 //!   spot's diameter) to a few percent.
 
-use scatterfit_optics::{Channel, Method, ModelFamily, OpticalProperties, Rgb};
+use scatterfit_optics::{Channel, Method, ModelFamily, Rgb};
 use serde::Serialize;
 
-use crate::fit::{ChannelOutcome, FitSettings};
-use crate::measure::Measurement;
+use crate::fit::outcome::ChannelOutcome;
+use crate::settings::FitSettings;
 use crate::spectro::SpectroStage;
 
 /// One channel's α′ from the profile's shape against the spectrophotometer's.
@@ -153,67 +153,6 @@ impl SpotScale {
             .iter()
             .all(|c| c.is_some_and(|f| if above { f > 1.0 + m } else { f < 1.0 - m }))
     }
-}
-
-/// The ratio of the image's spot half width to the one the fitted model predicts at the stated
-/// scale and spot ([`crate::checks::SPOT_FACTOR_RANGE`]): each fitted channel's model (convolved
-/// with the spot, × its fitted scale) averaged over the same rings as the image (8 radii per
-/// ring, equal areas), the channels summed as the image's half width is measured
-/// ([`crate::checks::spot_hwhm_px`]), and each channel alone. About mm_per_pixel(stated) /
-/// mm_per_pixel(true): 0.91 for a scale stated 10 % too large. With an approximate model the
-/// exact fit of the same data ([`crate::model_term::ExactFit`]) predicts the spot instead: a
-/// diffusion model's near field, inside the spot, is its least accurate part (the dipole's spot
-/// on red aluminium is 2.6× too wide). `None` without three fitted channels or a half width.
-pub fn spot_scale(m: &Measurement) -> Option<SpotScale> {
-    let rings = &m.profile.profile.rings;
-    let mmpp = m.profile.profile.mm_per_pixel;
-    if !(mmpp.is_finite() && mmpp > 0.0) {
-        return None;
-    }
-    let spot = m.settings.options().ok()?.spot;
-    let exact = m.settings.model == scatterfit_optics::ModelName::Mc;
-    let family = scatterfit_mc::family(scatterfit_optics::ModelName::Mc).ok()?;
-    let model = scatterfit_optics::AtG::new(family, m.settings.g).ok()?;
-    const SUB: usize = 8;
-    let radii: Vec<f64> = rings
-        .iter()
-        .flat_map(|ring| {
-            let (a2, b2) = (ring.r_inner_px.powi(2), ring.r_outer_px.powi(2));
-            (0..SUB).map(move |j| mmpp * (a2 + (j as f64 + 0.5) / SUB as f64 * (b2 - a2)).sqrt())
-        })
-        .collect();
-    let r_px: Vec<f64> = rings.iter().map(|r| r.r_px).collect();
-    let mut per_channel: Vec<Vec<f64>> = Vec::with_capacity(3);
-    for c in Channel::ALL {
-        let f = m.fits[c].fit().filter(|f| f.report.converged)?;
-        let (s, a, scale) = if exact {
-            let r = &f.report;
-            (r.sigma_s_prime.value, r.sigma_a.value, r.scale.value)
-        } else {
-            let x = f.exact?;
-            (x.sigma_s_prime, x.sigma_a, x.scale)
-        };
-        let props = OpticalProperties::new(s, a, m.spectro.eta).ok()?;
-        let values = scatterfit_fit::model_profile(&model, &props, spot, &radii).ok()?;
-        per_channel.push(
-            values
-                .chunks(SUB)
-                .map(|chunk| scale * chunk.iter().sum::<f64>() / SUB as f64)
-                .collect(),
-        );
-    }
-    let sum: Vec<f64> = (0..rings.len())
-        .map(|k| per_channel.iter().map(|v| v[k]).sum())
-        .collect();
-    let factor = crate::checks::spot_hwhm_px(m)? / hwhm_of(&sum, &r_px)?;
-    let channels = std::array::from_fn(|c| {
-        let data: Vec<f64> = rings
-            .iter()
-            .map(|r| r.channels.get(c).map_or(f64::NAN, |x| x.mean))
-            .collect();
-        Some(hwhm_of(&data, &r_px)? / hwhm_of(&per_channel[c], &r_px)?)
-    });
-    Some(SpotScale { factor, channels })
 }
 
 /// The half width at half maximum of ring values `v` at radii `r` \[px\], as

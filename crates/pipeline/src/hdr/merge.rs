@@ -522,6 +522,13 @@ pub(super) fn merge_linear(
         CameraFrame::U8(_) => None,
     });
     let ch = bufs[0].channels();
+    // The far corners' straight line in exposure time: the black level where nothing else gives
+    // it, the check of a stated one, and the ambient-light check's evidence (light that changed
+    // during the bracket bends it).
+    let corners = {
+        let refs: Vec<&ImageBuf<u16>> = bufs.iter().collect();
+        estimate_black_level(&refs, stated, saturation)
+    };
     // The black level: a dark frame is subtracted pixel by pixel (as before); otherwise a level
     // per channel from the settings, the RAW metadata or the far corners.
     let black: Option<(Vec<f64>, &'static str)> = if dark.is_some() {
@@ -537,14 +544,11 @@ pub(super) fn merge_linear(
             )),
             BlackLevel::Auto => match raw {
                 Some(r) => Some((r.levels.black[..ch.min(3)].to_vec(), "metadata")),
-                None => {
-                    let refs: Vec<&ImageBuf<u16>> = bufs.iter().collect();
-                    let est = estimate_black_level(&refs, stated, saturation);
-                    est.level
-                        .iter()
-                        .any(|l| *l >= 1.0)
-                        .then_some((est.level, "far corners"))
-                }
+                None => corners
+                    .level
+                    .iter()
+                    .any(|l| *l >= 1.0)
+                    .then(|| (corners.level.clone(), "far corners")),
             },
         }
     };
@@ -572,17 +576,16 @@ pub(super) fn merge_linear(
         _ => None,
     };
     if let Some((levels, source)) = stated_black {
-        let refs: Vec<&ImageBuf<u16>> = bufs.iter().collect();
-        let est = estimate_black_level(&refs, stated, saturation);
         corrections.black_level_check = Some(crate::hdr::BlackLevelCheck {
             source,
             stated: levels,
-            corners: est.level,
-            corners_stderr: est.level_stderr,
+            corners: corners.level.clone(),
+            corners_stderr: corners.level_stderr.clone(),
             saturation: f64::from(saturation),
-            clipped_at_zero: est.zero_fraction > 0.01,
+            clipped_at_zero: corners.zero_fraction > 0.01,
         });
     }
+    corrections.corners = Some(corners);
     let black_of = |c: usize| black.as_ref().map_or(0.0, |(b, _)| b[c]);
     // Exposure times from the frames: ratios of the linear values in the well-exposed range.
     let mut times_used = stated.to_vec();

@@ -127,6 +127,11 @@ pub struct Corrections {
     /// imaging` shows them).
     #[serde(skip)]
     pub timings: Vec<(&'static str, f64)>,
+    /// Linear merges: the far corners' straight line in exposure time and the frame that departs
+    /// most from it, per channel ([`crate::camera::estimate_black_level`]; the ambient-light check
+    /// reads it; not written).
+    #[serde(skip)]
+    pub corners: Option<crate::camera::BlackLevelEstimate>,
 }
 
 impl Corrections {

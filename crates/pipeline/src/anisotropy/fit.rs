@@ -46,14 +46,13 @@
 //! term ([`crate::anisotropy`]), as `g_range` alone gives.
 
 use scatterfit_fit::{ChannelInput, FitOptions, FitReport, ProfileData};
-use scatterfit_io::result_json::GFitRecord;
 use scatterfit_mc::McGridSet;
 use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
-use serde::Serialize;
 
-pub use crate::anisotropy::default_search_range;
-use crate::anisotropy::{AlbedoAtG, warm_start};
-use crate::fit::{ChannelOutcome, FitSettings};
+use super::record::{AlbedoAtG, GFit};
+use super::term::warm_start;
+use crate::fit::outcome::ChannelOutcome;
+use crate::settings::FitSettings;
 use crate::spectro::SpectroStage;
 
 /// The largest sd(g) at which g counts as determined: the Fisher study's threshold (BENCHMARKS.md,
@@ -89,60 +88,6 @@ pub const SCAN_FINE_FROM: f64 = 0.7;
 
 /// The Δg whose shape change is the signal (the Fisher study's).
 const SHAPE_DG: f64 = 0.05;
-
-/// One channel's fit of g.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct GFit {
-    /// The g of χ²'s minimum (given out only when [`GFit::determined`]).
-    pub g: f64,
-    /// sd(g), the fit's and the model's parts in quadrature.
-    pub stderr: f64,
-    /// The fit's part (curvature of χ², scaled by the reduced χ²).
-    pub stderr_fit: f64,
-    /// The model's part (0.05·δ/S, δ the fit's misfit beyond the rings' noise, at least 0.3 %).
-    pub stderr_model: f64,
-    /// The spectrophotometer's part (the minimum's shift with the reading at ± its error).
-    pub stderr_spectro: f64,
-    /// corr(σ′s, g) in the joint covariance.
-    pub corr_sigma_s_prime: f64,
-    /// S: the RMS shape change (ln) of Δg = 0.05 after refitting the other unknowns.
-    pub shape_change: f64,
-    /// The g searched: the first and last scan point the tables answered.
-    pub searched: [f64; 2],
-    /// χ²(g) over the scan, (g, χ²).
-    pub scan: Vec<(f64, f64)>,
-    /// Whether the data determine g (module docs).
-    pub determined: bool,
-    /// Why not, when not.
-    pub reason: Option<String>,
-    /// The channel's fit at ĝ (values, standard errors, residuals).
-    #[serde(skip)]
-    pub report: Option<FitReport>,
-    /// α′, σ′s, σa at ĝ − sd(g) and ĝ + sd(g) (clamped to the searched range): the g term.
-    #[serde(skip)]
-    pub term: Option<[f64; 3]>,
-}
-
-impl GFit {
-    /// The result file's record: g and its errors only where determined.
-    pub fn record(&self) -> GFitRecord {
-        let d = self.determined;
-        GFitRecord {
-            determined: d,
-            g: d.then_some(self.g),
-            g_stderr: d.then_some(self.stderr),
-            g_stderr_fit: d.then_some(self.stderr_fit),
-            g_stderr_model: d.then_some(self.stderr_model),
-            g_stderr_spectro: d.then_some(self.stderr_spectro),
-            corr_sigma_s_prime_g: d
-                .then_some(self.corr_sigma_s_prime)
-                .filter(|c| c.is_finite()),
-            shape_change: self.shape_change.is_finite().then_some(self.shape_change),
-            searched: Some(self.searched),
-            reason: self.reason.clone(),
-        }
-    }
-}
 
 /// The scan's points in `range`: steps of [`SCAN_STEP_COARSE`] below [`SCAN_FINE_FROM`] and of
 /// [`SCAN_STEP`] from it, the grid's nodes inside and the ends, each where the grid covers it (η is
@@ -509,6 +454,7 @@ pub fn fit_g_channels(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::anisotropy::plan::default_search_range;
 
     /// The parabola's vertex and curvature from three points of a known parabola, unevenly spaced.
     #[test]
