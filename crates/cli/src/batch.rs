@@ -9,12 +9,11 @@
 //! sample (round-robin over the sorted list) and writes their results into a partial file;
 //! `scatterfit combine` makes the summary and the index of all.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
 
-use scatterfit_io::result_json::MeasurementResult;
-use scatterfit_pipeline::Overrides;
+use scatterfit_pipeline::reuse::reusable_result;
 use serde::Serialize;
 
 use crate::batch_set::{Entry, failure_of, summarise};
@@ -55,48 +54,6 @@ struct BatchInputs {
     samples: Vec<PathBuf>,
     misspelt: Vec<PathBuf>,
     overrides: String,
-}
-
-/// Whether the result files in `dir` are one complete set whose result.json records the SHA-256
-/// its input files still have, made with the options `overrides` asks for. A g range or a g fit
-/// asked for on the command line is not recorded in a result: such runs measure every sample.
-fn reusable(dir: &Path, o: &Overrides) -> Option<MeasurementResult> {
-    use scatterfit_io::result_set::{SetStatus, verify};
-    if o.g.is_some_and(|p| p.range.is_some() || p.fit) {
-        return None;
-    }
-    let given_g = o.g.and_then(|p| p.g);
-    if !matches!(
-        verify(dir, &["result.json", "profile.csv"]),
-        Ok(SetStatus::Complete(_))
-    ) {
-        return None;
-    }
-    let r = scatterfit_io::result_json::read_result_json(&dir.join("result.json")).ok()?;
-    let inputs = &r.inputs;
-    let manifest = inputs.manifest.as_ref()?;
-    let refs = std::iter::once(manifest)
-        .chain(inputs.spectro.as_ref())
-        .chain(inputs.hdr.as_ref())
-        .chain(&inputs.frames);
-    for f in refs {
-        if scatterfit_pipeline::samples::hash_file(&dir.join(&f.path)).as_deref() != Some(&f.sha256)
-        {
-            return None;
-        }
-    }
-    let opt = &inputs.options;
-    let same = |given: bool, ok: bool| !given || ok;
-    (same(o.method.is_some(), opt.method == o.method)
-        && same(o.model.is_some(), opt.model == o.model)
-        && same(o.albedo_model.is_some(), opt.albedo_model == o.albedo_model)
-        && same(given_g.is_some(), opt.g == given_g)
-        && same(o.eta.is_some(), Some(r.eta) == o.eta)
-        && same(
-            o.normalise_with_spectro.is_some(),
-            opt.normalise_with_spectro == o.normalise_with_spectro,
-        ))
-    .then_some(r)
 }
 
 /// Runs `scatterfit batch`.
@@ -146,7 +103,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut todo: Vec<(usize, PathBuf)> = Vec::new();
     for (i, dir) in dirs.iter().enumerate().filter(|(i, _)| owned(*i)) {
         match (!args.samples.force)
-            .then(|| reusable(dir, &overrides))
+            .then(|| reusable_result(dir, &overrides))
             .flatten()
         {
             Some(r) => entries.push(Entry {
@@ -223,7 +180,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     entries.sort_by_key(|e| e.index);
     if let Some((shard, job)) = job {
-        job.write(&entries)?;
+        job.write(&entries, std::env::args().collect())?;
         if !quiet {
             errln!(
                 "shard {shard}: {} sample(s), {} failed, incomplete or suspect; {} (the summary: \

@@ -5,10 +5,10 @@
 //! The set is checked first, naming the file: every file a partial of one run (same kind,
 //! fingerprint and scatterfit version), shards 1…N each exactly once.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use serde::de::IgnoredAny;
 
 use crate::output::{errln, out};
@@ -40,87 +40,10 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Reads every file's envelope and checks that they are the shards 1…N of one run, once each.
-fn check_set(paths: &[PathBuf]) -> anyhow::Result<Vec<Partial<IgnoredAny>>> {
-    let mut parts = Vec::with_capacity(paths.len());
-    for p in paths {
-        parts.push(crate::shard::read::<IgnoredAny>(p)?);
-    }
-    let first = &parts[0];
-    let this = env!("CARGO_PKG_VERSION");
-    for (p, path) in parts.iter().zip(paths) {
-        if p.version != this {
-            bail!(
-                "{} was written by scatterfit {}, this is {this}: redo its shards with this version",
-                path.display(),
-                p.version
-            );
-        }
-        if p.kind != first.kind || p.run != first.run {
-            bail!(
-                "{} is a shard of another run ({} {}) than {} ({} {}): a foreign shard; give the \
-                 files of one run",
-                path.display(),
-                p.kind.name(),
-                p.run,
-                paths[0].display(),
-                first.kind.name(),
-                first.run
-            );
-        }
-        if p.shard.count() != first.shard.count() {
-            bail!(
-                "{} is shard {} but {} is of {} shards: give the files of one split",
-                path.display(),
-                p.shard,
-                paths[0].display(),
-                first.shard.count()
-            );
-        }
-    }
-    let n = first.shard.count();
-    let mut seen: Vec<Option<&PathBuf>> = vec![None; n as usize];
-    for (p, path) in parts.iter().zip(paths) {
-        let slot = &mut seen[p.shard.index() as usize - 1];
-        if let Some(other) = slot {
-            bail!(
-                "shard {} is given twice: {} and {}",
-                p.shard,
-                other.display(),
-                path.display()
-            );
-        }
-        *slot = Some(path);
-    }
-    let missing: Vec<PathBuf> = seen
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.is_none())
-        .map(|(k, _)| {
-            let shard = scatterfit_mc::Shard::new(k as u64 + 1, n).expect("1 ≤ k + 1 ≤ n");
-            let dir = paths[0].parent().unwrap_or(Path::new("."));
-            crate::shard::partial_path(dir, first.kind, &first.run, shard)
-        })
-        .collect();
-    if !missing.is_empty() {
-        bail!(
-            "{} of {n} shards missing: {}; run them (a resubmitted job array does only these) and \
-             combine again",
-            missing.len(),
-            missing
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    Ok(parts)
-}
-
 /// Runs `scatterfit combine`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let t0 = std::time::Instant::now();
-    let parts = check_set(&args.partials)?;
+    let parts = crate::shard::check_set(&args.partials)?;
     let kind = parts[0].kind;
     let code = match kind {
         Kind::Table => combine_table(&args, parts)?,

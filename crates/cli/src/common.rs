@@ -156,83 +156,21 @@ pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
 
 pub use scatterfit_pipeline::radiance::shutter;
 
-/// The fitting method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    /// Choi et al. 2014: α′ from the spectrophotometer, σ′s (and the profile's scale) fitted.
-    Proposed,
-    /// Jensen et al. 2001: σ′s, σa (and the scale) fitted.
-    Existing,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Self {
-        match m {
-            MethodArg::Proposed => Method::Proposed,
-            MethodArg::Existing => Method::Existing,
-        }
-    }
-}
-
-/// The forward model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ModelArg {
-    /// The classical dipole, Jensen et al. 2001 (the paper's; approximate).
-    Dipole,
-    /// d'Eon 2012, "A better dipole".
-    BetterDipole,
-    /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (slow: ~2 ms per
-    /// evaluation).
-    Pbd,
-    /// Monte Carlo tables shipped with scatterfit (exact transport; the default). Henyey–Greenstein
-    /// g 0–0.95 with --g or `[fit] g`; η 1.0–2.5; α′ up to 0.9999, and from 0.2 at g ≠ 0.
-    Mc,
-}
-
-/// How α′ comes from the spectrophotometer's Rd.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum AlbedoModelArg {
-    /// The diffusion model's own total Rd(α′, η) inverted (the dipole's closed form: the paper).
-    Diffusion,
-    /// The Monte Carlo tables' total inverted (exact transport).
-    Mc,
-}
-
-impl From<AlbedoModelArg> for AlbedoModel {
-    fn from(m: AlbedoModelArg) -> Self {
-        match m {
-            AlbedoModelArg::Diffusion => AlbedoModel::Diffusion,
-            AlbedoModelArg::Mc => AlbedoModel::Mc,
-        }
-    }
-}
-
-impl From<ModelArg> for ModelName {
-    fn from(m: ModelArg) -> Self {
-        match m {
-            ModelArg::Dipole => ModelName::Dipole,
-            ModelArg::BetterDipole => ModelName::BetterDipole,
-            ModelArg::Pbd => ModelName::Pbd,
-            ModelArg::Mc => ModelName::Mc,
-        }
-    }
-}
-
 /// Options shared by `measure`, `batch` and `compare`: what overrides the manifests' `[fit]`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FitArgs {
     /// The fitting method (default: the manifest's `fit.method`, else proposed).
     #[arg(long, value_enum)]
-    pub method: Option<MethodArg>,
+    pub method: Option<Method>,
     /// The forward model (default: the manifest's `fit.model`, else mc — exact transport; `dipole`
     /// is the paper's, whose bias reaches tens of percent: its error then joins the bars as the
     /// ± model term).
     #[arg(long, value_enum)]
-    pub model: Option<ModelArg>,
+    pub model: Option<ModelName>,
     /// How α′ comes from the spectrophotometer's Rd (default: the manifest's `fit.albedo_model`,
     /// else mc for the mc model and diffusion otherwise).
     #[arg(long, value_enum)]
-    pub albedo_model: Option<AlbedoModelArg>,
+    pub albedo_model: Option<AlbedoModel>,
     /// A known η instead of the one measured from SCI − SCE, in [1, 3].
     #[arg(long, value_parser = crate::numeric::parse_finite)]
     pub eta: Option<f64>,
@@ -274,9 +212,9 @@ impl FitArgs {
             );
         }
         Ok(Overrides {
-            method: self.method.map(Into::into),
-            model: self.model.map(Into::into),
-            albedo_model: self.albedo_model.map(Into::into),
+            method: self.method,
+            model: self.model,
+            albedo_model: self.albedo_model,
             eta: self.eta,
             normalise_with_spectro: self.normalise_with_spectro.then_some(true),
             g: (self.g.is_some() || self.g_range.is_some())
@@ -340,16 +278,6 @@ pub struct PhotonScaleArgs {
         value_parser = parse_photon_scale
     )]
     pub photon_scale: f64,
-}
-
-impl PhotonScaleArgs {
-    /// `rig` with the photons scaled (the factor was checked when parsed).
-    pub fn apply(
-        &self,
-        rig: scatterfit_synth::RigSpec,
-    ) -> anyhow::Result<scatterfit_synth::RigSpec> {
-        Ok(rig.with_photon_scale(self.photon_scale)?)
-    }
 }
 
 /// Parses `--photon-scale`: a finite number in [`scatterfit_synth::rig::PHOTON_SCALE_RANGE`].

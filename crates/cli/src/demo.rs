@@ -14,12 +14,11 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use scatterfit_io::result_json::MeasurementResult;
-use scatterfit_optics::materials::CHOI_2014;
+use scatterfit_lab::demo::{DemoFiles, materials, quality_line, write_demo};
 
 use crate::common::CacheArgs;
 use crate::output::{errln, out, outln};
-use crate::twin::{Material, synthesize, write_sample};
+use crate::twin::{synthesize, write_sample};
 
 /// Arguments of `scatterfit demo`.
 #[derive(Debug, clap::Args)]
@@ -100,15 +99,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let mut dirs = Vec::new();
     let mut truths = Vec::new();
-    for m in &CHOI_2014 {
-        let material = Material {
-            name: m.name.into(),
-            sigma_s_prime: m.sigma_s_prime,
-            sigma_a: m.sigma_a,
-            eta: m.eta,
-        };
+    for material in materials() {
         let sample = synthesize(&material, args.seed, cache.as_deref(), quiet, args.quick)?;
-        let dir = args.output_dir.join(m.name);
+        let dir = args.output_dir.join(&material.name);
         write_sample(&dir, &sample)?;
         dirs.push(dir);
         truths.push(sample.truth);
@@ -129,36 +122,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         true,
     )?;
     let measure_s = t1.elapsed().as_secs_f64();
-    let rows = scatterfit_lab::accuracy::accuracy_rows(&pairs, &papers, &truths);
-    let proposed: Vec<MeasurementResult> = pairs.iter().map(|(_, p)| p.clone()).collect();
     let out = &args.output_dir;
-    let accuracy = scatterfit_lab::accuracy_markdown(&rows);
-    scatterfit_report::write_table1(out, &proposed)?;
-    scatterfit_report::write_table2(out, &pairs)?;
-    let json = serde_json::to_string_pretty(&rows).context("serialising the summary")? + "\n";
-    for (name, text) in [("accuracy.md", &accuracy), ("demo-summary.json", &json)] {
-        scatterfit_report::tables::write_text(&out.join(name), text)?;
-    }
-    let index = scatterfit_report::html::write_results_index(
-        out,
-        "scatterfit demo: the seven materials of Choi, Lee & Chin (2014)",
-        "Monte Carlo rig-twin samples of the paper's seven materials, measured with the proposed \
-         method and the exact forward model (Monte Carlo tables); the paper's dipole fits are in \
-         accuracy.md beside them; the truth is in each sample's truth.json, the errors against it in \
-         accuracy.md. The sample's name opens its report: verdict, Table 1, Figures 4 and 6, the \
-         evidence and the inputs.",
-        &proposed,
-        &pair_dirs,
-        &failed,
-        &[
-            "summary.md",
-            "summary.csv",
-            "compare.md",
-            "compare.csv",
-            "accuracy.md",
-            "demo-summary.json",
-        ],
-    )?;
+    let DemoFiles {
+        rows,
+        accuracy,
+        proposed,
+        index,
+    } = write_demo(out, &pairs, &papers, &truths, &pair_dirs, &failed)?;
     if args.json {
         crate::output::print_json(&rows)?;
     } else {
@@ -180,22 +150,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             out.display()
         )?;
         // The data checks' verdict on the proposed method's channels (RELIABILITY.md).
-        let suspect: Vec<String> = proposed
-            .iter()
-            .filter(|r| !scatterfit_report::trusted(r))
-            .map(|r| {
-                format!(
-                    "{}: {}",
-                    scatterfit_io::escape::one_line(&r.name),
-                    scatterfit_report::suspect_text(r)
-                )
-            })
-            .collect();
-        if suspect.is_empty() {
-            outln!("quality: every channel of the proposed method passes the data checks (ok)")?;
-        } else {
-            outln!("quality: {}", suspect.join("; "))?;
-        }
+        outln!("quality: {}", quality_line(&proposed))?;
         // Last: the page a person opens (every sample's verdict and numbers, a link to each report).
         outln!("index: {}", index.display())?;
     }

@@ -8,11 +8,10 @@ use std::process::ExitCode;
 use anyhow::Context;
 use scatterfit_io::profile_csv::read_profile_csv;
 use scatterfit_io::result_json::write_result_json;
-use scatterfit_optics::Rgb;
+use scatterfit_optics::{Method, ModelName, Rgb};
 use scatterfit_pipeline::profile::channel_from_table;
 use scatterfit_pipeline::profile_fit::{ProfileFitRequest, fit_profile};
 
-use crate::common::{MethodArg, ModelArg};
 use crate::common::{parse_g, parse_g_range, parse_rgb};
 use crate::output::out;
 
@@ -34,11 +33,11 @@ pub struct Args {
     #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
     pub rd: Option<[f64; 3]>,
     /// The fitting method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Proposed)]
-    pub method: MethodArg,
+    #[arg(long, value_enum, default_value_t = Method::Proposed)]
+    pub method: Method,
     /// The forward model (mc, exact transport, by default; dipole is the paper's).
-    #[arg(long, value_enum, default_value_t = ModelArg::Mc)]
-    pub model: ModelArg,
+    #[arg(long, value_enum, default_value_t = ModelName::Mc)]
+    pub model: ModelName,
     /// Diameter of the light spot \[mm\], in (0, 20]; the model is convolved with it.
     #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub spot_diameter_mm: f64,
@@ -103,8 +102,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eta: args.eta,
         albedo_prime: args.albedo.map(Rgb::from_array),
         rd: args.rd.map(Rgb::from_array),
-        method: args.method.into(),
-        model: args.model.into(),
+        method: args.method,
+        model: args.model,
         spot_diameter_mm: args.spot_diameter_mm,
         r_min_mm: args.r_min_mm,
         normalise_with_spectro: args.normalise_with_spectro,

@@ -2,8 +2,6 @@
 //! budgets (memory, Monte Carlo work) that sizes derived from the flags are checked against before
 //! anything is allocated or traced.
 
-use scatterfit_io::budget::{MEMORY_BUDGET_ENV, default_memory_budget_mib, describe_bytes};
-
 /// Help text of `--max-memory-mib`.
 pub const MAX_MEMORY_HELP: &str = "Memory budget [MiB, ≥ 1] for what the other flags and the \
      inputs size (tallies, tables, rings, images); checked before anything is allocated. Default: \
@@ -129,7 +127,7 @@ pub fn parse_finite(text: &str) -> Result<f64, String> {
     }
 }
 
-/// The memory budget \[bytes\]: the flag's MiB, else [`MEMORY_BUDGET_ENV`], else
+/// The memory budget \[bytes\]: the flag's MiB, else [`scatterfit_io::budget::MEMORY_BUDGET_ENV`], else
 /// half of the machine's memory (`scatterfit_io::budget::default_memory_budget_mib`).
 pub fn memory_budget(flag_mib: Option<u64>) -> u64 {
     flag_mib.map_or_else(scatterfit_io::budget::memory_budget_bytes, |m| {
@@ -137,22 +135,13 @@ pub fn memory_budget(flag_mib: Option<u64>) -> u64 {
     })
 }
 
-/// Refuses `needed` bytes above `budget`, saying what needs them and how to raise the budget.
+/// Refuses `needed` bytes above `budget`, saying what needs them and how to raise the budget
+/// ([`scatterfit_io::budget::check_memory`]).
 ///
 /// # Errors
 /// The refusal.
 pub fn check_memory(what: &str, needed: u64, budget: u64) -> anyhow::Result<()> {
-    if needed > budget {
-        anyhow::bail!(
-            "{what} needs {} of memory, more than the budget of {}; use fewer, or raise the budget \
-             with --max-memory-mib (or {MEMORY_BUDGET_ENV}; default {} MiB, half of this \
-             machine's memory) if this machine has the memory",
-            describe_bytes(needed),
-            describe_bytes(budget),
-            default_memory_budget_mib()
-        );
-    }
-    Ok(())
+    Ok(scatterfit_io::budget::check_memory(what, needed, budget)?)
 }
 
 pub use scatterfit_io::budget::describe_seconds;

@@ -13,57 +13,19 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use crate::output::errln;
-use anyhow::{Context, bail};
+use anyhow::bail;
 use scatterfit_optics::ModelName;
 use scatterfit_render::colour::ColourParams;
 use scatterfit_render::measured::{profile_path, read_measured};
 use scatterfit_render::request::{
     MeshSummary, RenderEvent, RenderSummary, render_figure, write_figure,
 };
-use scatterfit_render::texture_space::{DipoleParams, Evaluation};
+use scatterfit_render::settings::RenderSettings;
 use scatterfit_render::tonemap::ToneMap;
 use scatterfit_render::{
     FigureRequest, LightRig, MeshSource, Methods, ParameterSet, ProfileRequest, RenderError,
     RenderOptions, Shape, StudioScene, Summary,
 };
-
-/// The built-in models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ShapeArg {
-    /// Sphere, 10 mm radius.
-    Sphere,
-    /// 30 × 30 × 4 mm slab.
-    Slab,
-    /// Goblet-shaped statue 40 mm tall: thick base and stem, bowl wall under 1 mm.
-    Statue,
-}
-
-/// Which method(s).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    /// Subsurface colour method (§4.1, eqs. 3–5).
-    Color,
-    /// Texture-space dipole method (§4.2, eq. 6).
-    Dipole,
-    /// Both, side by side.
-    Both,
-}
-
-/// Lighting.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum LightArg {
-    /// Key light from the upper front left (irradiance 1) and a back light from behind (0.8).
-    Studio,
-    /// The key light alone.
-    Key,
-    /// The back light alone (irradiance 1): light through thin parts.
-    Back,
-    /// A point light above the front left, giving irradiance 1 at the model's centre.
-    Point,
-    /// A collimated spot of 2 mm radius from the key light's direction, aimed at the model's
-    /// centre (irradiance 1), like the measurement rig's: light spreading under the surface.
-    Spot,
-}
 
 /// Arguments of `scatterfit render`.
 #[derive(Debug, clap::Args)]
@@ -84,18 +46,18 @@ pub struct Args {
     #[arg(long, default_value_t = 1.0, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub mesh_scale: f64,
     /// A built-in model (used when no --mesh is given).
-    #[arg(long, value_enum, default_value_t = ShapeArg::Statue)]
-    pub shape: ShapeArg,
+    #[arg(long, value_enum, default_value_t = Shape::Statue)]
+    pub shape: Shape,
     /// Triangles of the built-in sphere or statue (about): a count, 1000 to 1e7.
     #[arg(long, default_value = "100000", value_parser = crate::numeric::parse_size, value_name = "N")]
     pub triangles: usize,
     /// Which of the paper's rendering methods.
-    #[arg(long, value_enum, default_value_t = MethodArg::Both)]
-    pub method: MethodArg,
+    #[arg(long, value_enum, default_value_t = Methods::Both)]
+    pub method: Methods,
     /// The profile model of the texture-space method: dipole, better-dipole, pbd or mc (default: the
     /// model the result was fitted with; dipole for published parameters).
     #[arg(long, value_enum)]
-    pub model: Option<crate::common::ModelArg>,
+    pub model: Option<ModelName>,
     /// Write the luminance (grey) instead of colour, like the paper's Figure 5.
     #[arg(long)]
     pub gray: bool,
@@ -111,8 +73,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Lighting.
-    #[arg(long, value_enum, default_value_t = LightArg::Studio)]
-    pub light: LightArg,
+    #[arg(long, value_enum, default_value_t = LightRig::Studio)]
+    pub light: LightRig,
     /// Rays each light shoots to sample the irradiance (texture-space method): a count, 1e3 to 1e8
     /// (default: a spacing of a third of the profile's half-width over the model, 65 536–2 097 152).
     #[arg(long, value_parser = crate::numeric::parse_size, value_name = "N")]
@@ -201,49 +163,33 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Checks the numbers that no library checks, then the memory the flags size, before any work.
-fn check_numbers(args: &Args, panels: usize) -> anyhow::Result<()> {
-    use crate::numeric::ensure;
-    ensure(
-        (1..=4096).contains(&args.spp),
-        "--spp",
-        args.spp,
-        "the samples per pixel must lie in 1–4096",
-    )?;
-    ensure(
-        args.mesh_scale > 0.0 && args.mesh_scale <= 1e6,
-        "--mesh-scale",
-        args.mesh_scale,
-        "the mesh scale must lie in (0, 1e6] mm per file unit",
-    )?;
-    if let Some(ev) = args.exposure {
-        ensure(
-            (-60.0..=60.0).contains(&ev),
-            "--exposure",
-            ev,
-            "the exposure must lie in [−60, 60] EV",
-        )?;
+/// The render's settings from the flags (checked by [`RenderSettings::check`]).
+fn settings(args: &Args) -> RenderSettings {
+    RenderSettings {
+        size: args.size,
+        spp: args.spp,
+        seed: args.seed,
+        colour: ColourParams {
+            rho_d: args.rho_d,
+            rho_ts: args.rho_ts,
+            rho_s: args.rho_s,
+            alpha: args.alpha,
+            beta: args.beta,
+            gamma: args.gamma,
+            alpha_x: args.alpha_x,
+            alpha_y: args.alpha_y,
+            g: args.g,
+        },
+        light_rays: args.light_rays,
+        max_angle: args.max_angle,
+        direct: args.direct,
+        interpolate: !args.no_interpolation,
+        mesh_scale: args.mesh_scale,
+        triangles: args.triangles,
+        exposure: args.exposure,
+        white: args.white,
+        spot_radius_mm: args.spot_radius_mm,
     }
-    ensure(
-        (1.0..=1e6).contains(&args.white),
-        "--white",
-        args.white,
-        "the tone-curve white must lie in [1, 1e6]",
-    )?;
-    if let Some(r) = args.spot_radius_mm {
-        ensure(
-            r > 0.0 && r <= 10.0,
-            "--spot-radius-mm",
-            r,
-            "the light spot's radius must lie in (0, 10] mm",
-        )?;
-    }
-    let (w, h) = args.size;
-    crate::numeric::check_memory(
-        &format!("rendering {panels} panel(s) of {w}×{h} px"),
-        scatterfit_render::request::memory_bytes(w, h, panels, args.triangles, args.light_rays),
-        args.memory.budget(),
-    )
 }
 
 fn parse_size(text: &str) -> Result<(usize, usize), String> {
@@ -322,26 +268,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     inputs.extend(args.mesh.iter().cloned());
     inputs.extend(args.measured_profile.iter().cloned());
     check_outputs(&args, &inputs)?;
-    let methods = match args.method {
-        MethodArg::Color => Methods::Colour,
-        MethodArg::Dipole => Methods::Dipole,
-        MethodArg::Both => Methods::Both,
-    };
+    let methods = args.method;
     let panels = if args.profile {
         1
     } else {
         specs.len() * methods.list().len()
     };
-    check_numbers(&args, panels)?;
-    if !(1000..=10_000_000).contains(&args.triangles) {
-        bail!("--triangles {} must lie in 1000–1e7", args.triangles);
-    }
-    if let Some(n) = args.light_rays
-        && !(1000..=100_000_000).contains(&n)
-    {
-        bail!("--light-rays {n} must lie in 1e3–1e8");
-    }
-    let model = args.model.map(ModelName::from);
+    let settings = settings(&args);
+    settings.check(panels, args.memory.budget())?;
+    let model = args.model;
     let mut params: Vec<ParameterSet> = specs
         .iter()
         .map(|s| ParameterSet::load(s, model).map_err(cli_error))
@@ -355,41 +290,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             code = c;
         }
     }
-    let options = RenderOptions {
-        width: args.size.0,
-        height: args.size.1,
-        spp: args.spp,
-        seed: args.seed,
-        colour: ColourParams {
-            rho_d: args.rho_d,
-            rho_ts: args.rho_ts,
-            rho_s: args.rho_s,
-            alpha: args.alpha,
-            beta: args.beta,
-            gamma: args.gamma,
-            alpha_x: args.alpha_x,
-            alpha_y: args.alpha_y,
-            g: args.g,
-        },
-        dipole: DipoleParams {
-            light_rays: args.light_rays,
-            evaluation: if args.direct {
-                Evaluation::Direct
-            } else {
-                Evaluation::Hierarchical {
-                    max_angle: args.max_angle,
-                }
-            },
-            specular: true,
-            interpolate: !args.no_interpolation,
-        },
-    };
-    options.colour.validate().context("shading coefficients")?;
-    options.dipole.validate().context("texture-space options")?;
-    let tone = ToneMap {
-        exposure_ev: args.exposure.unwrap_or(0.0),
-        white: args.white,
-    };
+    let options = settings.options()?;
+    let tone = settings.tone();
     if args.profile {
         return run_profile(&args, params.remove(0), model, options, &tone)
             .map(|c| if c == ExitCode::SUCCESS { code } else { c });
@@ -403,11 +305,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             scale: args.mesh_scale,
         },
         None => MeshSource::Builtin {
-            shape: match args.shape {
-                ShapeArg::Sphere => Shape::Sphere,
-                ShapeArg::Slab => Shape::Slab,
-                ShapeArg::Statue => Shape::Statue,
-            },
+            shape: args.shape,
             triangles: args.triangles,
         },
     };
@@ -417,11 +315,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             errln!("{note}");
         }
     }
-    let studio = StudioScene::new(loaded, light_rig(args.light), t0)?;
+    let studio = StudioScene::new(loaded, args.light, t0)?;
     let request = FigureRequest {
         params,
         mesh,
-        lights: light_rig(args.light),
+        lights: args.light,
         methods,
         model,
         options,
@@ -452,16 +350,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     print_summary(&args, &summary)?;
     Ok(code)
-}
-
-fn light_rig(light: LightArg) -> LightRig {
-    match light {
-        LightArg::Studio => LightRig::Studio,
-        LightArg::Key => LightRig::Key,
-        LightArg::Back => LightRig::Back,
-        LightArg::Point => LightRig::Point,
-        LightArg::Spot => LightRig::Spot,
-    }
 }
 
 /// `--profile`: the measurement's slab and spot rendered by the texture-space method, compared ring

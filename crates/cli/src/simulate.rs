@@ -5,8 +5,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use crate::output::{errln, out, outln};
-use anyhow::{Context, bail};
-use scatterfit_mc::{Beam, BeamProfile, Layer, RadialGrid, Sample, Simulation, SimulationReport};
+use anyhow::Context;
+use scatterfit_mc::{Simulation, SimulationReport};
+use scatterfit_pipeline::monte_carlo::SimulateSettings;
 
 /// Arguments of `scatterfit simulate`. Every number is checked before any work (exit 2 when out of
 /// range); the run's memory and expected work are checked against `--max-memory-mib` and
@@ -78,162 +79,27 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Parses `pencil`, `disk:R`, `gauss:R` (R in mm).
-fn parse_beam(text: &str) -> anyhow::Result<BeamProfile> {
-    let radius = |r: &str| -> anyhow::Result<f64> {
-        let v = r
-            .trim()
-            .parse::<f64>()
-            .with_context(|| format!("--beam {text}: `{r}` is not a radius in mm"))?;
-        crate::numeric::ensure(
-            v > 0.0 && v <= 1000.0,
-            "--beam",
-            text,
-            "the beam radius must lie in (0, 1000] mm",
-        )?;
-        Ok(v)
-    };
-    match text.split_once(':') {
-        None if text == "pencil" => Ok(BeamProfile::Pencil),
-        Some(("disk", r)) => Ok(BeamProfile::Disk { radius: radius(r)? }),
-        Some(("gauss", r)) | Some(("gaussian", r)) => {
-            Ok(BeamProfile::Gaussian { radius: radius(r)? })
-        }
-        _ => bail!("--beam {text}: expected pencil, disk:R or gauss:R (R in mm)"),
-    }
-}
-
-/// Largest η accepted: beyond any solid's (diamond 2.42, germanium in the infrared 4).
-const MAX_ETA: f64 = 10.0;
-
-/// Validated configuration from the flags: every range, then the memory of the tallies (before the
-/// grid is made) and the expected work (before any photon is traced).
+/// The simulation the flags describe, checked ([`SimulateSettings::configure`]: the ranges, the
+/// tallies' memory, the expected work).
 fn configure(args: &Args) -> anyhow::Result<Simulation> {
-    let range = |ok: bool, flag: &str, value: f64, rule: &str| -> anyhow::Result<()> {
-        if ok {
-            Ok(())
-        } else {
-            bail!("{flag} {}: {rule}", crate::numeric::show(value))
-        }
+    let settings = SimulateSettings {
+        sigma_s_prime: args.sigma_s_prime,
+        sigma_a: args.sigma_a,
+        eta: args.eta,
+        g: args.g,
+        thickness_mm: args.thickness_mm,
+        photons: args.photons,
+        seed: args.seed,
+        beam: args.beam.clone(),
+        incidence_deg: args.incidence_deg,
+        r_max_mm: args.r_max_mm,
+        bins: args.bins,
+        angle_bins: args.angle_bins,
+        allow_eta_below_one: args.allow_eta_below_one,
+        max_interactions: args.work.max_interactions,
+        memory_budget: args.memory.budget(),
     };
-    range(
-        args.sigma_s_prime >= 0.0,
-        "--sigma-s-prime",
-        args.sigma_s_prime,
-        "the reduced scattering coefficient must be ≥ 0 mm⁻¹",
-    )?;
-    range(
-        args.sigma_a >= 0.0,
-        "--sigma-a",
-        args.sigma_a,
-        "the absorption coefficient must be ≥ 0 mm⁻¹",
-    )?;
-    range(
-        args.eta > 0.0 && args.eta <= MAX_ETA,
-        "--eta",
-        args.eta,
-        "the relative refractive index must lie in (0, 10]",
-    )?;
-    if args.eta < 1.0 && !args.allow_eta_below_one {
-        bail!(
-            "--eta {}: below 1 means the material is optically thinner than air, which is unusual for \
-             a solid; pass --allow-eta-below-one if you mean it",
-            crate::numeric::show(args.eta)
-        );
-    }
-    range(
-        args.g > -1.0 && args.g < 1.0,
-        "--g",
-        args.g,
-        "the Henyey–Greenstein asymmetry must lie in (−1, 1)",
-    )?;
-    if let Some(t) = args.thickness_mm {
-        range(
-            t > 0.0,
-            "--thickness-mm",
-            t,
-            "the slab thickness must be > 0 mm (omit it for a half-space)",
-        )?;
-    }
-    range(
-        (0.0..90.0).contains(&args.incidence_deg),
-        "--incidence-deg",
-        args.incidence_deg,
-        "the angle of incidence must lie in [0, 90) degrees",
-    )?;
-    // Below a micrometre the bins' areas (π r², down to 1e-600 mm² for 1e-300) underflow to 0 and
-    // the tallies divide by them: NaN. No measurement resolves less than a micrometre.
-    range(
-        (1e-3..=1e6).contains(&args.r_max_mm),
-        "--r-max-mm",
-        args.r_max_mm,
-        "the outer radius must lie in [1e-3, 1e6] mm (a micrometre to a kilometre)",
-    )?;
-    if args.photons == 0 {
-        bail!("--photons 0: trace at least one photon");
-    }
-    if args.bins == 0 {
-        bail!("--bins 0: the radial grid needs at least one bin");
-    }
-    let budget = args.memory.budget();
-    crate::numeric::check_memory(
-        &format!(
-            "tallying {} radial and {} angular bins",
-            args.bins, args.angle_bins
-        ),
-        Simulation::tally_memory_bytes(args.bins, args.angle_bins),
-        budget,
-    )?;
-    if args.sigma_a == 0.0 && args.thickness_mm.is_none() {
-        bail!(
-            "--sigma-a 0 without --thickness-mm: in a half-space a photon without absorption \
-             has no finite mean path (it must wander back to the surface), so the simulation would \
-             never end; give a slab thickness with --thickness-mm, or a small absorption such as \
-             --sigma-a 1e-4 (the run's cost is then estimated and checked before it starts)"
-        );
-    }
-    let thickness = args.thickness_mm.unwrap_or(f64::INFINITY);
-    let layer = Layer::from_reduced(
-        args.sigma_s_prime,
-        args.sigma_a,
-        args.g,
-        args.eta,
-        thickness,
-    )
-    .context("bad material parameters")?;
-    let sample = Sample::slab(layer, 1.0)?;
-    let beam = Beam::new(parse_beam(&args.beam)?)
-        .context("bad --beam")?
-        .with_incidence(args.incidence_deg.to_radians())
-        .context("bad --incidence-deg (must lie in [0, 90))")?;
-    let grid = RadialGrid::uniform(args.r_max_mm / args.bins as f64, args.bins)?;
-    let sim = Simulation::new(sample, beam, grid, args.photons, args.seed)?
-        .with_angle_bins(args.angle_bins);
-    let cost = sim.cost_estimate();
-    if cost.interactions > args.work.max_interactions as f64 {
-        bail!(
-            "this run is expected to take about {:.1e} interactions ({:.3e} per photon × {} \
-             photons; σs = σ′s/(1 − g) = {:.4e} mm⁻¹, σa = {} mm⁻¹{}), about {} on {} threads, \
-             more than the work budget of {:.1e} (--max-interactions); use fewer photons, a larger \
-             σa{}, a g further from 1, or raise --max-interactions if you mean it",
-            cost.interactions,
-            cost.interactions_per_photon,
-            args.photons,
-            layer.sigma_s(),
-            args.sigma_a,
-            args.thickness_mm
-                .map_or_else(|| ", half-space".to_owned(), |t| format!(", {t} mm thick")),
-            crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
-            rayon::current_num_threads(),
-            args.work.max_interactions as f64,
-            if args.thickness_mm.is_some() {
-                ", a thinner slab"
-            } else {
-                ""
-            },
-        );
-    }
-    Ok(sim)
+    Ok(settings.configure(rayon::current_num_threads())?)
 }
 
 /// Runs `scatterfit simulate`.

@@ -1,13 +1,15 @@
 //! `scatterfit slurm table|batch|study ARGS... --array N`: writes a Slurm batch script for the user to
-//! read and submit — a job array of N shards of the command (`--shard $SLURM_ARRAY_TASK_ID/N`,
-//! each writing its partial file) and a combine job that runs once every shard has succeeded
-//! (`sbatch --dependency=afterok`). No scheduler of our own: the script is plain `sbatch`, and
-//! submitting it again redoes only the shards whose partial file is missing.
+//! read and submit (`scatterfit_lab::slurm`: a job array of N shards of the command and a
+//! dependent combine job). This file takes the command's own arguments from the command line,
+//! checks them and the outputs, and writes the script.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
+
+use scatterfit_lab::partial::Kind;
+use scatterfit_lab::slurm::SlurmJob;
 
 use crate::output::{errln, outln};
 
@@ -81,18 +83,6 @@ const OWN_WITH_VALUE: [&str; 6] = [
     "--sbatch-option",
 ];
 const OWN_SWITCHES: [&str; 1] = ["--force-script"];
-
-/// `s` quoted for a POSIX shell.
-fn quote(s: &str) -> String {
-    if !s.is_empty()
-        && s.bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b"-_./=:,+@%".contains(&b))
-    {
-        s.to_owned()
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
-}
 
 /// The command's own tokens (after `slurm <kind>`) without `slurm`'s flags and without the flags
 /// in `strip` (with their values), and the last value of each flag in `take`.
@@ -172,7 +162,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )?;
             let spec = crate::table::spec_for_shards(args, slurm.array)?;
             (
-                crate::shard::Kind::Table,
+                Kind::Table,
                 slurm,
                 &args.shard,
                 args.shard.partial_dir.clone(),
@@ -181,7 +171,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )
         }
         What::Batch { slurm, args } => (
-            crate::shard::Kind::Batch,
+            Kind::Batch,
             slurm,
             &args.shard,
             args.shard.partial_dir.clone(),
@@ -190,7 +180,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ),
         // The shards need -o (their samples go there): it stays in their command line too.
         What::Study { slurm, args } => (
-            crate::shard::Kind::Study,
+            Kind::Study,
             slurm,
             &args.shard,
             args.shard.partial_dir.clone(),
@@ -227,119 +217,24 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let output = study_out.or_else(|| last(&taken, &output_flags).map(str::to_owned));
     let cache_dir = last(&taken, &["--cache-dir"]).map(str::to_owned);
     let cwd = std::env::current_dir().context("the current folder")?;
-    let abs = |p: &Path| {
-        if p.is_absolute() {
-            p.to_path_buf()
-        } else {
-            cwd.join(p)
-        }
+    let abs = |p: &Path| cwd.join(p);
+    let job = SlurmJob {
+        command: kind,
+        args: kept,
+        array: slurm.array,
+        cpus_per_task: slurm.cpus_per_task,
+        time: slurm.time.clone(),
+        partition: slurm.partition.clone(),
+        sbatch_options: slurm.sbatch_option.clone(),
+        exe: std::env::current_exe().context("finding the scatterfit binary")?,
+        partial_dir: abs(&partial_dir),
+        cache_dir: crate::common::cache_dir(cache_dir.as_deref().map(Path::new)).map(|c| abs(&c)),
+        output,
+        fingerprint,
+        script: slurm.script.clone(),
+        cwd,
     };
-    let exe = std::env::current_exe().context("finding the scatterfit binary")?;
-    let partial_abs = abs(&partial_dir);
-    let logs = partial_abs.join("logs");
-    let n = slurm.array;
-    let name = kind.name();
-    let mut header = String::new();
-    header.push_str(&format!(
-        "#SBATCH --chdir={}\n",
-        quote(&cwd.to_string_lossy())
-    ));
-    if let Some(t) = &slurm.time {
-        header.push_str(&format!("#SBATCH --time={}\n", quote(t)));
-    }
-    if let Some(p) = &slurm.partition {
-        header.push_str(&format!("#SBATCH --partition={}\n", quote(p)));
-    }
-    for o in &slurm.sbatch_option {
-        header.push_str(&format!("#SBATCH {o}\n"));
-    }
-    let mut env = String::from("export RAYON_NUM_THREADS=\"${SLURM_CPUS_PER_TASK:-1}\"\n");
-    let cache = crate::common::cache_dir(cache_dir.as_deref().map(Path::new));
-    if let Some(c) = &cache {
-        env.push_str(&format!(
-            "export SCATTERFIT_CACHE={}\n",
-            quote(&abs(c).to_string_lossy())
-        ));
-    }
-    let exe_q = quote(&exe.to_string_lossy());
-    let cmd: Vec<String> = kept.iter().map(|t| quote(t)).collect();
-    let pattern = format!(
-        "{}/{name}-{}-*-of-{n:04}.json",
-        quote(&partial_abs.to_string_lossy()),
-        fingerprint.as_deref().unwrap_or("*")
-    );
-    let mut combine = format!("{exe_q} combine {pattern}");
-    if let Some(o) = &output {
-        combine.push_str(&format!(" -o {}", quote(o)));
-    } else {
-        combine.push_str(" -o .");
-    }
-    let script = format!(
-        r#"#!/bin/bash
-# Written by `scatterfit slurm` (scatterfit {version}). Read it, then submit it from any login node:
-#
-#     bash {script}
-#
-# It submits two jobs:
-#   1. a job array of {n} tasks: task K runs shard K/{n} of
-#          scatterfit {name} {shown}
-#      and writes its partial file into {partials}
-#   2. a combine job, held until every task has succeeded (--dependency=afterok):
-#          scatterfit combine … {out_shown}
-#      — the same result as the command on one machine ({same}).
-# Submitting it again (a task failed, a node died) redoes only the shards whose partial file is
-# missing: a task whose partial file is there and matches returns at once.
-# Everything below must be on a file system every node sees: the binary, {cwd}, the partial
-# files and logs ({partials}){cache_note}.
-set -euo pipefail
-mkdir -p {logs}
-
-array=$(sbatch --parsable <<'SCATTERFIT_ARRAY'
-#!/bin/bash
-#SBATCH --job-name=scatterfit-{name}
-#SBATCH --array=1-{n}
-#SBATCH --cpus-per-task={cpus}
-#SBATCH --output={logs_q}/{name}-%A-%a.out
-{header}{env}exec {exe_q} {name} {cmd} --shard "${{SLURM_ARRAY_TASK_ID}}/{n}"
-SCATTERFIT_ARRAY
-)
-array=${{array%%;*}}
-
-combine=$(sbatch --parsable --dependency=afterok:"$array" <<'SCATTERFIT_COMBINE'
-#!/bin/bash
-#SBATCH --job-name=scatterfit-{name}-combine
-#SBATCH --cpus-per-task=1
-#SBATCH --output={logs_q}/{name}-combine-%j.out
-{header}{env}exec {combine}
-SCATTERFIT_COMBINE
-)
-combine=${{combine%%;*}}
-
-echo "submitted: job array $array ({n} shards of scatterfit {name}), combine job $combine after it"
-echo "logs: {logs}; squeue -j $array,$combine shows them"
-"#,
-        version = env!("CARGO_PKG_VERSION"),
-        script = quote(&slurm.script.to_string_lossy()),
-        shown = cmd.join(" "),
-        partials = partial_abs.display(),
-        out_shown = output
-            .as_deref()
-            .map_or(String::from("-o ."), |o| format!("-o {}", quote(o))),
-        same = match kind {
-            crate::shard::Kind::Table => "byte for byte",
-            crate::shard::Kind::Batch => "the same summary.csv, summary.md and index.html",
-            crate::shard::Kind::Study => "the same rows in study.csv and study.md",
-        },
-        cwd = cwd.display(),
-        cache_note = cache.as_deref().map_or(String::new(), |c| format!(
-            ", and the table cache ({})",
-            abs(c).display()
-        )),
-        logs = quote(&logs.to_string_lossy()),
-        logs_q = quote(&logs.to_string_lossy()),
-        cpus = slurm.cpus_per_task,
-        cmd = cmd.join(" "),
-    );
+    let (n, name, script) = (job.array, kind.name(), job.script());
     scatterfit_io::atomic::write_atomic(&slurm.script, script.as_bytes())
         .with_context(|| format!("--script {}", slurm.script.display()))?;
     errln!(
@@ -356,10 +251,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn quoting_and_splitting() {
-        assert_eq!(quote("a b"), "'a b'");
-        assert_eq!(quote("it's"), r"'it'\''s'");
-        assert_eq!(quote("--eta=1.3"), "--eta=1.3");
+    fn splitting() {
         let t: Vec<String> = [
             "--eta",
             "1.3",

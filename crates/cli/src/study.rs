@@ -19,14 +19,12 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use rayon::prelude::*;
-use scatterfit_lab::study::{
-    Row, StudySample, combos, g_given_combo, has_g_axis, samples, study_sample,
-};
+use scatterfit_lab::study::StudySample;
+use scatterfit_lab::study_run::{StudyConfig, StudyPart, fit_plan, fit_samples};
 
 use crate::common::{JobsArgs, PhotonScaleArgs, cache_dir};
 use crate::output::errln;
-use crate::twin::{Material, synthesize_on, write_sample};
+use crate::twin::{synthesize_on, write_sample};
 
 /// Arguments of `scatterfit study`.
 #[derive(Debug, clap::Args)]
@@ -87,41 +85,23 @@ pub struct Args {
 
 const MARKER: &str = ".scatterfit-study";
 
-fn check_args(args: &Args) -> anyhow::Result<()> {
-    if args.etas.is_empty() || args.albedos.is_empty() || args.g.is_empty() {
-        bail!("give at least one η, one α′ and one g");
+/// The study's settings from the flags.
+fn config(args: &Args) -> StudyConfig {
+    StudyConfig {
+        etas: args.etas.clone(),
+        albedos: args.albedos.clone(),
+        sigma_t_prime: args.sigma_t_prime,
+        quick: args.quick,
+        g: args.g.clone(),
+        seed: args.seed,
+        photon_scale: args.photons.photon_scale,
+        no_pbd: args.no_pbd,
     }
-    if let Some(e) = args.etas.iter().find(|e| !(1.0..=2.5).contains(*e)) {
-        bail!(
-            "--etas: {} is outside [1, 2.5], the range of the Monte Carlo tables",
-            crate::numeric::show(*e)
-        );
-    }
-    if let Some(a) = args.albedos.iter().find(|a| !(0.3..=0.9999).contains(*a)) {
-        bail!(
-            "--albedos: {} is outside [0.3, 0.9999]",
-            crate::numeric::show(*a)
-        );
-    }
-    let g_max = scatterfit_io::manifest::G_RANGE_MAX;
-    if let Some(g) = args.g.iter().find(|g| !(0.0..=g_max).contains(*g)) {
-        bail!(
-            "--g: {} is outside [0, {g_max}] (the range a g may be stated in)",
-            crate::numeric::show(*g)
-        );
-    }
-    if let Some(k) = (1..args.g.len()).find(|&k| args.g[..k].contains(&args.g[k])) {
-        bail!(
-            "--g: {} is given twice; give each g once",
-            crate::numeric::show(args.g[k])
-        );
-    }
-    if !(0.2..=20.0).contains(&args.sigma_t_prime) {
-        bail!(
-            "--sigma-t-prime {}: must lie in [0.2, 20] mm⁻¹",
-            crate::numeric::show(args.sigma_t_prime)
-        );
-    }
+}
+
+/// Checks the grid ([`StudyConfig::check`]) and that the output folder is the study's own.
+fn check_args(args: &Args, config: &StudyConfig) -> anyhow::Result<()> {
+    config.check()?;
     let dir = &args.output_dir;
     if dir.exists()
         && !args.force
@@ -140,7 +120,8 @@ fn check_args(args: &Args) -> anyhow::Result<()> {
 
 /// Runs `scatterfit study`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    check_args(&args)?;
+    let config = config(&args);
+    check_args(&args, &config)?;
     let t0 = Instant::now();
     let out = &args.output_dir;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -150,24 +131,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )?;
     let quiet = args.quiet || args.json;
     let cache = cache_dir(args.cache_dir.as_deref());
-    // Samples: three albedos per η each (the last triple padded with its last albedo).
-    let g_axis = has_g_axis(&args.g);
-    let all: Vec<StudySample> = samples(out, &args.etas, &args.albedos, &args.g);
-    let config = crate::study_set::StudyConfig {
-        etas: args.etas.clone(),
-        albedos: args.albedos.clone(),
-        sigma_t_prime: args.sigma_t_prime,
-        quick: args.quick,
-        g: args.g.clone(),
-        seed: args.seed,
-        photon_scale: args.photons.photon_scale,
-        no_pbd: args.no_pbd,
-    };
+    let g_axis = config.g_axis();
+    let all: Vec<StudySample> = config.samples(out);
     // With --shard, every Nth sample (round-robin over the grid's samples).
     let job = match args.shard.get()? {
         Some((shard, dir)) => {
             let job = crate::shard::Job::new(dir, crate::shard::Kind::Study, shard, &config);
-            if job.done::<crate::study_set::StudyPart>(args.force, |_| true)? {
+            if job.done::<StudyPart>(args.force, |_| true)? {
                 if !quiet {
                     errln!(
                         "shard {shard}: {} is there and matches; nothing to do",
@@ -204,35 +174,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
     }
     for sample in &samples {
-        let m = Material {
-            name: sample.name(),
-            sigma_s_prime: sample.sigma_s_prime(args.sigma_t_prime),
-            sigma_a: sample.sigma_a(args.sigma_t_prime),
-            eta: sample.eta,
-        };
-        let mut rig = if args.quick {
-            scatterfit_synth::RigSpec::quick()
-        } else {
-            scatterfit_synth::RigSpec::paper()
-        };
-        rig.g = sample.twin_g();
-        let rig = args.photons.apply(rig)?;
+        let (m, rig) = config.twin(sample)?;
         let s = synthesize_on(&m, &rig, args.seed, cache.as_deref(), quiet)?;
         write_sample(&sample.dir, &s)?;
     }
     let synth_s = t0.elapsed().as_secs_f64();
-    let assuming_g_0 = combos(args.no_pbd);
-    let mut combos = assuming_g_0.clone();
-    if g_axis {
-        combos.push(g_given_combo());
-    }
+    let combos = config.combos();
     // As many samples at once as `-j` asks and the memory budget allows (as `batch`).
-    let plan = scatterfit_pipeline::batch::BatchRequest::new(
-        samples.iter().map(|s| s.dir.clone()),
-        scatterfit_pipeline::Overrides::default(),
-    )
-    .jobs(args.jobs.count())
-    .plan();
+    let plan = fit_plan(&samples, args.jobs.count());
     if plan.reduced() && !quiet {
         errln!(
             "note: fitting {} sample(s) at a time instead of {}: that many would need about {} of \
@@ -244,24 +193,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             scatterfit_io::budget::MEMORY_BUDGET_ENV
         );
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.jobs)
-        .build()?;
     let bar = crate::common::bar(
         samples.len() as u64,
         "fitting {bar:30} {pos}/{len} samples {elapsed}",
         quiet,
     );
-    let results: Vec<anyhow::Result<Vec<Row>>> = pool.install(|| {
-        samples
-            .par_iter()
-            .map(|sample| {
-                let r = study_sample(sample, &combos).map_err(anyhow::Error::from);
-                bar.inc(1);
-                r
-            })
-            .collect()
-    });
+    let results = fit_samples(&samples, &combos, plan.jobs, &|| bar.inc(1))?;
     bar.finish_and_clear();
     let mut rows = Vec::new();
     let mut failed = Vec::new();
@@ -271,19 +208,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             Err(e) => failed.push(format!(
                 "{}: {}",
                 dir.display(),
-                crate::common::error_text(&e)
+                crate::common::error_text(&e.into())
             )),
         }
     }
-    let synth_s_total = synth_s;
     if let Some((shard, job)) = job {
         let n = samples.len();
-        job.write(crate::study_set::StudyPart {
-            rows: rows.clone(),
-            failed: failed.clone(),
-            synth_s,
-            fit_s: t0.elapsed().as_secs_f64() - synth_s,
-        })?;
+        job.write(
+            StudyPart {
+                rows: rows.clone(),
+                failed: failed.clone(),
+                synth_s,
+                fit_s: t0.elapsed().as_secs_f64() - synth_s,
+            },
+            std::env::args().collect(),
+        )?;
         if !quiet {
             errln!(
                 "shard {shard}: {n} sample(s), {} failed; {} (the tables and the figure: \
@@ -301,8 +240,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &config,
         rows,
         &failed,
-        synth_s_total,
-        t0.elapsed().as_secs_f64() - synth_s_total,
+        synth_s,
+        t0.elapsed().as_secs_f64() - synth_s,
         args.json,
     )
 }

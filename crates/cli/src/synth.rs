@@ -5,9 +5,9 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use scatterfit_io::sample_folder::file_names;
-use scatterfit_optics::materials;
+use scatterfit_lab::twin_settings::{MaterialSettings, RigSettings};
 use scatterfit_synth::RigSpec;
 use serde::Serialize;
 
@@ -46,10 +46,10 @@ pub struct Args {
     /// The forward model written into the manifest's `[fit]` (how `measure` will fit this sample;
     /// the sample itself is always made by Monte Carlo).
     #[arg(long, value_enum)]
-    pub model: Option<crate::common::ModelArg>,
+    pub model: Option<scatterfit_optics::ModelName>,
     /// The albedo model written into the manifest's `[fit]`.
     #[arg(long, value_enum)]
-    pub albedo_model: Option<crate::common::AlbedoModelArg>,
+    pub albedo_model: Option<scatterfit_optics::AlbedoModel>,
     /// A small fast sample (256 × 256 px at 0.1 mm/px, a tenth of the photons) for trying the tool
     /// and for tests; not for accuracy studies.
     #[arg(long)]
@@ -116,50 +116,14 @@ pub struct Args {
 }
 
 fn material_from(args: &Args) -> anyhow::Result<Material> {
-    let m = match (&args.material, args.sigma_s_prime, args.sigma_a) {
-        (Some(name), _, _) => {
-            let m = materials::by_name(name).with_context(|| {
-                let names: Vec<&str> = materials::all().map(|m| m.name).collect();
-                format!(
-                    "--material {name}: unknown; built-in materials: {}",
-                    names.join(", ")
-                )
-            })?;
-            Material {
-                name: m.name.into(),
-                sigma_s_prime: m.sigma_s_prime,
-                sigma_a: m.sigma_a,
-                eta: args.eta.unwrap_or(m.eta),
-            }
-        }
-        (None, Some(sp), Some(sa)) => Material {
-            name: "synthetic".into(),
-            sigma_s_prime: sp,
-            sigma_a: sa,
-            eta: args.eta.context("--eta is required with --sigma-s-prime")?,
-        },
-        _ => bail!(
-            "say what to synthesise: --material NAME, or --sigma-s-prime R,G,B --sigma-a R,G,B --eta X"
-        ),
+    let settings = MaterialSettings {
+        material: args.material.clone(),
+        sigma_s_prime: args.sigma_s_prime,
+        sigma_a: args.sigma_a,
+        eta: args.eta,
+        name: args.name.clone(),
     };
-    for (what, v) in [
-        ("--sigma-s-prime", m.sigma_s_prime),
-        ("--sigma-a", m.sigma_a),
-    ] {
-        if let Some(x) = v.iter().find(|x| !(**x > 0.0 && **x <= 100.0)) {
-            bail!(
-                "{what}: {} is outside (0, 100] mm⁻¹",
-                crate::numeric::show(*x)
-            );
-        }
-    }
-    if !(1.0..=3.0).contains(&m.eta) {
-        bail!("--eta {}: the rig twin takes η in [1, 3]", m.eta);
-    }
-    Ok(Material {
-        name: args.name.clone().unwrap_or(m.name),
-        ..m
-    })
+    Ok(settings.material()?)
 }
 
 /// The camera names `--camera` takes.
@@ -176,58 +140,21 @@ fn parse_camera(s: &str) -> Result<String, String> {
 
 /// The rig the flags describe.
 fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
-    let mut rig = if args.quick {
-        RigSpec::quick()
-    } else {
-        RigSpec::paper()
+    let settings = RigSettings {
+        quick: args.quick,
+        g: args.g,
+        photon_scale: args.photons.photon_scale,
+        camera: Some(args.camera.clone()),
+        read_noise: args.read_noise,
+        effects: scatterfit_synth::rig::RigEffects {
+            glare: args.glare,
+            vignetting: args.vignetting,
+            exposure_error: args.exposure_error,
+            gaussian_spot: args.gaussian_spot,
+            spot_image: args.spot_image,
+        },
     };
-    let g_max = scatterfit_io::manifest::G_RANGE_MAX;
-    crate::numeric::ensure(
-        (0.0..=g_max).contains(&args.g),
-        "--g",
-        args.g,
-        &format!("the twin's Henyey–Greenstein g must lie in [0, {g_max}]"),
-    )?;
-    rig.g = args.g;
-    let mut rig = args.photons.apply(rig)?;
-    rig.camera = scatterfit_synth::CameraModel::named(&args.camera)
-        .with_context(|| format!("--camera {}: unknown", args.camera))?;
-    if let Some(e) = args.read_noise {
-        crate::numeric::ensure(
-            (0.0..=1000.0).contains(&e),
-            "--read-noise",
-            e,
-            "0 to 1000 electrons",
-        )?;
-        rig.camera.read_noise_e = e;
-    }
-    rig.effects = scatterfit_synth::rig::RigEffects {
-        glare: args.glare,
-        vignetting: args.vignetting,
-        exposure_error: args.exposure_error,
-        gaussian_spot: args.gaussian_spot,
-        spot_image: args.spot_image,
-    };
-    rig.validate()
-        .map_err(|e| anyhow::anyhow!("{e} (check --glare, --vignetting, --exposure-error)"))?;
-    Ok(rig)
-}
-
-/// The port the flags describe (`None`: a loss-free reading).
-fn port_from(args: &Args) -> anyhow::Result<Option<scatterfit_optics::port::Port>> {
-    let Some(aperture) = args.aperture_mm else {
-        return Ok(None);
-    };
-    let lit = args.illuminated_mm.unwrap_or(aperture);
-    for (flag, v) in [("--aperture-mm", aperture), ("--illuminated-mm", lit)] {
-        crate::numeric::ensure(
-            (1.0..=100.0).contains(&v),
-            flag,
-            v,
-            "a port diameter in millimetres, 1 to 100",
-        )?;
-    }
-    Ok(Some(scatterfit_optics::port::Port::new(lit, aperture)?))
+    Ok(settings.rig()?)
 }
 
 #[derive(Serialize)]
@@ -241,7 +168,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let m = material_from(&args)?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
     let rig = rig_from(&args)?;
-    let port = port_from(&args)?;
+    let port = scatterfit_lab::twin_settings::port(args.aperture_mm, args.illuminated_mm)?;
     let mut names = file_names(rig.times_s.len(), true);
     if args.camera == "dng" {
         for n in &mut names {
@@ -281,8 +208,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &args.output_dir,
         &sample,
         scatterfit_io::manifest::FitSection {
-            model: args.model.map(Into::into),
-            albedo_model: args.albedo_model.map(Into::into),
+            model: args.model,
+            albedo_model: args.albedo_model,
             ..Default::default()
         },
     )?;

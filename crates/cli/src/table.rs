@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use crate::output::{errln, out};
 use anyhow::{Context, bail};
 use scatterfit_mc::{McTableSpec, TableSummary};
+use scatterfit_pipeline::monte_carlo::TableSettings;
 
 /// Arguments of `scatterfit table`. Every number is checked before any work (exit 2 when out of
 /// range); the build's expected work and memory are checked against `--max-interactions` and
@@ -63,93 +64,27 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Most albedo nodes of a table: far more than interpolation needs.
-const MAX_ALBEDOS: usize = 1000;
-
-/// Albedo nodes and full-length photons of a table built with other settings than the shipped
-/// g = 0 ones (`McTableSpec::new`'s layout).
-const DEFAULT_ALBEDOS: usize = 64;
-const DEFAULT_PHOTONS: u64 = 2_000_000;
-
 /// The spec of a table split into `shards` shards (`scatterfit slurm table`), checked as
 /// `scatterfit table --shard K/N` checks it.
 ///
 /// # Errors
-/// As [`spec_from`].
+/// As [`TableSettings::spec`].
 pub fn spec_for_shards(args: &Args, shards: u64) -> anyhow::Result<McTableSpec> {
-    spec_with(args, shards)
-}
-
-/// Checks the flags' ranges, then the spec's expected work and memory, before anything is built.
-fn spec_from(args: &Args) -> anyhow::Result<McTableSpec> {
-    spec_with(args, args.shard.shard.map_or(1, |s| s.count()))
-}
-
-/// [`spec_from`] with the work split into `shards` shards (the work budget is per shard).
-fn spec_with(args: &Args, shards: u64) -> anyhow::Result<McTableSpec> {
-    if !(args.eta >= 1.0 && args.eta <= 10.0) {
-        bail!(
-            "--eta {}: the relative refractive index must lie in [1, 10]",
-            crate::numeric::show(args.eta)
-        );
-    }
-    if !(args.g > -1.0 && args.g < 1.0) {
-        bail!(
-            "--g {}: the Henyey–Greenstein asymmetry must lie in (−1, 1)",
-            crate::numeric::show(args.g)
-        );
-    }
-    if !args.coarse {
-        if let Some(n) = args.albedos
-            && !(4..=MAX_ALBEDOS).contains(&n)
-        {
-            bail!("--albedos {n}: a table has 4 to {MAX_ALBEDOS} albedos");
-        }
-        if args.photons == Some(0) {
-            bail!("--photons 0: trace at least one photon");
-        }
-    }
-    let spec = if args.coarse {
-        McTableSpec::coarse(args.eta, args.g)
-    } else if args.g == 0.0 && args.albedos.is_none() && args.photons.is_none() {
-        McTableSpec::shipped(args.eta)
-    } else {
-        McTableSpec::new(args.eta, args.g, args.photons.unwrap_or(DEFAULT_PHOTONS)).map(|mut s| {
-            s.albedo_count = args.albedos.unwrap_or(DEFAULT_ALBEDOS);
-            s
-        })
-    }
-    .context("bad table parameters")?;
-    let mut cost = spec.cost_estimate()?;
-    // A shard does its share of the work.
-    cost.interactions /= shards as f64;
-    // The table itself beside the tallies: coefficients and raw profiles, and the JSON text.
-    let table_bytes = (spec.albedo_count as u64) * (spec.radial_bins as u64 + 64) * 8 * 6;
-    crate::numeric::check_memory(
-        "the table",
-        cost.memory_bytes + table_bytes,
-        args.memory.budget(),
-    )?;
-    if cost.interactions > args.work.max_interactions as f64 {
-        bail!(
-            "building this table is expected to take about {:.1e} interactions ({} photons, \
-             {:.3e} per photon on average; η and g lengthen the walks), about {} on {} threads, \
-             more than the work budget of {:.1e} (--max-interactions); use fewer photons, or raise \
-             --max-interactions",
-            cost.interactions,
-            spec.photons.iter().sum::<u64>(),
-            cost.interactions_per_photon,
-            crate::numeric::describe_seconds(cost.seconds(rayon::current_num_threads())),
-            rayon::current_num_threads(),
-            args.work.max_interactions as f64,
-        );
-    }
-    Ok(spec)
+    let settings = TableSettings {
+        eta: args.eta,
+        g: args.g,
+        albedos: args.albedos,
+        photons: args.photons,
+        coarse: args.coarse,
+        max_interactions: args.work.max_interactions,
+        memory_budget: args.memory.budget(),
+    };
+    Ok(settings.spec(shards, rayon::current_num_threads())?)
 }
 
 /// Runs `scatterfit table`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let spec = spec_from(&args)?;
+    let spec = spec_for_shards(&args, args.shard.shard.map_or(1, |s| s.count()))?;
     if let Some((shard, dir)) = args.shard.get()? {
         return run_shard(&args, &spec, shard, dir);
     }
@@ -244,7 +179,7 @@ fn run_shard(
     })?;
     bar.finish_and_clear();
     let photons = white.shard_photons(shard);
-    job.write(&part)?;
+    job.write(&part, std::env::args().collect())?;
     if !args.quiet {
         errln!(
             "shard {shard}: {photons} of {} photons in {:.1} s; {}",

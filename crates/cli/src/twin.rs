@@ -2,26 +2,14 @@
 //! a sample folder.
 
 use std::path::Path;
-use std::sync::Mutex;
 
-use anyhow::Context;
 use scatterfit_lab::twin::{TwinFolder, synth_provenance, write_twin_folder};
+use scatterfit_lab::twin_settings::synthesize_material;
 use scatterfit_synth::{RigSpec, SyntheticSample};
 
 use crate::common::bar;
 
-/// What a material to synthesise is.
-#[derive(Debug, Clone)]
-pub struct Material {
-    /// Name.
-    pub name: String,
-    /// σ′s per channel.
-    pub sigma_s_prime: [f64; 3],
-    /// σa per channel.
-    pub sigma_a: [f64; 3],
-    /// η.
-    pub eta: f64,
-}
+pub use scatterfit_lab::twin_settings::Material;
 
 /// Synthesises `m` on the paper's rig (or the quick one), with a progress bar.
 pub fn synthesize(
@@ -48,32 +36,16 @@ pub fn synthesize_on(
     quiet: bool,
 ) -> anyhow::Result<SyntheticSample> {
     let bar = bar(
-        3,
+        300,
         &format!("{} {{msg}} {{bar:30}} {{percent}}% {{elapsed}}", m.name),
         quiet,
     );
-    let done = Mutex::new([0.0f64; 3]);
     let status = crate::common::StatusLines::new(quiet);
-    let sample = scatterfit_synth::synthesize(
-        &m.name,
-        m.sigma_s_prime,
-        m.sigma_a,
-        m.eta,
-        rig,
-        seed,
-        cache,
-        &|c, d, t| {
-            if let Ok(mut f) = done.lock() {
-                f[c] = d as f64 / t.max(1) as f64;
-                bar.set_length(300);
-                bar.set_position((100.0 * f.iter().sum::<f64>()) as u64);
-                bar.set_message("Monte Carlo");
-                let percent = 100.0 * f.iter().sum::<f64>() / 3.0;
-                status.update(|| format!("{}: Monte Carlo {percent:.0} %", m.name));
-            }
-        },
-    )
-    .with_context(|| format!("synthesising {}", m.name))?;
+    bar.set_message("Monte Carlo");
+    let sample = synthesize_material(m, rig, seed, cache, &|done| {
+        bar.set_position((300.0 * done) as u64);
+        status.update(|| format!("{}: Monte Carlo {:.0} %", m.name, 100.0 * done));
+    })?;
     bar.finish_and_clear();
     Ok(sample)
 }

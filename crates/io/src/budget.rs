@@ -44,6 +44,41 @@ pub fn memory_budget_bytes() -> u64 {
         .saturating_mul(1 << 20)
 }
 
+/// Bytes that something sized by the user's flags or inputs would need, above the budget: the
+/// refusal names what needs them and how to raise the budget.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{what} needs {} of memory, more than the budget of {}; use fewer, or raise the budget with \
+     --max-memory-mib (or {MEMORY_BUDGET_ENV}; default {} MiB, half of this machine's memory) if \
+     this machine has the memory",
+    describe_bytes(*needed),
+    describe_bytes(*budget),
+    default_memory_budget_mib()
+)]
+pub struct OverBudget {
+    /// What needs the memory, e.g. `the table` or `tallying 200 radial and 0 angular bins`.
+    pub what: String,
+    /// Bytes needed.
+    pub needed: u64,
+    /// The budget \[bytes\].
+    pub budget: u64,
+}
+
+/// Refuses `needed` bytes above `budget` ([`OverBudget`]), saying what needs them.
+///
+/// # Errors
+/// The refusal.
+pub fn check_memory(what: &str, needed: u64, budget: u64) -> Result<(), OverBudget> {
+    if needed > budget {
+        return Err(OverBudget {
+            what: what.to_owned(),
+            needed,
+            budget,
+        });
+    }
+    Ok(())
+}
+
 /// A byte count for messages: `512 MiB`, `3.2 GiB`, `1.5 TiB`.
 pub fn describe_bytes(bytes: u64) -> String {
     const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
@@ -91,6 +126,19 @@ pub fn how_to_raise() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refusal_names_what_needs_the_memory_and_both_sizes() {
+        assert_eq!(check_memory("the table", 1 << 20, 1 << 20), Ok(()));
+        let e = check_memory("the table", 3 << 30, 512 << 20).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.starts_with("the table needs 3.0 GiB of memory, more than the budget of 512 MiB;"),
+            "{text}"
+        );
+        assert!(text.contains("--max-memory-mib"), "{text}");
+        assert!(text.contains(MEMORY_BUDGET_ENV), "{text}");
+    }
 
     #[test]
     fn bytes_are_described_in_binary_units() {

@@ -14,17 +14,35 @@ use crate::error::OpticsError;
 /// The forward model of the radial profile Rd(r).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ModelName {
     /// The classical dipole, Jensen et al. 2001 (the paper's model): `dipole`.
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "The classical dipole, Jensen et al. 2001 (the paper's; approximate)")
+    )]
     Dipole,
     /// d'Eon 2012, "A better dipole": `better-dipole`.
+    #[cfg_attr(feature = "clap", value(help = "d'Eon 2012, \"A better dipole\""))]
     BetterDipole,
     /// Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it: `pbd`.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Photon beam diffusion, Habel et al. 2013, as pbrt-v4 evaluates it (slow: ~2 ms per evaluation)"
+        )
+    )]
     Pbd,
     /// Monte Carlo profile tables (exact transport): `mc`, the default — the diffusion models'
     /// bias reaches tens of percent at low α′ and high η (BENCHMARKS.md, "the bias study"), the
     /// tables' is within their noise, at the same cost per fit.
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Monte Carlo tables shipped with scatterfit (exact transport; the default). Henyey–Greenstein g 0–0.95 with --g or `[fit] g`; η 1.0–2.5; α′ up to 0.9999, and from 0.2 at g ≠ 0"
+        )
+    )]
     Mc,
 }
 
@@ -46,11 +64,22 @@ impl ModelName {
 /// How the reduced albedo α′ comes from the spectrophotometer's total diffuse reflectance Rd.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum AlbedoModel {
     /// The diffusion model's own total Rd(α′, η) inverted (the dipole's closed form for the paper,
     /// Choi et al. 2014 eq. 1, and for the `mc` profile model): `diffusion`.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "The diffusion model's own total Rd(α′, η) inverted (the dipole's closed form: the paper)"
+        )
+    )]
     Diffusion,
     /// The Monte Carlo tables' total Rd(α′, η) inverted ("by the Monte Carlo method", exactly): `mc`.
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "The Monte Carlo tables' total inverted (exact transport)")
+    )]
     Mc,
 }
 
@@ -78,12 +107,23 @@ impl AlbedoModel {
 /// Which unknowns the fit has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Method {
     /// Choi, Lee & Chin 2014: α′ from the spectrophotometer, unknowns σ′s and the scale k:
     /// `proposed`.
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Choi et al. 2014: α′ from the spectrophotometer, σ′s (and the profile's scale) fitted"
+        )
+    )]
     Proposed,
     /// Jensen et al. 2001: unknowns σ′s, σa and the scale k: `existing`.
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Jensen et al. 2001: σ′s, σa (and the scale) fitted")
+    )]
     Existing,
 }
 

@@ -38,6 +38,7 @@ pub mod request;
 mod rng;
 pub mod scene;
 pub mod scenes;
+pub mod settings;
 pub mod setup;
 pub mod texture_space;
 pub mod tonemap;

@@ -21,13 +21,23 @@ use crate::validation::{MeasuredProfile, ProfileValidation, validate_profile};
 
 /// Which of the paper's rendering methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Methods {
     /// Subsurface colour (§4.1).
+    #[cfg_attr(
+        feature = "clap",
+        value(name = "color", help = "Subsurface colour method (§4.1, eqs. 3–5)")
+    )]
     Colour,
     /// Texture-space dipole (§4.2).
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Texture-space dipole method (§4.2, eq. 6)")
+    )]
     Dipole,
     /// Both, colour first (Figure 5's order).
     #[default]
+    #[cfg_attr(feature = "clap", value(help = "Both, side by side"))]
     Both,
 }
 

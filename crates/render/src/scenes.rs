@@ -9,12 +9,19 @@ use crate::scene::{Camera, Light, Scene};
 
 /// The built-in models.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Shape {
     /// A sphere of radius 10 mm.
+    #[cfg_attr(feature = "clap", value(help = "Sphere, 10 mm radius"))]
     Sphere,
     /// A 30 × 30 × 4 mm slab.
+    #[cfg_attr(feature = "clap", value(help = "30 × 30 × 4 mm slab"))]
     Slab,
     /// The goblet-shaped statue, 40 mm tall, with a bowl wall under 1 mm ([`Mesh::statue`]).
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Goblet-shaped statue 40 mm tall: thick base and stem, bowl wall under 1 mm")
+    )]
     Statue,
 }
 

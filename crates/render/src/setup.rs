@@ -15,6 +15,7 @@ use crate::scenes::{Shape, studio, studio_lights};
 
 /// The lighting of a render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LightRig {
     /// Key light from the upper front left (irradiance 1) and a back light from behind (0.8).
     #[default]
@@ -27,6 +28,12 @@ pub enum LightRig {
     Point,
     /// A collimated spot of 2 mm radius from the key light's direction, aimed at the model's
     /// centre (irradiance 1), like the measurement rig's.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "A collimated spot of 2 mm radius from the key light's direction, aimed at the model's centre (irradiance 1), like the measurement rig's: light spreading under the surface"
+        )
+    )]
     Spot,
 }
 

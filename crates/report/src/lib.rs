@@ -40,6 +40,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod batch_set;
 pub mod error;
 pub mod figures;
 pub mod html;
