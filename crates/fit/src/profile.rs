@@ -271,7 +271,10 @@ pub struct Selected {
     pub invalid: usize,
 }
 
-/// Applies `sel` to `profile`.
+/// Applies `sel` to `profile`: the rings inside r_min, beyond r_max or below the detection limit
+/// are left out; each kept ring's relative error is its own, or for a ring of fewer than
+/// [`THIN_RING_PIXELS`] at least its neighbours' per-pixel scatter over its √n, never below the
+/// floor.
 ///
 /// # Errors
 /// None today (the selection is valid by construction); kept for future checks.
@@ -328,8 +331,9 @@ pub fn select_rings(profile: &ProfileData, sel: &RingSelection) -> Result<Select
     Ok(s)
 }
 
-/// A ring of fewer pixels than this has its error from its neighbours' pixels
-/// ([`thin_rings_from_neighbours`]).
+/// A ring of fewer pixels than this has its error from its neighbours' pixels: at least the
+/// per-pixel relative scatter of the nearest ring with enough pixels over its own √n
+/// ([`select_rings`]).
 pub const THIN_RING_PIXELS: u64 = 8;
 
 /// The relative error of the rings with fewer than [`THIN_RING_PIXELS`] pixels (the frame's

@@ -33,7 +33,7 @@ use crate::spectro::spectro_stage;
 /// # Errors
 /// [`PipelineError`] for bad input (exit 2) or a stage that failed (exit 1, see
 /// [`PipelineError::is_measurement_failure`]). Channels that cannot be fitted are not errors: they
-/// are [`ChannelOutcome::NotFitted`] in the result.
+/// are [`ChannelOutcome::NotFitted`](crate::ChannelOutcome::NotFitted) in the result.
 pub fn measure_sample(
     dir: &Path,
     overrides: &Overrides,
@@ -250,7 +250,7 @@ impl Measurement {
     /// profile are reused): what `compare` needs.
     ///
     /// # Errors
-    /// [`PipelineError::Input`] as [`fit_settings`].
+    /// [`PipelineError::Input`] as [`fit_settings`](crate::fit_settings).
     pub fn refit(&self, method: Method) -> Result<Measurement> {
         let mut settings = self.settings;
         settings.method = method;

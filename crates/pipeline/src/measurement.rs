@@ -15,7 +15,7 @@ use crate::profile::ProfileStage;
 use crate::settings::FitSettings;
 use crate::spectro::SpectroStage;
 
-/// A stage of [`measure_sample`], for progress reports.
+/// A stage of [`measure_sample`](crate::measure_sample), for progress reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Stage {
@@ -77,7 +77,7 @@ pub struct Timings {
     /// The three fits (start search + solver).
     pub fit_s: f64,
     /// The checks of the image and the bracket ([`crate::checks::image_checks`]) and the spot's
-    /// scale against the fits ([`crate::checks::evidence::spot_scale`]).
+    /// scale against the fits ([`crate::checks::spot_scale`]).
     pub checks_s: f64,
     /// The whole measurement.
     pub total_s: f64,

@@ -10,7 +10,7 @@
 //!
 //! **How.** The estimate is recomputed with the g-aware exact model — the `mc` tables over (η, g)
 //! for the profile and for the α′ inversion (`scatterfit_mc::family(ModelName::Mc)` and
-//! `albedo_family(AlbedoModel::Mc, …)` at each g through [`AtG`]) — at every g of the range the
+//! `albedo_family(AlbedoModel::Mc, …)` at each g through [`AtG`](scatterfit_optics::AtG)) — at every g of the range the
 //! tables answer: the tables' g nodes inside the range and the range's ends
 //! ([`GPlan::points`]). Proposed method: α′(g′) from the reading's Rd, then σ′s fitted with it;
 //! existing method: σ′s and σa both fitted at g′. The term is

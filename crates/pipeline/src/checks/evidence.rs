@@ -10,7 +10,7 @@
 //! - **The spot's size in pixels.** The fitted model convolved with the stated spot, at the
 //!   stated scale, predicts the profile inside the spot too, where the fit did not look: its half
 //!   width in pixels is the spot's radius over `mm_per_pixel`, widened by the light's spread in
-//!   the material. The image's half width against it ([`spot_scale`]) measures the scale (or the
+//!   the material. The image's half width against it ([`spot_scale`](super::spot_scale)) measures the scale (or the
 //!   spot's diameter) to a few percent.
 
 use scatterfit_optics::{Channel, Method, ModelFamily, Rgb};
@@ -40,13 +40,13 @@ pub struct AlbedoCheck {
     pub chi2_profile: f64,
 }
 
-/// What the measurement's redundancy gave, kept with it ([`Measurement::evidence`]).
+/// What the measurement's redundancy gave, kept with it ([`Measurement::evidence`](crate::Measurement::evidence)).
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Evidence {
     /// Per channel, the profile's α′ against the reading's (proposed method only; `None` where
     /// either fit is missing).
     pub albedo: Rgb<Option<AlbedoCheck>>,
-    /// The image's spot half width over the fitted model's at the stated scale ([`spot_scale`]),
+    /// The image's spot half width over the fitted model's at the stated scale ([`spot_scale`](super::spot_scale)),
     /// made with the measurement (and its full refits) after the fits; `None` where it could not
     /// be measured, and for a refit of values only.
     pub spot_scale: Option<SpotScale>,
@@ -132,7 +132,7 @@ fn albedo_check(
 }
 
 /// The image's spot half width against the fitted model's at the stated scale: for the channel
-/// sum and for each channel alone ([`spot_scale`]).
+/// sum and for each channel alone ([`spot_scale`](super::spot_scale)).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SpotScale {
     /// The channel sum's ratio (image over model).

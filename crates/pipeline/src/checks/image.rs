@@ -23,8 +23,8 @@ use crate::measurement::Measurement;
 /// The sample's checks: the spot inside the frame with its fitted rings complete (or cut
 /// symmetrically), the measurement's image checks ([`Measurement::image_checks`], made once when
 /// the bracket was merged), and the spot's size in the image against the one the fitted model
-/// predicts at the manifest's scale ([`evidence::spot_scale`], made with the measurement:
-/// [`evidence::Evidence::spot_scale`]).
+/// predicts at the manifest's scale ([`spot_scale`], made with the measurement:
+/// [`Evidence::spot_scale`](super::evidence::Evidence::spot_scale)).
 pub fn sample_checks(m: &Measurement) -> SampleChecks {
     let mut reasons = Vec::new();
     let radiance = &m.hdr.hdr.radiance;
@@ -334,7 +334,7 @@ fn second_spot(m: &Measurement, a_px: f64) -> Option<String> {
 /// ring, equal areas), the channels summed as the image's half width is measured
 /// ([`crate::checks::spot_hwhm_px`]), and each channel alone. About mm_per_pixel(stated) /
 /// mm_per_pixel(true): 0.91 for a scale stated 10 % too large. With an approximate model the
-/// exact fit of the same data ([`crate::model_term::ExactFit`]) predicts the spot instead: a
+/// exact fit of the same data ([`crate::fit::ExactFit`]) predicts the spot instead: a
 /// diffusion model's near field, inside the spot, is its least accurate part (the dipole's spot
 /// on red aluminium is 2.6× too wide). `None` without three fitted channels or a half width.
 pub fn spot_scale(m: &Measurement) -> Option<SpotScale> {

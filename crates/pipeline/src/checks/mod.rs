@@ -91,7 +91,7 @@ pub const MAX_MODEL_CHI2_RATIO: f64 = 3.0;
 pub const MAX_LAB_DELTA_E: f64 = 3.0;
 
 /// The image's spot half width over the one the fitted model predicts at the stated scale and
-/// spot ([`evidence::spot_scale`]) outside this range makes every channel suspect: a scale (or a
+/// spot ([`spot_scale`]) outside this range makes every channel suspect: a scale (or a
 /// spot diameter) 10 % off gives 0.91 or 1.10. The demo's twins give 0.99–1.01, the quick twins
 /// and the camera sweep 0.97–1.03 (RELIABILITY.md, "The evidence behind ok").
 pub const SPOT_FACTOR_RANGE: (f64, f64) = (0.94, 1.06);

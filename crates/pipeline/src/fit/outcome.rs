@@ -29,7 +29,7 @@ pub struct ChannelFit {
     /// What the solver did and reached (rings, residuals, correlations, its own standard errors).
     pub report: FitReport,
     /// σ′s \[mm⁻¹\]: the fit's value with the fit's standard error and, once propagated
-    /// ([`propagate_spectro`]), the spectrophotometer's.
+    /// ([`propagate_spectro`](super::propagate_spectro)), the spectrophotometer's.
     pub sigma_s_prime: Estimate,
     /// σa \[mm⁻¹\], with the same terms.
     pub sigma_a: Estimate,
@@ -130,7 +130,7 @@ impl ChannelOutcome {
     }
 
     /// The same outcome with the spectrophotometer's part of σ′s's and σa's uncertainty
-    /// ([`propagate_spectro`]; `None` leaves it unknown).
+    /// ([`propagate_spectro`](super::propagate_spectro); `None` leaves it unknown).
     #[must_use]
     pub fn with_spectro(mut self, errors: Option<SpectroErrors>) -> Self {
         if let (ChannelOutcome::Fitted(f), Some(e)) = (&mut self, errors) {
