@@ -261,11 +261,21 @@ fn linear_corner_reasons(m: &Measurement) -> Vec<Reason> {
     vec![suspect(
         ReasonKind::AmbientLight,
         format!(
-            "the far corners of {} ({} s, {} channel) read {:+.1} DN off the straight line in              exposure time that the other frames' corners follow ({:.0} standard errors, {:.1}×              what grows with the time there): light reached the sample in some frames and not in              others (room light or daylight switched on or off during the bracket), which also              moves the black level read from the corners — switch off the room light or shade the              sample, and shoot the bracket again",
+            "the far corners of {} ({} s, {} channel) read {:.1} DN {} the straight line in \
+             exposure time that the other frames' corners follow ({:.0} standard errors, {:.1}× \
+             what grows with the time there): light reached the sample in some frames and not in \
+             others (room light or daylight switched on or off during the bracket), which also \
+             moves the black level read from the corners — switch off the room light or shade the \
+             sample, and shoot the bracket again",
             scatterfit_io::escape::one_line(&name),
             short(d.time_s),
             ["R", "G", "B"].get(c).copied().unwrap_or("the"),
-            d.residual_dn,
+            d.residual_dn.abs(),
+            if d.residual_dn < 0.0 {
+                "below"
+            } else {
+                "above"
+            },
             d.z.abs(),
             d.relative.abs(),
         ),
