@@ -280,6 +280,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
         }
         let cell = |col: usize, name: &str| -> Result<f64, SpectroCsvError> {
             let text = record.get(col).unwrap_or("");
+            let parsed = dialect.parse_f64(text);
             let bad = |reason: String| SpectroCsvError::BadValue {
                 path: p(),
                 line,
@@ -287,7 +288,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 value: crate::text::cell_for_message(text),
                 reason,
             };
-            let v: f64 = dialect.parse_f64(text).ok_or_else(|| {
+            let v: f64 = parsed.ok_or_else(|| {
                 bad(format!(
                     "is not a number (columns separated by {}{})",
                     dialect.delimiter_name(),

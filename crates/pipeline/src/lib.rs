@@ -84,4 +84,4 @@ pub use scatterfit_mc::{albedo_family, family};
 /// The vocabulary a program using the pipeline needs: what to fit with, per-channel values, and
 /// a value with its uncertainty terms.
 pub use scatterfit_optics::{AlbedoModel, Channel, Estimate, Method, ModelFamily, ModelName, Rgb};
-pub use settings::{FitSettings, Overrides, SpotShape, fit_settings};
+pub use settings::{FitPlan, FitSettings, Overrides, SpotShape, fit_settings};

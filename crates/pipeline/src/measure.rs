@@ -17,14 +17,14 @@ use crate::checks::evidence::{Evidence, gather};
 use crate::checks::findings::SampleChecks;
 use crate::checks::{image_checks, spot_scale};
 use crate::error::{PipelineError, Result};
-use crate::fit::{fit_and_propagate, fit_stage};
+use crate::fit::{fit_and_propagate, fit_stage, free_fits};
 use crate::hdr::{BlackLevel, HdrInputs, read_and_merge, read_radiance_map};
 use crate::measurement::{Measurement, Stage, Timings};
 use crate::model_term;
 use crate::port::{correct_port, port_of, propagate_fit_through_port};
 use crate::profile::{ProfileSettings, profile_stage_with};
 use crate::samples::{SampleInputs, sample_inputs};
-use crate::settings::{FitSettings, Overrides, SpotShape, families, resolve};
+use crate::settings::{FitPlan, FitSettings, Overrides, fit_plan};
 use crate::spectro::spectro_stage;
 
 /// Measures the sample in folder `dir` (its `sample.toml`): [`sample_inputs`], then
@@ -101,52 +101,14 @@ fn measure_from(
         Ok(())
     };
     let manifest = inputs.manifest.clone();
-    let (settings, (model, albedo)) = resolve(&manifest, overrides)?;
-    let (model, albedo) = (&model, &albedo);
+    let plan = fit_plan(&manifest, overrides)?;
     begin(Stage::Spectro)?;
-    let spectro = spectro_stage(&manifest, overrides.eta, albedo)?;
+    let spectro = spectro_stage(&manifest, overrides.eta, &plan.albedo)?;
     let spectro_s = t0.elapsed().as_secs_f64();
     let hdr = match &manifest.camera.hdr {
         Some(p) => read_radiance_map(&manifest.resolve(p))?,
         None => {
-            let mut inputs = HdrInputs::new(
-                manifest
-                    .camera
-                    .exposures
-                    .as_ref()
-                    .map(|p| manifest.resolve(p)),
-                manifest
-                    .camera
-                    .images
-                    .iter()
-                    .flatten()
-                    .map(|p| manifest.resolve(p))
-                    .collect(),
-            );
-            inputs.response = manifest
-                .camera
-                .response
-                .as_ref()
-                .map(|p| manifest.resolve(p));
-            inputs.dark = manifest.camera.dark.as_ref().map(|p| manifest.resolve(p));
-            // A real camera: black level, shutter times, flat frame.
-            inputs.flat = manifest.camera.flat.as_ref().map(|p| manifest.resolve(p));
-            inputs.exposure_correction = manifest.camera.exposure_correction.unwrap_or_default();
-            if let Some(s) = manifest.camera.saturation {
-                inputs.saturation = s;
-                inputs.saturation_given = true;
-            }
-            inputs.black_level = match manifest.camera.black_level {
-                None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
-                Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
-                Some(BlackLevelSetting::One(v)) => BlackLevel::Given(vec![v]),
-                Some(BlackLevelSetting::PerChannel(v)) => BlackLevel::Given(v.to_vec()),
-            };
-            // Pixels dark in every frame are evidence of radiance below the first code: keep them
-            // as 0 so far rings are not averaged over their brighter pixels only; pixels saturated
-            // everywhere are masked out by the profile stage.
-            inputs.clipped_fill = scatterfit_imaging::ClippedFill::LowerBound;
-            let stage = read_and_merge(&inputs, &|_| progress(Stage::ReadFrame))?;
+            let stage = read_and_merge(&hdr_inputs(&manifest), &|_| progress(Stage::ReadFrame))?;
             begin(Stage::Merge)?;
             stage
         }
@@ -165,16 +127,14 @@ fn measure_from(
         },
         manifest.camera.background.unwrap_or_default(),
     )?;
-    let mut settings = settings;
-    if let Some(p) = &manifest.camera.spot_image {
-        let s = crate::hdr::spot_kernel_from_image(
+    let plan = match &manifest.camera.spot_image {
+        Some(p) => plan.with_spot(crate::hdr::spot_kernel_from_image(
             &manifest.resolve(p),
             &hdr,
             manifest.camera.mm_per_pixel.unwrap_or(f64::NAN),
-        )?;
-        settings.spot = SpotShape::Radial(s);
-        settings.spot_radius_mm = s.radius_enclosing(0.99);
-    }
+        )?)?,
+        None => plan,
+    };
     let profile_s = t_profile.elapsed().as_secs_f64();
     let data = profile.rgb_data()?;
     begin(Stage::Fit)?;
@@ -185,8 +145,8 @@ fn measure_from(
     )?;
     let (spectro, port) = match port {
         Some(p) => {
-            let (mut s, c) = correct_port(&data, &spectro, &settings, model, albedo, p);
-            if let Some([lo, hi]) = settings.g_prior.propagated_range() {
+            let (mut s, c) = correct_port(&data, &spectro, &plan, p);
+            if let Some([lo, hi]) = plan.settings.g_prior.propagated_range() {
                 // The g term refits at each g from the Rd corrected here, at the values' g; the
                 // port's F is not recomputed at each g (BENCHMARKS.md, "The port's
                 // conditioning"): say so rather than let the term look complete.
@@ -195,24 +155,24 @@ fn measure_from(
                      {lo}–{hi}) keeps that corrected Rd, but F itself changes with g (by 2–9 % \
                      between g = 0 and 0.8 at α′ ≥ 0.99 behind an 8 mm port), so with a port the \
                      g term understates; give [fit] g if it is known",
-                    settings.g
+                    plan.settings.g
                 ));
             }
             (s, Some(c))
         }
         None => (spectro, None),
     };
-    let fits = fit_and_propagate(&data, &spectro, &settings, model);
+    let fits = fit_and_propagate(&data, &spectro, &plan);
     let fits = match &port {
-        Some(c) => propagate_fit_through_port(&data, &spectro, &settings, model, albedo, c, fits),
+        Some(c) => propagate_fit_through_port(&data, &spectro, &plan, c, fits),
         None => fits,
     };
     // With an approximate model the evidence comes from exact transport's fits
     // (`Measurement::with_model_term`): the model's own error would confound it.
-    let evidence = if settings.is_approximate() {
+    let evidence = if plan.settings.is_approximate() {
         Evidence::default()
     } else {
-        gather(&data, &spectro, &settings, model, &fits)
+        gather(&spectro, &fits, free_fits(&data, &spectro, &plan).as_ref())
     };
     let timings = Timings {
         spectro_s,
@@ -224,7 +184,7 @@ fn measure_from(
     // An approximate model's error joins the bars (crate::model_term).
     let mut m = Measurement {
         manifest,
-        settings,
+        settings: plan.settings,
         spectro,
         hdr,
         profile,
@@ -243,6 +203,40 @@ fn measure_from(
     m.timings.checks_s = t_checks.elapsed().as_secs_f64();
     m.timings.total_s = t0.elapsed().as_secs_f64();
     Ok(m)
+}
+
+/// The merge's inputs as the manifest's `[camera]` names them.
+fn hdr_inputs(manifest: &scatterfit_io::manifest::SampleManifest) -> HdrInputs {
+    let camera = &manifest.camera;
+    let mut inputs = HdrInputs::new(
+        camera.exposures.as_ref().map(|p| manifest.resolve(p)),
+        camera
+            .images
+            .iter()
+            .flatten()
+            .map(|p| manifest.resolve(p))
+            .collect(),
+    );
+    inputs.response = camera.response.as_ref().map(|p| manifest.resolve(p));
+    inputs.dark = camera.dark.as_ref().map(|p| manifest.resolve(p));
+    // A real camera: black level, shutter times, flat frame.
+    inputs.flat = camera.flat.as_ref().map(|p| manifest.resolve(p));
+    inputs.exposure_correction = camera.exposure_correction.unwrap_or_default();
+    if let Some(s) = camera.saturation {
+        inputs.saturation = s;
+        inputs.saturation_given = true;
+    }
+    inputs.black_level = match camera.black_level {
+        None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
+        Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
+        Some(BlackLevelSetting::One(v)) => BlackLevel::Given(vec![v]),
+        Some(BlackLevelSetting::PerChannel(v)) => BlackLevel::Given(v.to_vec()),
+    };
+    // Pixels dark in every frame are evidence of radiance below the first code: keep them as 0 so
+    // far rings are not averaged over their brighter pixels only; pixels saturated everywhere are
+    // masked out by the profile stage.
+    inputs.clipped_fill = scatterfit_imaging::ClippedFill::LowerBound;
+    inputs
 }
 
 impl Measurement {
@@ -282,8 +276,7 @@ impl Measurement {
     }
 
     fn refit_inner(&self, settings: FitSettings, propagate: bool) -> Result<Measurement> {
-        let (model, albedo) = families(&settings)?;
-        let (model, albedo) = (&model, &albedo);
+        let plan = FitPlan::new(settings)?;
         let t = Instant::now();
         let data = self.profile.rgb_data()?;
         // The port correction depends on the model: start again from the reading.
@@ -292,25 +285,23 @@ impl Measurement {
                 let port = Port::new(p.illuminated_mm, p.aperture_mm).map_err(|e| {
                     PipelineError::Input(format!("the spectrophotometer port: {e}"))
                 })?;
-                let read = p.read.with_albedo_model(albedo);
-                let (s, c) = correct_port(&data, &read, &settings, model, albedo, port);
+                let read = p.read.with_albedo_model(&plan.albedo);
+                let (s, c) = correct_port(&data, &read, &plan, port);
                 (s, Some(c))
             }
-            None => (self.spectro.with_albedo_model(albedo), None),
+            None => (self.spectro.with_albedo_model(&plan.albedo), None),
         };
         let fits = if propagate {
-            let fits = fit_and_propagate(&data, &spectro, &settings, model);
+            let fits = fit_and_propagate(&data, &spectro, &plan);
             match &port {
-                Some(c) => {
-                    propagate_fit_through_port(&data, &spectro, &settings, model, albedo, c, fits)
-                }
+                Some(c) => propagate_fit_through_port(&data, &spectro, &plan, c, fits),
                 None => fits,
             }
         } else {
-            fit_stage(&data, &spectro, &settings, model)
+            fit_stage(&data, &spectro, &plan)
         };
         let evidence = if propagate && !settings.is_approximate() {
-            gather(&data, &spectro, &settings, model, &fits)
+            gather(&spectro, &fits, free_fits(&data, &spectro, &plan).as_ref())
         } else {
             Evidence::default()
         };
@@ -349,9 +340,13 @@ impl Measurement {
         // would read as a disagreement between the profile and the reading).
         if let Ok(x) = &exact
             && let Ok(data) = x.profile.rgb_data()
-            && let Ok((model, _)) = families(&x.settings)
+            && let Ok(plan) = FitPlan::new(x.settings)
         {
-            self.evidence = gather(&data, &x.spectro, &x.settings, &model, &x.fits);
+            self.evidence = gather(
+                &x.spectro,
+                &x.fits,
+                free_fits(&data, &x.spectro, &plan).as_ref(),
+            );
         }
         let exact = exact.as_ref().map(|m| &m.fits).map_err(ToString::to_string);
         model_term::apply(&mut self.fits, exact, self.settings.model);

@@ -7,10 +7,11 @@ use scatterfit_io::result_json::{AlbedoSource, Inputs, MeasurementResult, RunOpt
 use scatterfit_optics::{AlbedoModel, Method, ModelFamily, ModelName, Rgb};
 
 use crate::anisotropy::record::AlbedoAtG;
+use crate::anisotropy::with_g_term;
 use crate::error::Result;
 use crate::fit::outcome::ChannelOutcome;
-use crate::fit::{channel_result, fit_stage, with_g_term};
-use crate::settings::FitSettings;
+use crate::fit::{channel_result, fit_stage};
+use crate::settings::{FitPlan, FitSettings};
 use crate::spectro::SpectroStage;
 
 /// What to fit a given profile with.
@@ -187,16 +188,23 @@ pub fn fit_profile(profile: &Rgb<ProfileData>, request: &ProfileFitRequest) -> R
         g,
         g_prior: request.g_prior,
     };
-    let fits = fit_stage(profile, &spectro, &settings, model);
     let albedo_at_g = if request.rd.is_some() {
         AlbedoAtG::FromRd
     } else {
         AlbedoAtG::Fixed
     };
-    // Options the rings refuse leave every channel not fitted (fit_stage says why): no g term.
-    let mut fits = match settings.options() {
-        Ok(opts) => with_g_term(profile, &spectro, &settings, &opts, fits, albedo_at_g),
-        Err(_) => fits,
+    // Options the rings refuse leave every channel not fitted, saying why: no g term.
+    let mut fits = match FitPlan::new(settings) {
+        Ok(plan) => with_g_term(
+            profile,
+            &spectro,
+            &plan,
+            fit_stage(profile, &spectro, &plan),
+            albedo_at_g,
+        ),
+        Err(e) => Rgb::from_fn(|_| ChannelOutcome::NotFitted {
+            problem: e.to_string(),
+        }),
     };
     // An approximate model's error: the same rings fitted again with exact transport (α′ as
     // given, or inverted from the given Rd through the `mc` total), |approximate − exact| the
@@ -242,8 +250,8 @@ fn exact_fits(
         })
     });
     let spectro = SpectroStage::given(request.eta, rd, albedo);
-    let settings = settings.exact();
-    Ok(fit_stage(profile, &spectro, &settings, &model))
+    let plan = FitPlan::new(settings.exact()).map_err(|e| e.to_string())?;
+    Ok(fit_stage(profile, &spectro, &plan))
 }
 
 /// α′ per channel from the request: as given, inverted from the given Rd through `model` at η

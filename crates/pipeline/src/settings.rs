@@ -173,15 +173,19 @@ impl FitSettings {
 /// [`PipelineError::Input`] for a model that is not available or normalisation with the existing
 /// method.
 pub fn fit_settings(manifest: &SampleManifest, o: &Overrides) -> Result<FitSettings> {
-    resolve(manifest, o).map(|(settings, _)| settings)
+    settings_from(manifest, o)
 }
 
-/// [`fit_settings`] with the profile model and the albedo model they name, both at their g
-/// ([`families`]).
+/// The manifest's and the overrides' [`FitPlan`]: [`fit_settings`] with what they make.
 ///
 /// # Errors
-/// As [`fit_settings`].
-pub(crate) fn resolve(manifest: &SampleManifest, o: &Overrides) -> Result<(FitSettings, Families)> {
+/// As [`fit_settings`], and [`FitPlan::new`]'s.
+pub(crate) fn fit_plan(manifest: &SampleManifest, o: &Overrides) -> Result<FitPlan> {
+    FitPlan::new(settings_from(manifest, o)?)
+}
+
+/// The fit settings of a manifest and a caller's overrides.
+fn settings_from(manifest: &SampleManifest, o: &Overrides) -> Result<FitSettings> {
     let method = o.method.or(manifest.fit.method).unwrap_or_default();
     let model = o.model.or(manifest.fit.model).unwrap_or_default();
     family(model)?;
@@ -225,8 +229,56 @@ pub(crate) fn resolve(manifest: &SampleManifest, o: &Overrides) -> Result<(FitSe
         g: values_g(&g_prior)?,
         g_prior,
     };
-    let models = families(&settings)?;
-    Ok((settings, models))
+    families(&settings)?;
+    Ok(settings)
+}
+
+/// Fit settings resolved for the stages, once: the settings, the options of `scatterfit_fit` they
+/// make ([`FitSettings::options`]) and the profile and albedo models at their g (`scatterfit_mc::family`, `albedo_family`).
+/// Every stage from the port on takes the plan by reference, so none resolves the settings again.
+#[derive(Clone, Copy)]
+pub struct FitPlan {
+    /// What was asked.
+    pub settings: FitSettings,
+    /// The fit's options for [`FitPlan::settings`] (no start: each fit and refit sets its own).
+    pub options: FitOptions,
+    /// The forward model at the settings' g.
+    pub model: AtG<'static>,
+    /// The albedo model (Rd → α′) at the settings' g.
+    pub albedo: AtG<'static>,
+}
+
+impl FitPlan {
+    /// The plan of `settings`.
+    ///
+    /// # Errors
+    /// [`PipelineError::Input`] for a model the tables cannot give at the settings' g, or a spot
+    /// radius or r_min the ring selection refuses.
+    pub fn new(settings: FitSettings) -> Result<Self> {
+        let (model, albedo) = families(&settings)?;
+        Ok(Self {
+            settings,
+            options: settings.options()?,
+            model,
+            albedo,
+        })
+    }
+
+    /// The plan with a radial spot (a measured spot image) of `radius_mm` enclosing 99 % of its
+    /// power in place of the manifest's spot.
+    ///
+    /// # Errors
+    /// As [`FitPlan::new`]: the ring selection refuses the spot's radius.
+    pub fn with_spot(self, spot: scatterfit_fit::RadialSpot) -> Result<Self> {
+        let mut settings = self.settings;
+        settings.spot = SpotShape::Radial(spot);
+        settings.spot_radius_mm = spot.radius_enclosing(0.99);
+        Ok(Self {
+            settings,
+            options: settings.options()?,
+            ..self
+        })
+    }
 }
 
 /// The profile model and the albedo model of a [`FitSettings`], at its g.

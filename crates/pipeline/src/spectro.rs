@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use scatterfit_io::manifest::SampleManifest;
 pub use scatterfit_io::result_json::EtaSource;
 use scatterfit_optics::colour::{Lab, Observer};
-use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, SpectroReading, analyse};
+use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, analyse};
 use scatterfit_optics::{Channel, Estimate, ModelFamily, Rgb};
 use serde::Serialize;
 
@@ -19,7 +19,7 @@ pub struct SpectroStage {
     /// The reading's file, when there is one.
     pub file: Option<PathBuf>,
     /// SHA-256 of the reading file's bytes as [`spectro_stage`] read and parsed them (lower-case
-    /// hex); `None` without a file, or for a reading given in memory ([`from_reading`]).
+    /// hex); `None` without a file, or for a reading analysed in memory ([`from_analysis`]).
     #[serde(skip)]
     pub file_sha256: Option<String>,
     /// The full analysis of the reading (η per wavelength, colour, …), when there is a reading.
@@ -213,6 +213,13 @@ pub fn spectro_stage(
     albedo: &dyn ModelFamily,
 ) -> Result<SpectroStage> {
     let eta = eta.or(manifest.spectro.eta);
+    if let Some(e) = eta
+        && !(e.is_finite() && e >= 1.0)
+    {
+        return Err(PipelineError::Input(format!(
+            "η = {e}: the relative refractive index must be a number ≥ 1"
+        )));
+    }
     let lab = manifest.spectro.lab.map(|[l, a, b]| {
         let observer = match manifest.spectro.lab_observer {
             Some(2) => Observer::TwoDegree,
@@ -228,7 +235,13 @@ pub fn spectro_stage(
         Some(file) => {
             let path = manifest.resolve(file);
             let (reading, read) = scatterfit_io::spectro::read_spectro_file(&path)?;
-            let mut stage = from_reading(&reading, &path, lab, eta, repeatability, albedo)?;
+            let analysis = analyse(&reading, &SpectroOptions { lab, eta }).map_err(|source| {
+                PipelineError::Spectro {
+                    file: path.clone(),
+                    source,
+                }
+            })?;
+            let mut stage = from_analysis(analysis, &path, repeatability, albedo);
             stage.file_sha256 = Some(read.sha256);
             Ok(stage)
         }
@@ -258,39 +271,22 @@ pub fn spectro_stage(
     }
 }
 
-/// The stage from a reading already in memory (`path` names it in messages); `repeatability` is
-/// the reading's relative standard deviation ([`SpectroUncertainty`]).
-///
-/// # Errors
-/// As [`spectro_stage`].
-pub fn from_reading(
-    reading: &SpectroReading,
+/// The stage from a reading's analysis ([`analyse`]; `path` names the reading in messages and the
+/// result); `repeatability` is the reading's relative standard deviation
+/// ([`SpectroUncertainty`]).
+pub fn from_analysis(
+    analysis: SpectroAnalysis,
     path: &Path,
-    lab: Option<(Lab, Observer)>,
-    eta: Option<f64>,
     repeatability: f64,
     albedo: &dyn ModelFamily,
-) -> Result<SpectroStage> {
-    if let Some(e) = eta
-        && !(e.is_finite() && e >= 1.0)
-    {
-        return Err(PipelineError::Input(format!(
-            "η = {e}: the relative refractive index must be a number ≥ 1"
-        )));
-    }
-    let analysis = analyse(reading, &SpectroOptions { lab, eta }).map_err(|source| {
-        PipelineError::Spectro {
-            file: path.to_path_buf(),
-            source,
-        }
-    })?;
+) -> SpectroStage {
     // The analysis keeps its channels in an array, R, G, B.
     let rd = Rgb::from_fn(|c| analysis.channels[c.index()].rd_total);
     let source = EtaSource::from(analysis.eta_source);
     let warnings = analysis.warnings.clone();
     let eta = analysis.eta;
     let eta_pm = eta_pm(&analysis, repeatability);
-    Ok(from_rd(
+    from_rd(
         Reading {
             file: Some(path.to_path_buf()),
             file_sha256: None,
@@ -303,7 +299,7 @@ pub fn from_reading(
             eta_pm,
         },
         albedo,
-    ))
+    )
 }
 
 /// The Henyey–Greenstein g α′ is inverted at: 0, an isotropic medium with σs = σ′s (what the

@@ -13,11 +13,11 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use scatterfit_fit::{ProfileData, Ring};
 use scatterfit_optics::OpticalProperties;
 use scatterfit_optics::dipole::Dipole;
-use scatterfit_optics::spectro::SpectroReading;
+use scatterfit_optics::spectro::{SpectroOptions, SpectroReading, analyse};
 use scatterfit_optics::{AlbedoModel, Channel, DiffusionModel, Method, ModelName, Rgb};
-use scatterfit_pipeline::FitSettings;
 use scatterfit_pipeline::fit::{fit_stage, propagate_spectro};
-use scatterfit_pipeline::spectro::{SpectroStage, from_reading};
+use scatterfit_pipeline::spectro::{SpectroStage, from_analysis};
+use scatterfit_pipeline::{FitPlan, FitSettings};
 
 const EPS: f64 = 0.005;
 const DRAWS: usize = 400;
@@ -35,15 +35,13 @@ fn reading(f: f64) -> SpectroReading {
 }
 
 fn stage(f: f64, repeatability: f64) -> SpectroStage {
-    from_reading(
-        &reading(f),
+    let analysis = analyse(&reading(f), &SpectroOptions::default()).unwrap();
+    from_analysis(
+        analysis,
         Path::new("test.csv"),
-        None,
-        None,
         repeatability,
         &DiffusionModel::Dipole,
     )
-    .unwrap()
 }
 
 /// Sample standard deviation.
@@ -142,15 +140,13 @@ fn sigma_errors_match_refits_of_repeated_readings() {
     };
     let nominal = stage(1.0, EPS);
     let data = profiles(&nominal);
-    let fits = fit_stage(&data, &nominal, &settings, &DiffusionModel::Dipole);
-    let errors = propagate_spectro(&data, &nominal, &settings, &DiffusionModel::Dipole, &fits);
+    let plan = FitPlan::new(settings).unwrap();
+    let fits = fit_stage(&data, &nominal, &plan);
+    let errors = propagate_spectro(&data, &nominal, &plan, &fits);
     let (mut sp, mut sa) = (vec![Vec::new(); 3], vec![Vec::new(); 3]);
     for f in draws() {
         let s = stage(f, 0.0);
-        for (c, outcome) in fit_stage(&data, &s, &settings, &DiffusionModel::Dipole)
-            .iter()
-            .enumerate()
-        {
+        for (c, outcome) in fit_stage(&data, &s, &plan).iter().enumerate() {
             let r = outcome.report().unwrap();
             assert!(r.converged);
             sp[c].push(r.sigma_s_prime.value);

@@ -52,7 +52,7 @@ use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
 use super::record::{AlbedoAtG, GFit};
 use super::term::warm_start;
 use crate::fit::outcome::ChannelOutcome;
-use crate::settings::FitSettings;
+use crate::settings::FitPlan;
 use crate::spectro::SpectroStage;
 
 /// The largest sd(g) at which g counts as determined: the Fisher study's threshold (BENCHMARKS.md,
@@ -398,8 +398,7 @@ pub fn fit_g(
 pub fn fit_g_channels(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
-    settings: &FitSettings,
-    opts: &FitOptions,
+    plan: &FitPlan,
     fits: &Rgb<ChannelOutcome>,
     range: [f64; 2],
     albedo_at_g: AlbedoAtG,
@@ -409,12 +408,12 @@ pub fn fit_g_channels(
         .zip(profiles.as_ref())
         .map_with_channel(|c, (outcome, data)| {
             let report = outcome.report().filter(|r| r.converged)?;
-            let opts = warm_start(opts, report);
+            let opts = warm_start(&plan.options, report);
             let grid = match &grid {
                 Ok(g) => *g,
                 Err(e) => return Some(Err(e.to_string())),
             };
-            let proposed = settings.method == Method::Proposed;
+            let proposed = plan.settings.method == Method::Proposed;
             let at = |eta: f64, rd: f64| ChannelAtG {
                 data,
                 input: ChannelInput {

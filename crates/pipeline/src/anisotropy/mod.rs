@@ -27,8 +27,9 @@
 //! the spectrophotometer's standard errors ([`scatterfit_optics::Estimate::total`]). The
 //! diffusion dipoles do not depend on g; their g term is the sensitivity of the g-aware estimate,
 //! which is what their user needs to know. Parts of the range the tables do not cover are not
+//! evaluated (never extrapolated) and are named in the result ([`GPlan::not_covered`]).
 //!
-//! The parts: [`plan`] (what is known about g, where the term is evaluated), [`term`] (the term
+//! [`with_g_term`] gives the fitted channels their term (and their fit of g). The parts: [`plan`] (what is known about g, where the term is evaluated), [`term`] (the term
 //! itself), [`fit`] (`g = "fit"`: g fitted from the profile) and [`record`] (what they give a
 //! fitted channel: its term, its fit of g).
 
@@ -44,3 +45,38 @@ pub use fit::{
 pub use plan::{DEFAULT_G_RANGE, GPlan, GPrior, default_search_range, known_g_record};
 pub use record::{AlbedoAtG, GFit, GTerm};
 pub use term::propagate_g;
+
+use scatterfit_fit::ProfileData;
+use scatterfit_optics::Rgb;
+
+use crate::fit::outcome::ChannelOutcome;
+use crate::settings::FitPlan;
+use crate::spectro::SpectroStage;
+
+/// The outcomes with the g term of the plan's g prior ([`crate::anisotropy`]; 0 when g is known),
+/// its refits made with the plan's options. A g plan that cannot be made (the tables cover no g of
+/// the range) leaves the terms unknown, with the reason in each channel's note.
+pub fn with_g_term(
+    profiles: &Rgb<ProfileData>,
+    spectro: &SpectroStage,
+    plan: &FitPlan,
+    fits: Rgb<ChannelOutcome>,
+    albedo_at_g: AlbedoAtG,
+) -> Rgb<ChannelOutcome> {
+    let settings = &plan.settings;
+    match GPlan::new(&settings.g_prior, settings.g) {
+        Ok(None) => fits.map(|f| f.with_g(None)),
+        Ok(Some(g_plan)) if settings.g_prior.fit => {
+            let fitted = fit_g_channels(profiles, spectro, plan, &fits, g_plan.range, albedo_at_g);
+            let terms = propagate_g(profiles, spectro, plan, &fits, &g_plan, albedo_at_g);
+            fits.zip(fitted)
+                .zip(terms)
+                .map(|((f, g), t)| f.with_g_fit(g, t))
+        }
+        Ok(Some(g_plan)) => {
+            let terms = propagate_g(profiles, spectro, plan, &fits, &g_plan, albedo_at_g);
+            fits.zip(terms).map(|(f, t)| f.with_g(t))
+        }
+        Err(e) => fits.map(|f| f.with_g(Some(Err(e.to_string())))),
+    }
+}

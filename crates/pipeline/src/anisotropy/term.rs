@@ -7,7 +7,7 @@ use scatterfit_optics::{AlbedoModel, AtG, Method, ModelName, Rgb};
 use super::plan::{GPlan, SAME_G};
 use super::record::{AlbedoAtG, GTerm};
 use crate::fit::outcome::ChannelOutcome;
-use crate::settings::FitSettings;
+use crate::settings::FitPlan;
 use crate::spectro::SpectroStage;
 
 /// The `mc` estimate (σ′s, σa, α′) of one channel at g.
@@ -39,26 +39,26 @@ fn estimate_at(
     Ok([r.sigma_s_prime.value, r.sigma_a.value, r.albedo_prime])
 }
 
-/// The g term of every fitted channel ([module docs](self)), each refit with `opts` (the
-/// settings' [`FitSettings::options`]) started from the channel's own fit: `None` for a channel not
+/// The g term of every fitted channel ([module docs](self)), each refit with the plan's options
+/// started from the channel's own fit: `None` for a channel not
 /// fitted, `Err` (why) where no term could be computed — the g the values are at could not be
 /// evaluated, or no point could.
 pub fn propagate_g(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
-    settings: &FitSettings,
-    opts: &FitOptions,
+    fit_plan: &FitPlan,
     fits: &Rgb<ChannelOutcome>,
     plan: &GPlan,
     albedo_at_g: AlbedoAtG,
 ) -> Rgb<Option<std::result::Result<GTerm, String>>> {
+    let settings = &fit_plan.settings;
     let proposed = settings.method == Method::Proposed;
     let value_is_mc = settings.model == ModelName::Mc && settings.albedo_model == AlbedoModel::Mc;
     fits.as_ref()
         .zip(profiles.as_ref())
         .map_with_channel(|c, (outcome, data)| {
             let report = outcome.report().filter(|r| r.converged)?;
-            let opts = warm_start(opts, report);
+            let opts = warm_start(&fit_plan.options, report);
             let input = ChannelInput {
                 eta: spectro.eta,
                 albedo_prime: spectro.albedo_prime[c],

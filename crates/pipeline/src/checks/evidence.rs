@@ -13,11 +13,10 @@
 //!   the material. The image's half width against it ([`spot_scale`](super::spot_scale)) measures the scale (or the
 //!   spot's diameter) to a few percent.
 
-use scatterfit_optics::{Channel, Method, ModelFamily, Rgb};
+use scatterfit_optics::{Channel, Rgb};
 use serde::Serialize;
 
 use crate::fit::outcome::ChannelOutcome;
-use crate::settings::FitSettings;
 use crate::spectro::SpectroStage;
 
 /// One channel's α′ from the profile's shape against the spectrophotometer's.
@@ -52,24 +51,17 @@ pub struct Evidence {
     pub spot_scale: Option<SpotScale>,
 }
 
-/// Gathers the evidence of a measurement made with the proposed method: the two-parameter fit
-/// of every channel on the same rings with the same model (one more fit per channel).
+/// Gathers the evidence of a measurement made with the proposed method from its fits and the
+/// two-parameter fits of the same rings with the same model ([`crate::fit::free_fits`]; `None`,
+/// no evidence, for the existing method).
 pub fn gather(
-    data: &Rgb<scatterfit_fit::ProfileData>,
     spectro: &SpectroStage,
-    settings: &FitSettings,
-    model: &dyn ModelFamily,
     fits: &Rgb<ChannelOutcome>,
+    free_fits: Option<&Rgb<ChannelOutcome>>,
 ) -> Evidence {
-    if settings.method != Method::Proposed {
+    let Some(profile_fits) = free_fits else {
         return Evidence::default();
-    }
-    let free = FitSettings {
-        method: Method::Existing,
-        normalise_with_spectro: false,
-        ..*settings
     };
-    let profile_fits = crate::fit::fit_stage(data, spectro, &free, model);
     let albedo = Rgb::from_fn(|c: Channel| {
         let proposed = fits[c].report().filter(|r| r.converged)?;
         let free = profile_fits[c].report().filter(|r| r.converged)?;

@@ -1,24 +1,23 @@
 //! The fit stage: σ′s and σa per channel from the radial profile and the spectrophotometer's η
 //! and α′ ([`fit_stage`]; Levenberg–Marquardt in `scatterfit_fit`), the spectrophotometer's part of
-//! their uncertainty ([`propagate_spectro`]), the g term ([`with_g_term`], [`crate::anisotropy`])
-//! and a channel's line of the result file ([`channel_result`]).
+//! their uncertainty ([`propagate_spectro`]), the g term ([`crate::anisotropy::with_g_term`])
+//! and a channel's line of the result file ([`channel_result`]). Every function takes the
+//! [`FitPlan`]: the settings, the options and the models made once.
 
-//! Stage 4: the fit per channel, and its conversion into the result file's shape.
-
-use scatterfit_fit::{ChannelInput, FitOptions, FitReport, PreparedFit, ProfileData, Start};
+use scatterfit_fit::{ChannelInput, ProfileData};
 use scatterfit_io::result_json::{ChannelResult, ChannelStatus, Correlation};
-use scatterfit_optics::{Channel, Estimate, Method, ModelFamily, Rgb};
+use scatterfit_optics::{Channel, Estimate, Method, Rgb};
 
-use crate::anisotropy::plan::GPlan;
 use crate::anisotropy::record::AlbedoAtG;
-use crate::anisotropy::term::propagate_g;
-use crate::settings::FitSettings;
+use crate::settings::FitPlan;
 use crate::spectro::SpectroStage;
 
 pub mod outcome;
+mod spectro_term;
 
 use outcome::finite;
 pub use outcome::{ChannelFit, ChannelOutcome, ExactFit, SpectroErrors};
+pub use spectro_term::propagate_spectro;
 
 fn finite_estimate(e: Estimate) -> Option<Estimate> {
     let term = |t: Option<f64>| t.filter(|t| t.is_finite());
@@ -37,33 +36,11 @@ fn finite_estimate(e: Estimate) -> Option<Estimate> {
 pub fn fit_stage(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
-    settings: &FitSettings,
-    model: &dyn ModelFamily,
-) -> Rgb<ChannelOutcome> {
-    match settings.options() {
-        Ok(opts) => fit_with(profiles, spectro, settings, &opts, model),
-        Err(e) => not_fitted(&e),
-    }
-}
-
-/// Every channel not fitted, for why.
-fn not_fitted(why: &dyn std::fmt::Display) -> Rgb<ChannelOutcome> {
-    Rgb::from_fn(|_| ChannelOutcome::NotFitted {
-        problem: why.to_string(),
-    })
-}
-
-/// [`fit_stage`] with the settings' options made.
-fn fit_with(
-    profiles: &Rgb<ProfileData>,
-    spectro: &SpectroStage,
-    settings: &FitSettings,
-    opts: &FitOptions,
-    model: &dyn ModelFamily,
+    plan: &FitPlan,
 ) -> Rgb<ChannelOutcome> {
     profiles.as_ref().map_with_channel(|c, data| {
         let albedo = spectro.albedo_prime[c];
-        if settings.method == Method::Proposed && albedo.is_none() {
+        if plan.settings.method == Method::Proposed && albedo.is_none() {
             return ChannelOutcome::NotFitted {
                 problem: spectro.problems[c]
                     .clone()
@@ -75,7 +52,7 @@ fn fit_with(
             albedo_prime: albedo,
             rd_total: Some(spectro.rd[c]),
         };
-        match scatterfit_fit::fit_channel(data, &input, model, opts) {
+        match scatterfit_fit::fit_channel(data, &input, &plan.model, &plan.options) {
             Ok(r) => ChannelOutcome::Fitted(Box::new(ChannelFit::new(
                 r,
                 spectro.uncertainty.albedo_prime_stderr[c],
@@ -87,134 +64,37 @@ fn fit_with(
     })
 }
 
-/// [`fit_stage`], then [`propagate_spectro`] and the g term ([`with_g_term`]) into the outcomes:
+/// The two-parameter fit (σ′s and σa both free: the existing method, not normalised) of every
+/// channel on the same rings with the same model — the profile's own reading of α′, which the
+/// data's cross-checks hold against the spectrophotometer's (`crate::checks::evidence`). `None`
+/// when the plan's method is the existing one already.
+pub fn free_fits(
+    profiles: &Rgb<ProfileData>,
+    spectro: &SpectroStage,
+    plan: &FitPlan,
+) -> Option<Rgb<ChannelOutcome>> {
+    if plan.settings.method != Method::Proposed {
+        return None;
+    }
+    let mut free = *plan;
+    free.settings.method = Method::Existing;
+    free.settings.normalise_with_spectro = false;
+    free.options.method = Method::Existing;
+    free.options.normalise_with_spectro = false;
+    Some(fit_stage(profiles, spectro, &free))
+}
+
+/// [`fit_stage`], then [`propagate_spectro`] and the g term ([`crate::anisotropy::with_g_term`]) into the outcomes:
 /// the channels with every uncertainty term the measurement knows.
 pub fn fit_and_propagate(
     profiles: &Rgb<ProfileData>,
     spectro: &SpectroStage,
-    settings: &FitSettings,
-    model: &dyn ModelFamily,
+    plan: &FitPlan,
 ) -> Rgb<ChannelOutcome> {
-    // The options once, for the fit and every refit after it.
-    let opts = match settings.options() {
-        Ok(o) => o,
-        Err(e) => return not_fitted(&e),
-    };
-    let fits = fit_with(profiles, spectro, settings, &opts, model);
-    let errors = spectro_errors(profiles, spectro, settings, &opts, model, &fits);
+    let fits = fit_stage(profiles, spectro, plan);
+    let errors = propagate_spectro(profiles, spectro, plan, &fits);
     let fits = fits.zip(errors).map(|(f, e)| f.with_spectro(e));
-    with_g_term(profiles, spectro, settings, &opts, fits, AlbedoAtG::FromRd)
-}
-
-/// The outcomes with the g term of `settings.g_prior` ([`crate::anisotropy`]; 0 when g is
-/// known), its refits made with `opts` (the settings' [`FitSettings::options`]). A plan that cannot
-/// be made (the tables cover no g of the range) leaves the terms unknown, with the reason in each
-/// channel's note.
-pub fn with_g_term(
-    profiles: &Rgb<ProfileData>,
-    spectro: &SpectroStage,
-    settings: &FitSettings,
-    opts: &FitOptions,
-    fits: Rgb<ChannelOutcome>,
-    albedo_at_g: AlbedoAtG,
-) -> Rgb<ChannelOutcome> {
-    match GPlan::new(&settings.g_prior, settings.g) {
-        Ok(None) => fits.map(|f| f.with_g(None)),
-        Ok(Some(plan)) if settings.g_prior.fit => {
-            let terms = propagate_g(profiles, spectro, settings, opts, &fits, &plan, albedo_at_g);
-            let fitted = crate::anisotropy::fit::fit_g_channels(
-                profiles,
-                spectro,
-                settings,
-                opts,
-                &fits,
-                plan.range,
-                albedo_at_g,
-            );
-            fits.zip(fitted)
-                .zip(terms)
-                .map(|((f, g), t)| f.with_g_fit(g, t))
-        }
-        Ok(Some(plan)) => {
-            let terms = propagate_g(profiles, spectro, settings, opts, &fits, &plan, albedo_at_g);
-            fits.zip(terms).map(|(f, t)| f.with_g(t))
-        }
-        Err(e) => fits.map(|f| f.with_g(Some(Err(e.to_string())))),
-    }
-}
-
-/// Propagates the spectrophotometer's uncertainty ([`SpectroStage::uncertainty`]) to σ′s and σa:
-/// each fitted channel is refitted at the two perturbed readings — × (1 − ε) and × (1 + ε), which
-/// move Rd (hence α′) and η together — from the fit's own solution as the start, and the standard
-/// error is half the difference of the two refits (central differences at ±1 standard deviation:
-/// first-order error propagation, no derivative of the fit itself needed; `tests/uncertainty.rs`
-/// checks it against the spread of refits of many randomly scaled readings). The existing method
-/// does not use α′: only its η moves. `None` for a channel that was not fitted, or when a perturbed
-/// α′ cannot be inverted or a refit does not converge (the uncertainty is then unknown, not zero).
-pub fn propagate_spectro(
-    profiles: &Rgb<ProfileData>,
-    spectro: &SpectroStage,
-    settings: &FitSettings,
-    model: &dyn ModelFamily,
-    fits: &Rgb<ChannelOutcome>,
-) -> Rgb<Option<SpectroErrors>> {
-    match settings.options() {
-        Ok(opts) => spectro_errors(profiles, spectro, settings, &opts, model, fits),
-        Err(_) => Rgb::default(),
-    }
-}
-
-/// [`propagate_spectro`] with the settings' options made.
-fn spectro_errors(
-    profiles: &Rgb<ProfileData>,
-    spectro: &SpectroStage,
-    settings: &FitSettings,
-    opts: &FitOptions,
-    model: &dyn ModelFamily,
-    fits: &Rgb<ChannelOutcome>,
-) -> Rgb<Option<SpectroErrors>> {
-    let u = &spectro.uncertainty;
-    let proposed = settings.method == Method::Proposed;
-    fits.as_ref()
-        .zip(profiles.as_ref())
-        .map_with_channel(|c, (outcome, data)| {
-            let report = outcome.report().filter(|r| r.converged)?;
-            if u.repeatability == 0.0 {
-                return Some(SpectroErrors {
-                    sigma_s_prime: 0.0,
-                    sigma_a: 0.0,
-                });
-            }
-            let start = Some(Start {
-                sigma_s_prime: report.sigma_s_prime.value,
-                sigma_a: Some(report.sigma_a.value),
-                scale: None,
-            });
-            let input = |k: usize| -> Option<ChannelInput> {
-                Some(ChannelInput {
-                    eta: u.eta_pm[k],
-                    albedo_prime: if proposed {
-                        Some(u.albedo_pm[c][k]?)
-                    } else {
-                        spectro.albedo_prime[c]
-                    },
-                    rd_total: Some(u.rd_pm[c][k]),
-                })
-            };
-            let values = |r: FitReport| {
-                r.converged
-                    .then_some((r.sigma_s_prime.value, r.sigma_a.value))
-            };
-            // One preparation (rings, spot kernel) for both refits.
-            let lo_fit =
-                PreparedFit::new(data, &input(0)?, model, &FitOptions { start, ..*opts }).ok()?;
-            let hi = values(lo_fit.with_input(&input(1)?, start).ok()?.solve())?;
-            let lo = values(lo_fit.solve())?;
-            Some(SpectroErrors {
-                sigma_s_prime: 0.5 * (hi.0 - lo.0).abs(),
-                sigma_a: 0.5 * (hi.1 - lo.1).abs(),
-            })
-        })
+    crate::anisotropy::with_g_term(profiles, spectro, plan, fits, AlbedoAtG::FromRd)
 }
 
 /// Channel `c`'s row of `result.json`: the outcome's estimates as they are (one record of a value
