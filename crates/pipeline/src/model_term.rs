@@ -9,7 +9,11 @@
 //! same reading are fitted again with exact transport (the `mc` profile and α′ from the `mc`
 //! total, everything else as chosen), and |approximate − exact| becomes each estimate's `model`
 //! term ([`scatterfit_optics::Estimate::model`]): a bounded systematic, added linearly like the g
-//! term. The verdict also compares the two fits' χ²/dof on the same rings
+//! term. The truth lies within exact transport's own noise of the exact estimate, and where the
+//! approximate value is smaller (the dipole's σ′s at −77 %) its noise terms, being relative, are
+//! smaller too; so the term also carries the part of the exact estimate's noise that the
+//! approximate one's terms do not ([`model_term`]): the total bar is then |approximate − exact|
+//! plus the larger of the two noises. The verdict also compares the two fits' χ²/dof on the same rings
 //! ([`crate::checks::model_reasons`]): a model whose residuals are many times exact transport's
 //! does not describe the profile.
 
@@ -43,10 +47,9 @@ pub fn apply(
         };
         match x {
             Ok(x) => {
-                let term = |a: f64, b: f64| (a - b).abs();
-                f.sigma_s_prime.model = Some(term(f.sigma_s_prime.value, x.sigma_s_prime.value));
-                f.sigma_a.model = Some(term(f.sigma_a.value, x.sigma_a.value));
-                f.albedo_prime.model = Some(term(f.albedo_prime.value, x.albedo_prime.value));
+                f.sigma_s_prime.model = Some(model_term(&f.sigma_s_prime, &x.sigma_s_prime));
+                f.sigma_a.model = Some(model_term(&f.sigma_a, &x.sigma_a));
+                f.albedo_prime.model = Some(model_term(&f.albedo_prime, &x.albedo_prime));
                 f.exact = Some(ExactFit {
                     sigma_s_prime: x.sigma_s_prime.value,
                     sigma_a: x.sigma_a.value,
@@ -62,5 +65,70 @@ pub fn apply(
                 ));
             }
         }
+    }
+}
+
+/// The `model` term of an approximate estimate `a` against exact transport's `x` on the same data:
+/// |a − x|, plus how far the exact estimate's noise exceeds the approximate one's (0 when it does
+/// not). The approximate noise is √(fit² + spectro²) of `a`; the exact one is the exact fit's own
+/// fit term (the approximate's scaled by |x/a| where the exact fit has none) with the
+/// spectrophotometer's term scaled by |x/a| (exact transport's values are fitted without that
+/// propagation, `Measurement::refit_values_only`; the reading's relative error moves both fits
+/// alike). The total, noise + `model`, is then |a − x| + max(noise of a, noise of x): the bar of
+/// the exact estimate moved to the approximate value.
+pub fn model_term(a: &scatterfit_optics::Estimate, x: &scatterfit_optics::Estimate) -> f64 {
+    let distance = (a.value - x.value).abs();
+    let ratio = if a.value != 0.0 {
+        (x.value / a.value).abs()
+    } else {
+        1.0
+    };
+    let (fit, spectro) = (a.fit.unwrap_or(0.0), a.spectro.unwrap_or(0.0));
+    let noise_a = fit.hypot(spectro);
+    let noise_x = x.fit.unwrap_or(fit * ratio).hypot(spectro * ratio);
+    let extra = noise_x - noise_a;
+    if extra.is_finite() && extra > 0.0 {
+        distance + extra
+    } else {
+        distance
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use scatterfit_optics::Estimate;
+
+    /// Worked by hand: a dipole σ′s of 0.5 ± 0.005 (fit) ± 0.003 (spectro) against exact
+    /// transport's 2.0 ± 0.012 (fit, no spectro term): the exact noise is √(0.012² + (0.003·4)²)
+    /// = 0.016971, the approximate 0.005831, so the term is 1.5 + 0.011140; an approximate value
+    /// above the exact one with the larger noise keeps the bare distance.
+    #[test]
+    fn the_term_carries_the_exact_estimates_larger_noise() {
+        let a = Estimate {
+            fit: Some(0.005),
+            spectro: Some(0.003),
+            ..Estimate::new(0.5)
+        };
+        let x = Estimate {
+            fit: Some(0.012),
+            ..Estimate::new(2.0)
+        };
+        let want = 1.5 + (0.012f64.hypot(0.012) - 0.005f64.hypot(0.003));
+        assert!(
+            (model_term(&a, &x) - want).abs() < 1e-12,
+            "{}",
+            model_term(&a, &x)
+        );
+        let above = Estimate {
+            fit: Some(0.05),
+            spectro: Some(0.03),
+            ..Estimate::new(3.0)
+        };
+        assert!((model_term(&above, &x) - 1.0).abs() < 1e-12);
+        // No exact fit term: the approximate one scaled by |x/a| (4): 0.02 ⊕ 0.012.
+        let bare = Estimate::new(2.0);
+        let want = 1.5 + (0.02f64.hypot(0.012) - 0.005f64.hypot(0.003));
+        assert!((model_term(&a, &bare) - want).abs() < 1e-12);
     }
 }
