@@ -9,7 +9,6 @@
 use std::path::Path;
 use std::time::Instant;
 
-use scatterfit_io::manifest::{AutoOrNone, BlackLevelSetting};
 use scatterfit_optics::Method;
 use scatterfit_optics::port::Port;
 
@@ -18,7 +17,10 @@ use crate::checks::findings::SampleChecks;
 use crate::checks::{image_checks, spot_scale};
 use crate::error::{PipelineError, Result};
 use crate::fit::{fit_and_propagate, fit_stage, free_fits};
-use crate::hdr::{BlackLevel, HdrInputs, read_and_merge, read_radiance_map};
+use crate::hdr::inputs::HdrInputs;
+use crate::hdr::radiance_map::read_radiance_map;
+use crate::hdr::read_and_merge;
+use crate::hdr::spot_image::spot_kernel_from_image;
 use crate::measurement::{Measurement, Stage, Timings};
 use crate::model_term;
 use crate::port::{correct_port, port_of, propagate_fit_through_port};
@@ -108,7 +110,8 @@ fn measure_from(
     let hdr = match &manifest.camera.hdr {
         Some(p) => read_radiance_map(&manifest.resolve(p))?,
         None => {
-            let stage = read_and_merge(&hdr_inputs(&manifest), &|_| progress(Stage::ReadFrame))?;
+            let inputs = HdrInputs::from_manifest(&manifest);
+            let stage = read_and_merge(&inputs, &|_| progress(Stage::ReadFrame))?;
             begin(Stage::Merge)?;
             stage
         }
@@ -128,11 +131,11 @@ fn measure_from(
         manifest.camera.background.unwrap_or_default(),
     )?;
     let plan = match &manifest.camera.spot_image {
-        Some(p) => plan.with_spot(crate::hdr::spot_kernel_from_image(
-            &manifest.resolve(p),
-            &hdr,
-            manifest.camera.mm_per_pixel.unwrap_or(f64::NAN),
-        )?)?,
+        Some(p) => {
+            let mm_per_pixel = manifest.camera.mm_per_pixel.unwrap_or(f64::NAN);
+            let spot = spot_kernel_from_image(&manifest.resolve(p), &hdr, mm_per_pixel)?;
+            plan.with_spot(spot)?
+        }
         None => plan,
     };
     let profile_s = t_profile.elapsed().as_secs_f64();
@@ -203,40 +206,6 @@ fn measure_from(
     m.timings.checks_s = t_checks.elapsed().as_secs_f64();
     m.timings.total_s = t0.elapsed().as_secs_f64();
     Ok(m)
-}
-
-/// The merge's inputs as the manifest's `[camera]` names them.
-fn hdr_inputs(manifest: &scatterfit_io::manifest::SampleManifest) -> HdrInputs {
-    let camera = &manifest.camera;
-    let mut inputs = HdrInputs::new(
-        camera.exposures.as_ref().map(|p| manifest.resolve(p)),
-        camera
-            .images
-            .iter()
-            .flatten()
-            .map(|p| manifest.resolve(p))
-            .collect(),
-    );
-    inputs.response = camera.response.as_ref().map(|p| manifest.resolve(p));
-    inputs.dark = camera.dark.as_ref().map(|p| manifest.resolve(p));
-    // A real camera: black level, shutter times, flat frame.
-    inputs.flat = camera.flat.as_ref().map(|p| manifest.resolve(p));
-    inputs.exposure_correction = camera.exposure_correction.unwrap_or_default();
-    if let Some(s) = camera.saturation {
-        inputs.saturation = s;
-        inputs.saturation_given = true;
-    }
-    inputs.black_level = match camera.black_level {
-        None | Some(BlackLevelSetting::Mode(AutoOrNone::Auto)) => BlackLevel::Auto,
-        Some(BlackLevelSetting::Mode(AutoOrNone::None)) => BlackLevel::None,
-        Some(BlackLevelSetting::One(v)) => BlackLevel::Given(vec![v]),
-        Some(BlackLevelSetting::PerChannel(v)) => BlackLevel::Given(v.to_vec()),
-    };
-    // Pixels dark in every frame are evidence of radiance below the first code: keep them as 0 so
-    // far rings are not averaged over their brighter pixels only; pixels saturated everywhere are
-    // masked out by the profile stage.
-    inputs.clipped_fill = scatterfit_imaging::ClippedFill::LowerBound;
-    inputs
 }
 
 impl Measurement {

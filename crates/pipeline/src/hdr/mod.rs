@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use scatterfit_imaging::{
-    CalibrateOptions, ClippedFill, HdrImage, ImageBuf, LEVELS, LinearMergeOptions, MergeOptions,
-    ResponseCurve, SelfConsistency, Weighting,
+    CalibrateOptions, HdrImage, ImageBuf, LEVELS, LinearMergeOptions, MergeOptions, ResponseCurve,
+    SelfConsistency, Weighting,
 };
 use scatterfit_io::bracket::{Bracket, read_bracket_within};
 use scatterfit_io::image_files::{CameraFrame, RawInfo, read_camera_frame};
@@ -27,8 +27,14 @@ use crate::error::{PipelineError, Result};
 pub use scatterfit_io::result_json::ResponseKind;
 
 pub mod frames;
+pub mod inputs;
 mod merge;
+pub mod radiance_map;
+pub mod spot_image;
+pub use inputs::{BlackLevel, HdrInputs};
 pub use merge::{FLAT_MAX_PEAK, FLAT_MIN_LOW};
+pub use radiance_map::read_radiance_map;
+pub use spot_image::spot_kernel_from_image;
 
 use merge::*;
 
@@ -66,19 +72,6 @@ fn check_exposure(est: &ExposureEstimate, times: &[f64]) -> Result<()> {
         });
     }
     Ok(())
-}
-
-/// The black level of linear frames.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub enum BlackLevel {
-    /// From a dark frame when given, else the RAW file's metadata, else the far corners
-    /// ([`crate::camera::estimate_black_level`]).
-    #[default]
-    Auto,
-    /// None (the frames are black-subtracted already).
-    None,
-    /// Given per channel \[DN\] (one value for all channels is repeated).
-    Given(Vec<f64>),
 }
 
 /// What the HDR stage found and corrected of a real camera (BENCHMARKS.md, "Real cameras").
@@ -202,91 +195,6 @@ pub const EXPECTED_FLOOR_FRACTION: f64 = 0.3;
 
 /// The 16-bit linear value at which a pixel counts as detected in the longest exposure.
 pub const DETECTION_DN_16BIT: f64 = 64.0;
-
-/// What to merge and how.
-#[derive(Debug, Clone, PartialEq)]
-pub struct HdrInputs {
-    /// The frames (may be empty when `exposures` lists them).
-    pub images: Vec<PathBuf>,
-    /// `exposures.csv` (file,time_s), or `None` for EXIF times.
-    pub exposures: Option<PathBuf>,
-    /// A known response CSV (8-bit only).
-    pub response: Option<PathBuf>,
-    /// A dark frame.
-    pub dark: Option<PathBuf>,
-    /// Smoothness λ of the response recovery.
-    pub lambda: f64,
-    /// Sample pixels per channel for the response recovery; `None` for
-    /// [`default_response_samples`] of the bracket's frame count (what `measure` uses).
-    pub samples: Option<usize>,
-    /// 16-bit saturation value.
-    pub saturation: u16,
-    /// True when `saturation` was stated (`camera.saturation`): it then overrides the clipping
-    /// plateau found in the frames and a RAW file's white level; 8-bit frames are refused with it.
-    pub saturation_given: bool,
-    /// What to store for pixel-channels clipped in every exposure.
-    pub clipped_fill: ClippedFill,
-    /// 8-bit sample weighting when `weighting_auto` is false.
-    pub weighting: Weighting,
-    /// 8-bit brackets (without a dark frame): choose the weighting from the bracket — the
-    /// noise-aware one unless the paper's hat explains the frames clearly better
-    /// (`merge::AUTO_HAT_MARGIN`). Default true.
-    pub weighting_auto: bool,
-    /// Memory budget in bytes that the decoded frames are checked against before any is decoded;
-    /// `None` for the environment's ([`scatterfit_io::budget::memory_budget_bytes`]).
-    pub memory_budget: Option<u64>,
-    /// The black level of linear frames (default auto).
-    pub black_level: BlackLevel,
-    /// Whether exposure times are estimated from the frames and used (default auto).
-    pub exposure_correction: ExposureCorrection,
-    /// A flat frame (vignetting), divided out of the radiance.
-    pub flat: Option<PathBuf>,
-}
-
-impl HdrInputs {
-    /// Defaults (λ = 10, the bracket's default sample count, 65535 saturation, NaN fill, noise-optimal weighting, the
-    /// environment's memory budget) for a bracket listed in `exposures`.
-    pub fn new(exposures: Option<PathBuf>, images: Vec<PathBuf>) -> Self {
-        Self {
-            images,
-            exposures,
-            response: None,
-            dark: None,
-            lambda: 10.0,
-            samples: None,
-            saturation: u16::MAX,
-            saturation_given: false,
-            clipped_fill: ClippedFill::Nan,
-            weighting: Weighting::NoiseOptimal,
-            weighting_auto: true,
-            memory_budget: None,
-            black_level: BlackLevel::Auto,
-            exposure_correction: ExposureCorrection::Auto,
-            flat: None,
-        }
-    }
-
-    /// Every input file named (for "is this output one of the inputs?" checks), frames listed in
-    /// the exposures CSV included.
-    ///
-    /// # Errors
-    /// [`PipelineError::Bracket`] when the exposures CSV cannot be read.
-    pub fn input_files(&self) -> Result<Vec<PathBuf>> {
-        let mut v = self.images.clone();
-        v.extend(self.exposures.clone());
-        v.extend(self.response.clone());
-        v.extend(self.dark.clone());
-        v.extend(self.flat.clone());
-        if let Some(csv) = &self.exposures {
-            v.extend(
-                scatterfit_io::bracket::read_exposures_csv(csv)?
-                    .into_iter()
-                    .map(|e| e.path),
-            );
-        }
-        Ok(v)
-    }
-}
 
 /// One frame of the bracket.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -567,7 +475,7 @@ pub fn read_frames(
 /// An 8-bit frame's codes as relative exposure through the camera response: exp g(Z) per sample
 /// (one table for every channel, or one per channel), code 0 as no light. A flat frame and a spot
 /// image taken with the bracket's camera are linearised this way.
-fn linearise_u8(frame: &ImageBuf<u8>, response: &ResponseCurve) -> Vec<f32> {
+pub(crate) fn linearise_u8(frame: &ImageBuf<u8>, response: &ResponseCurve) -> Vec<f32> {
     let tables = response.tables();
     let ch = frame.channels();
     // exp g(z) per channel and code, once (the same values as per sample).
@@ -698,84 +606,6 @@ pub fn merge_frames(read: FramesRead, inputs: &HdrInputs) -> Result<HdrStage> {
     stage.corrections = corrections;
     stage.merge_s = t1.elapsed().as_secs_f64();
     Ok(stage)
-}
-
-/// The fit's spot kernel from `camera.spot_image` ([`crate::camera::spot_from_image`]): the image
-/// linearised as the bracket was (8-bit through the bracket's response; linear data less the
-/// black level found for the bracket).
-///
-/// # Errors
-/// [`PipelineError::Input`] naming the file and what is wrong with it.
-pub fn spot_kernel_from_image(
-    path: &Path,
-    stage: &HdrStage,
-    mm_per_pixel: f64,
-) -> Result<scatterfit_fit::RadialSpot> {
-    let bad = |what: String| {
-        PipelineError::Input(format!(
-            "{} (camera.spot_image): {what}; it is a photograph of the light spot on a thin \
-             opaque white target (paper, a white tile) with the bracket's camera and scale",
-            path.display()
-        ))
-    };
-    let frame = read_camera_frame(path)
-        .map_err(|e| bad(e.to_string()))?
-        .frame;
-    let linear: Vec<f32> = match (&frame, &stage.response) {
-        (CameraFrame::U8(f), Some(r)) => linearise_u8(f, r),
-        (CameraFrame::U8(f), None) => f.data().iter().map(|&z| f32::from(z)).collect(),
-        (CameraFrame::U16(f), _) => {
-            let ch = f.channels();
-            let black = stage.corrections.black_level.as_ref();
-            f.data()
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| {
-                    (f64::from(v) - black.map_or(0.0, |(b, _)| b[(i % ch).min(b.len() - 1)])) as f32
-                })
-                .collect()
-        }
-    };
-    let buf = ImageBuf::new(frame.width(), frame.height(), frame.channels(), linear)
-        .map_err(|e| bad(e.to_string()))?;
-    crate::camera::spot_from_image(&buf, mm_per_pixel).map_err(bad)
-}
-
-/// A radiance map read from a file (the manifest's `camera.hdr`): no bracket, no detection limit;
-/// the stage records the file with the hash of the bytes decoded ([`HdrStage::radiance_file`]).
-///
-/// # Errors
-/// [`PipelineError::Image`].
-pub fn read_radiance_map(path: &Path) -> Result<HdrStage> {
-    let t0 = Instant::now();
-    let budget = scatterfit_io::budget::memory_budget_bytes();
-    let bytes = scatterfit_io::image_files::read_image_bytes(path, budget)?;
-    let radiance = scatterfit_io::image_files::decode_radiance(&bytes, path, budget)?;
-    let radiance_file = scatterfit_io::digest::ReadFile::of(path, &bytes);
-    drop(bytes);
-    let (w, h, ch) = (radiance.width(), radiance.height(), radiance.channels());
-    let clipped = ImageBuf::filled(w, h, ch, 0u8).map_err(|e| {
-        PipelineError::Input(format!("{}: inconsistent image size ({e})", path.display()))
-    })?;
-    Ok(HdrStage {
-        hdr: HdrImage {
-            radiance,
-            clipped,
-            clipped_count: 0,
-        },
-        response: None,
-        response_kind: ResponseKind::Merged,
-        rms: Vec::new(),
-        frames: Vec::new(),
-        radiance_file: Some(radiance_file),
-        image: format!("{w}×{h} {}", if ch == 1 { "grey" } else { "RGB" }),
-        detection_limit: vec![f64::NAN; ch],
-        dropped_alpha: Vec::new(),
-        read_s: t0.elapsed().as_secs_f64(),
-        merge_s: 0.0,
-        corrections: Corrections::default(),
-        thumbnails: Vec::new(),
-    })
 }
 
 /// Reads a response CSV into a curve with 256 levels.
