@@ -132,8 +132,11 @@ fn measure_from(
     )?;
     let plan = match &manifest.camera.spot_image {
         Some(p) => {
-            let mm_per_pixel = manifest.camera.mm_per_pixel.unwrap_or(f64::NAN);
-            let spot = spot_kernel_from_image(&manifest.resolve(p), &hdr, mm_per_pixel)?;
+            let (scale, diameter) = (
+                manifest.camera.mm_per_pixel.unwrap_or(f64::NAN),
+                manifest.camera.spot_diameter_mm.unwrap_or(1.0),
+            );
+            let spot = spot_kernel_from_image(&manifest.resolve(p), &hdr, scale, diameter)?;
             plan.with_spot(spot)?
         }
         None => plan,

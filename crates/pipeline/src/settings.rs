@@ -161,6 +161,16 @@ impl FitSettings {
         Ok(o)
     }
 
+    /// The spot's half width at half maximum \[mm\]: a disk's radius, a radial spot's
+    /// [`RadialSpot::half_maximum_radius`](scatterfit_fit::RadialSpot::half_maximum_radius) (a
+    /// Gaussian's 0.589 w, where its 99 % radius, `spot_radius_mm`, is 1.52 w).
+    pub fn spot_half_width_mm(&self) -> f64 {
+        match self.spot {
+            SpotShape::Disk => self.spot_radius_mm,
+            SpotShape::Radial(s) => s.half_maximum_radius(),
+        }
+    }
+
     /// The innermost fitted radius \[mm\]: the given one, else the spot's diameter.
     pub fn r_min_mm(&self) -> f64 {
         self.r_min_mm.unwrap_or(2.0 * self.spot_radius_mm)

@@ -19,6 +19,7 @@ use super::{
 };
 use crate::fit::outcome::ChannelOutcome;
 use crate::measurement::Measurement;
+use crate::settings::SpotShape;
 
 /// The sample's checks: the spot inside the frame with its fitted rings complete (or cut
 /// symmetrically), the measurement's image checks ([`Measurement::image_checks`], made once when
@@ -118,24 +119,33 @@ pub fn image_checks(m: &Measurement) -> SampleChecks {
     if let Some(msg) = second_spot(m, a_px) {
         reasons.push(suspect(ReasonKind::SecondSpot, msg));
     }
-    // (c) The spot's size in the image against the manifest's scale and spot diameter.
+    // (c) The spot's size in the image against the manifest's scale and spot: its half width at
+    // half maximum (a disk's radius; a Gaussian's or a spot image's is well inside the radius
+    // holding 99 % of its power, which the other checks use).
+    let half_width_mm = m.settings.spot_half_width_mm();
+    let hw_px = half_width_mm / mmpp;
     if let Some(hwhm) = spot_hwhm_px(m)
-        && a_px.is_finite()
-        && a_px > 0.0
+        && hw_px.is_finite()
+        && hw_px > 0.0
     {
-        let ratio = hwhm / a_px;
+        let ratio = hwhm / hw_px;
         if !(SPOT_SIZE_RATIO.0..=SPOT_SIZE_RATIO.1).contains(&ratio) {
+            let stated = match m.settings.spot {
+                SpotShape::Disk => "spot_diameter_mm / 2".to_string(),
+                SpotShape::Radial(_) => {
+                    "the stated spot's half width at half maximum (camera.spot_diameter_mm \
+                     with camera.spot_profile, or camera.spot_image)"
+                        .to_string()
+                }
+            };
             reasons.push(suspect(
                 ReasonKind::SpotSize,
                 format!(
-                    "the spot's half width in the image is {hwhm:.1} px, but spot_diameter_mm / 2 / \
-                     mm_per_pixel = {:.3} / {mmpp} = {a_px:.1} px (ratio {ratio:.2}, expected \
-                     {}–{}): check camera.mm_per_pixel and camera.spot_diameter_mm (a scale {:.2}× \
-                     off makes σ′s and σa as many times off)",
-                    m.settings.spot_radius_mm,
-                    SPOT_SIZE_RATIO.0,
-                    SPOT_SIZE_RATIO.1,
-                    ratio
+                    "the spot's half width in the image is {hwhm:.1} px, but {stated} / \
+                     mm_per_pixel = {half_width_mm:.3} / {mmpp} = {hw_px:.1} px (ratio {ratio:.2}, \
+                     expected {}–{}): check camera.mm_per_pixel and camera.spot_diameter_mm (a \
+                     scale {:.2}× off makes σ′s and σa as many times off)",
+                    SPOT_SIZE_RATIO.0, SPOT_SIZE_RATIO.1, ratio
                 ),
             ));
         }

@@ -9,9 +9,16 @@ use scatterfit_io::image_files::{CameraFrame, read_camera_frame};
 use super::{HdrStage, linearise_u8};
 use crate::error::{PipelineError, Result};
 
+/// How far a spot image's light may reach (the radius holding 99 % of its power) beyond the stated
+/// spot's radius: a Gaussian spot reaches 1.52× its 1/e² radius, a disk 1.0×, a white target's own
+/// blur adds a little; a frame of the sample reaches many times further (the material's glow).
+pub const SPOT_IMAGE_MAX_REACH: f64 = 3.0;
+
 /// The fit's spot kernel from `camera.spot_image` ([`crate::camera::spot_from_image`]): the image
 /// linearised as the bracket was (8-bit through the bracket's response; linear data less the
-/// black level found for the bracket).
+/// black level found for the bracket). `stated_diameter_mm` is the manifest's spot diameter: an
+/// image whose light reaches more than [`SPOT_IMAGE_MAX_REACH`] times its radius is not a
+/// photograph of that spot.
 ///
 /// # Errors
 /// [`PipelineError::Input`] naming the file and what is wrong with it.
@@ -19,6 +26,7 @@ pub fn spot_kernel_from_image(
     path: &Path,
     stage: &HdrStage,
     mm_per_pixel: f64,
+    stated_diameter_mm: f64,
 ) -> Result<scatterfit_fit::RadialSpot> {
     let bad = |what: String| {
         PipelineError::Input(format!(
@@ -47,5 +55,16 @@ pub fn spot_kernel_from_image(
     };
     let buf = ImageBuf::new(frame.width(), frame.height(), frame.channels(), linear)
         .map_err(|e| bad(e.to_string()))?;
-    crate::camera::spot_from_image(&buf, mm_per_pixel).map_err(bad)
+    let spot = crate::camera::spot_from_image(&buf, mm_per_pixel).map_err(bad)?;
+    let (reach, stated) = (spot.radius_enclosing(0.99), 0.5 * stated_diameter_mm);
+    if reach > SPOT_IMAGE_MAX_REACH * stated {
+        return Err(bad(format!(
+            "its light reaches {reach:.3} mm from its centre (99 % of its power), {:.1}× the \
+             stated spot's radius ({stated} mm, camera.spot_diameter_mm) where a photographed \
+             spot reaches at most about {SPOT_IMAGE_MAX_REACH}×: is it a frame of the sample (the \
+             material's glow around the spot), or taken at another image scale?",
+            reach / stated
+        )));
+    }
+    Ok(spot)
 }
