@@ -9,12 +9,13 @@
 //! folder holding anything else unless `--force`. Monte Carlo profiles are cached (the second run
 //! takes seconds).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, bail};
 use scatterfit_lab::demo::{DemoFiles, materials, quality_line, write_demo};
+
+use scatterfit_pipeline::outputs::claim_folder;
 
 use crate::common::CacheArgs;
 use crate::output::{errln, out, outln};
@@ -56,36 +57,16 @@ pub struct Args {
     pub quiet: bool,
 }
 
-const MARKER: &str = ".scatterfit-demo";
-
-fn check_folder(dir: &Path, force: bool) -> anyhow::Result<()> {
-    if !dir.exists() || force || dir.join(MARKER).exists() {
-        return Ok(());
-    }
-    let mut entries = std::fs::read_dir(dir)
-        .with_context(|| format!("reading {}", dir.display()))?
-        .flatten();
-    if let Some(e) = entries.next() {
-        bail!(
-            "{} holds {} and was not made by `scatterfit demo`; choose another folder with -o or \
-             pass --force to write there",
-            dir.display(),
-            e.file_name().to_string_lossy()
-        );
-    }
-    Ok(())
-}
-
 /// Runs `scatterfit demo`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let t0 = Instant::now();
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    check_folder(&args.output_dir, args.force)?;
-    std::fs::create_dir_all(&args.output_dir)
-        .with_context(|| format!("creating {}", args.output_dir.display()))?;
-    scatterfit_io::atomic::write_atomic(
-        &args.output_dir.join(MARKER),
-        b"made by `scatterfit demo`; it may replace the files in this folder\n",
+    claim_folder(
+        &args.output_dir,
+        ".scatterfit-demo",
+        "demo",
+        " to write there",
+        args.force,
     )?;
     let quiet = args.quiet || args.json;
     let cache = args.cache.dir();

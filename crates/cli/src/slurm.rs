@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 
 use scatterfit_lab::partial::Kind;
-use scatterfit_lab::slurm::SlurmJob;
+use scatterfit_lab::slurm::{SlurmJob, split_tokens};
 
 use crate::output::{errln, outln};
 
@@ -71,69 +71,6 @@ pub enum What {
 pub struct Args {
     #[command(subcommand)]
     pub what: What,
-}
-
-/// `slurm`'s own flags, taking a value: removed from the command line the array tasks run.
-const OWN_WITH_VALUE: [&str; 6] = [
-    "--array",
-    "--script",
-    "--cpus-per-task",
-    "--time",
-    "--partition",
-    "--sbatch-option",
-];
-const OWN_SWITCHES: [&str; 1] = ["--force-script"];
-
-/// The command's own tokens (after `slurm <kind>`) without `slurm`'s flags and without the flags
-/// in `strip` (with their values), and the last value of each flag in `take`.
-fn split_tokens(
-    tokens: &[String],
-    strip_with_value: &[&str],
-    strip_switches: &[&str],
-) -> (Vec<String>, Vec<(String, String)>) {
-    let mut kept = Vec::new();
-    let mut taken = Vec::new();
-    let mut i = 0;
-    while i < tokens.len() {
-        let t = &tokens[i];
-        let (name, inline) = match t.split_once('=') {
-            Some((n, v)) if n.starts_with("--") => (n.to_owned(), Some(v.to_owned())),
-            _ if t.starts_with("-o") && t.len() > 2 && !t.starts_with("--") => {
-                ("-o".to_owned(), Some(t[2..].to_owned()))
-            }
-            _ => (t.clone(), None),
-        };
-        if t == "--" {
-            kept.extend(tokens[i..].iter().cloned());
-            break;
-        }
-        let with_value =
-            OWN_WITH_VALUE.contains(&name.as_str()) || strip_with_value.contains(&name.as_str());
-        if with_value {
-            let value = match inline {
-                Some(v) => v,
-                None => {
-                    i += 1;
-                    tokens.get(i).cloned().unwrap_or_default()
-                }
-            };
-            taken.push((name, value));
-        } else if OWN_SWITCHES.contains(&name.as_str()) || strip_switches.contains(&name.as_str()) {
-            taken.push((name, String::new()));
-        } else {
-            kept.push(t.clone());
-        }
-        i += 1;
-    }
-    (kept, taken)
-}
-
-fn last<'a>(taken: &'a [(String, String)], names: &[&str]) -> Option<&'a str> {
-    taken
-        .iter()
-        .rev()
-        .find(|(n, _)| names.contains(&n.as_str()))
-        .map(|(_, v)| v.as_str())
 }
 
 /// Runs `scatterfit slurm`.
@@ -213,14 +150,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )?;
     let mut strip: Vec<&str> = output_flags.clone();
     strip.extend(["--cache-dir"]);
-    let (kept, taken) = split_tokens(tokens, &strip, &["--json", "--quiet"]);
-    let output = study_out.or_else(|| last(&taken, &output_flags).map(str::to_owned));
-    let cache_dir = last(&taken, &["--cache-dir"]).map(str::to_owned);
+    let split = split_tokens(tokens, &strip, &["--json", "--quiet"]);
+    let output = study_out.or_else(|| split.last(&output_flags).map(str::to_owned));
+    let cache_dir = split.last(&["--cache-dir"]).map(str::to_owned);
     let cwd = std::env::current_dir().context("the current folder")?;
     let abs = |p: &Path| cwd.join(p);
     let job = SlurmJob {
         command: kind,
-        args: kept,
+        args: split.kept,
         array: slurm.array,
         cpus_per_task: slurm.cpus_per_task,
         time: slurm.time.clone(),
@@ -244,32 +181,4 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     );
     outln!("{}", slurm.script.display())?;
     Ok(ExitCode::SUCCESS)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn splitting() {
-        let t: Vec<String> = [
-            "--eta",
-            "1.3",
-            "--array",
-            "8",
-            "-o",
-            "t.json",
-            "--time=1:00",
-            "--json",
-            "--g",
-            "0.9",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let (kept, taken) = split_tokens(&t, &["-o"], &["--json"]);
-        assert_eq!(kept, ["--eta", "1.3", "--g", "0.9"]);
-        assert_eq!(last(&taken, &["-o"]), Some("t.json"));
-        assert_eq!(last(&taken, &["--array"]), Some("8"));
-    }
 }

@@ -18,9 +18,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, bail};
 use scatterfit_lab::study::StudySample;
 use scatterfit_lab::study_run::{StudyConfig, StudyPart, fit_plan, fit_samples};
+use scatterfit_pipeline::outputs::claim_folder;
 
 use crate::common::{JobsArgs, PhotonScaleArgs, cache_dir};
 use crate::output::errln;
@@ -83,8 +83,6 @@ pub struct Args {
     pub quiet: bool,
 }
 
-const MARKER: &str = ".scatterfit-study";
-
 /// The study's settings from the flags.
 fn config(args: &Args) -> StudyConfig {
     StudyConfig {
@@ -99,36 +97,13 @@ fn config(args: &Args) -> StudyConfig {
     }
 }
 
-/// Checks the grid ([`StudyConfig::check`]) and that the output folder is the study's own.
-fn check_args(args: &Args, config: &StudyConfig) -> anyhow::Result<()> {
-    config.check()?;
-    let dir = &args.output_dir;
-    if dir.exists()
-        && !args.force
-        && !dir.join(MARKER).exists()
-        && let Some(e) = std::fs::read_dir(dir)?.flatten().next()
-    {
-        bail!(
-            "{} holds {} and was not made by `scatterfit study`; choose another folder with -o or \
-             pass --force",
-            dir.display(),
-            e.file_name().to_string_lossy()
-        );
-    }
-    Ok(())
-}
-
 /// Runs `scatterfit study`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let config = config(&args);
-    check_args(&args, &config)?;
+    config.check()?;
     let t0 = Instant::now();
     let out = &args.output_dir;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    scatterfit_io::atomic::write_atomic(
-        &out.join(MARKER),
-        b"made by `scatterfit study`; it may replace the files in this folder\n",
-    )?;
+    claim_folder(out, ".scatterfit-study", "study", "", args.force)?;
     let quiet = args.quiet || args.json;
     let cache = cache_dir(args.cache_dir.as_deref());
     let g_axis = config.g_axis();

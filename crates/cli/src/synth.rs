@@ -6,35 +6,19 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use scatterfit_io::sample_folder::file_names;
-use scatterfit_lab::twin_settings::{MaterialSettings, RigSettings};
+use scatterfit_lab::twin_settings::{MaterialSettings, RigSettings, twin_files};
 use scatterfit_synth::RigSpec;
 use serde::Serialize;
 
-use crate::common::{CacheArgs, check_output_files, parse_rgb, shutter};
+use crate::common::{CacheArgs, check_output_files, shutter};
 use crate::output::outln;
-use crate::twin::{Material, synthesize_on, write_sample_with};
+use crate::twin::{synthesize_on, write_sample_with};
 
 /// Arguments of `scatterfit synth`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A built-in material: the seven of Choi et al. 2014 (pink-plastic, blue-coating, brown-leather,
-    /// nephrite, wood-tile, sulfur, red-aluminum) or Jensen et al. 2001's (apple, chicken1,
-    /// chicken2, cream, ketchup, marble, potato, skimmilk, skin1, skin2, wholemilk; η = 1.3).
-    #[arg(long, value_name = "NAME", conflicts_with_all = ["sigma_s_prime", "sigma_a"])]
-    pub material: Option<String>,
-    /// Reduced scattering coefficient per channel R,G,B [mm⁻¹, each in (0, 100]].
-    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, requires_all = ["sigma_a", "eta"])]
-    pub sigma_s_prime: Option<[f64; 3]>,
-    /// Absorption coefficient per channel R,G,B [mm⁻¹, each in (0, 100]].
-    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, requires = "sigma_s_prime")]
-    pub sigma_a: Option<[f64; 3]>,
-    /// Relative refractive index η, in [1, 3] (overrides the material's).
-    #[arg(long, value_parser = crate::numeric::parse_finite)]
-    pub eta: Option<f64>,
-    /// Sample name (default: the material's, or "synthetic").
-    #[arg(long)]
-    pub name: Option<String>,
+    #[command(flatten)]
+    pub material: MaterialSettings,
     /// Folder to write (created; checked before the Monte Carlo runs; existing files are not
     /// overwritten without --force).
     #[arg(short = 'o', long = "output-dir", value_name = "DIR")]
@@ -115,17 +99,6 @@ pub struct Args {
     pub json: bool,
 }
 
-fn material_from(args: &Args) -> anyhow::Result<Material> {
-    let settings = MaterialSettings {
-        material: args.material.clone(),
-        sigma_s_prime: args.sigma_s_prime,
-        sigma_a: args.sigma_a,
-        eta: args.eta,
-        name: args.name.clone(),
-    };
-    Ok(settings.material()?)
-}
-
 /// The camera names `--camera` takes.
 fn parse_camera(s: &str) -> Result<String, String> {
     if scatterfit_synth::CameraModel::named(s).is_some() {
@@ -165,24 +138,11 @@ struct Summary<'a> {
 
 /// Runs `scatterfit synth`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let m = material_from(&args)?;
+    let m = args.material.material()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
     let rig = rig_from(&args)?;
     let port = scatterfit_lab::twin_settings::port(args.aperture_mm, args.illuminated_mm)?;
-    let mut names = file_names(rig.times_s.len(), true);
-    if args.camera == "dng" {
-        for n in &mut names {
-            if n.starts_with("frame_") {
-                *n = n.replace(".png", ".dng");
-            }
-        }
-    }
-    if args.vignetting > 0.0 {
-        names.push("flat.png".into());
-    }
-    if args.spot_image {
-        names.push("spot.png".into());
-    }
+    let names = twin_files(&rig, args.camera == "dng");
     check_output_files(&args.output_dir, &names, args.force)?;
     let cache = args.cache.dir();
     let mut sample = synthesize_on(

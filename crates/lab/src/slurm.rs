@@ -2,7 +2,8 @@
 //! command (`--shard $SLURM_ARRAY_TASK_ID/N`, each writing its partial file) and a combine job that
 //! runs once every shard has succeeded (`sbatch --dependency=afterok`). No scheduler of our own:
 //! the script is plain `sbatch`, and submitting it again redoes only the shards whose partial file
-//! is missing. [`SlurmJob::script`] is the text; the command line gathers the job's pieces.
+//! is missing. [`SlurmJob::script`] is the text; [`split_tokens`] takes the sharded command's own
+//! arguments from the command line.
 
 use std::path::PathBuf;
 
@@ -62,6 +63,84 @@ pub fn quote(s: &str) -> String {
     } else {
         format!("'{}'", s.replace('\'', r"'\''"))
     }
+}
+
+/// `scatterfit slurm`'s own flags that take a value: never passed on to the array tasks.
+pub const OWN_WITH_VALUE: [&str; 6] = [
+    "--array",
+    "--script",
+    "--cpus-per-task",
+    "--time",
+    "--partition",
+    "--sbatch-option",
+];
+
+/// `scatterfit slurm`'s own switches: never passed on to the array tasks.
+pub const OWN_SWITCHES: [&str; 1] = ["--force-script"];
+
+/// A sharded command's tokens as given (after `slurm <kind>`), split ([`split_tokens`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SplitTokens {
+    /// The tokens the array tasks run with.
+    pub kept: Vec<String>,
+    /// The flags taken out, in order, each with its value (empty for a switch).
+    pub taken: Vec<(String, String)>,
+}
+
+impl SplitTokens {
+    /// The value of the last of the flags `names` taken out.
+    pub fn last(&self, names: &[&str]) -> Option<&str> {
+        self.taken
+            .iter()
+            .rev()
+            .find(|(n, _)| names.contains(&n.as_str()))
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+/// Splits a command's `tokens` (after `slurm <kind>`) into those the array tasks run with and the
+/// flags taken out: `scatterfit slurm`'s own ([`OWN_WITH_VALUE`], [`OWN_SWITCHES`]) and those in
+/// `strip_with_value` (with their value: `--flag V`, `--flag=V`, `-oV`) and `strip_switches`.
+/// Everything from a `--` on is kept as it is.
+pub fn split_tokens(
+    tokens: &[String],
+    strip_with_value: &[&str],
+    strip_switches: &[&str],
+) -> SplitTokens {
+    let mut split = SplitTokens::default();
+    let mut i = 0;
+    while i < tokens.len() {
+        let t = &tokens[i];
+        let (name, inline) = match t.split_once('=') {
+            Some((n, v)) if n.starts_with("--") => (n.to_owned(), Some(v.to_owned())),
+            _ if t.starts_with("-o") && t.len() > 2 && !t.starts_with("--") => {
+                ("-o".to_owned(), Some(t[2..].to_owned()))
+            }
+            _ => (t.clone(), None),
+        };
+        if t == "--" {
+            split.kept.extend(tokens[i..].iter().cloned());
+            break;
+        }
+        let with_value =
+            OWN_WITH_VALUE.contains(&name.as_str()) || strip_with_value.contains(&name.as_str());
+        if with_value {
+            let value = match inline {
+                Some(v) => v,
+                None => {
+                    i += 1;
+                    tokens.get(i).cloned().unwrap_or_default()
+                }
+            };
+            split.taken.push((name, value));
+        } else if OWN_SWITCHES.contains(&name.as_str()) || strip_switches.contains(&name.as_str()) {
+            split.taken.push((name, String::new()));
+        } else {
+            split.kept.push(t.clone());
+        }
+        i += 1;
+    }
+    split
 }
 
 impl SlurmJob {
@@ -168,6 +247,30 @@ echo "logs: {logs}; squeue -j $array,$combine shows them"
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn splitting() {
+        let t: Vec<String> = [
+            "--eta",
+            "1.3",
+            "--array",
+            "8",
+            "-o",
+            "t.json",
+            "--time=1:00",
+            "--json",
+            "--g",
+            "0.9",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let split = split_tokens(&t, &["-o"], &["--json"]);
+        assert_eq!(split.kept, ["--eta", "1.3", "--g", "0.9"]);
+        assert_eq!(split.last(&["-o"]), Some("t.json"));
+        assert_eq!(split.last(&["--array"]), Some("8"));
+        assert_eq!(split.last(&["--time"]), Some("1:00"));
+    }
 
     fn job() -> SlurmJob {
         SlurmJob {

@@ -80,20 +80,36 @@ impl From<&PublishedMaterial> for Material {
 }
 
 /// The material's settings: a published material by name (its η replaced by `eta` when given), or
-/// coefficients and η.
+/// coefficients and η (also `scatterfit synth`'s flags, whose help texts are given with each field).
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct MaterialSettings {
     /// A published material (`scatterfit_optics::materials::by_name`).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME", conflicts_with_all = ["sigma_s_prime", "sigma_a"], help = MATERIAL_HELP))]
     pub material: Option<String>,
     /// σ′s per channel \[mm⁻¹, each in (0, 100]\].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "R,G,B", value_parser = scatterfit_io::flags::parse_rgb, requires_all = ["sigma_a", "eta"], help = "Reduced scattering coefficient per channel R,G,B [mm⁻¹, each in (0, 100]]"))]
     pub sigma_s_prime: Option<[f64; 3]>,
     /// σa per channel \[mm⁻¹, each in (0, 100]\].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "R,G,B", value_parser = scatterfit_io::flags::parse_rgb, requires = "sigma_s_prime", help = "Absorption coefficient per channel R,G,B [mm⁻¹, each in (0, 100]]"))]
     pub sigma_a: Option<[f64; 3]>,
     /// η, in [1, 3].
+    #[cfg_attr(feature = "clap", arg(long, value_parser = scatterfit_io::flags::parse_finite, help = "Relative refractive index η, in [1, 3] (overrides the material's)"))]
     pub eta: Option<f64>,
     /// The sample's name (default: the material's, or "synthetic").
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, help = "Sample name (default: the material's, or \"synthetic\")")
+    )]
     pub name: Option<String>,
 }
+
+/// Help text of `--material`: the published materials by name.
+#[cfg(feature = "clap")]
+const MATERIAL_HELP: &str = "A built-in material: the seven of Choi et al. 2014 (pink-plastic, \
+    blue-coating, brown-leather, nephrite, wood-tile, sulfur, red-aluminum) or Jensen et al. \
+    2001's (apple, chicken1, chicken2, cream, ketchup, marble, potato, skimmilk, skin1, skin2, \
+    wholemilk; η = 1.3)";
 
 impl MaterialSettings {
     /// The material.
@@ -152,6 +168,45 @@ impl MaterialSettings {
     }
 }
 
+/// The twins' Monte Carlo photons × a factor (`scatterfit synth`, `study`: `--photon-scale`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct PhotonScaleArgs {
+    /// Monte Carlo photons of every twin channel × this factor, 0.01–1000 (default 1): a twin's
+    /// own noise (its profile's and its reading's) falls as 1/√factor at factor times its Monte
+    /// Carlo time. At α′ ≥ 0.999 the paper rig's twins carry noise that reaches σ′s and σa at
+    /// 1–2.5 %, so a study that is to resolve the method's error there needs 10–20.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            value_name = "FACTOR",
+            default_value_t = 1.0,
+            allow_negative_numbers = true,
+            value_parser = parse_photon_scale
+        )
+    )]
+    pub photon_scale: f64,
+}
+
+/// Parses `--photon-scale`: a finite number in [`scatterfit_synth::rig::PHOTON_SCALE_RANGE`].
+///
+/// # Errors
+/// Not a number, or outside the range.
+pub fn parse_photon_scale(text: &str) -> Result<f64, scatterfit_io::flags::FlagError> {
+    let v = scatterfit_io::flags::parse_finite(text)?;
+    let range = scatterfit_synth::rig::PHOTON_SCALE_RANGE;
+    if range.contains(&v) {
+        Ok(v)
+    } else {
+        Err(scatterfit_io::flags::FlagError(format!(
+            "must lie in [{}, {}] (1 is the rig's own photon count)",
+            range.start(),
+            range.end()
+        )))
+    }
+}
+
 /// The rig's settings.
 #[derive(Debug, Clone)]
 pub struct RigSettings {
@@ -205,6 +260,27 @@ impl RigSettings {
         })?;
         Ok(rig)
     }
+}
+
+/// The files a twin's sample folder gets on `rig` (`scatterfit_io::sample_folder::file_names`
+/// with the truth), so that they can be checked before the Monte Carlo runs: the frames as `.dng`
+/// when `dng` (the `dng` camera), `flat.png` with vignetting, `spot.png` with a spot image.
+pub fn twin_files(rig: &RigSpec, dng: bool) -> Vec<String> {
+    let mut names = scatterfit_io::sample_folder::file_names(rig.times_s.len(), true);
+    if dng {
+        for n in &mut names {
+            if n.starts_with("frame_") {
+                *n = n.replace(".png", ".dng");
+            }
+        }
+    }
+    if rig.effects.vignetting > 0.0 {
+        names.push("flat.png".into());
+    }
+    if rig.effects.spot_image {
+        names.push("spot.png".into());
+    }
+    names
 }
 
 /// The spectrophotometer's port: the aperture's diameter and the lit disc's (default: the

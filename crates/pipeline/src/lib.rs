@@ -48,9 +48,11 @@ pub mod compare;
 mod error;
 pub mod export;
 pub mod fit;
+pub mod fit_args;
 pub mod hdr;
 pub mod measure;
 pub mod measurement;
+pub mod merge_settings;
 pub mod model_term;
 pub mod monte_carlo;
 pub mod outputs;
@@ -63,6 +65,7 @@ pub mod reuse;
 pub mod samples;
 pub mod settings;
 pub mod spectro;
+pub mod spectro_args;
 
 pub use batch::{
     BatchError, BatchEvent, BatchOutcome, BatchRequest, BatchSample, JobPlan, SampleOutcome,
