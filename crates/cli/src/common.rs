@@ -101,8 +101,6 @@ pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
         .or_else(scatterfit_mc::cache::default_cache_dir)
 }
 
-pub use scatterfit_pipeline::radiance::shutter;
-
 pub use scatterfit_pipeline::fit_args::FitArgs;
 
 /// The sample folders of `batch` and `compare`, and how many are measured at once.
@@ -122,8 +120,6 @@ pub struct SamplesArgs {
     #[arg(long)]
     pub force: bool,
 }
-
-pub use scatterfit_lab::twin_settings::PhotonScaleArgs;
 
 /// How many samples are measured at once (`batch`, `compare`, `demo`, `study`).
 #[derive(Debug, Clone, clap::Args)]

@@ -3,41 +3,14 @@
 //! dependent combine job). This file takes the command's own arguments from the command line,
 //! checks them and the outputs, and writes the script.
 
-use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
 use scatterfit_lab::partial::Kind;
-use scatterfit_lab::slurm::{SlurmJob, split_tokens};
+use scatterfit_lab::slurm::SlurmSettings;
 
 use crate::output::{errln, outln};
-
-/// Slurm's side of the script.
-#[derive(Debug, clap::Args)]
-pub struct SlurmArgs {
-    /// Shards: the job array's size, 1 to 10 000 (tasks 1…N).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000))]
-    pub array: u64,
-    /// Where to write the script (a `.sh` file; an existing one only with --force-script).
-    #[arg(long, value_name = "FILE", default_value = "scatterfit-slurm.sh")]
-    pub script: PathBuf,
-    /// Replace an existing script file.
-    #[arg(long)]
-    pub force_script: bool,
-    /// CPUs of each array task (`#SBATCH --cpus-per-task`; the task's threads), 1 to 1024.
-    #[arg(long, value_name = "C", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1024))]
-    pub cpus_per_task: u64,
-    /// Time limit of each task (`#SBATCH --time`, Slurm's format, e.g. 2:00:00).
-    #[arg(long, value_name = "TIME")]
-    pub time: Option<String>,
-    /// Partition (`#SBATCH --partition`).
-    #[arg(long, value_name = "NAME")]
-    pub partition: Option<String>,
-    /// Another `#SBATCH` option for both jobs, verbatim (repeatable; e.g. --sbatch-option=--account=lab).
-    #[arg(long, value_name = "OPTION", allow_hyphen_values = true)]
-    pub sbatch_option: Vec<String>,
-}
 
 /// The commands `slurm` can shard.
 #[derive(Debug, clap::Subcommand)]
@@ -45,14 +18,14 @@ pub enum What {
     /// A Monte Carlo table (`scatterfit table`'s arguments; -o FILE is written by the combine job).
     Table {
         #[command(flatten)]
-        slurm: SlurmArgs,
+        slurm: SlurmSettings,
         #[command(flatten)]
         args: crate::table::Args,
     },
     /// A batch of samples (`scatterfit batch`'s arguments; -o DIR gets the combine job's summary).
     Batch {
         #[command(flatten)]
-        slurm: SlurmArgs,
+        slurm: SlurmSettings,
         #[command(flatten)]
         args: crate::batch::Args,
     },
@@ -60,7 +33,7 @@ pub enum What {
     /// the combine job the tables and the figure).
     Study {
         #[command(flatten)]
-        slurm: SlurmArgs,
+        slurm: SlurmSettings,
         #[command(flatten)]
         args: crate::study::Args,
     },
@@ -148,29 +121,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &[],
         slurm.force_script,
     )?;
-    let mut strip: Vec<&str> = output_flags.clone();
-    strip.extend(["--cache-dir"]);
-    let split = split_tokens(tokens, &strip, &["--json", "--quiet"]);
-    let output = study_out.or_else(|| split.last(&output_flags).map(str::to_owned));
-    let cache_dir = split.last(&["--cache-dir"]).map(str::to_owned);
     let cwd = std::env::current_dir().context("the current folder")?;
-    let abs = |p: &Path| cwd.join(p);
-    let job = SlurmJob {
-        command: kind,
-        args: split.kept,
-        array: slurm.array,
-        cpus_per_task: slurm.cpus_per_task,
-        time: slurm.time.clone(),
-        partition: slurm.partition.clone(),
-        sbatch_options: slurm.sbatch_option.clone(),
-        exe: std::env::current_exe().context("finding the scatterfit binary")?,
-        partial_dir: abs(&partial_dir),
-        cache_dir: crate::common::cache_dir(cache_dir.as_deref().map(Path::new)).map(|c| abs(&c)),
-        output,
+    let exe = std::env::current_exe().context("finding the scatterfit binary")?;
+    let job = slurm.job(
+        kind,
+        tokens,
+        &output_flags,
+        study_out,
+        &partial_dir,
         fingerprint,
-        script: slurm.script.clone(),
+        exe,
         cwd,
-    };
+    );
     let (n, name, script) = (job.array, kind.name(), job.script());
     scatterfit_io::atomic::write_atomic(&slurm.script, script.as_bytes())
         .with_context(|| format!("--script {}", slurm.script.display()))?;

@@ -52,6 +52,84 @@ pub struct SlurmJob {
     pub script: PathBuf,
 }
 
+/// Slurm's side of a script: `scatterfit slurm`'s own flags (their help is the field's text).
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct SlurmSettings {
+    /// Shards: the job array's size, 1 to 10 000 (tasks 1…N).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000)))]
+    pub array: u64,
+    /// Where to write the script (a `.sh` file; an existing one only with --force-script).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "FILE", default_value = "scatterfit-slurm.sh")
+    )]
+    pub script: PathBuf,
+    /// Replace an existing script file.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub force_script: bool,
+    /// CPUs of each array task (`#SBATCH --cpus-per-task`; the task's threads), 1 to 1024.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "C", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1024)))]
+    pub cpus_per_task: u64,
+    /// Time limit of each task (`#SBATCH --time`, Slurm's format, e.g. 2:00:00).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "TIME"))]
+    pub time: Option<String>,
+    /// Partition (`#SBATCH --partition`).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME"))]
+    pub partition: Option<String>,
+    /// Another `#SBATCH` option for both jobs, verbatim (repeatable; e.g. --sbatch-option=--account=lab).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "OPTION", allow_hyphen_values = true)
+    )]
+    pub sbatch_option: Vec<String>,
+}
+
+impl SlurmSettings {
+    /// The job of `command` from its own command-line `tokens` (after `slurm <kind>`,
+    /// [`split_tokens`]): the flags `output_flags` and `--cache-dir` are taken out, and `--json`
+    /// and `--quiet`; the combine job's `-o` is `output` if given, else the last output flag's
+    /// value; the Monte Carlo cache is `--cache-dir`, else `scatterfit_mc::cache::default_cache_dir`;
+    /// paths are made absolute from `cwd`, where the jobs run.
+    #[allow(clippy::too_many_arguments)]
+    pub fn job(
+        &self,
+        command: Kind,
+        tokens: &[String],
+        output_flags: &[&str],
+        output: Option<String>,
+        partial_dir: &std::path::Path,
+        fingerprint: Option<String>,
+        exe: PathBuf,
+        cwd: PathBuf,
+    ) -> SlurmJob {
+        let mut strip: Vec<&str> = output_flags.to_vec();
+        strip.push("--cache-dir");
+        let split = split_tokens(tokens, &strip, &["--json", "--quiet"]);
+        let output = output.or_else(|| split.last(output_flags).map(str::to_owned));
+        let cache_dir = split
+            .last(&["--cache-dir"])
+            .map(PathBuf::from)
+            .or_else(scatterfit_mc::cache::default_cache_dir);
+        SlurmJob {
+            command,
+            args: split.kept,
+            array: self.array,
+            cpus_per_task: self.cpus_per_task,
+            time: self.time.clone(),
+            partition: self.partition.clone(),
+            sbatch_options: self.sbatch_option.clone(),
+            exe,
+            partial_dir: cwd.join(partial_dir),
+            cache_dir: cache_dir.map(|c| cwd.join(c)),
+            output,
+            fingerprint,
+            script: self.script.clone(),
+            cwd,
+        }
+    }
+}
+
 /// `s` quoted for a POSIX shell (left as it is when it holds only characters no shell treats
 /// specially).
 pub fn quote(s: &str) -> String {

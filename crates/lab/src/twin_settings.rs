@@ -168,26 +168,13 @@ impl MaterialSettings {
     }
 }
 
-/// The twins' Monte Carlo photons × a factor (`scatterfit synth`, `study`: `--photon-scale`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "clap", derive(clap::Args))]
-pub struct PhotonScaleArgs {
-    /// Monte Carlo photons of every twin channel × this factor, 0.01–1000 (default 1): a twin's
-    /// own noise (its profile's and its reading's) falls as 1/√factor at factor times its Monte
-    /// Carlo time. At α′ ≥ 0.999 the paper rig's twins carry noise that reaches σ′s and σa at
-    /// 1–2.5 %, so a study that is to resolve the method's error there needs 10–20.
-    #[cfg_attr(
-        feature = "clap",
-        arg(
-            long,
-            value_name = "FACTOR",
-            default_value_t = 1.0,
-            allow_negative_numbers = true,
-            value_parser = parse_photon_scale
-        )
-    )]
-    pub photon_scale: f64,
-}
+/// Help text of `--photon-scale` (`scatterfit synth`, `study`): the twins' Monte Carlo photons × a
+/// factor, and what it buys.
+pub const PHOTON_SCALE_HELP: &str = "Monte Carlo photons of every twin channel × this factor, \
+    0.01–1000 (default 1): a twin's own noise (its profile's and its reading's) falls as 1/√factor \
+    at factor times its Monte Carlo time. At α′ ≥ 0.999 the paper rig's twins carry noise that \
+    reaches σ′s and σa at 1–2.5 %, so a study that is to resolve the method's error there needs \
+    10–20";
 
 /// Parses `--photon-scale`: a finite number in [`scatterfit_synth::rig::PHOTON_SCALE_RANGE`].
 ///
@@ -207,21 +194,50 @@ pub fn parse_photon_scale(text: &str) -> Result<f64, scatterfit_io::flags::FlagE
     }
 }
 
-/// The rig's settings.
+/// The rig's settings (also `scatterfit synth`'s flags, whose help is the field's text; the
+/// effects' flags follow them on the command line and are set after parsing).
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct RigSettings {
-    /// The quick rig (`RigSpec::quick`) instead of the paper's.
+    /// A small fast sample (256 × 256 px at 0.1 mm/px, a tenth of the photons) for trying the tool
+    /// and for tests; not for accuracy studies.
+    #[cfg_attr(feature = "clap", arg(long))]
     pub quick: bool,
-    /// The material's Henyey–Greenstein g, in [0, `G_RANGE_MAX`].
-    pub g: f64,
-    /// Monte Carlo photons × this factor (`RigSpec::with_photon_scale`).
+    /// Monte Carlo photons × this factor (`RigSpec::with_photon_scale`; [`PHOTON_SCALE_HELP`]).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FACTOR", default_value_t = 1.0, allow_negative_numbers = true, value_parser = parse_photon_scale, help = PHOTON_SCALE_HELP))]
     pub photon_scale: f64,
-    /// The camera (`CameraModel::named`; `None`: the rig's own).
+    /// The material's Henyey–Greenstein anisotropy g, in [0, 0.95] (default 0, isotropic): the
+    /// profile and the spectrophotometer's reading are traced with it (σs = σ′s/(1 − g)). It goes
+    /// into truth.json, never into the manifest: the twin plays a user who does not know g. A g of
+    /// 0.9 traces about 10× the interactions of g = 0, 0.95 about 20×.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "G", default_value_t = 0.0, value_parser = scatterfit_io::flags::parse_finite))]
+    pub g: f64,
+    /// The twin's camera: naka-rushton (the default, 8-bit), linear, gamma22, srgb, log, s-curve
+    /// (8-bit tone curves), linear16 (linear 16-bit PNG, black level 1024 DN) or dng (14-bit raw
+    /// DNG files, black level 512, white 16383, exposure times in their metadata).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME", value_parser = parse_camera, default_value = "naka-rushton"))]
     pub camera: Option<String>,
-    /// Camera read noise \[electrons, 0 to 1000\] (`None`: the camera's).
+    /// Camera read noise [electrons, 0 to 1000] (default 3).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "E", value_parser = scatterfit_io::flags::parse_finite))]
     pub read_noise: Option<f64>,
     /// A real rig's effects.
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub effects: RigEffects,
+}
+
+/// Parses `--camera`: a camera of the twin ([`CameraModel::named`]).
+///
+/// # Errors
+/// An unknown name, listing the twin's cameras.
+pub fn parse_camera(s: &str) -> Result<String, scatterfit_io::flags::FlagError> {
+    if CameraModel::named(s).is_some() {
+        Ok(s.to_string())
+    } else {
+        Err(scatterfit_io::flags::FlagError(format!(
+            "unknown camera `{s}`; the twin has: {}",
+            CameraModel::NAMES.join(", ")
+        )))
+    }
 }
 
 impl RigSettings {
