@@ -30,7 +30,7 @@ pub fn error_text(err: &anyhow::Error) -> String {
     scatterfit_report::error::error_text(err.as_ref())
 }
 
-pub use scatterfit_io::flags::{parse_g, parse_g_range, parse_rgb};
+pub use scatterfit_io::flags::parse_rgb;
 
 /// A progress bar on stderr when it is a terminal and not `quiet`, else hidden.
 pub fn bar(len: u64, template: &str, quiet: bool) -> indicatif::ProgressBar {

@@ -59,6 +59,7 @@ pub mod outputs;
 pub mod port;
 pub mod profile;
 pub mod profile_fit;
+pub mod profile_fit_args;
 pub mod radiance;
 mod result;
 pub mod reuse;
