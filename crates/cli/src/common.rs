@@ -103,57 +103,7 @@ pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
 
 pub use scatterfit_pipeline::fit_args::FitArgs;
 
-/// The sample folders of `batch` and `compare`, and how many are measured at once.
-#[derive(Debug, Clone, clap::Args)]
-pub struct SamplesArgs {
-    /// Sample folders (each with a sample.toml), or folders holding sample folders.
-    #[arg(required = true)]
-    pub dirs: Vec<PathBuf>,
-    #[command(flatten)]
-    pub jobs: JobsArgs,
-    /// Write -o into another sample's folder, and replace files there or in the sample folders
-    /// that scatterfit did not write (its ledger, .scatterfit-written.json, does not list them);
-    /// for `batch`, also measure every sample again, even one whose result files match its inputs
-    /// (by default such a sample's result is reused: its result set complete, its inputs' SHA-256
-    /// and the options given as result.json records them), and with --shard redo a shard whose
-    /// partial file is there.
-    #[arg(long)]
-    pub force: bool,
-}
-
-/// How many samples are measured at once (`batch`, `compare`, `demo`, `study`).
-#[derive(Debug, Clone, clap::Args)]
-pub struct JobsArgs {
-    #[arg(short = 'j', long, value_name = "N", value_parser = parse_jobs, help = JOBS_HELP)]
-    pub jobs: Option<usize>,
-}
-
-impl JobsArgs {
-    /// The count asked for; 0 for the default (one per core, fewer when the memory budget says so).
-    pub fn count(&self) -> usize {
-        self.jobs.unwrap_or(0)
-    }
-}
-
-/// Samples measured at once \[1, 256\] (`-j`): the help text shared by `batch`, `compare`, `demo`,
-/// `study`.
-pub const JOBS_HELP: &str = "Samples measured at the same time: a count, 1 to 256 (default: one \
-     per core). Fewer are run at once when that many would not fit the memory budget \
-     ($SCATTERFIT_MAX_MEMORY_MIB, default half of this machine's memory; each sample holds its decoded bracket and \
-     radiance map); a note on stderr says so";
-
-/// Parses `-j`: a count in 1..=256.
-///
-/// # Errors
-/// A message for clap.
-pub fn parse_jobs(text: &str) -> Result<usize, String> {
-    match crate::numeric::parse_size(text).map_err(|e| e.to_string())? {
-        n @ 1..=256 => Ok(n),
-        n => Err(format!(
-            "{n} samples at once: give 1 to 256 (each holds a whole bracket in memory)"
-        )),
-    }
-}
+pub use scatterfit_pipeline::batch_args::{JobsArgs, SamplesArgs};
 
 /// The Monte Carlo profile cache of the rig twin (`synth`, `demo`).
 #[derive(Debug, Clone, clap::Args)]

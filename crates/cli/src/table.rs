@@ -104,10 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let summary = TableSummary::new(&table, &spec, status, path, args.output.clone());
     if let Some(out) = &args.output {
-        let json = serde_json::to_vec(&table.clone().compact())
-            .context("the table does not serialise (a defect)")?;
-        scatterfit_io::atomic::write_atomic(out, &json)
-            .with_context(|| format!("-o {}", out.display()))?;
+        write_compact(&table, out)?;
     }
     if args.json {
         crate::output::print_json(&summary)?;
@@ -115,6 +112,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         out!("{}", summary.text())?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes `table` to `out` (-o) in the compact form of the shipped tables (no raw profiles).
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_compact(table: &scatterfit_mc::McTable, out: &std::path::Path) -> anyhow::Result<()> {
+    let json = serde_json::to_vec(&table.clone().compact())
+        .context("the table does not serialise (a defect)")?;
+    scatterfit_io::atomic::write_atomic(out, &json).with_context(|| format!("-o {}", out.display()))
 }
 
 /// `scatterfit table --shard K/N`: the shard's part of the table's white run, written as a partial

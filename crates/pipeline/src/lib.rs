@@ -42,6 +42,7 @@
 
 pub mod anisotropy;
 pub mod batch;
+pub mod batch_args;
 pub mod camera;
 pub mod checks;
 pub mod compare;
