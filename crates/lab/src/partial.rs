@@ -377,6 +377,41 @@ pub fn check_set(paths: &[PathBuf]) -> Result<Vec<Partial<IgnoredAny>>, PartialE
     Ok(parts)
 }
 
+/// The table of a sharded `scatterfit table` run from its `partials` (checked by [`check_set`]:
+/// `count` shards of one run): the spec from the first file's run `inputs`, then each file's exact
+/// sums added into the running sums one at a time (memory: the sums and one part, not every file
+/// at once), smoothed once — the table the run on one machine builds, byte for byte.
+///
+/// # Errors
+/// A damaged partial file, a spec the engine refuses, shards that do not add up (named).
+pub fn combine_table(
+    inputs: &serde_json::Value,
+    count: u64,
+    partials: &[PathBuf],
+) -> Result<(scatterfit_mc::McTableSpec, scatterfit_mc::McTable), PartialError> {
+    use scatterfit_mc::white::{Combiner, WhitePartial};
+    let first = partials.first().cloned().unwrap_or_default();
+    let spec: scatterfit_mc::McTableSpec =
+        serde_json::from_value(inputs.clone()).map_err(|source| PartialError::TableSpec {
+            path: first,
+            source,
+        })?;
+    let table_error = |what: String| move |source| PartialError::Table { what, source };
+    let mut combiner = Combiner::new(spec.white()?, count)?;
+    for path in partials {
+        let p = read::<WhitePartial>(path)?;
+        combiner
+            .add(&p.data)
+            .map_err(table_error(path.display().to_string()))?;
+    }
+    let tally = combiner
+        .finish()
+        .map_err(table_error("combining the shards".into()))?;
+    let table = scatterfit_mc::McTable::from_tally(&spec, &tally)
+        .map_err(table_error("smoothing the combined table".into()))?;
+    Ok((spec, table))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -442,39 +477,4 @@ mod tests {
         let e = check_set(&[junk]).unwrap_err().to_string();
         assert!(e.contains("not a scatterfit partial file"), "{e}");
     }
-}
-
-/// The table of a sharded `scatterfit table` run from its `partials` (checked by [`check_set`]:
-/// `count` shards of one run): the spec from the first file's run `inputs`, then each file's exact
-/// sums added into the running sums one at a time (memory: the sums and one part, not every file
-/// at once), smoothed once — the table the run on one machine builds, byte for byte.
-///
-/// # Errors
-/// A damaged partial file, a spec the engine refuses, shards that do not add up (named).
-pub fn combine_table(
-    inputs: &serde_json::Value,
-    count: u64,
-    partials: &[PathBuf],
-) -> Result<(scatterfit_mc::McTableSpec, scatterfit_mc::McTable), PartialError> {
-    use scatterfit_mc::white::{Combiner, WhitePartial};
-    let first = partials.first().cloned().unwrap_or_default();
-    let spec: scatterfit_mc::McTableSpec =
-        serde_json::from_value(inputs.clone()).map_err(|source| PartialError::TableSpec {
-            path: first,
-            source,
-        })?;
-    let table_error = |what: String| move |source| PartialError::Table { what, source };
-    let mut combiner = Combiner::new(spec.white()?, count)?;
-    for path in partials {
-        let p = read::<WhitePartial>(path)?;
-        combiner
-            .add(&p.data)
-            .map_err(table_error(path.display().to_string()))?;
-    }
-    let tally = combiner
-        .finish()
-        .map_err(table_error("combining the shards".into()))?;
-    let table = scatterfit_mc::McTable::from_tally(&spec, &tally)
-        .map_err(table_error("smoothing the combined table".into()))?;
-    Ok((spec, table))
 }
