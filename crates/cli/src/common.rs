@@ -95,11 +95,7 @@ pub const PHOTONS_BAR: &str = "{bar:40} {human_pos}/{human_len} photons  {per_se
 
 /// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default. (Its
 /// writes go through `scatterfit-safefs` like every other, so Ctrl-C removes their temporaries.)
-pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
-    given
-        .map(Path::to_path_buf)
-        .or_else(scatterfit_mc::cache::default_cache_dir)
-}
+pub use scatterfit_mc::cache::cache_dir_or_default as cache_dir;
 
 pub use scatterfit_pipeline::fit_args::FitArgs;
 

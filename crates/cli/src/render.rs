@@ -17,9 +17,7 @@ use anyhow::bail;
 use scatterfit_optics::ModelName;
 use scatterfit_render::colour::ColourParams;
 use scatterfit_render::measured::{profile_path, read_measured};
-use scatterfit_render::request::{
-    MeshSummary, RenderEvent, RenderSummary, render_figure, write_figure,
-};
+use scatterfit_render::request::{RenderEvent, render_figure, write_figure};
 use scatterfit_render::settings::{RenderSettings, check_output_kind};
 use scatterfit_render::tonemap::ToneMap;
 use scatterfit_render::{
@@ -268,21 +266,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     })?;
     bar.finish_and_clear();
     write_figure(&request, &panels, &args.output, &tone, args.gray)?;
-    let summary = Summary {
-        mesh: MeshSummary {
-            source: studio.source,
-            triangles: studio.triangles,
-            size_mm: studio.size_mm,
-            bvh_build_s: studio.build_s,
-        },
-        renders: panels
-            .iter()
-            .map(|p| RenderSummary::new(&request.params[p.set], &p.rendered, &options))
-            .collect(),
-        profile: None,
-        outputs: args.output.clone(),
-        threads: rayon::current_num_threads(),
-    };
+    let summary = request.summary(&studio, &panels, &args.output, rayon::current_num_threads());
     print_summary(&args, &summary)?;
     Ok(code)
 }

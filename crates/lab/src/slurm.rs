@@ -107,10 +107,8 @@ impl SlurmSettings {
         strip.push("--cache-dir");
         let split = split_tokens(tokens, &strip, &["--json", "--quiet"]);
         let output = output.or_else(|| split.last(output_flags).map(str::to_owned));
-        let cache_dir = split
-            .last(&["--cache-dir"])
-            .map(PathBuf::from)
-            .or_else(scatterfit_mc::cache::default_cache_dir);
+        let given = split.last(&["--cache-dir"]).map(std::path::Path::new);
+        let cache_dir = scatterfit_mc::cache::cache_dir_or_default(given);
         SlurmJob {
             command,
             args: split.kept,
