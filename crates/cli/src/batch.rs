@@ -13,10 +13,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
 
-use scatterfit_pipeline::reuse::reusable_result;
+use scatterfit_report::batch_set::{BatchPlan, plan_batch};
 use serde::Serialize;
 
-use crate::batch_set::{Entry, failure_of, summarise};
+use crate::batch_set::{Entry, summarise};
 use crate::common::{FitArgs, SamplesArgs};
 use crate::output::errln;
 
@@ -99,34 +99,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => None,
     };
     let owned = |i: usize| job.as_ref().is_none_or(|(shard, _)| shard.owns(i));
-    let mut entries: Vec<Entry> = Vec::new();
-    let mut todo: Vec<(usize, PathBuf)> = Vec::new();
-    for (i, dir) in dirs.iter().enumerate().filter(|(i, _)| owned(*i)) {
-        match (!args.samples.force)
-            .then(|| reusable_result(dir, &overrides))
-            .flatten()
-        {
-            Some(r) => entries.push(Entry {
-                index: i,
-                dir: dir.clone(),
-                failure: failure_of(&r),
-                result: Some(r),
-                reused: true,
-            }),
-            None => todo.push((i, dir.clone())),
-        }
-    }
-    for (j, (dir, why)) in misspelt.iter().enumerate() {
-        if owned(dirs.len() + j) {
-            entries.push(Entry {
-                index: dirs.len() + j,
-                dir: dir.clone(),
-                result: None,
-                failure: Some(why.clone()),
-                reused: false,
-            });
-        }
-    }
+    let BatchPlan { mut entries, todo } =
+        plan_batch(&dirs, &misspelt, &overrides, args.samples.force, &owned);
     let reused = entries.iter().filter(|e| e.reused).count();
     if reused > 0 && !quiet {
         errln!(
@@ -161,21 +135,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .iter()
             .find(|(d, _)| d == dir)
             .map(|(_, e)| e.clone());
-        let (result, failure) = match (&o.result, written) {
+        entries.push(match (&o.result, written) {
             (Ok(m), None) => {
-                let r = m.to_result(Some("profile.csv"));
-                let f = failure_of(&r);
-                (Some(r), f)
+                Entry::with_result(i, dir.clone(), m.to_result(Some("profile.csv")), false)
             }
-            (Ok(_), Some(e)) => (None, Some(e)),
-            (Err(e), _) => (None, Some(crate::common::error_text(e))),
-        };
-        entries.push(Entry {
-            index: i,
-            dir: dir.clone(),
-            result,
-            failure,
-            reused: false,
+            (Ok(_), Some(e)) => Entry::failed(i, dir.clone(), e),
+            (Err(e), _) => Entry::failed(i, dir.clone(), crate::common::error_text(e)),
         });
     }
     entries.sort_by_key(|e| e.index);

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-pub use scatterfit_report::batch_set::{BatchEntry as Entry, failure_of};
+pub use scatterfit_report::batch_set::BatchEntry as Entry;
 use scatterfit_report::batch_set::{BatchSummary, write_batch_summary};
 
 use crate::output::{out, outln};

@@ -80,25 +80,10 @@ fn combine_table(args: &Args, parts: Vec<Partial<IgnoredAny>>) -> anyhow::Result
             .collect::<Vec<_>>(),
         args.force,
     )?;
-    let spec: scatterfit_mc::McTableSpec = serde_json::from_value(parts[0].inputs.clone())
-        .with_context(|| format!("{}: the table spec", args.partials[0].display()))?;
-    let count = parts[0].shard.count();
+    let (inputs, count) = (parts[0].inputs.clone(), parts[0].shard.count());
     drop(parts);
-    // One part at a time into the running exact sums (memory: the sums and one part).
-    let mut combiner = scatterfit_mc::white::Combiner::new(spec.white()?, count)?;
-    for path in &args.partials {
-        let p = crate::shard::read::<scatterfit_mc::white::WhitePartial>(path)?;
-        combiner
-            .add(&p.data)
-            .with_context(|| format!("{}", path.display()))?;
-    }
-    let tally = combiner.finish().context("combining the shards")?;
-    let table = scatterfit_mc::McTable::from_tally(&spec, &tally)
-        .context("smoothing the combined table")?;
-    let json = serde_json::to_vec(&table.clone().compact())
-        .context("the table does not serialise (a defect)")?;
-    scatterfit_io::atomic::write_atomic(&args.output, &json)
-        .with_context(|| format!("-o {}", args.output.display()))?;
+    let (spec, table) = scatterfit_lab::partial::combine_table(&inputs, count, &args.partials)?;
+    crate::table::write_compact(&table, &args.output)?;
     // Also where `scatterfit table` keeps it, so that the tool finds it as if built here.
     let cached =
         crate::common::cache_dir(args.cache_dir.as_deref()).map(|d| d.join(spec.file_name()));

@@ -4,12 +4,6 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use anyhow::bail;
-use scatterfit_io::manifest::GSetting;
-use scatterfit_optics::{AlbedoModel, Method, ModelName};
-use scatterfit_pipeline::Overrides;
-use scatterfit_pipeline::anisotropy::GPrior;
-
 /// A measurement that ran and failed (exit code 1), as opposed to bad input (2).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
@@ -33,35 +27,10 @@ pub fn is_measurement_failure(err: &anyhow::Error) -> bool {
 /// The error and its causes joined by ": ", skipping a cause whose text the message already holds
 /// (many library errors name their source in their own message, and `{:#}` would repeat it).
 pub fn error_text(err: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in err.chain() {
-        let c = cause.to_string();
-        if text.contains(&c) {
-            continue;
-        }
-        if !text.is_empty() {
-            text.push_str(": ");
-        }
-        text.push_str(&c);
-    }
-    text
+    scatterfit_report::error::error_text(err.as_ref())
 }
 
-/// Parses `R,G,B` (three numbers).
-pub fn parse_rgb(text: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
-    match (parts.len(), values.as_slice()) {
-        (3, &[r, g, b]) if [r, g, b].iter().all(|v| v.is_finite()) => Ok([r, g, b]),
-        // One number: say how to give it for every channel (the example is the user's own value).
-        (1, &[v]) => Err(format!(
-            "`{text}` is one number; give one per channel, R,G,B (e.g. {v},{v},{v})"
-        )),
-        _ => Err(format!(
-            "`{text}` is not three numbers R,G,B (one per channel, comma-separated)"
-        )),
-    }
-}
+pub use scatterfit_io::flags::parse_rgb;
 
 /// A progress bar on stderr when it is a terminal and not `quiet`, else hidden.
 pub fn bar(len: u64, template: &str, quiet: bool) -> indicatif::ProgressBar {
@@ -124,213 +93,13 @@ impl StatusLines {
 /// The progress bar of a Monte Carlo run (`simulate`, `table`).
 pub const PHOTONS_BAR: &str = "{bar:40} {human_pos}/{human_len} photons  {per_sec}  ETA {eta}";
 
-/// Refuses to write into `dir` when any of `files` already exists there, unless `force`; a link or a
-/// non-file at one of their names always.
-///
-/// # Errors
-/// Names the first existing file and says how to proceed.
-pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> anyhow::Result<()> {
-    for f in files {
-        check_destination(&dir.join(f), "-o")?;
-    }
-    if force {
-        return Ok(());
-    }
-    if let Some(f) = files.iter().find(|f| dir.join(f).exists()) {
-        bail!(
-            "{} already exists; nothing was written — choose another folder or pass --force to \
-             overwrite",
-            dir.join(f).display()
-        );
-    }
-    Ok(())
-}
-
 /// The cache folder for Monte Carlo results: `--cache-dir`, else the mc crate's default. (Its
 /// writes go through `scatterfit-safefs` like every other, so Ctrl-C removes their temporaries.)
-pub fn cache_dir(given: Option<&Path>) -> Option<PathBuf> {
-    given
-        .map(Path::to_path_buf)
-        .or_else(scatterfit_mc::cache::default_cache_dir)
-}
+pub use scatterfit_mc::cache::cache_dir_or_default as cache_dir;
 
-pub use scatterfit_pipeline::radiance::shutter;
+pub use scatterfit_pipeline::fit_args::FitArgs;
 
-/// Options shared by `measure`, `batch` and `compare`: what overrides the manifests' `[fit]`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct FitArgs {
-    /// The fitting method (default: the manifest's `fit.method`, else proposed).
-    #[arg(long, value_enum)]
-    pub method: Option<Method>,
-    /// The forward model (default: the manifest's `fit.model`, else mc — exact transport; `dipole`
-    /// is the paper's, whose bias reaches tens of percent: its error then joins the bars as the
-    /// ± model term).
-    #[arg(long, value_enum)]
-    pub model: Option<ModelName>,
-    /// How α′ comes from the spectrophotometer's Rd (default: the manifest's `fit.albedo_model`,
-    /// else mc for the mc model and diffusion otherwise).
-    #[arg(long, value_enum)]
-    pub albedo_model: Option<AlbedoModel>,
-    /// A known η instead of the one measured from SCI − SCE, in [1, 3].
-    #[arg(long, value_parser = crate::numeric::parse_finite)]
-    pub eta: Option<f64>,
-    /// Proposed method: fix the profile's scale by the spectrophotometer's Rd instead of fitting it.
-    #[arg(long)]
-    pub normalise_with_spectro: bool,
-    /// The material's Henyey–Greenstein g, known or assumed (replaces the manifest's `[fit] g`
-    /// and `g_range`): the `mc` model is evaluated at it and its ± g term is 0 (the tables cover
-    /// g 0–0.95; another g is refused naming what they hold). Or `fit` (needs --model mc): g
-    /// fitted per channel from the profile within --g-range, printed with its standard error
-    /// only where the data determine it. Without --g and --g-range, the manifest's keys; with
-    /// neither there, the values at g = 0 and a ± g term over 0–0.95 (g not stated is g not known).
-    #[arg(long, value_name = "G|fit", value_parser = parse_g)]
-    pub g: Option<GSetting>,
-    /// The range LO,HI (0 ≤ LO ≤ HI ≤ 0.95) the material's g lies in (replaces `[fit] g_range`):
-    /// propagated into σ′s, σa and α′ as the ± g term; with --g the values are at that g, without
-    /// it the middle of the estimates over the range.
-    #[arg(long, value_name = "LO,HI", value_parser = parse_g_range)]
-    pub g_range: Option<[f64; 2]>,
-    /// Let a manifest name files outside its sample folder (`../dark.png`, an absolute path, a
-    /// link that leaves the folder). Without it they are refused before any work: whoever can
-    /// write a manifest could otherwise make scatterfit read any file you can.
-    #[arg(long)]
-    pub allow_outside_paths: bool,
-}
-
-impl FitArgs {
-    /// The pipeline's overrides.
-    ///
-    /// # Errors
-    /// An η outside [1, 3].
-    pub fn overrides(&self) -> anyhow::Result<Overrides> {
-        if let Some(e) = self.eta
-            && !(e.is_finite() && (1.0..=3.0).contains(&e))
-        {
-            anyhow::bail!(
-                "--eta {}: the relative refractive index must lie in [1, 3]",
-                crate::numeric::show(e)
-            );
-        }
-        Ok(Overrides {
-            method: self.method,
-            model: self.model,
-            albedo_model: self.albedo_model,
-            eta: self.eta,
-            normalise_with_spectro: self.normalise_with_spectro.then_some(true),
-            g: (self.g.is_some() || self.g_range.is_some())
-                .then(|| GPrior::from_setting(self.g, self.g_range)),
-            allow_outside_paths: self.allow_outside_paths,
-        })
-    }
-}
-
-/// Parses `--g G|fit` into the manifest's `[fit] g` setting (its `FromStr`; numbers as the
-/// other flags take them: `1_000`-style digits and exponents through [`crate::numeric::parse_finite`]).
-pub fn parse_g(text: &str) -> Result<GSetting, String> {
-    crate::numeric::parse_finite(text)
-        .map(GSetting::Value)
-        .or_else(|_| text.parse::<GSetting>())
-}
-
-/// Parses `--g-range LO,HI`: two finite numbers (the range's rule is checked with the other
-/// options).
-pub fn parse_g_range(text: &str) -> Result<[f64; 2], String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
-    match (parts.len(), values.as_slice()) {
-        (2, &[lo, hi]) if lo.is_finite() && hi.is_finite() => Ok([lo, hi]),
-        _ => Err(format!(
-            "`{text}` is not a range LO,HI of g (e.g. 0.7,0.95)"
-        )),
-    }
-}
-
-/// The sample folders of `batch` and `compare`, and how many are measured at once.
-#[derive(Debug, Clone, clap::Args)]
-pub struct SamplesArgs {
-    /// Sample folders (each with a sample.toml), or folders holding sample folders.
-    #[arg(required = true)]
-    pub dirs: Vec<PathBuf>,
-    #[command(flatten)]
-    pub jobs: JobsArgs,
-    /// Write -o into another sample's folder, and replace files there or in the sample folders
-    /// that scatterfit did not write (its ledger, .scatterfit-written.json, does not list them);
-    /// for `batch`, also measure every sample again, even one whose result files match its inputs
-    /// (by default such a sample's result is reused: its result set complete, its inputs' SHA-256
-    /// and the options given as result.json records them), and with --shard redo a shard whose
-    /// partial file is there.
-    #[arg(long)]
-    pub force: bool,
-}
-
-/// The twins' Monte Carlo photons × a factor (`synth`, `study`).
-#[derive(Debug, Clone, clap::Args)]
-pub struct PhotonScaleArgs {
-    /// Monte Carlo photons of every twin channel × this factor, 0.01–1000 (default 1): a twin's
-    /// own noise (its profile's and its reading's) falls as 1/√factor at factor times its Monte
-    /// Carlo time. At α′ ≥ 0.999 the paper rig's twins carry noise that reaches σ′s and σa at
-    /// 1–2.5 %, so a study that is to resolve the method's error there needs 10–20.
-    #[arg(
-        long,
-        value_name = "FACTOR",
-        default_value_t = 1.0,
-        allow_negative_numbers = true,
-        value_parser = parse_photon_scale
-    )]
-    pub photon_scale: f64,
-}
-
-/// Parses `--photon-scale`: a finite number in [`scatterfit_synth::rig::PHOTON_SCALE_RANGE`].
-///
-/// # Errors
-/// A message for clap.
-fn parse_photon_scale(text: &str) -> Result<f64, String> {
-    let v = crate::numeric::parse_finite(text)?;
-    let range = scatterfit_synth::rig::PHOTON_SCALE_RANGE;
-    if range.contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!(
-            "must lie in [{}, {}] (1 is the rig's own photon count)",
-            range.start(),
-            range.end()
-        ))
-    }
-}
-
-/// How many samples are measured at once (`batch`, `compare`, `demo`, `study`).
-#[derive(Debug, Clone, clap::Args)]
-pub struct JobsArgs {
-    #[arg(short = 'j', long, value_name = "N", value_parser = parse_jobs, help = JOBS_HELP)]
-    pub jobs: Option<usize>,
-}
-
-impl JobsArgs {
-    /// The count asked for; 0 for the default (one per core, fewer when the memory budget says so).
-    pub fn count(&self) -> usize {
-        self.jobs.unwrap_or(0)
-    }
-}
-
-/// Samples measured at once \[1, 256\] (`-j`): the help text shared by `batch`, `compare`, `demo`,
-/// `study`.
-pub const JOBS_HELP: &str = "Samples measured at the same time: a count, 1 to 256 (default: one \
-     per core). Fewer are run at once when that many would not fit the memory budget \
-     ($SCATTERFIT_MAX_MEMORY_MIB, default half of this machine's memory; each sample holds its decoded bracket and \
-     radiance map); a note on stderr says so";
-
-/// Parses `-j`: a count in 1..=256.
-///
-/// # Errors
-/// A message for clap.
-pub fn parse_jobs(text: &str) -> Result<usize, String> {
-    match crate::numeric::parse_size(text)? {
-        n @ 1..=256 => Ok(n),
-        n => Err(format!(
-            "{n} samples at once: give 1 to 256 (each holds a whole bracket in memory)"
-        )),
-    }
-}
+pub use scatterfit_pipeline::batch_args::{JobsArgs, SamplesArgs};
 
 /// The Monte Carlo profile cache of the rig twin (`synth`, `demo`).
 #[derive(Debug, Clone, clap::Args)]
@@ -347,11 +116,9 @@ impl CacheArgs {
     }
 }
 
-pub use scatterfit_io::inputs::{identity, same_file};
-
 pub use scatterfit_pipeline::outputs::{
-    Failures, Format, RESULT_FILES, check_destination, check_output_dir, check_output_file,
-    check_output_folder, refuse_foreign_folder, refuse_foreign_results,
+    Failures, Format, RESULT_FILES, check_destination, check_new_output, check_output_dir,
+    check_output_file, check_output_files, refuse_foreign_folder, refuse_foreign_results,
     refuse_outputs_that_are_inputs, refuse_overwrite,
 };
 

@@ -9,15 +9,16 @@
 //! folder holding anything else unless `--force`. Monte Carlo profiles are cached (the second run
 //! takes seconds).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, bail};
-use scatterfit_lab::demo::{DemoFiles, materials, quality_line, write_demo};
+use scatterfit_lab::demo::{materials, write_demo};
+
+use scatterfit_pipeline::outputs::claim_folder;
 
 use crate::common::CacheArgs;
-use crate::output::{errln, out, outln};
+use crate::output::{errln, out};
 use crate::twin::{synthesize, write_sample};
 
 /// Arguments of `scatterfit demo`.
@@ -56,36 +57,16 @@ pub struct Args {
     pub quiet: bool,
 }
 
-const MARKER: &str = ".scatterfit-demo";
-
-fn check_folder(dir: &Path, force: bool) -> anyhow::Result<()> {
-    if !dir.exists() || force || dir.join(MARKER).exists() {
-        return Ok(());
-    }
-    let mut entries = std::fs::read_dir(dir)
-        .with_context(|| format!("reading {}", dir.display()))?
-        .flatten();
-    if let Some(e) = entries.next() {
-        bail!(
-            "{} holds {} and was not made by `scatterfit demo`; choose another folder with -o or \
-             pass --force to write there",
-            dir.display(),
-            e.file_name().to_string_lossy()
-        );
-    }
-    Ok(())
-}
-
 /// Runs `scatterfit demo`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let t0 = Instant::now();
     crate::common::check_output_dir(&args.output_dir, "-o")?;
-    check_folder(&args.output_dir, args.force)?;
-    std::fs::create_dir_all(&args.output_dir)
-        .with_context(|| format!("creating {}", args.output_dir.display()))?;
-    scatterfit_io::atomic::write_atomic(
-        &args.output_dir.join(MARKER),
-        b"made by `scatterfit demo`; it may replace the files in this folder\n",
+    claim_folder(
+        &args.output_dir,
+        ".scatterfit-demo",
+        "demo",
+        " to write there",
+        args.force,
     )?;
     let quiet = args.quiet || args.json;
     let cache = args.cache.dir();
@@ -123,36 +104,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )?;
     let measure_s = t1.elapsed().as_secs_f64();
     let out = &args.output_dir;
-    let DemoFiles {
-        rows,
-        accuracy,
-        proposed,
-        index,
-    } = write_demo(out, &pairs, &papers, &truths, &pair_dirs, &failed)?;
+    let files = write_demo(out, &pairs, &papers, &truths, &pair_dirs, &failed)?;
     if args.json {
-        crate::output::print_json(&rows)?;
+        crate::output::print_json(&files.rows)?;
     } else {
-        outln!(
-            "The method of Choi, Lee & Chin (2014) on Monte Carlo rig-twin samples of their seven materials"
-        )?;
-        outln!(
-            "(samples in {}; the fitted model never made these data; truth in each truth.json)\n",
-            out.display()
-        )?;
-        out!("{accuracy}")?;
-        outln!(
-            "\ntime: {synth_s:.1} s synthesising (Monte Carlo, cached for the next run), {measure_s:.1} s measuring 7 \
-             samples with both methods"
-        )?;
-        outln!(
-            "files: {0}/<material>/result.json, report.html, fit.png, compare.png; {0}/summary.md \
-             (Table 1), compare.md (Table 2), accuracy.md",
-            out.display()
-        )?;
-        // The data checks' verdict on the proposed method's channels (RELIABILITY.md).
-        outln!("quality: {}", quality_line(&proposed))?;
-        // Last: the page a person opens (every sample's verdict and numbers, a link to each report).
-        outln!("index: {}", index.display())?;
+        out!("{}", files.text(out, synth_s, measure_s))?;
     }
     Ok(crate::common::list_failures("failed", &failed))
 }

@@ -7,13 +7,14 @@
 //! A result with a failed channel exports nothing (exit 1, the channel named); unconstrained channels
 //! are exported with a warning on stderr.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::output::errln;
-use anyhow::{Context, bail};
+use anyhow::Context;
 use scatterfit_io::export::{ExportError, Format, MitsubaVariant, SceneUnit, export_with};
 use scatterfit_io::result_json::read_result_json;
+use scatterfit_pipeline::export::check_export_output;
 
 /// Arguments of `scatterfit export`.
 #[derive(Debug, clap::Args)]
@@ -24,11 +25,11 @@ pub struct Args {
     /// (Mitsuba 3 XML fragment: dielectric boundary + homogeneous medium, .xml), blender (bpy script
     /// setting a Principled BSDF, Blender ≥ 4.0, .py), json (renderer-neutral, .json).
     #[arg(long, value_enum, value_name = "FORMAT")]
-    pub to: FormatArg,
+    pub to: Format,
     /// Length unit of the target scene: coefficients are written per mm (mm⁻¹, as measured) or per
     /// metre (m⁻¹ = 1000 × mm⁻¹), mean free paths in that unit.
     #[arg(long, value_enum, default_value = "mm", value_name = "UNIT")]
-    pub scale: UnitArg,
+    pub scale: SceneUnit,
     /// Write to FILE (atomically; its extension must match the format: .pbrt, .xml, .py, .json)
     /// instead of stdout.
     #[arg(short, long, value_name = "FILE")]
@@ -39,7 +40,7 @@ pub struct Args {
     /// measured colour (their uplift of RGB coefficients shifts strongly coloured materials by tens
     /// of per cent).
     #[arg(long, value_enum, default_value = "rgb", value_name = "KIND")]
-    pub mitsuba_variant: VariantArg,
+    pub mitsuba_variant: MitsubaVariant,
     /// Replace an existing output file.
     #[arg(long)]
     pub force: bool,
@@ -52,71 +53,14 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// `--to`.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum FormatArg {
-    /// pbrt-v4 (.pbrt).
-    Pbrt,
-    /// Mitsuba 3 (.xml).
-    Mitsuba,
-    /// Blender ≥ 4.0 bpy script (.py).
-    Blender,
-    /// Renderer-neutral JSON (.json).
-    Json,
-}
-
-impl From<FormatArg> for Format {
-    fn from(f: FormatArg) -> Self {
-        match f {
-            FormatArg::Pbrt => Format::Pbrt,
-            FormatArg::Mitsuba => Format::Mitsuba,
-            FormatArg::Blender => Format::Blender,
-            FormatArg::Json => Format::Json,
-        }
-    }
-}
-
-/// `--mitsuba-variant`.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum VariantArg {
-    /// RGB variants.
-    Rgb,
-    /// Spectral variants.
-    Spectral,
-}
-
-/// `--scale`.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum UnitArg {
-    /// One scene unit is one millimetre.
-    Mm,
-    /// One scene unit is one metre.
-    M,
-}
-
-impl From<UnitArg> for SceneUnit {
-    fn from(u: UnitArg) -> Self {
-        match u {
-            UnitArg::Mm => SceneUnit::Millimetre,
-            UnitArg::M => SceneUnit::Metre,
-        }
-    }
-}
-
 /// Runs `scatterfit export`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let format = Format::from(args.to);
-    let unit = SceneUnit::from(args.scale);
+    let (format, unit, variant) = (args.to, args.scale, args.mitsuba_variant);
     if let Some(out) = &args.output {
-        check_output(out, format, &args.result, args.force)?;
-        crate::common::check_output_folder(out, "-o")?;
+        check_export_output(out, format, &args.result, args.force)?;
     }
     // The error's message already includes its cause; flatten it so `{:#}` does not repeat it.
     let result = read_result_json(&args.result).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let variant = match args.mitsuba_variant {
-        VariantArg::Rgb => MitsubaVariant::Rgb,
-        VariantArg::Spectral => MitsubaVariant::Spectral,
-    };
     let options = scatterfit_pipeline::export::export_options(&result, unit, variant);
     let exported = match export_with(&result, format, &options) {
         Ok(e) => e,
@@ -156,41 +100,4 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &result,
         args.allow_suspect,
     ))
-}
-
-/// Refuses an output whose extension does not match the format, an existing file without `--force`,
-/// and the input itself (inputs are never overwritten).
-fn check_output(out: &Path, format: Format, input: &Path, force: bool) -> anyhow::Result<()> {
-    let want = format.extension();
-    let ext = out
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    if ext.as_deref() != Some(want) {
-        bail!(
-            "output {}: a {} export is written to a .{want} file; name it e.g. `{}`",
-            out.display(),
-            format.name(),
-            out.with_extension(want).display()
-        );
-    }
-    crate::common::check_destination(out, "output")?;
-    if out.exists() {
-        // The same file by resolved path, or by device and inode (a hard link).
-        if crate::common::same_file(out, input) {
-            bail!(
-                "output {} is the input result; write the export to another file",
-                out.display()
-            );
-        }
-        if !force {
-            bail!(
-                "output {} exists; pass --force to replace it, or choose another name",
-                out.display()
-            );
-        }
-        if out.is_dir() {
-            bail!("output {} is a folder; name a file", out.display());
-        }
-    }
-    Ok(())
 }

@@ -21,22 +21,8 @@ use scatterfit_pipeline::profile::{ProfileSettings, ProfileSummary, profile_stag
 pub struct Args {
     /// The radiance map (EXR or Radiance HDR), e.g. from `scatterfit merge`.
     pub radiance: PathBuf,
-    /// Image scale on the sample surface [mm per pixel], in (0, 100] (as the manifest's
-    /// `camera.mm_per_pixel`).
-    #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
-    pub mm_per_pixel: f64,
-    /// Spot centre `X,Y` in pixels (pixel centres at integers), inside the image; found
-    /// automatically if omitted.
-    #[arg(long, value_name = "X,Y", value_parser = parse_center)]
-    pub center: Option<[f64; 2]>,
-    /// Outer radius of the profile \[px\], in (0, 10⁶] (the paper's cut-off is 300); at most 10⁶
-    /// rings (r_max / ring width).
-    #[arg(long, default_value_t = 300.0, value_name = "PX", value_parser = crate::numeric::parse_finite)]
-    pub r_max_px: f64,
-    /// Ring width \[px\], > 0, with at most 10⁶ rings (r_max / ring width; 1 px gives the paper's
-    /// profile).
-    #[arg(long, default_value_t = 1.0, value_name = "PX", value_parser = crate::numeric::parse_finite)]
-    pub ring_width_px: f64,
+    #[command(flatten)]
+    pub settings: ProfileSettings,
     /// The bracket's detection limit per channel R,G,B (relative radiance, each finite and ≥ 0, as
     /// `scatterfit merge` prints it): written as `limit_<c>` columns so that `scatterfit fit` leaves
     /// out rings below it.
@@ -56,80 +42,10 @@ pub struct Args {
     pub json: bool,
 }
 
-/// The largest ring radius accepted \[px\]: beyond any camera sensor's diagonal.
-const MAX_R_PX: f64 = 1e6;
-
-/// Memory per ring and channel of the profile and its CSV row \[bytes\] (the ring's statistics, its
-/// share of the table, and the text), an upper bound.
-const BYTES_PER_RING_CHANNEL: u64 = 160;
-
-/// Checks every number before anything is read: ranges, the ring count, the rings' memory.
-fn check_args(args: &Args) -> anyhow::Result<()> {
-    use crate::numeric::ensure;
-    ensure(
-        args.mm_per_pixel > 0.0 && args.mm_per_pixel <= 100.0,
-        "--mm-per-pixel",
-        args.mm_per_pixel,
-        "the image scale must lie in (0, 100] mm per pixel",
-    )?;
-    ensure(
-        args.r_max_px > 0.0 && args.r_max_px <= MAX_R_PX,
-        "--r-max-px",
-        args.r_max_px,
-        "the outer radius must lie in (0, 1e6] px (the paper's is 300)",
-    )?;
-    ensure(
-        args.ring_width_px > 0.0,
-        "--ring-width-px",
-        args.ring_width_px,
-        "the ring width must be > 0 px (1 px gives the paper's profile)",
-    )?;
-    let rings = (args.r_max_px / args.ring_width_px).ceil();
-    ensure(
-        rings <= scatterfit_imaging::MAX_RINGS as f64,
-        "--ring-width-px",
-        args.ring_width_px,
-        &format!(
-            "--r-max-px {} / --ring-width-px {} makes {rings:.3e} rings, more than 10⁶ — a light \
-             spot's profile needs hundreds; widen the rings or reduce r_max",
-            crate::numeric::show(args.r_max_px),
-            crate::numeric::show(args.ring_width_px)
-        ),
-    )?;
-    if let Some(l) = args.detection_limit
-        && let Some(bad) = l.iter().find(|v| !(v.is_finite() && **v >= 0.0))
-    {
-        anyhow::bail!(
-            "--detection-limit: {} is not a radiance ≥ 0 (relative units, as `scatterfit merge` \
-             prints it)",
-            crate::numeric::show(*bad)
-        );
-    }
-    crate::numeric::check_memory(
-        &format!("a profile of {rings} rings × 3 channels"),
-        (rings as u64 + 1).saturating_mul(3 * BYTES_PER_RING_CHANNEL),
-        args.memory.budget(),
-    )
-}
-
-fn parse_center(text: &str) -> Result<[f64; 2], String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    match parts.as_slice() {
-        [x, y] => match (x.parse::<f64>(), y.parse::<f64>()) {
-            (Ok(x), Ok(y)) if x.is_finite() && y.is_finite() => Ok([x, y]),
-            _ => Err(format!(
-                "`{text}` is not two numbers; write the centre as X,Y in pixels, e.g. 512.3,498.7"
-            )),
-        },
-        _ => Err(format!(
-            "`{text}` is not X,Y; write the centre in pixels, e.g. 512.3,498.7"
-        )),
-    }
-}
-
 /// Runs `scatterfit profile`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    check_args(&args)?;
+    args.settings
+        .check(args.detection_limit, args.memory.budget())?;
     crate::common::check_output_file(
         &args.output,
         "-o",
@@ -143,12 +59,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let budget = args.memory.budget();
     let image = read_radiance_within(&args.radiance, budget)?;
     let limits = args.detection_limit.map_or_else(Vec::new, |l| l.to_vec());
-    let settings = ProfileSettings {
-        mm_per_pixel: args.mm_per_pixel,
-        r_max_px: args.r_max_px,
-        ring_width_px: args.ring_width_px,
-        center_px: args.center,
-    };
+    let settings = args.settings;
     let stage = profile_stage(&image, None, &limits, &settings)
         .with_context(|| format!("{}", args.radiance.display()))?;
     write_profile_csv(&args.output, &stage.to_table())?;

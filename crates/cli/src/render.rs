@@ -17,10 +17,8 @@ use anyhow::bail;
 use scatterfit_optics::ModelName;
 use scatterfit_render::colour::ColourParams;
 use scatterfit_render::measured::{profile_path, read_measured};
-use scatterfit_render::request::{
-    MeshSummary, RenderEvent, RenderSummary, render_figure, write_figure,
-};
-use scatterfit_render::settings::RenderSettings;
+use scatterfit_render::request::{RenderEvent, render_figure, write_figure};
+use scatterfit_render::settings::{RenderSettings, check_output_kind};
 use scatterfit_render::tonemap::ToneMap;
 use scatterfit_render::{
     FigureRequest, LightRig, MeshSource, Methods, ParameterSet, ProfileRequest, RenderError,
@@ -89,34 +87,8 @@ pub struct Args {
     /// interpolated where the surface is smooth.
     #[arg(long)]
     pub no_interpolation: bool,
-    /// ρd, diffuse coefficient of eq. 5 (≥ 0).
-    #[arg(long, default_value_t = 1.0)]
-    pub rho_d: f64,
-    /// ρs, specular coefficient of eq. 5 (≥ 0; default the Fresnel reflectance at normal
-    /// incidence ((η−1)/(η+1))²).
-    #[arg(long)]
-    pub rho_s: Option<f64>,
-    /// ρts, translucent coefficient of eq. 5 (≥ 0).
-    #[arg(long, default_value_t = 1.0)]
-    pub rho_ts: f64,
-    /// α of the translucent fall-off (α d + β)^−γ [mm⁻¹, ≥ 0].
-    #[arg(long, default_value_t = 1.0)]
-    pub alpha: f64,
-    /// β of the translucent fall-off (> 0).
-    #[arg(long, default_value_t = 1.0)]
-    pub beta: f64,
-    /// γ of the translucent fall-off (≥ 0).
-    #[arg(long, default_value_t = 1.0)]
-    pub gamma: f64,
-    /// αx, surface slope deviation along the tangent (Ward; > 0).
-    #[arg(long, default_value_t = 0.15)]
-    pub alpha_x: f64,
-    /// αy, surface slope deviation along the bitangent (Ward; > 0).
-    #[arg(long, default_value_t = 0.15)]
-    pub alpha_y: f64,
-    /// Henyey–Greenstein g of P(g) in eqs. 3–4, in (−1, 1).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub g: f64,
+    #[command(flatten)]
+    pub colour: ColourParams,
     /// Exposure \[EV\], in [−60, 60]; at 0 a white diffuser facing a light of irradiance 1 is the
     /// reference white.
     /// Default 0, except with --profile, where the slab image is exposed so that the glow at twice
@@ -169,17 +141,7 @@ fn settings(args: &Args) -> RenderSettings {
         size: args.size,
         spp: args.spp,
         seed: args.seed,
-        colour: ColourParams {
-            rho_d: args.rho_d,
-            rho_ts: args.rho_ts,
-            rho_s: args.rho_s,
-            alpha: args.alpha,
-            beta: args.beta,
-            gamma: args.gamma,
-            alpha_x: args.alpha_x,
-            alpha_y: args.alpha_y,
-            g: args.g,
-        },
+        colour: args.colour,
         light_rays: args.light_rays,
         max_angle: args.max_angle,
         direct: args.direct,
@@ -220,39 +182,10 @@ fn cli_error(e: RenderError) -> anyhow::Error {
 /// Checks the outputs before any work: extension, not an input, not a link or folder, not an
 /// existing file unless --force, a writable folder.
 fn check_outputs(args: &Args, inputs: &[PathBuf]) -> anyhow::Result<()> {
+    let refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     for out in &args.output {
-        let ext = out
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .unwrap_or_default();
-        match ext.as_str() {
-            "png" | "exr" => {}
-            "csv" if args.profile => {}
-            "csv" => bail!(
-                "-o {}: a .csv output is the profile comparison; add --profile, or write .png/.exr",
-                out.display()
-            ),
-            _ => bail!(
-                "-o {}: write .png (tone-mapped sRGB) or .exr (linear radiance){}",
-                out.display(),
-                if args.profile { " or .csv" } else { "" }
-            ),
-        }
-        crate::common::check_destination(out, "-o")?;
-        if out.exists() && !args.force {
-            bail!(
-                "-o {}: the file exists; nothing was done — pass --force to replace it, or choose \
-                 another name",
-                out.display()
-            );
-        }
-        let refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-        crate::common::refuse_overwrite(out, "-o", &refs)?;
-        if out.is_dir() {
-            bail!("-o {}: is a folder; name a file", out.display());
-        }
-        crate::common::check_output_folder(out, "-o")?;
+        check_output_kind(out, args.profile)?;
+        crate::common::check_new_output(out, "-o", &refs, args.force)?;
     }
     Ok(())
 }
@@ -333,21 +266,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     })?;
     bar.finish_and_clear();
     write_figure(&request, &panels, &args.output, &tone, args.gray)?;
-    let summary = Summary {
-        mesh: MeshSummary {
-            source: studio.source,
-            triangles: studio.triangles,
-            size_mm: studio.size_mm,
-            bvh_build_s: studio.build_s,
-        },
-        renders: panels
-            .iter()
-            .map(|p| RenderSummary::new(&request.params[p.set], &p.rendered, &options))
-            .collect(),
-        profile: None,
-        outputs: args.output.clone(),
-        threads: rayon::current_num_threads(),
-    };
+    let summary = request.summary(&studio, &panels, &args.output, rayon::current_num_threads());
     print_summary(&args, &summary)?;
     Ok(code)
 }

@@ -1,5 +1,5 @@
 //! Many sample folders with one progress bar (`batch`, `compare`, `demo`): the scheduling is the
-//! library's ([`scatterfit_pipeline::batch`], [`scatterfit_pipeline::compare`]); this file turns
+//! library's ([`scatterfit_pipeline::batch`], [`scatterfit_report::compare_set`]); this file turns
 //! its events into the progress bar and its outcomes into the commands' error texts. A failed
 //! sample never stops the others; each outcome is kept with its folder.
 
@@ -7,11 +7,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use indicatif::ProgressBar;
-use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_pipeline::batch::{BatchEvent, BatchRequest, measure_batch_with};
-use scatterfit_pipeline::compare::compare_batch_with;
-use scatterfit_pipeline::outputs::Failures;
 use scatterfit_pipeline::{Measurement, Overrides};
+use scatterfit_report::compare_set::compare_dirs as compare_dirs_with;
 
 /// One sample's outcome.
 pub struct Outcome {
@@ -90,30 +88,10 @@ pub fn measure_many(
         .collect())
 }
 
-/// One sample compared: (existing, proposed).
-pub type Pair = (MeasurementResult, MeasurementResult);
+pub use scatterfit_report::compare_set::Comparison;
 
-/// What one sample's comparison gave the command.
-type Compared = Result<(Pair, Option<MeasurementResult>, Vec<String>), String>;
-
-/// What [`compare_dirs`] gives.
-pub struct Comparison {
-    /// The samples compared: (existing, proposed).
-    pub pairs: Vec<Pair>,
-    /// Each pair's folder.
-    pub dirs: Vec<PathBuf>,
-    /// Per pair, the paper's fit (the dipole, α′ from its total; empty without `paper`).
-    pub papers: Vec<Option<MeasurementResult>>,
-    /// The samples that failed, with why.
-    pub failed: Failures,
-}
-
-/// Measures `dirs` once and fits each both ways ([`scatterfit_pipeline::compare`]); writes
-/// compare.svg/png into each sample folder (and, with `write_results`, the proposed measurement's
-/// result files as `measure` does, its report.html with Figure 6); with `paper` each sample is also
-/// fitted with the paper's own model ([`scatterfit_pipeline::compare::paper_settings`]; `None` where
-/// that fit cannot run). Returns the pairs with their folders, the paper's fits (empty without
-/// `paper`) and the samples that failed.
+/// Measures `dirs` once and fits each both ways, with the progress bar
+/// ([`scatterfit_report::compare_set::compare_dirs`]: its files, the paper's fits with `paper`).
 ///
 /// # Errors
 /// Only when the worker threads cannot start.
@@ -127,47 +105,9 @@ pub fn compare_dirs(
 ) -> anyhow::Result<Comparison> {
     let bar = progress(dirs.len(), quiet);
     let request = BatchRequest::new(dirs.iter().cloned(), *overrides).jobs(jobs);
-    let batch = compare_batch_with(
-        request,
-        paper,
-        &|dir, compared| -> Compared {
-            let c = compared.map_err(|e| {
-                let e = anyhow::Error::from(e).context(format!("measuring {}", dir.display()));
-                crate::common::error_text(&e)
-            })?;
-            let problems = scatterfit_report::write_comparison(dir, &c, write_results);
-            let paper = c
-                .paper
-                .and_then(Result::ok)
-                .map(|m| m.to_result(Some("profile.csv")));
-            let pair = (
-                c.existing.to_result(Some("profile.csv")),
-                c.proposed.to_result(Some("profile.csv")),
-            );
-            Ok((pair, paper, problems))
-        },
-        &|e| on_event(e, &bar, quiet),
-    )?;
+    let comparison = compare_dirs_with(request, write_results, paper, &|e| {
+        on_event(e, &bar, quiet);
+    })?;
     bar.finish_and_clear();
-    let (mut pairs, mut papers, mut failed) = (Vec::new(), Vec::new(), Vec::new());
-    let mut pair_dirs = Vec::new();
-    for s in batch.samples {
-        match s.outcome {
-            Ok((pair, paper_fit, problems)) => {
-                failed.extend(problems.into_iter().map(|p| (s.dir.clone(), p)));
-                pairs.push(pair);
-                pair_dirs.push(s.dir);
-                if paper {
-                    papers.push(paper_fit);
-                }
-            }
-            Err(e) => failed.push((s.dir, e)),
-        }
-    }
-    Ok(Comparison {
-        pairs,
-        dirs: pair_dirs,
-        papers,
-        failed,
-    })
+    Ok(comparison)
 }

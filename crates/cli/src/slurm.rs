@@ -3,41 +3,14 @@
 //! dependent combine job). This file takes the command's own arguments from the command line,
 //! checks them and the outputs, and writes the script.
 
-use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
 use scatterfit_lab::partial::Kind;
-use scatterfit_lab::slurm::SlurmJob;
+use scatterfit_lab::slurm::SlurmSettings;
 
 use crate::output::{errln, outln};
-
-/// Slurm's side of the script.
-#[derive(Debug, clap::Args)]
-pub struct SlurmArgs {
-    /// Shards: the job array's size, 1 to 10 000 (tasks 1…N).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000))]
-    pub array: u64,
-    /// Where to write the script (a `.sh` file; an existing one only with --force-script).
-    #[arg(long, value_name = "FILE", default_value = "scatterfit-slurm.sh")]
-    pub script: PathBuf,
-    /// Replace an existing script file.
-    #[arg(long)]
-    pub force_script: bool,
-    /// CPUs of each array task (`#SBATCH --cpus-per-task`; the task's threads), 1 to 1024.
-    #[arg(long, value_name = "C", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1024))]
-    pub cpus_per_task: u64,
-    /// Time limit of each task (`#SBATCH --time`, Slurm's format, e.g. 2:00:00).
-    #[arg(long, value_name = "TIME")]
-    pub time: Option<String>,
-    /// Partition (`#SBATCH --partition`).
-    #[arg(long, value_name = "NAME")]
-    pub partition: Option<String>,
-    /// Another `#SBATCH` option for both jobs, verbatim (repeatable; e.g. --sbatch-option=--account=lab).
-    #[arg(long, value_name = "OPTION", allow_hyphen_values = true)]
-    pub sbatch_option: Vec<String>,
-}
 
 /// The commands `slurm` can shard.
 #[derive(Debug, clap::Subcommand)]
@@ -45,14 +18,14 @@ pub enum What {
     /// A Monte Carlo table (`scatterfit table`'s arguments; -o FILE is written by the combine job).
     Table {
         #[command(flatten)]
-        slurm: SlurmArgs,
+        slurm: SlurmSettings,
         #[command(flatten)]
         args: crate::table::Args,
     },
     /// A batch of samples (`scatterfit batch`'s arguments; -o DIR gets the combine job's summary).
     Batch {
         #[command(flatten)]
-        slurm: SlurmArgs,
+        slurm: SlurmSettings,
         #[command(flatten)]
         args: crate::batch::Args,
     },
@@ -60,7 +33,7 @@ pub enum What {
     /// the combine job the tables and the figure).
     Study {
         #[command(flatten)]
-        slurm: SlurmArgs,
+        slurm: SlurmSettings,
         #[command(flatten)]
         args: crate::study::Args,
     },
@@ -71,69 +44,6 @@ pub enum What {
 pub struct Args {
     #[command(subcommand)]
     pub what: What,
-}
-
-/// `slurm`'s own flags, taking a value: removed from the command line the array tasks run.
-const OWN_WITH_VALUE: [&str; 6] = [
-    "--array",
-    "--script",
-    "--cpus-per-task",
-    "--time",
-    "--partition",
-    "--sbatch-option",
-];
-const OWN_SWITCHES: [&str; 1] = ["--force-script"];
-
-/// The command's own tokens (after `slurm <kind>`) without `slurm`'s flags and without the flags
-/// in `strip` (with their values), and the last value of each flag in `take`.
-fn split_tokens(
-    tokens: &[String],
-    strip_with_value: &[&str],
-    strip_switches: &[&str],
-) -> (Vec<String>, Vec<(String, String)>) {
-    let mut kept = Vec::new();
-    let mut taken = Vec::new();
-    let mut i = 0;
-    while i < tokens.len() {
-        let t = &tokens[i];
-        let (name, inline) = match t.split_once('=') {
-            Some((n, v)) if n.starts_with("--") => (n.to_owned(), Some(v.to_owned())),
-            _ if t.starts_with("-o") && t.len() > 2 && !t.starts_with("--") => {
-                ("-o".to_owned(), Some(t[2..].to_owned()))
-            }
-            _ => (t.clone(), None),
-        };
-        if t == "--" {
-            kept.extend(tokens[i..].iter().cloned());
-            break;
-        }
-        let with_value =
-            OWN_WITH_VALUE.contains(&name.as_str()) || strip_with_value.contains(&name.as_str());
-        if with_value {
-            let value = match inline {
-                Some(v) => v,
-                None => {
-                    i += 1;
-                    tokens.get(i).cloned().unwrap_or_default()
-                }
-            };
-            taken.push((name, value));
-        } else if OWN_SWITCHES.contains(&name.as_str()) || strip_switches.contains(&name.as_str()) {
-            taken.push((name, String::new()));
-        } else {
-            kept.push(t.clone());
-        }
-        i += 1;
-    }
-    (kept, taken)
-}
-
-fn last<'a>(taken: &'a [(String, String)], names: &[&str]) -> Option<&'a str> {
-    taken
-        .iter()
-        .rev()
-        .find(|(n, _)| names.contains(&n.as_str()))
-        .map(|(_, v)| v.as_str())
 }
 
 /// Runs `scatterfit slurm`.
@@ -211,29 +121,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &[],
         slurm.force_script,
     )?;
-    let mut strip: Vec<&str> = output_flags.clone();
-    strip.extend(["--cache-dir"]);
-    let (kept, taken) = split_tokens(tokens, &strip, &["--json", "--quiet"]);
-    let output = study_out.or_else(|| last(&taken, &output_flags).map(str::to_owned));
-    let cache_dir = last(&taken, &["--cache-dir"]).map(str::to_owned);
     let cwd = std::env::current_dir().context("the current folder")?;
-    let abs = |p: &Path| cwd.join(p);
-    let job = SlurmJob {
-        command: kind,
-        args: kept,
-        array: slurm.array,
-        cpus_per_task: slurm.cpus_per_task,
-        time: slurm.time.clone(),
-        partition: slurm.partition.clone(),
-        sbatch_options: slurm.sbatch_option.clone(),
-        exe: std::env::current_exe().context("finding the scatterfit binary")?,
-        partial_dir: abs(&partial_dir),
-        cache_dir: crate::common::cache_dir(cache_dir.as_deref().map(Path::new)).map(|c| abs(&c)),
-        output,
+    let exe = std::env::current_exe().context("finding the scatterfit binary")?;
+    let job = slurm.job(
+        kind,
+        tokens,
+        &output_flags,
+        study_out,
+        &partial_dir,
         fingerprint,
-        script: slurm.script.clone(),
+        exe,
         cwd,
-    };
+    );
     let (n, name, script) = (job.array, kind.name(), job.script());
     scatterfit_io::atomic::write_atomic(&slurm.script, script.as_bytes())
         .with_context(|| format!("--script {}", slurm.script.display()))?;
@@ -244,32 +143,4 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     );
     outln!("{}", slurm.script.display())?;
     Ok(ExitCode::SUCCESS)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn splitting() {
-        let t: Vec<String> = [
-            "--eta",
-            "1.3",
-            "--array",
-            "8",
-            "-o",
-            "t.json",
-            "--time=1:00",
-            "--json",
-            "--g",
-            "0.9",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let (kept, taken) = split_tokens(&t, &["-o"], &["--json"]);
-        assert_eq!(kept, ["--eta", "1.3", "--g", "0.9"]);
-        assert_eq!(last(&taken, &["-o"]), Some("t.json"));
-        assert_eq!(last(&taken, &["--array"]), Some("8"));
-    }
 }

@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::output::out;
-use anyhow::{Context, bail};
-use scatterfit_optics::colour::{Lab, Observer};
-use scatterfit_optics::spectro::{SpectroAnalysis, SpectroOptions, analyse};
+use anyhow::Context;
+use scatterfit_optics::spectro::{SpectroAnalysis, analyse};
+use scatterfit_pipeline::spectro_args::SpectroArgs;
 use scatterfit_report::{SpectroReport, spectro_text};
 
 /// Arguments of `scatterfit spectro`.
@@ -15,17 +15,8 @@ use scatterfit_report::{SpectroReport, spectro_text};
 pub struct Args {
     /// Spectrophotometer CSV: `wavelength_nm,sci,sce` (fractions) or `…,sci_pct,sce_pct` (percent).
     pub file: PathBuf,
-    /// Measured L*a*b* (D65) to use for the colour instead of the SCE spectrum: L* in [0, 100], a*
-    /// and b* finite.
-    #[arg(long, num_args = 3, value_names = ["L", "A", "B"], allow_negative_numbers = true)]
-    pub lab: Option<Vec<f64>>,
-    /// Observer of --lab: 10 (the instrument default) or 2.
-    #[arg(long, default_value_t = 10, value_name = "2|10")]
-    pub observer: u32,
-    /// A known η to use instead of the one measured from SCI − SCE (e.g. for matte samples), in
-    /// [1, 3].
-    #[arg(long, value_parser = crate::numeric::parse_finite)]
-    pub eta: Option<f64>,
+    #[command(flatten)]
+    pub spectro: SpectroArgs,
     /// Print the full result as JSON on stdout instead of the summary.
     #[arg(long)]
     pub json: bool,
@@ -40,7 +31,7 @@ pub struct Args {
 
 /// Runs `scatterfit spectro`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let options = options_from(&args)?;
+    let options = args.spectro.options()?;
     if let Some(out) = &args.out {
         crate::common::check_output_file(
             out,
@@ -71,45 +62,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn options_from(args: &Args) -> anyhow::Result<SpectroOptions> {
-    let lab = match &args.lab {
-        None => None,
-        Some(v) => {
-            let [l, a, b] = v[..] else {
-                bail!("--lab takes three numbers: L* a* b*")
-            };
-            if !(0.0..=100.0).contains(&l) || !a.is_finite() || !b.is_finite() {
-                bail!(
-                    "--lab {} {} {}: L* must lie in 0..100 and a*, b* be finite numbers",
-                    crate::numeric::show(l),
-                    crate::numeric::show(a),
-                    crate::numeric::show(b)
-                );
-            }
-            let observer = Observer::from_degrees(args.observer)
-                .with_context(|| format!("--observer {}: use 2 or 10", args.observer))?;
-            Some((Lab { l, a, b }, observer))
-        }
-    };
-    if let Some(eta) = args.eta
-        && !(1.0..=3.0).contains(&eta)
-    {
-        bail!(
-            "--eta {}: the relative refractive index must lie in [1, 3]",
-            crate::numeric::show(eta)
-        );
-    }
-    Ok(SpectroOptions { lab, eta: args.eta })
-}
-
 fn report<'a>(args: &Args, analysis: &'a SpectroAnalysis) -> SpectroReport<'a> {
-    let lab = args.lab.as_ref().map(|v| {
-        let lab = Lab {
-            l: v[0],
-            a: v[1],
-            b: v[2],
-        };
-        (lab, args.observer)
-    });
-    SpectroReport::new(&args.file, lab, analysis)
+    SpectroReport::new(&args.file, args.spectro.lab_given(), analysis)
 }

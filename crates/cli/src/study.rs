@@ -18,11 +18,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, bail};
 use scatterfit_lab::study::StudySample;
 use scatterfit_lab::study_run::{StudyConfig, StudyPart, fit_plan, fit_samples};
+use scatterfit_pipeline::outputs::claim_folder;
 
-use crate::common::{JobsArgs, PhotonScaleArgs, cache_dir};
+use crate::common::{JobsArgs, cache_dir};
 use crate::output::errln;
 use crate::twin::{synthesize_on, write_sample};
 
@@ -37,31 +37,8 @@ pub struct Args {
         value_name = "DIR"
     )]
     pub output_dir: PathBuf,
-    /// Refractive indices η, each in [1, 2.5] (the Monte Carlo tables' range).
-    #[arg(long, value_delimiter = ',', default_values_t = [1.0, 1.2, 1.4, 1.6, 2.0, 2.4])]
-    pub etas: Vec<f64>,
-    /// Reduced albedos α′, each in [0.3, 0.9999].
-    #[arg(long, value_delimiter = ',', default_values_t = [0.3, 0.5, 0.7, 0.9, 0.95, 0.98, 0.99, 0.999, 0.9999])]
-    pub albedos: Vec<f64>,
-    /// Reduced extinction σ′t of every grid point [mm⁻¹, 0.2–20].
-    #[arg(long, default_value_t = 2.0, value_name = "MM-1")]
-    pub sigma_t_prime: f64,
-    /// Small fast samples (256 × 256 px at 0.1 mm/px, a tenth of the photons).
-    #[arg(long)]
-    pub quick: bool,
-    /// Henyey–Greenstein g of the twins, each in [0, 0.95] (default 0: the isotropic study). Any
-    /// g ≠ 0 gives the study a g axis: every twin is made at each g, fitted every way assuming
-    /// g = 0 (what a manifest without `[fit] g` gets) and once more with the g-aware `mc` model
-    /// told the true g ("g given"; "not covered" where the `mc` tables do not answer at that η
-    /// and g); study.md gains a table per model over g. A twin at g costs about 1/(1 − g) times
-    /// the Monte Carlo time of one at g = 0 (g = 0.95: 20×).
-    #[arg(long = "g", value_name = "G", value_delimiter = ',', default_values_t = [0.0])]
-    pub g: Vec<f64>,
-    /// Seed of the rig twin.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
     #[command(flatten)]
-    pub photons: PhotonScaleArgs,
+    pub config: StudyConfig,
     #[command(flatten)]
     pub jobs: JobsArgs,
     /// Leave out photon beam diffusion (its fits take milliseconds, not microseconds).
@@ -83,52 +60,16 @@ pub struct Args {
     pub quiet: bool,
 }
 
-const MARKER: &str = ".scatterfit-study";
-
-/// The study's settings from the flags.
-fn config(args: &Args) -> StudyConfig {
-    StudyConfig {
-        etas: args.etas.clone(),
-        albedos: args.albedos.clone(),
-        sigma_t_prime: args.sigma_t_prime,
-        quick: args.quick,
-        g: args.g.clone(),
-        seed: args.seed,
-        photon_scale: args.photons.photon_scale,
-        no_pbd: args.no_pbd,
-    }
-}
-
-/// Checks the grid ([`StudyConfig::check`]) and that the output folder is the study's own.
-fn check_args(args: &Args, config: &StudyConfig) -> anyhow::Result<()> {
-    config.check()?;
-    let dir = &args.output_dir;
-    if dir.exists()
-        && !args.force
-        && !dir.join(MARKER).exists()
-        && let Some(e) = std::fs::read_dir(dir)?.flatten().next()
-    {
-        bail!(
-            "{} holds {} and was not made by `scatterfit study`; choose another folder with -o or \
-             pass --force",
-            dir.display(),
-            e.file_name().to_string_lossy()
-        );
-    }
-    Ok(())
-}
-
 /// Runs `scatterfit study`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let config = config(&args);
-    check_args(&args, &config)?;
+    let config = StudyConfig {
+        no_pbd: args.no_pbd,
+        ..args.config.clone()
+    };
+    config.check()?;
     let t0 = Instant::now();
     let out = &args.output_dir;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    scatterfit_io::atomic::write_atomic(
-        &out.join(MARKER),
-        b"made by `scatterfit study`; it may replace the files in this folder\n",
-    )?;
+    claim_folder(out, ".scatterfit-study", "study", "", args.force)?;
     let quiet = args.quiet || args.json;
     let cache = cache_dir(args.cache_dir.as_deref());
     let g_axis = config.g_axis();
@@ -160,14 +101,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         errln!(
             "study: {} samples ({} η × {} α′{}) on the {} rig, Monte Carlo cached in {}",
             samples.len(),
-            args.etas.len(),
-            args.albedos.len(),
+            config.etas.len(),
+            config.albedos.len(),
             if g_axis {
-                format!(" × {} g", args.g.len())
+                format!(" × {} g", config.g.len())
             } else {
                 String::new()
             },
-            if args.quick { "quick" } else { "paper's" },
+            if config.quick { "quick" } else { "paper's" },
             cache
                 .as_deref()
                 .map_or("no cache".into(), |p| p.display().to_string())
@@ -175,7 +116,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     for sample in &samples {
         let (m, rig) = config.twin(sample)?;
-        let s = synthesize_on(&m, &rig, args.seed, cache.as_deref(), quiet)?;
+        let s = synthesize_on(&m, &rig, config.seed, cache.as_deref(), quiet)?;
         write_sample(&sample.dir, &s)?;
     }
     let synth_s = t0.elapsed().as_secs_f64();

@@ -6,35 +6,19 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use scatterfit_io::sample_folder::file_names;
-use scatterfit_lab::twin_settings::{MaterialSettings, RigSettings};
+use scatterfit_lab::twin::SynthSummary;
+use scatterfit_lab::twin_settings::{MaterialSettings, RigSettings, twin_files};
 use scatterfit_synth::RigSpec;
-use serde::Serialize;
 
-use crate::common::{CacheArgs, check_output_files, parse_rgb, shutter};
-use crate::output::outln;
-use crate::twin::{Material, synthesize_on, write_sample_with};
+use crate::common::{CacheArgs, check_output_files};
+use crate::output::out;
+use crate::twin::{synthesize_on, write_sample_with};
 
 /// Arguments of `scatterfit synth`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A built-in material: the seven of Choi et al. 2014 (pink-plastic, blue-coating, brown-leather,
-    /// nephrite, wood-tile, sulfur, red-aluminum) or Jensen et al. 2001's (apple, chicken1,
-    /// chicken2, cream, ketchup, marble, potato, skimmilk, skin1, skin2, wholemilk; η = 1.3).
-    #[arg(long, value_name = "NAME", conflicts_with_all = ["sigma_s_prime", "sigma_a"])]
-    pub material: Option<String>,
-    /// Reduced scattering coefficient per channel R,G,B [mm⁻¹, each in (0, 100]].
-    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, requires_all = ["sigma_a", "eta"])]
-    pub sigma_s_prime: Option<[f64; 3]>,
-    /// Absorption coefficient per channel R,G,B [mm⁻¹, each in (0, 100]].
-    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, requires = "sigma_s_prime")]
-    pub sigma_a: Option<[f64; 3]>,
-    /// Relative refractive index η, in [1, 3] (overrides the material's).
-    #[arg(long, value_parser = crate::numeric::parse_finite)]
-    pub eta: Option<f64>,
-    /// Sample name (default: the material's, or "synthetic").
-    #[arg(long)]
-    pub name: Option<String>,
+    #[command(flatten)]
+    pub material: MaterialSettings,
     /// Folder to write (created; checked before the Monte Carlo runs; existing files are not
     /// overwritten without --force).
     #[arg(short = 'o', long = "output-dir", value_name = "DIR")]
@@ -50,26 +34,8 @@ pub struct Args {
     /// The albedo model written into the manifest's `[fit]`.
     #[arg(long, value_enum)]
     pub albedo_model: Option<scatterfit_optics::AlbedoModel>,
-    /// A small fast sample (256 × 256 px at 0.1 mm/px, a tenth of the photons) for trying the tool
-    /// and for tests; not for accuracy studies.
-    #[arg(long)]
-    pub quick: bool,
     #[command(flatten)]
-    pub photons: crate::common::PhotonScaleArgs,
-    /// The material's Henyey–Greenstein anisotropy g, in [0, 0.95] (default 0, isotropic): the
-    /// profile and the spectrophotometer's reading are traced with it (σs = σ′s/(1 − g)). It goes
-    /// into truth.json, never into the manifest: the twin plays a user who does not know g. A g of
-    /// 0.9 traces about 10× the interactions of g = 0, 0.95 about 20×.
-    #[arg(long, value_name = "G", default_value_t = 0.0, value_parser = crate::numeric::parse_finite)]
-    pub g: f64,
-    /// The twin's camera: naka-rushton (the default, 8-bit), linear, gamma22, srgb, log, s-curve
-    /// (8-bit tone curves), linear16 (linear 16-bit PNG, black level 1024 DN) or dng (14-bit raw
-    /// DNG files, black level 512, white 16383, exposure times in their metadata).
-    #[arg(long, value_name = "NAME", value_parser = parse_camera, default_value = "naka-rushton")]
-    pub camera: String,
-    /// Camera read noise [electrons, 0 to 1000] (default 3).
-    #[arg(long, value_name = "E", value_parser = crate::numeric::parse_finite)]
-    pub read_noise: Option<f64>,
+    pub rig: RigSettings,
     /// Veiling glare: stray light spread over the frame, as a fraction of the spot's central
     /// radiance, in [0, 0.1] (a lens: 1e-4 to 1e-3; the profile's far tail is 1e-5).
     #[arg(long, value_name = "F", default_value_t = 0.0, value_parser = crate::numeric::parse_finite)]
@@ -115,37 +81,9 @@ pub struct Args {
     pub json: bool,
 }
 
-fn material_from(args: &Args) -> anyhow::Result<Material> {
-    let settings = MaterialSettings {
-        material: args.material.clone(),
-        sigma_s_prime: args.sigma_s_prime,
-        sigma_a: args.sigma_a,
-        eta: args.eta,
-        name: args.name.clone(),
-    };
-    Ok(settings.material()?)
-}
-
-/// The camera names `--camera` takes.
-fn parse_camera(s: &str) -> Result<String, String> {
-    if scatterfit_synth::CameraModel::named(s).is_some() {
-        Ok(s.to_string())
-    } else {
-        Err(format!(
-            "unknown camera `{s}`; the twin has: {}",
-            scatterfit_synth::CameraModel::NAMES.join(", ")
-        ))
-    }
-}
-
 /// The rig the flags describe.
 fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
     let settings = RigSettings {
-        quick: args.quick,
-        g: args.g,
-        photon_scale: args.photons.photon_scale,
-        camera: Some(args.camera.clone()),
-        read_noise: args.read_noise,
         effects: scatterfit_synth::rig::RigEffects {
             glare: args.glare,
             vignetting: args.vignetting,
@@ -153,36 +91,18 @@ fn rig_from(args: &Args) -> anyhow::Result<RigSpec> {
             gaussian_spot: args.gaussian_spot,
             spot_image: args.spot_image,
         },
+        ..args.rig.clone()
     };
     Ok(settings.rig()?)
 }
 
-#[derive(Serialize)]
-struct Summary<'a> {
-    output_dir: &'a std::path::Path,
-    truth: &'a scatterfit_synth::Truth,
-}
-
 /// Runs `scatterfit synth`.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let m = material_from(&args)?;
+    let m = args.material.material()?;
     crate::common::check_output_dir(&args.output_dir, "-o")?;
     let rig = rig_from(&args)?;
     let port = scatterfit_lab::twin_settings::port(args.aperture_mm, args.illuminated_mm)?;
-    let mut names = file_names(rig.times_s.len(), true);
-    if args.camera == "dng" {
-        for n in &mut names {
-            if n.starts_with("frame_") {
-                *n = n.replace(".png", ".dng");
-            }
-        }
-    }
-    if args.vignetting > 0.0 {
-        names.push("flat.png".into());
-    }
-    if args.spot_image {
-        names.push("spot.png".into());
-    }
+    let names = twin_files(&rig, args.rig.camera.as_deref() == Some("dng"));
     check_output_files(&args.output_dir, &names, args.force)?;
     let cache = args.cache.dir();
     let mut sample = synthesize_on(
@@ -213,57 +133,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             ..Default::default()
         },
     )?;
+    let summary = SynthSummary {
+        output_dir: &args.output_dir,
+        truth: &sample.truth,
+    };
     if args.json {
-        crate::output::print_json(&Summary {
-            output_dir: &args.output_dir,
-            truth: &sample.truth,
-        })?;
+        crate::output::print_json(&summary)?;
     } else {
-        outln!(
-            "wrote {} ({} exposures {}–{} s, {}×{} px at {} mm/px, spot ⌀ {} mm)",
-            args.output_dir.display(),
-            sample.bracket.times_s.len(),
-            shutter(sample.bracket.times_s[0]),
-            shutter(*sample.bracket.times_s.last().unwrap_or(&0.0)),
-            rig.width,
-            rig.height,
-            rig.mm_per_pixel,
-            2.0 * rig.spot_radius_mm
-        )?;
-        outln!("truth    η = {:.4}", sample.truth.eta)?;
-        if let Some(p) = &sample.truth.port {
-            let f = p.reading_fraction;
-            outln!(
-                "port     {} mm aperture lit over {} mm reads F = {:.4} / {:.4} / {:.4} of Rd \
-                 (R/G/B; named in the manifest's [spectro], so measure corrects it)",
-                p.aperture_mm,
-                p.illuminated_mm,
-                f[0],
-                f[1],
-                f[2]
-            )?;
-        }
-        if sample.truth.g != 0.0 {
-            outln!(
-                "         g = {} (in truth.json only: the manifest does not state it)",
-                sample.truth.g
-            )?;
-        }
-        for (name, c) in ["R", "G", "B"].iter().zip(&sample.truth.channels) {
-            outln!(
-                "  {name}  σ′s = {:<8} σa = {:<10} α′ = {:.5}  Rd(MC) = {:.4} ± {:.4}  ({} photons)",
-                c.sigma_s_prime,
-                c.sigma_a,
-                c.albedo_prime,
-                c.rd_total,
-                c.rd_total_stderr,
-                c.photons
-            )?;
-        }
-        outln!(
-            "measure it with: scatterfit measure {}",
-            args.output_dir.display()
-        )?;
+        out!("{}", summary.text(&sample, &rig))?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -16,29 +16,8 @@ use scatterfit_pipeline::monte_carlo::TableSettings;
 /// `--max-memory-mib` before it starts.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Relative refractive index η of the material: 1 to 10.
-    #[arg(long, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
-    pub eta: f64,
-    /// Henyey–Greenstein asymmetry g, in (−1, 1). The table is in the single-scattering albedo
-    /// a = σs/σt (0.02 … 0.9999), so for g > 0 it covers α′ = a(1 − g)/(1 − ag) up to less than
-    /// 0.9999.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::numeric::parse_finite)]
-    pub g: f64,
-    /// Number of albedo nodes (equally spaced in √(1 − a) from a = 0.02 to 0.9999): a count, 4 to
-    /// 1000 (default 64; without --albedos and --photons a g = 0 table is built exactly as the
-    /// shipped ones: 128 albedos, 4·10⁶ full-length photons, 4× and 8× as many in the shorter
-    /// strata, a seed per η — 2–8 min on two cores).
-    #[arg(long, value_parser = crate::numeric::parse_size)]
-    pub albedos: Option<usize>,
-    /// Full-length photons: a count ≥ 1; 4× and 16× as many photons trace the paths shorter than
-    /// 1024 and 64 interactions (default 2e6); the expected work must fit --max-interactions.
-    #[arg(long, value_parser = crate::numeric::parse_count)]
-    pub photons: Option<u64>,
-    /// A coarse table that builds in seconds (20 000 full-length photons, the default albedos);
-    /// overrides --photons and --albedos. Enough for g = 0 and 0.5; at g ≳ 0.7 the lowest albedos
-    /// then reflect too little light to smooth: use --photons 2e5 or more.
-    #[arg(long)]
-    pub coarse: bool,
+    #[command(flatten)]
+    pub table: TableSettings,
     /// Cache folder (default: $SCATTERFIT_CACHE, else $XDG_CACHE_HOME/scatterfit, else ~/.cache/scatterfit).
     #[arg(long)]
     pub cache_dir: Option<PathBuf>,
@@ -71,13 +50,9 @@ pub struct Args {
 /// As [`TableSettings::spec`].
 pub fn spec_for_shards(args: &Args, shards: u64) -> anyhow::Result<McTableSpec> {
     let settings = TableSettings {
-        eta: args.eta,
-        g: args.g,
-        albedos: args.albedos,
-        photons: args.photons,
-        coarse: args.coarse,
         max_interactions: args.work.max_interactions,
         memory_budget: args.memory.budget(),
+        ..args.table.clone()
     };
     Ok(settings.spec(shards, rayon::current_num_threads())?)
 }
@@ -129,10 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let summary = TableSummary::new(&table, &spec, status, path, args.output.clone());
     if let Some(out) = &args.output {
-        let json = serde_json::to_vec(&table.clone().compact())
-            .context("the table does not serialise (a defect)")?;
-        scatterfit_io::atomic::write_atomic(out, &json)
-            .with_context(|| format!("-o {}", out.display()))?;
+        write_compact(&table, out)?;
     }
     if args.json {
         crate::output::print_json(&summary)?;
@@ -140,6 +112,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         out!("{}", summary.text())?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes `table` to `out` (-o) in the compact form of the shipped tables (no raw profiles).
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_compact(table: &scatterfit_mc::McTable, out: &std::path::Path) -> anyhow::Result<()> {
+    let json = serde_json::to_vec(&table.clone().compact())
+        .context("the table does not serialise (a defect)")?;
+    scatterfit_io::atomic::write_atomic(out, &json).with_context(|| format!("-o {}", out.display()))
 }
 
 /// `scatterfit table --shard K/N`: the shard's part of the table's white run, written as a partial

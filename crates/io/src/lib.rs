@@ -12,6 +12,7 @@ pub mod budget;
 pub mod digest;
 pub mod escape;
 pub mod export;
+pub mod flags;
 pub mod image_files;
 pub mod inputs;
 pub mod manifest;

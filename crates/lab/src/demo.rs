@@ -52,6 +52,30 @@ pub struct DemoFiles {
     pub index: PathBuf,
 }
 
+impl DemoFiles {
+    /// What `scatterfit demo` prints of the files it wrote into `out`: the accuracy table, the time
+    /// spent synthesising (`synth_s`) and measuring (`measure_s`) \[s\], the files, the data
+    /// checks' verdict ([`quality_line`]) and, last, the index page a person opens.
+    pub fn text(&self, out: &Path, synth_s: f64, measure_s: f64) -> String {
+        format!(
+            "The method of Choi, Lee & Chin (2014) on Monte Carlo rig-twin samples of their seven \
+             materials\n\
+             (samples in {0}; the fitted model never made these data; truth in each truth.json)\n\n\
+             {1}\n\
+             time: {synth_s:.1} s synthesising (Monte Carlo, cached for the next run), \
+             {measure_s:.1} s measuring 7 samples with both methods\n\
+             files: {0}/<material>/result.json, report.html, fit.png, compare.png; {0}/summary.md \
+             (Table 1), compare.md (Table 2), accuracy.md\n\
+             quality: {2}\n\
+             index: {3}\n",
+            out.display(),
+            self.accuracy,
+            quality_line(&self.proposed),
+            self.index.display()
+        )
+    }
+}
+
 /// Writes the demo's files into `out`: summary.csv/md (Table 1 of the proposed method),
 /// compare.csv/md (Table 2), accuracy.md and demo-summary.json (every value against the twins'
 /// `truths`, the paper's own fits beside them) and index.html (each pair's folder in `dirs`, the

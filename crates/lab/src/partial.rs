@@ -65,6 +65,27 @@ pub enum PartialError {
     /// The partial folder cannot take the file.
     #[error(transparent)]
     Output(#[from] scatterfit_pipeline::outputs::OutputError),
+    /// A table's partial file holds no table spec.
+    #[error("{}: the table spec", path.display())]
+    TableSpec {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: serde_json::Error,
+    },
+    /// The Monte Carlo engine refused the spec or the shards' sums, with what was being done.
+    #[error("{what}")]
+    Table {
+        /// The file being added, `combining the shards` or `smoothing the combined table`.
+        what: String,
+        /// The engine's reason.
+        #[source]
+        source: scatterfit_mc::McError,
+    },
+    /// The Monte Carlo engine refused the spec.
+    #[error(transparent)]
+    Mc(#[from] scatterfit_mc::McError),
 }
 
 /// What a partial file is a part of: the sharded command.
@@ -354,6 +375,41 @@ pub fn check_set(paths: &[PathBuf]) -> Result<Vec<Partial<IgnoredAny>>, PartialE
         ));
     }
     Ok(parts)
+}
+
+/// The table of a sharded `scatterfit table` run from its `partials` (checked by [`check_set`]:
+/// `count` shards of one run): the spec from the first file's run `inputs`, then each file's exact
+/// sums added into the running sums one at a time (memory: the sums and one part, not every file
+/// at once), smoothed once — the table the run on one machine builds, byte for byte.
+///
+/// # Errors
+/// A damaged partial file, a spec the engine refuses, shards that do not add up (named).
+pub fn combine_table(
+    inputs: &serde_json::Value,
+    count: u64,
+    partials: &[PathBuf],
+) -> Result<(scatterfit_mc::McTableSpec, scatterfit_mc::McTable), PartialError> {
+    use scatterfit_mc::white::{Combiner, WhitePartial};
+    let first = partials.first().cloned().unwrap_or_default();
+    let spec: scatterfit_mc::McTableSpec =
+        serde_json::from_value(inputs.clone()).map_err(|source| PartialError::TableSpec {
+            path: first,
+            source,
+        })?;
+    let table_error = |what: String| move |source| PartialError::Table { what, source };
+    let mut combiner = Combiner::new(spec.white()?, count)?;
+    for path in partials {
+        let p = read::<WhitePartial>(path)?;
+        combiner
+            .add(&p.data)
+            .map_err(table_error(path.display().to_string()))?;
+    }
+    let tally = combiner
+        .finish()
+        .map_err(table_error("combining the shards".into()))?;
+    let table = scatterfit_mc::McTable::from_tally(&spec, &tally)
+        .map_err(table_error("smoothing the combined table".into()))?;
+    Ok((spec, table))
 }
 
 #[cfg(test)]

@@ -2,7 +2,8 @@
 //! command (`--shard $SLURM_ARRAY_TASK_ID/N`, each writing its partial file) and a combine job that
 //! runs once every shard has succeeded (`sbatch --dependency=afterok`). No scheduler of our own:
 //! the script is plain `sbatch`, and submitting it again redoes only the shards whose partial file
-//! is missing. [`SlurmJob::script`] is the text; the command line gathers the job's pieces.
+//! is missing. [`SlurmJob::script`] is the text; [`split_tokens`] takes the sharded command's own
+//! arguments from the command line.
 
 use std::path::PathBuf;
 
@@ -51,6 +52,82 @@ pub struct SlurmJob {
     pub script: PathBuf,
 }
 
+/// Slurm's side of a script: `scatterfit slurm`'s own flags (their help is the field's text).
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct SlurmSettings {
+    /// Shards: the job array's size, 1 to 10 000 (tasks 1…N).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000)))]
+    pub array: u64,
+    /// Where to write the script (a `.sh` file; an existing one only with --force-script).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "FILE", default_value = "scatterfit-slurm.sh")
+    )]
+    pub script: PathBuf,
+    /// Replace an existing script file.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub force_script: bool,
+    /// CPUs of each array task (`#SBATCH --cpus-per-task`; the task's threads), 1 to 1024.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "C", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1024)))]
+    pub cpus_per_task: u64,
+    /// Time limit of each task (`#SBATCH --time`, Slurm's format, e.g. 2:00:00).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "TIME"))]
+    pub time: Option<String>,
+    /// Partition (`#SBATCH --partition`).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME"))]
+    pub partition: Option<String>,
+    /// Another `#SBATCH` option for both jobs, verbatim (repeatable; e.g. --sbatch-option=--account=lab).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "OPTION", allow_hyphen_values = true)
+    )]
+    pub sbatch_option: Vec<String>,
+}
+
+impl SlurmSettings {
+    /// The job of `command` from its own command-line `tokens` (after `slurm <kind>`,
+    /// [`split_tokens`]): the flags `output_flags` and `--cache-dir` are taken out, and `--json`
+    /// and `--quiet`; the combine job's `-o` is `output` if given, else the last output flag's
+    /// value; the Monte Carlo cache is `--cache-dir`, else `scatterfit_mc::cache::default_cache_dir`;
+    /// paths are made absolute from `cwd`, where the jobs run.
+    #[allow(clippy::too_many_arguments)]
+    pub fn job(
+        &self,
+        command: Kind,
+        tokens: &[String],
+        output_flags: &[&str],
+        output: Option<String>,
+        partial_dir: &std::path::Path,
+        fingerprint: Option<String>,
+        exe: PathBuf,
+        cwd: PathBuf,
+    ) -> SlurmJob {
+        let mut strip: Vec<&str> = output_flags.to_vec();
+        strip.push("--cache-dir");
+        let split = split_tokens(tokens, &strip, &["--json", "--quiet"]);
+        let output = output.or_else(|| split.last(output_flags).map(str::to_owned));
+        let given = split.last(&["--cache-dir"]).map(std::path::Path::new);
+        let cache_dir = scatterfit_mc::cache::cache_dir_or_default(given);
+        SlurmJob {
+            command,
+            args: split.kept,
+            array: self.array,
+            cpus_per_task: self.cpus_per_task,
+            time: self.time.clone(),
+            partition: self.partition.clone(),
+            sbatch_options: self.sbatch_option.clone(),
+            exe,
+            partial_dir: cwd.join(partial_dir),
+            cache_dir: cache_dir.map(|c| cwd.join(c)),
+            output,
+            fingerprint,
+            script: self.script.clone(),
+            cwd,
+        }
+    }
+}
+
 /// `s` quoted for a POSIX shell (left as it is when it holds only characters no shell treats
 /// specially).
 pub fn quote(s: &str) -> String {
@@ -62,6 +139,84 @@ pub fn quote(s: &str) -> String {
     } else {
         format!("'{}'", s.replace('\'', r"'\''"))
     }
+}
+
+/// `scatterfit slurm`'s own flags that take a value: never passed on to the array tasks.
+pub const OWN_WITH_VALUE: [&str; 6] = [
+    "--array",
+    "--script",
+    "--cpus-per-task",
+    "--time",
+    "--partition",
+    "--sbatch-option",
+];
+
+/// `scatterfit slurm`'s own switches: never passed on to the array tasks.
+pub const OWN_SWITCHES: [&str; 1] = ["--force-script"];
+
+/// A sharded command's tokens as given (after `slurm <kind>`), split ([`split_tokens`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SplitTokens {
+    /// The tokens the array tasks run with.
+    pub kept: Vec<String>,
+    /// The flags taken out, in order, each with its value (empty for a switch).
+    pub taken: Vec<(String, String)>,
+}
+
+impl SplitTokens {
+    /// The value of the last of the flags `names` taken out.
+    pub fn last(&self, names: &[&str]) -> Option<&str> {
+        self.taken
+            .iter()
+            .rev()
+            .find(|(n, _)| names.contains(&n.as_str()))
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+/// Splits a command's `tokens` (after `slurm <kind>`) into those the array tasks run with and the
+/// flags taken out: `scatterfit slurm`'s own ([`OWN_WITH_VALUE`], [`OWN_SWITCHES`]) and those in
+/// `strip_with_value` (with their value: `--flag V`, `--flag=V`, `-oV`) and `strip_switches`.
+/// Everything from a `--` on is kept as it is.
+pub fn split_tokens(
+    tokens: &[String],
+    strip_with_value: &[&str],
+    strip_switches: &[&str],
+) -> SplitTokens {
+    let mut split = SplitTokens::default();
+    let mut i = 0;
+    while i < tokens.len() {
+        let t = &tokens[i];
+        let (name, inline) = match t.split_once('=') {
+            Some((n, v)) if n.starts_with("--") => (n.to_owned(), Some(v.to_owned())),
+            _ if t.starts_with("-o") && t.len() > 2 && !t.starts_with("--") => {
+                ("-o".to_owned(), Some(t[2..].to_owned()))
+            }
+            _ => (t.clone(), None),
+        };
+        if t == "--" {
+            split.kept.extend(tokens[i..].iter().cloned());
+            break;
+        }
+        let with_value =
+            OWN_WITH_VALUE.contains(&name.as_str()) || strip_with_value.contains(&name.as_str());
+        if with_value {
+            let value = match inline {
+                Some(v) => v,
+                None => {
+                    i += 1;
+                    tokens.get(i).cloned().unwrap_or_default()
+                }
+            };
+            split.taken.push((name, value));
+        } else if OWN_SWITCHES.contains(&name.as_str()) || strip_switches.contains(&name.as_str()) {
+            split.taken.push((name, String::new()));
+        } else {
+            split.kept.push(t.clone());
+        }
+        i += 1;
+    }
+    split
 }
 
 impl SlurmJob {
@@ -168,6 +323,30 @@ echo "logs: {logs}; squeue -j $array,$combine shows them"
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn splitting() {
+        let t: Vec<String> = [
+            "--eta",
+            "1.3",
+            "--array",
+            "8",
+            "-o",
+            "t.json",
+            "--time=1:00",
+            "--json",
+            "--g",
+            "0.9",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let split = split_tokens(&t, &["-o"], &["--json"]);
+        assert_eq!(split.kept, ["--eta", "1.3", "--g", "0.9"]);
+        assert_eq!(split.last(&["-o"]), Some("t.json"));
+        assert_eq!(split.last(&["--array"]), Some("8"));
+        assert_eq!(split.last(&["--time"]), Some("1:00"));
+    }
 
     fn job() -> SlurmJob {
         SlurmJob {

@@ -47,24 +47,44 @@ pub enum StudyRunError {
     Threads(#[from] rayon::ThreadPoolBuildError),
 }
 
-/// What a study computes from (every shard's the same; the partial files' run fingerprint).
+/// What a study computes from (every shard's the same; the partial files' run fingerprint), and
+/// `scatterfit study`'s flags (their help is the field's text).
 #[derive(Debug, Clone, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct StudyConfig {
-    /// η of the grid.
+    /// Refractive indices η, each in [1, 2.5] (the Monte Carlo tables' range).
+    #[cfg_attr(feature = "clap", arg(long, value_delimiter = ',', default_values_t = [1.0, 1.2, 1.4, 1.6, 2.0, 2.4]))]
     pub etas: Vec<f64>,
-    /// α′ of the grid.
+    /// Reduced albedos α′, each in [0.3, 0.9999].
+    #[cfg_attr(feature = "clap", arg(long, value_delimiter = ',', default_values_t = [0.3, 0.5, 0.7, 0.9, 0.95, 0.98, 0.99, 0.999, 0.9999]))]
     pub albedos: Vec<f64>,
-    /// σ′t of every point [mm⁻¹].
+    /// Reduced extinction σ′t of every grid point [mm⁻¹, 0.2–20].
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, default_value_t = 2.0, value_name = "MM-1")
+    )]
     pub sigma_t_prime: f64,
-    /// The quick rig.
+    /// Small fast samples (256 × 256 px at 0.1 mm/px, a tenth of the photons).
+    #[cfg_attr(feature = "clap", arg(long))]
     pub quick: bool,
-    /// The twins' g.
+    /// Henyey–Greenstein g of the twins, each in [0, 0.95] (default 0: the isotropic study). Any
+    /// g ≠ 0 gives the study a g axis: every twin is made at each g, fitted every way assuming
+    /// g = 0 (what a manifest without `[fit] g` gets) and once more with the g-aware `mc` model
+    /// told the true g ("g given"; "not covered" where the `mc` tables do not answer at that η
+    /// and g); study.md gains a table per model over g. A twin at g costs about 1/(1 − g) times
+    /// the Monte Carlo time of one at g = 0 (g = 0.95: 20×).
+    #[cfg_attr(feature = "clap", arg(long = "g", value_name = "G", value_delimiter = ',', default_values_t = [0.0]))]
     pub g: Vec<f64>,
-    /// The twin's seed.
+    /// Seed of the rig twin.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 1))]
     pub seed: u64,
-    /// The twins' photon scale.
+    /// The twins' Monte Carlo photons × this factor
+    /// ([`crate::twin_settings::PHOTON_SCALE_HELP`]).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FACTOR", default_value_t = 1.0, allow_negative_numbers = true, value_parser = crate::twin_settings::parse_photon_scale, help = crate::twin_settings::PHOTON_SCALE_HELP))]
     pub photon_scale: f64,
-    /// Photon beam diffusion left out.
+    /// Photon beam diffusion left out (on the command line `--no-pbd`, after `-j`: set after
+    /// parsing).
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub no_pbd: bool,
 }
 

@@ -120,3 +120,71 @@ pub fn write_twin_folder(
         &extra,
     )
 }
+
+/// What `scatterfit synth` reports of a twin written into `output_dir` (its JSON: the folder and
+/// the truth; its text: [`SynthSummary::text`]).
+#[derive(Debug, serde::Serialize)]
+pub struct SynthSummary<'a> {
+    /// The sample folder written.
+    pub output_dir: &'a Path,
+    /// What the tool should find.
+    pub truth: &'a scatterfit_synth::Truth,
+}
+
+impl SynthSummary<'_> {
+    /// The summary printed: the folder and its bracket on `rig`, the truth (η, the port's reading
+    /// fraction, g, and per channel σ′s, σa, α′ and the Monte Carlo Rd), and how to measure it.
+    pub fn text(&self, sample: &SyntheticSample, rig: &scatterfit_synth::RigSpec) -> String {
+        use scatterfit_pipeline::radiance::shutter;
+        use std::fmt::Write as _;
+        let mut t = String::new();
+        let times = &sample.bracket.times_s;
+        let _ = writeln!(
+            t,
+            "wrote {} ({} exposures {}–{} s, {}×{} px at {} mm/px, spot ⌀ {} mm)",
+            self.output_dir.display(),
+            times.len(),
+            shutter(times[0]),
+            shutter(*times.last().unwrap_or(&0.0)),
+            rig.width,
+            rig.height,
+            rig.mm_per_pixel,
+            2.0 * rig.spot_radius_mm
+        );
+        let _ = writeln!(t, "truth    η = {:.4}", self.truth.eta);
+        if let Some(p) = &self.truth.port {
+            let f = p.reading_fraction;
+            let _ = writeln!(
+                t,
+                "port     {} mm aperture lit over {} mm reads F = {:.4} / {:.4} / {:.4} of Rd \
+                 (R/G/B; named in the manifest's [spectro], so measure corrects it)",
+                p.aperture_mm, p.illuminated_mm, f[0], f[1], f[2]
+            );
+        }
+        if self.truth.g != 0.0 {
+            let _ = writeln!(
+                t,
+                "         g = {} (in truth.json only: the manifest does not state it)",
+                self.truth.g
+            );
+        }
+        for (name, c) in ["R", "G", "B"].iter().zip(&self.truth.channels) {
+            let _ = writeln!(
+                t,
+                "  {name}  σ′s = {:<8} σa = {:<10} α′ = {:.5}  Rd(MC) = {:.4} ± {:.4}  ({} photons)",
+                c.sigma_s_prime,
+                c.sigma_a,
+                c.albedo_prime,
+                c.rd_total,
+                c.rd_total_stderr,
+                c.photons
+            );
+        }
+        let _ = writeln!(
+            t,
+            "measure it with: scatterfit measure {}",
+            self.output_dir.display()
+        );
+        t
+    }
+}

@@ -80,20 +80,36 @@ impl From<&PublishedMaterial> for Material {
 }
 
 /// The material's settings: a published material by name (its η replaced by `eta` when given), or
-/// coefficients and η.
+/// coefficients and η (also `scatterfit synth`'s flags, whose help texts are given with each field).
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct MaterialSettings {
     /// A published material (`scatterfit_optics::materials::by_name`).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME", conflicts_with_all = ["sigma_s_prime", "sigma_a"], help = MATERIAL_HELP))]
     pub material: Option<String>,
     /// σ′s per channel \[mm⁻¹, each in (0, 100]\].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "R,G,B", value_parser = scatterfit_io::flags::parse_rgb, requires_all = ["sigma_a", "eta"], help = "Reduced scattering coefficient per channel R,G,B [mm⁻¹, each in (0, 100]]"))]
     pub sigma_s_prime: Option<[f64; 3]>,
     /// σa per channel \[mm⁻¹, each in (0, 100]\].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "R,G,B", value_parser = scatterfit_io::flags::parse_rgb, requires = "sigma_s_prime", help = "Absorption coefficient per channel R,G,B [mm⁻¹, each in (0, 100]]"))]
     pub sigma_a: Option<[f64; 3]>,
     /// η, in [1, 3].
+    #[cfg_attr(feature = "clap", arg(long, value_parser = scatterfit_io::flags::parse_finite, help = "Relative refractive index η, in [1, 3] (overrides the material's)"))]
     pub eta: Option<f64>,
     /// The sample's name (default: the material's, or "synthetic").
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, help = "Sample name (default: the material's, or \"synthetic\")")
+    )]
     pub name: Option<String>,
 }
+
+/// Help text of `--material`: the published materials by name.
+#[cfg(feature = "clap")]
+const MATERIAL_HELP: &str = "A built-in material: the seven of Choi et al. 2014 (pink-plastic, \
+    blue-coating, brown-leather, nephrite, wood-tile, sulfur, red-aluminum) or Jensen et al. \
+    2001's (apple, chicken1, chicken2, cream, ketchup, marble, potato, skimmilk, skin1, skin2, \
+    wholemilk; η = 1.3)";
 
 impl MaterialSettings {
     /// The material.
@@ -152,21 +168,76 @@ impl MaterialSettings {
     }
 }
 
-/// The rig's settings.
+/// Help text of `--photon-scale` (`scatterfit synth`, `study`): the twins' Monte Carlo photons × a
+/// factor, and what it buys.
+pub const PHOTON_SCALE_HELP: &str = "Monte Carlo photons of every twin channel × this factor, \
+    0.01–1000 (default 1): a twin's own noise (its profile's and its reading's) falls as 1/√factor \
+    at factor times its Monte Carlo time. At α′ ≥ 0.999 the paper rig's twins carry noise that \
+    reaches σ′s and σa at 1–2.5 %, so a study that is to resolve the method's error there needs \
+    10–20";
+
+/// Parses `--photon-scale`: a finite number in [`scatterfit_synth::rig::PHOTON_SCALE_RANGE`].
+///
+/// # Errors
+/// Not a number, or outside the range.
+pub fn parse_photon_scale(text: &str) -> Result<f64, scatterfit_io::flags::FlagError> {
+    let v = scatterfit_io::flags::parse_finite(text)?;
+    let range = scatterfit_synth::rig::PHOTON_SCALE_RANGE;
+    if range.contains(&v) {
+        Ok(v)
+    } else {
+        Err(scatterfit_io::flags::FlagError(format!(
+            "must lie in [{}, {}] (1 is the rig's own photon count)",
+            range.start(),
+            range.end()
+        )))
+    }
+}
+
+/// The rig's settings (also `scatterfit synth`'s flags, whose help is the field's text; the
+/// effects' flags follow them on the command line and are set after parsing).
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct RigSettings {
-    /// The quick rig (`RigSpec::quick`) instead of the paper's.
+    /// A small fast sample (256 × 256 px at 0.1 mm/px, a tenth of the photons) for trying the tool
+    /// and for tests; not for accuracy studies.
+    #[cfg_attr(feature = "clap", arg(long))]
     pub quick: bool,
-    /// The material's Henyey–Greenstein g, in [0, `G_RANGE_MAX`].
-    pub g: f64,
-    /// Monte Carlo photons × this factor (`RigSpec::with_photon_scale`).
+    /// Monte Carlo photons × this factor (`RigSpec::with_photon_scale`; [`PHOTON_SCALE_HELP`]).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FACTOR", default_value_t = 1.0, allow_negative_numbers = true, value_parser = parse_photon_scale, help = PHOTON_SCALE_HELP))]
     pub photon_scale: f64,
-    /// The camera (`CameraModel::named`; `None`: the rig's own).
+    /// The material's Henyey–Greenstein anisotropy g, in [0, 0.95] (default 0, isotropic): the
+    /// profile and the spectrophotometer's reading are traced with it (σs = σ′s/(1 − g)). It goes
+    /// into truth.json, never into the manifest: the twin plays a user who does not know g. A g of
+    /// 0.9 traces about 10× the interactions of g = 0, 0.95 about 20×.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "G", default_value_t = 0.0, value_parser = scatterfit_io::flags::parse_finite))]
+    pub g: f64,
+    /// The twin's camera: naka-rushton (the default, 8-bit), linear, gamma22, srgb, log, s-curve
+    /// (8-bit tone curves), linear16 (linear 16-bit PNG, black level 1024 DN) or dng (14-bit raw
+    /// DNG files, black level 512, white 16383, exposure times in their metadata).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME", value_parser = parse_camera, default_value = "naka-rushton"))]
     pub camera: Option<String>,
-    /// Camera read noise \[electrons, 0 to 1000\] (`None`: the camera's).
+    /// Camera read noise [electrons, 0 to 1000] (default 3).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "E", value_parser = scatterfit_io::flags::parse_finite))]
     pub read_noise: Option<f64>,
     /// A real rig's effects.
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub effects: RigEffects,
+}
+
+/// Parses `--camera`: a camera of the twin ([`CameraModel::named`]).
+///
+/// # Errors
+/// An unknown name, listing the twin's cameras.
+pub fn parse_camera(s: &str) -> Result<String, scatterfit_io::flags::FlagError> {
+    if CameraModel::named(s).is_some() {
+        Ok(s.to_string())
+    } else {
+        Err(scatterfit_io::flags::FlagError(format!(
+            "unknown camera `{s}`; the twin has: {}",
+            CameraModel::NAMES.join(", ")
+        )))
+    }
 }
 
 impl RigSettings {
@@ -205,6 +276,27 @@ impl RigSettings {
         })?;
         Ok(rig)
     }
+}
+
+/// The files a twin's sample folder gets on `rig` (`scatterfit_io::sample_folder::file_names`
+/// with the truth), so that they can be checked before the Monte Carlo runs: the frames as `.dng`
+/// when `dng` (the `dng` camera), `flat.png` with vignetting, `spot.png` with a spot image.
+pub fn twin_files(rig: &RigSpec, dng: bool) -> Vec<String> {
+    let mut names = scatterfit_io::sample_folder::file_names(rig.times_s.len(), true);
+    if dng {
+        for n in &mut names {
+            if n.starts_with("frame_") {
+                *n = n.replace(".png", ".dng");
+            }
+        }
+    }
+    if rig.effects.vignetting > 0.0 {
+        names.push("flat.png".into());
+    }
+    if rig.effects.spot_image {
+        names.push("spot.png".into());
+    }
+    names
 }
 
 /// The spectrophotometer's port: the aperture's diameter and the lit disc's (default: the

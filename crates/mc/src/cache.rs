@@ -18,6 +18,13 @@ pub enum CacheStatus {
     Built,
 }
 
+/// The cache folder a user gave (`--cache-dir`), else [`default_cache_dir`].
+pub fn cache_dir_or_default(given: Option<&std::path::Path>) -> Option<PathBuf> {
+    given
+        .map(std::path::Path::to_path_buf)
+        .or_else(default_cache_dir)
+}
+
 /// The cache folder: `$SCATTERFIT_CACHE`, else `$XDG_CACHE_HOME/scatterfit`, else
 /// `$HOME/.cache/scatterfit`; `None` when none of these is set.
 pub fn default_cache_dir() -> Option<PathBuf> {

@@ -1,10 +1,15 @@
 //! What an export needs from the Monte Carlo tables (`scatterfit export`): the exact-transport
 //! figures that `scatterfit_io::export`, which does not depend on `scatterfit_mc`, takes from its
-//! caller in [`ExportOptions`].
+//! caller in [`ExportOptions`]; and the checks of the export's output file
+//! ([`check_export_output`]).
 
-use scatterfit_io::export::{ExportOptions, MitsubaVariant, SceneUnit};
+use std::path::{Path, PathBuf};
+
+use scatterfit_io::export::{ExportOptions, Format, MitsubaVariant, SceneUnit};
 use scatterfit_io::result_json::MeasurementResult;
 use scatterfit_optics::{ModelFamily, ModelName};
+
+use crate::outputs::{OutputError, check_destination, check_output_folder, same_file};
 
 /// The options of an export of `result` in `unit` for `mitsuba_variant`, with the exact-transport
 /// figures of the Monte Carlo tables shipped with scatterfit ([`exact_transport_rd`],
@@ -104,4 +109,82 @@ mod tests {
         let mc = scatterfit_mc::family(ModelName::Mc).expect("the shipped tables");
         assert_eq!(albedo_at(mc, &[0.5], 3.5), None);
     }
+}
+
+/// Why an export's output file is refused ([`check_export_output`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExportOutputError {
+    /// The file's extension is not the format's.
+    #[error(
+        "output {}: a {} export is written to a .{} file; name it e.g. `{}`",
+        path.display(),
+        format.name(),
+        format.extension(),
+        path.with_extension(format.extension()).display()
+    )]
+    Extension {
+        /// The output.
+        path: PathBuf,
+        /// The format asked for.
+        format: Format,
+    },
+    /// The output is the result being exported.
+    #[error("output {} is the input result; write the export to another file", path.display())]
+    IsInput {
+        /// The output.
+        path: PathBuf,
+    },
+    /// The output exists and `force` was not given.
+    #[error("output {} exists; pass --force to replace it, or choose another name", path.display())]
+    Exists {
+        /// The output.
+        path: PathBuf,
+    },
+    /// The output is a folder.
+    #[error("output {} is a folder; name a file", path.display())]
+    IsFolder {
+        /// The output.
+        path: PathBuf,
+    },
+    /// A link at the output's name, or its folder cannot take the file.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// Checks an export's output file `out` before the result is read: its extension is `format`'s,
+/// it is not a link, not the `input` result (by resolved path, or by device and inode: a hard
+/// link), not an existing file unless `force`, not a folder; its folder exists and is writable.
+///
+/// # Errors
+/// The first problem, naming the file and what to do.
+pub fn check_export_output(
+    out: &Path,
+    format: Format,
+    input: &Path,
+    force: bool,
+) -> Result<(), ExportOutputError> {
+    let path = || out.to_path_buf();
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if ext.as_deref() != Some(format.extension()) {
+        return Err(ExportOutputError::Extension {
+            path: path(),
+            format,
+        });
+    }
+    check_destination(out, "output")?;
+    if out.exists() {
+        if same_file(out, input) {
+            return Err(ExportOutputError::IsInput { path: path() });
+        }
+        if !force {
+            return Err(ExportOutputError::Exists { path: path() });
+        }
+        if out.is_dir() {
+            return Err(ExportOutputError::IsFolder { path: path() });
+        }
+    }
+    Ok(check_output_folder(out, "-o")?)
 }

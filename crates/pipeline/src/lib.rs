@@ -42,27 +42,32 @@
 
 pub mod anisotropy;
 pub mod batch;
+pub mod batch_args;
 pub mod camera;
 pub mod checks;
 pub mod compare;
 mod error;
 pub mod export;
 pub mod fit;
+pub mod fit_args;
 pub mod hdr;
 pub mod measure;
 pub mod measurement;
+pub mod merge_settings;
 pub mod model_term;
 pub mod monte_carlo;
 pub mod outputs;
 pub mod port;
 pub mod profile;
 pub mod profile_fit;
+pub mod profile_fit_args;
 pub mod radiance;
 mod result;
 pub mod reuse;
 pub mod samples;
 pub mod settings;
 pub mod spectro;
+pub mod spectro_args;
 
 pub use batch::{
     BatchError, BatchEvent, BatchOutcome, BatchRequest, BatchSample, JobPlan, SampleOutcome,

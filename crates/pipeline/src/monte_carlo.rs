@@ -6,6 +6,8 @@
 
 use scatterfit_io::budget::{OverBudget, check_memory, describe_seconds};
 use scatterfit_io::escape::number as show;
+#[cfg(feature = "clap")]
+use scatterfit_io::flags::{parse_count, parse_finite, parse_size};
 use scatterfit_mc::{
     Beam, BeamProfile, Layer, McError, McTableSpec, RadialGrid, Sample, Simulation,
 };
@@ -49,38 +51,67 @@ fn engine(what: &str) -> impl FnOnce(McError) -> MonteCarloSettingsError {
 /// Largest η a simulation accepts: beyond any solid's (diamond 2.42, germanium in the infrared 4).
 pub const MAX_ETA: f64 = 10.0;
 
-/// A simulation's settings (`scatterfit simulate`'s flags).
+/// Help text of `--max-interactions`, the work budget of `scatterfit simulate` and `table`.
+pub const MAX_INTERACTIONS_HELP: &str = "Work budget: the most photon interactions (scattering \
+     events, all photons together) the run may be expected to take, estimated before it starts from \
+     σs, σa, g, η and the thickness; a count (default 1e12: about 7 h on 2 cores at 2e7 \
+     interactions/s per thread). Raise it to allow longer runs";
+
+/// A simulation's settings (`scatterfit simulate`'s flags; their help is the field's text). Every
+/// number is checked by [`SimulateSettings::configure`], not by the parser.
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct SimulateSettings {
-    /// σ′s \[mm⁻¹\], ≥ 0.
+    /// Reduced scattering coefficient σ′s [mm⁻¹]: finite, ≥ 0.
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_finite))]
     pub sigma_s_prime: f64,
-    /// σa \[mm⁻¹\], ≥ 0; > 0 for a half-space.
+    /// Absorption coefficient σa [mm⁻¹]: finite, ≥ 0; > 0 for a half-space (no --thickness-mm),
+    /// where a photon without absorption never has to stop.
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_finite))]
     pub sigma_a: f64,
-    /// Relative refractive index η, in (0, [`MAX_ETA`]]; below 1 only with `allow_eta_below_one`.
+    /// Relative refractive index η of the material (the outside is air, n = 1): 1 to 10 (below 1
+    /// with --allow-eta-below-one).
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_finite))]
     pub eta: f64,
-    /// Henyey–Greenstein g, in (−1, 1).
+    /// Henyey–Greenstein asymmetry g, in (−1, 1); the scattering coefficient is σ′s/(1 − g), so the
+    /// work grows like 1/(1 − g) as g → 1.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite))]
     pub g: f64,
-    /// Slab thickness \[mm\]; `None` for a half-space.
+    /// Slab thickness \[mm\]: finite, > 0; omit for a half-space.
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_finite))]
     pub thickness_mm: Option<f64>,
-    /// Photons, ≥ 1.
+    /// Number of photons: a count ≥ 1 (1e6 is fine); the expected work must fit --max-interactions.
+    #[cfg_attr(feature = "clap", arg(long, default_value = "1000000", value_parser = parse_count))]
     pub photons: u64,
-    /// Seed of the random streams.
+    /// Seed of the random streams, 0 to 2⁶⁴ − 1 (the result is identical for any thread count).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 1))]
     pub seed: u64,
-    /// Beam: `pencil`, `disk:R` or `gauss:R` (R in mm, (0, 1000]).
+    /// Beam: `pencil`, `disk:R` (uniform disk of radius R mm, R in (0, 1000]) or `gauss:R`
+    /// (Gaussian, 1/e² radius R mm, R in (0, 1000]).
+    #[cfg_attr(feature = "clap", arg(long, default_value = "pencil"))]
     pub beam: String,
-    /// Angle of incidence in air \[degrees\], [0, 90).
+    /// Angle of incidence \[degrees\] in air, in [0, 90) (0 = normal).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite))]
     pub incidence_deg: f64,
-    /// Outer radius of the Rd(r) grid \[mm\], [1e-3, 1e6].
+    /// Outer radius of the Rd(r) grid \[mm\]: in (0, 10⁶].
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 10.0, value_parser = parse_finite))]
     pub r_max_mm: f64,
-    /// Radial bins, ≥ 1.
+    /// Number of radial bins (uniform width r_max/bins): a count ≥ 1, within the memory budget
+    /// (about 1 KiB per bin; 8 GiB holds 8 million).
+    #[cfg_attr(feature = "clap", arg(long, default_value = "200", value_parser = parse_size))]
     pub bins: usize,
-    /// Exit-angle bins (0: none).
+    /// Also tally reflectance by exit angle in this many bins over [0°, 90°]: a count, 0 (off) or
+    /// more, within the memory budget with --bins.
+    #[cfg_attr(feature = "clap", arg(long, default_value = "0", value_parser = parse_size))]
     pub angle_bins: usize,
-    /// Accept η < 1.
+    /// Accept η < 1 (a material optically thinner than air).
+    #[cfg_attr(feature = "clap", arg(long))]
     pub allow_eta_below_one: bool,
     /// The work budget: the most interactions the run may be expected to take.
+    #[cfg_attr(feature = "clap", arg(long, default_value = "1e12", value_parser = parse_count, help = MAX_INTERACTIONS_HELP))]
     pub max_interactions: u64,
-    /// The memory budget \[bytes\].
+    /// The memory budget \[bytes\] (on the command line `--max-memory-mib`, set after parsing).
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub memory_budget: u64,
 }
 
@@ -248,22 +279,40 @@ pub const DEFAULT_TABLE_ALBEDOS: usize = 64;
 /// Full-length photons of a table built with other settings than the shipped ones.
 pub const DEFAULT_TABLE_PHOTONS: u64 = 2_000_000;
 
-/// A table's settings (`scatterfit table`'s flags).
+/// A table's settings (`scatterfit table`'s flags; their help is the field's text), checked by
+/// [`TableSettings::spec`].
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct TableSettings {
-    /// η, in [1, 10].
+    /// Relative refractive index η of the material: 1 to 10.
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true, value_parser = parse_finite))]
     pub eta: f64,
-    /// Henyey–Greenstein g, in (−1, 1).
+    /// Henyey–Greenstein asymmetry g, in (−1, 1). The table is in the single-scattering albedo
+    /// a = σs/σt (0.02 … 0.9999), so for g > 0 it covers α′ = a(1 − g)/(1 − ag) up to less than
+    /// 0.9999.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite))]
     pub g: f64,
-    /// Albedo nodes, 4 to [`MAX_TABLE_ALBEDOS`] (`None`: the default layout).
+    /// Number of albedo nodes (equally spaced in √(1 − a) from a = 0.02 to 0.9999): a count, 4 to
+    /// 1000 (default 64; without --albedos and --photons a g = 0 table is built exactly as the
+    /// shipped ones: 128 albedos, 4·10⁶ full-length photons, 4× and 8× as many in the shorter
+    /// strata, a seed per η — 2–8 min on two cores).
+    #[cfg_attr(feature = "clap", arg(long, value_parser = parse_size))]
     pub albedos: Option<usize>,
-    /// Full-length photons, ≥ 1 (`None`: the default).
+    /// Full-length photons: a count ≥ 1; 4× and 16× as many photons trace the paths shorter than
+    /// 1024 and 64 interactions (default 2e6); the expected work must fit --max-interactions.
+    #[cfg_attr(feature = "clap", arg(long, value_parser = parse_count))]
     pub photons: Option<u64>,
-    /// A coarse table that builds in seconds (`McTableSpec::coarse`; overrides the two above).
+    /// A coarse table that builds in seconds (20 000 full-length photons, the default albedos);
+    /// overrides --photons and --albedos. Enough for g = 0 and 0.5; at g ≳ 0.7 the lowest albedos
+    /// then reflect too little light to smooth: use --photons 2e5 or more.
+    #[cfg_attr(feature = "clap", arg(long))]
     pub coarse: bool,
-    /// The work budget of one shard: the most interactions it may be expected to take.
+    /// The work budget of one shard: the most interactions it may be expected to take (on the
+    /// command line `--max-interactions`, set after parsing).
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub max_interactions: u64,
-    /// The memory budget \[bytes\].
+    /// The memory budget \[bytes\] (on the command line `--max-memory-mib`, set after parsing).
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub memory_budget: u64,
 }
 

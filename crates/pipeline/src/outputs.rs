@@ -177,6 +177,42 @@ pub enum OutputError {
         /// Why.
         source: io::Error,
     },
+    /// A file a command writes into an output folder exists and `force` was not given.
+    #[error(
+        "{} already exists; nothing was written — choose another folder or pass --force to \
+         overwrite",
+        path.display()
+    )]
+    InFolderExists {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A command's own folder (`--output-dir` of the demo, the study) holds files it did not make.
+    #[error(
+        "{} holds {holds} and was not made by `scatterfit {command}`; choose another folder with -o \
+         or pass --force{hint}",
+        dir.display()
+    )]
+    NotOwnFolder {
+        /// The folder.
+        dir: PathBuf,
+        /// The first entry found there.
+        holds: String,
+        /// The command that owns its folders.
+        command: &'static str,
+        /// What `--force` does, after "pass --force" (e.g. " to write there"), or empty.
+        hint: &'static str,
+    },
+    /// A folder could not be read or made, or a file in it written.
+    #[error("{action} {}", path.display())]
+    Folder {
+        /// `reading`, `creating`, `writing`.
+        action: &'static str,
+        /// The folder or file.
+        path: PathBuf,
+        /// Why.
+        source: io::Error,
+    },
     /// A refusal concerning one sample of many.
     #[error("sample {}", dir.display())]
     Sample {
@@ -427,6 +463,30 @@ pub fn check_output_file(
     check_output_folder(path, flag)
 }
 
+/// Checks an output file whose extension the caller has checked (`render -o`, repeatable): not a
+/// link or non-file, not an existing file unless `force`, not one of the `inputs`, not a folder,
+/// and its folder exists and is writable.
+///
+/// # Errors
+/// The first problem, naming `flag` and the path and saying what to do.
+pub fn check_new_output(
+    path: &Path,
+    flag: &str,
+    inputs: &[&Path],
+    force: bool,
+) -> Result<(), OutputError> {
+    check_destination(path, flag)?;
+    let err = |make: fn(String, PathBuf) -> OutputError| Err(make(flag.to_owned(), path.into()));
+    if path.exists() && !force {
+        return err(|flag, path| OutputError::Exists { flag, path });
+    }
+    refuse_overwrite(path, flag, inputs)?;
+    if path.is_dir() {
+        return err(|flag, path| OutputError::IsFolder { flag, path });
+    }
+    check_output_folder(path, flag)
+}
+
 /// Refuses an output path that is a symbolic link (even a dangling one) or exists and is not a
 /// regular file: writes never go through a link (`scatterfit_io::atomic`), and saying so before the
 /// work saves it.
@@ -498,6 +558,68 @@ pub fn check_output_dir(dir: &Path, flag: &str) -> Result<(), OutputError> {
         });
     }
     writable(dir, probe, flag)
+}
+
+/// Refuses to write `files` into `dir` when any of them already exists there, unless `force`; a
+/// link or a non-file at one of their names always (`-o`).
+///
+/// # Errors
+/// [`OutputError::Destination`]; [`OutputError::InFolderExists`], naming the first file that
+/// exists.
+pub fn check_output_files(dir: &Path, files: &[String], force: bool) -> Result<(), OutputError> {
+    for f in files {
+        check_destination(&dir.join(f), "-o")?;
+    }
+    match files
+        .iter()
+        .map(|f| dir.join(f))
+        .find(|p| !force && p.exists())
+    {
+        Some(path) => Err(OutputError::InFolderExists { path }),
+        None => Ok(()),
+    }
+}
+
+/// Takes `dir` as the folder of `command` (the demo, the study), which replaces its own files
+/// there on every run: a folder is the command's when it is new, empty or holds the command's
+/// `marker` file; another is refused unless `force` (`hint` says what `--force` does, for the
+/// message). Then the folder is created and the marker written into it.
+///
+/// # Errors
+/// [`OutputError::NotOwnFolder`], naming the first entry found; [`OutputError::Folder`] when the
+/// folder cannot be read or made or the marker written.
+pub fn claim_folder(
+    dir: &Path,
+    marker: &str,
+    command: &'static str,
+    hint: &'static str,
+    force: bool,
+) -> Result<(), OutputError> {
+    let failed = |action, path: &Path| {
+        let path = path.to_path_buf();
+        move |source| OutputError::Folder {
+            action,
+            path,
+            source,
+        }
+    };
+    if dir.exists() && !force && !dir.join(marker).exists() {
+        let mut entries = std::fs::read_dir(dir)
+            .map_err(failed("reading", dir))?
+            .flatten();
+        if let Some(e) = entries.next() {
+            return Err(OutputError::NotOwnFolder {
+                dir: dir.to_path_buf(),
+                holds: e.file_name().to_string_lossy().into_owned(),
+                command,
+                hint,
+            });
+        }
+    }
+    std::fs::create_dir_all(dir).map_err(failed("creating", dir))?;
+    let marker = dir.join(marker);
+    let text = format!("made by `scatterfit {command}`; it may replace the files in this folder\n");
+    atomic::write_atomic(&marker, text.as_bytes()).map_err(failed("writing", &marker))
 }
 
 fn writable(path: &Path, folder: &Path, flag: &str) -> Result<(), OutputError> {

@@ -45,17 +45,116 @@ pub struct ProfileStage {
     pub background: Vec<Background>,
 }
 
-/// Options of the profile stage.
+/// Options of the profile stage (and `scatterfit profile`'s flags: their help is the field's text;
+/// [`ProfileSettings::check`] checks them).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct ProfileSettings {
-    /// Image scale on the sample [mm per pixel].
+    /// Image scale on the sample surface [mm per pixel], in (0, 100] (as the manifest's
+    /// `camera.mm_per_pixel`).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "MM", value_parser = scatterfit_io::flags::parse_finite))]
     pub mm_per_pixel: f64,
-    /// Outermost ring \[px\] (the paper's 300).
-    pub r_max_px: f64,
-    /// Ring width \[px\].
-    pub ring_width_px: f64,
-    /// A given spot centre [x, y] px.
+    /// Spot centre `X,Y` in pixels (pixel centres at integers), inside the image; found
+    /// automatically if omitted.
+    #[cfg_attr(feature = "clap", arg(long = "center", value_name = "X,Y", value_parser = scatterfit_io::flags::parse_center))]
     pub center_px: Option<[f64; 2]>,
+    /// Outer radius of the profile \[px\], in (0, 10⁶] (the paper's cut-off is 300); at most 10⁶
+    /// rings (r_max / ring width).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 300.0, value_name = "PX", value_parser = scatterfit_io::flags::parse_finite))]
+    pub r_max_px: f64,
+    /// Ring width \[px\], > 0, with at most 10⁶ rings (r_max / ring width; 1 px gives the paper's
+    /// profile).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 1.0, value_name = "PX", value_parser = scatterfit_io::flags::parse_finite))]
+    pub ring_width_px: f64,
+}
+
+/// Why profile settings are refused ([`ProfileSettings::check`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ProfileSettingsError {
+    /// A setting out of its range: the flag, the value, the rule.
+    #[error("{0}")]
+    Refused(String),
+    /// The rings' memory is beyond the budget.
+    #[error(transparent)]
+    OverBudget(#[from] scatterfit_io::budget::OverBudget),
+}
+
+/// The largest ring radius accepted \[px\]: beyond any camera sensor's diagonal.
+pub const MAX_R_PX: f64 = 1e6;
+
+/// Memory per ring and channel of the profile and its CSV row \[bytes\] (the ring's statistics,
+/// its share of the table, and the text), an upper bound.
+const BYTES_PER_RING_CHANNEL: u64 = 160;
+
+impl ProfileSettings {
+    /// Checks every number before anything is read (`scatterfit profile`): the ranges, the ring
+    /// count (at most [`scatterfit_imaging::MAX_RINGS`]), the `detection_limit` (each finite and
+    /// ≥ 0) and the rings' memory against `memory_budget` \[bytes\].
+    ///
+    /// # Errors
+    /// The first setting out of range, naming its flag; the memory over the budget.
+    pub fn check(
+        &self,
+        detection_limit: Option<[f64; 3]>,
+        memory_budget: u64,
+    ) -> std::result::Result<(), ProfileSettingsError> {
+        use scatterfit_io::escape::number as show;
+        let range = |ok: bool, flag: &str, value: f64, rule: &str| {
+            if ok {
+                Ok(())
+            } else {
+                Err(ProfileSettingsError::Refused(format!(
+                    "{flag} {}: {rule}",
+                    show(value)
+                )))
+            }
+        };
+        range(
+            self.mm_per_pixel > 0.0 && self.mm_per_pixel <= 100.0,
+            "--mm-per-pixel",
+            self.mm_per_pixel,
+            "the image scale must lie in (0, 100] mm per pixel",
+        )?;
+        range(
+            self.r_max_px > 0.0 && self.r_max_px <= MAX_R_PX,
+            "--r-max-px",
+            self.r_max_px,
+            "the outer radius must lie in (0, 1e6] px (the paper's is 300)",
+        )?;
+        range(
+            self.ring_width_px > 0.0,
+            "--ring-width-px",
+            self.ring_width_px,
+            "the ring width must be > 0 px (1 px gives the paper's profile)",
+        )?;
+        let rings = (self.r_max_px / self.ring_width_px).ceil();
+        range(
+            rings <= scatterfit_imaging::MAX_RINGS as f64,
+            "--ring-width-px",
+            self.ring_width_px,
+            &format!(
+                "--r-max-px {} / --ring-width-px {} makes {rings:.3e} rings, more than 10⁶ — a \
+                 light spot's profile needs hundreds; widen the rings or reduce r_max",
+                show(self.r_max_px),
+                show(self.ring_width_px)
+            ),
+        )?;
+        if let Some(l) = detection_limit
+            && let Some(bad) = l.iter().find(|v| !(v.is_finite() && **v >= 0.0))
+        {
+            return Err(ProfileSettingsError::Refused(format!(
+                "--detection-limit: {} is not a radiance ≥ 0 (relative units, as `scatterfit \
+                 merge` prints it)",
+                show(*bad)
+            )));
+        }
+        Ok(scatterfit_io::budget::check_memory(
+            &format!("a profile of {rings} rings × 3 channels"),
+            (rings as u64 + 1).saturating_mul(3 * BYTES_PER_RING_CHANNEL),
+            memory_budget,
+        )?)
+    }
 }
 
 /// Finds the spot (unless given) and averages rings. Pixel-channels saturated in every exposure

@@ -37,28 +37,102 @@ use scatterfit_optics::fresnel::r0_from_eta;
 
 use crate::error::{Result, invalid};
 
-/// The coefficients that eq. (5) leaves to experiment, and g, with our defaults.
+/// The coefficients that eq. (5) leaves to experiment, and g, with our defaults (also
+/// `scatterfit render`'s flags, whose help texts are given with each field).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct ColourParams {
     /// ρd, diffuse coefficient. Default 1: R(d) already is the layer's albedo.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 1.0,
+            help = "ρd, diffuse coefficient of eq. 5 (≥ 0)"
+        )
+    )]
     pub rho_d: f64,
-    /// ρts, translucent coefficient. Default 1: T(d) already is the transmitted fraction.
-    pub rho_ts: f64,
     /// ρs, specular coefficient; `None` (default) takes the Fresnel reflectance at normal incidence
     /// R₀ = ((η − 1)/(η + 1))², the specular albedo of a smooth dielectric.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            help = "ρs, specular coefficient of eq. 5 (≥ 0; default the Fresnel reflectance at normal incidence ((η−1)/(η+1))²)"
+        )
+    )]
     pub rho_s: Option<f64>,
+    /// ρts, translucent coefficient. Default 1: T(d) already is the transmitted fraction.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 1.0,
+            help = "ρts, translucent coefficient of eq. 5 (≥ 0)"
+        )
+    )]
+    pub rho_ts: f64,
     /// α [mm⁻¹] of the translucent fall-off (α d + β)^−γ. Default 1 mm⁻¹.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 1.0,
+            help = "α of the translucent fall-off (α d + β)^−γ [mm⁻¹, ≥ 0]"
+        )
+    )]
     pub alpha: f64,
     /// β (dimensionless). Default 1, so the fall-off is 1 at d = 0.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 1.0,
+            help = "β of the translucent fall-off (> 0)"
+        )
+    )]
     pub beta: f64,
     /// γ (dimensionless). Default 1: light through 1 mm is halved by spreading, on top of T(d).
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 1.0,
+            help = "γ of the translucent fall-off (≥ 0)"
+        )
+    )]
     pub gamma: f64,
     /// αx, surface slope standard deviation along the tangent (Ward 1992). Default 0.15 (semi-gloss).
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 0.15,
+            help = "αx, surface slope deviation along the tangent (Ward; > 0)"
+        )
+    )]
     pub alpha_x: f64,
     /// αy, along the bitangent. Default 0.15 (isotropic, so the tangent frame does not matter).
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 0.15,
+            help = "αy, surface slope deviation along the bitangent (Ward; > 0)"
+        )
+    )]
     pub alpha_y: f64,
     /// Henyey–Greenstein anisotropy g of P(g), in (−1, 1). Default 0 (P = ½): the fit measures σ′s
     /// only, which is the isotropic equivalent.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            default_value_t = 0.0,
+            allow_hyphen_values = true,
+            help = "Henyey–Greenstein g of P(g) in eqs. 3–4, in (−1, 1)"
+        )
+    )]
     pub g: f64,
 }
 

@@ -70,6 +70,32 @@ pub struct FigureRequest {
 }
 
 impl FigureRequest {
+    /// The summary record of the figure's `panels` rendered on `studio` into `outputs` with
+    /// `threads` threads (written as `render --json` prints it).
+    pub fn summary(
+        &self,
+        studio: &crate::setup::StudioScene,
+        panels: &[PanelRender],
+        outputs: &[PathBuf],
+        threads: usize,
+    ) -> Summary {
+        Summary {
+            mesh: MeshSummary {
+                source: studio.source.clone(),
+                triangles: studio.triangles,
+                size_mm: studio.size_mm,
+                bvh_build_s: studio.build_s,
+            },
+            renders: panels
+                .iter()
+                .map(|p| RenderSummary::new(&self.params[p.set], &p.rendered, &self.options))
+                .collect(),
+            profile: None,
+            outputs: outputs.to_vec(),
+            threads,
+        }
+    }
+
     /// The panels in Figure 5's order: for each method, every parameter set (by index).
     pub fn panels(&self) -> Vec<(Method, usize)> {
         self.methods

@@ -2,7 +2,9 @@
 //! part checks, checked with the setting named by its command-line flag and the memory they size
 //! checked against the budget before any work ([`RenderSettings::check`]); then the renderer's
 //! options, validated ([`RenderSettings::options`]), and the tone curve
-//! ([`RenderSettings::tone`]).
+//! ([`RenderSettings::tone`]); and what its output files may be ([`check_output_kind`]).
+
+use std::path::Path;
 
 use scatterfit_io::budget::{OverBudget, check_memory};
 use scatterfit_io::escape::number as show;
@@ -31,6 +33,33 @@ pub enum RenderSettingsError {
         #[source]
         source: RenderError,
     },
+}
+
+/// Checks that an output file of a render (`-o`) is one it writes: `.png` (tone-mapped sRGB),
+/// `.exr` (linear radiance), and with `profile` (the validation against the measured profile)
+/// `.csv`.
+///
+/// # Errors
+/// [`RenderSettingsError::Refused`], saying what to write.
+pub fn check_output_kind(path: &Path, profile: bool) -> Result<(), RenderSettingsError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    match ext.as_str() {
+        "png" | "exr" => Ok(()),
+        "csv" if profile => Ok(()),
+        "csv" => Err(RenderSettingsError::Refused(format!(
+            "-o {}: a .csv output is the profile comparison; add --profile, or write .png/.exr",
+            path.display()
+        ))),
+        _ => Err(RenderSettingsError::Refused(format!(
+            "-o {}: write .png (tone-mapped sRGB) or .exr (linear radiance){}",
+            path.display(),
+            if profile { " or .csv" } else { "" }
+        ))),
+    }
 }
 
 /// The settings of a render.

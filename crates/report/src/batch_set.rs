@@ -1,7 +1,8 @@
 //! A batch's results as one set (`scatterfit batch`, and `scatterfit combine` of its shards): each
 //! sample's entry ([`BatchEntry`], also a shard's partial data), why a result is not a complete,
 //! trusted measurement ([`failure_of`]), and the summary files made of the entries
-//! ([`write_batch_summary`]: Table 1 and the index page).
+//! ([`write_batch_summary`]: Table 1 and the index page); which samples are measured and which
+//! reused ([`plan_batch`]).
 
 use std::path::{Path, PathBuf};
 
@@ -23,6 +24,77 @@ pub struct BatchEntry {
     pub failure: Option<String>,
     /// Whether the result was reused (it matched its inputs), not measured now.
     pub reused: bool,
+}
+
+impl BatchEntry {
+    /// A sample with its result (measured now, or `reused`); its failure is [`failure_of`] it.
+    pub fn with_result(
+        index: usize,
+        dir: PathBuf,
+        result: MeasurementResult,
+        reused: bool,
+    ) -> Self {
+        Self {
+            index,
+            dir,
+            failure: failure_of(&result),
+            result: Some(result),
+            reused,
+        }
+    }
+
+    /// A sample without a result, and why.
+    pub fn failed(index: usize, dir: PathBuf, why: String) -> Self {
+        Self {
+            index,
+            dir,
+            result: None,
+            failure: Some(why),
+            reused: false,
+        }
+    }
+}
+
+/// A batch's samples before any is measured ([`plan_batch`]).
+#[derive(Debug, Default)]
+pub struct BatchPlan {
+    /// The samples that are not measured: reused results, misspelt folders.
+    pub entries: Vec<BatchEntry>,
+    /// The samples to measure: (index, folder).
+    pub todo: Vec<(usize, PathBuf)>,
+}
+
+/// Sorts a batch's samples — `dirs` (indices 0…), then the `misspelt` folders with why (numbered
+/// after them), only those `owned` (all, or a shard's) — into entries and work: a sample whose
+/// result files match its inputs and `overrides` is reused unless `force`
+/// ([`scatterfit_pipeline::reuse::reusable_result`]), a misspelt folder is an entry with why, the
+/// others are to be measured.
+pub fn plan_batch(
+    dirs: &[PathBuf],
+    misspelt: &[(PathBuf, String)],
+    overrides: &scatterfit_pipeline::Overrides,
+    force: bool,
+    owned: &dyn Fn(usize) -> bool,
+) -> BatchPlan {
+    let mut plan = BatchPlan::default();
+    for (i, dir) in dirs.iter().enumerate().filter(|(i, _)| owned(*i)) {
+        match (!force)
+            .then(|| scatterfit_pipeline::reuse::reusable_result(dir, overrides))
+            .flatten()
+        {
+            Some(r) => plan
+                .entries
+                .push(BatchEntry::with_result(i, dir.clone(), r, true)),
+            None => plan.todo.push((i, dir.clone())),
+        }
+    }
+    for (j, (dir, why)) in misspelt.iter().enumerate() {
+        if owned(dirs.len() + j) {
+            let entry = BatchEntry::failed(dirs.len() + j, dir.clone(), why.clone());
+            plan.entries.push(entry);
+        }
+    }
+    plan
 }
 
 /// Why a result is not a complete, trusted measurement (None: it is): its channels' problems, else

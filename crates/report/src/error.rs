@@ -92,3 +92,27 @@ pub(crate) fn draw_error(stage: &'static str, e: impl std::fmt::Display) -> Repo
         detail: e.to_string(),
     }
 }
+
+/// An error and its causes joined by ": ", after `text` (the context, or empty), skipping a cause
+/// whose text is already there: many errors name their source in their own message, and the chain
+/// printed whole would repeat it.
+pub fn chain_text_after(mut text: String, err: &dyn std::error::Error) -> String {
+    let mut next = Some(err);
+    while let Some(cause) = next {
+        let c = cause.to_string();
+        if !text.contains(&c) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&c);
+        }
+        next = cause.source();
+    }
+    text
+}
+
+/// An error and its causes joined by ": ", a cause the text already holds left out
+/// ([`chain_text_after`]); what `scatterfit` prints after `error: `.
+pub fn error_text(err: &dyn std::error::Error) -> String {
+    chain_text_after(String::new(), err)
+}

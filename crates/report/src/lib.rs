@@ -41,6 +41,7 @@
 #![forbid(unsafe_code)]
 
 pub mod batch_set;
+pub mod compare_set;
 pub mod error;
 pub mod figures;
 pub mod html;

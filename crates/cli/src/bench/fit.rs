@@ -11,12 +11,7 @@ pub fn figures(args: &Args) -> anyhow::Result<Vec<Figure>> {
     let temp = tempfile::tempdir()?;
     let dir = temp.path().join("wood-tile");
     let m = by_name("wood-tile").context("the built-in material")?;
-    let material = crate::twin::Material {
-        name: m.name.into(),
-        sigma_s_prime: m.sigma_s_prime,
-        sigma_a: m.sigma_a,
-        eta: m.eta,
-    };
+    let material = crate::twin::Material::from(m);
     let cache = crate::common::cache_dir(None);
     let sample = crate::twin::synthesize(&material, 1, cache.as_deref(), true, args.quick)?;
     crate::twin::write_sample(&dir, &sample)?;

@@ -21,15 +21,19 @@ pub fn mitsuba_fragment(params: &RendererParameters) -> String {
     mitsuba_fragment_for(params, MitsubaVariant::Rgb)
 }
 
-/// Which of Mitsuba's variants a fragment is for: it decides the medium `<id>_medium` holds.
+/// Which of Mitsuba's variants a fragment is for: it decides the medium `<id>_medium` holds
+/// (`--mitsuba-variant`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[non_exhaustive]
 pub enum MitsubaVariant {
     /// RGB variants (`scalar_rgb`, `llvm_ad_rgb`, …): the channels' coefficients as RGB.
     #[default]
+    #[cfg_attr(feature = "clap", value(help = "RGB variants"))]
     Rgb,
     /// Spectral variants (`scalar_spectral`, …): the medium per wavelength from the measured spectrum
     /// ([`RendererParameters::spectral_medium`]); the RGB medium when the result has no spectrum.
+    #[cfg_attr(feature = "clap", value(help = "Spectral variants"))]
     Spectral,
 }
 

@@ -121,17 +121,22 @@ mod result_spectrum {
     }
 }
 
-/// A target format of `scatterfit export`.
+/// A target format of `scatterfit export` (`--to`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[non_exhaustive]
 pub enum Format {
     /// pbrt-v4 scene-file fragment (`.pbrt`).
+    #[cfg_attr(feature = "clap", value(help = "pbrt-v4 (.pbrt)"))]
     Pbrt,
     /// Mitsuba 3 XML scene fragment (`.xml`).
+    #[cfg_attr(feature = "clap", value(help = "Mitsuba 3 (.xml)"))]
     Mitsuba,
     /// Blender Python (bpy) script (`.py`).
+    #[cfg_attr(feature = "clap", value(help = "Blender ≥ 4.0 bpy script (.py)"))]
     Blender,
     /// Renderer-neutral JSON (`.json`).
+    #[cfg_attr(feature = "clap", value(help = "Renderer-neutral JSON (.json)"))]
     Json,
 }
 
@@ -160,15 +165,24 @@ impl Format {
     }
 }
 
-/// The length unit of the target scene: coefficients are written per this unit.
+/// The length unit of the target scene: coefficients are written per this unit (`--scale`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[non_exhaustive]
 pub enum SceneUnit {
     /// One scene unit is one millimetre (coefficients in mm⁻¹, as measured).
     #[serde(rename = "mm")]
+    #[cfg_attr(
+        feature = "clap",
+        value(name = "mm", help = "One scene unit is one millimetre")
+    )]
     Millimetre,
     /// One scene unit is one metre (coefficients in m⁻¹).
     #[serde(rename = "m")]
+    #[cfg_attr(
+        feature = "clap",
+        value(name = "m", help = "One scene unit is one metre")
+    )]
     Metre,
 }
 
