@@ -4,6 +4,8 @@
 //! (OpenCV's convention). The same convention is used by [`crate::radial_profile`] and by the
 //! manifest's `center_px`.
 
+use rayon::prelude::*;
+
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result};
 
@@ -131,8 +133,9 @@ pub fn find_spot_center(img: &ImageBuf<f32>, opts: &CenterOptions) -> Result<Spo
     let bin = ((w * h) as f64 / 1.0e6).sqrt().round().max(1.0) as usize;
     let (bw, bh) = (w.div_ceil(bin), h.div_ceil(bin));
     let mut coarse = vec![f64::NAN; bw * bh];
-    for by in 0..bh {
-        for bx in 0..bw {
+    // Rows of bins in parallel (each bin's sum in the same order as one loop would form it).
+    coarse.par_chunks_mut(bw).enumerate().for_each(|(by, row)| {
+        for (bx, out) in row.iter_mut().enumerate() {
             let (mut s, mut n) = (0.0, 0usize);
             for y in by * bin..((by + 1) * bin).min(h) {
                 for x in bx * bin..((bx + 1) * bin).min(w) {
@@ -144,10 +147,10 @@ pub fn find_spot_center(img: &ImageBuf<f32>, opts: &CenterOptions) -> Result<Spo
                 }
             }
             if n > 0 {
-                coarse[by * bw + bx] = s / n as f64;
+                *out = s / n as f64;
             }
         }
-    }
+    });
     let smooth = box3(&coarse, bw, bh);
     let mut finite: Vec<f64> = smooth.iter().copied().filter(|v| v.is_finite()).collect();
     if !finite.iter().any(|&v| v > 0.0) {
@@ -281,24 +284,27 @@ fn channel_mean(p: &[f32]) -> f64 {
 /// 3 × 3 mean of the finite neighbours; NaN stays NaN.
 fn box3(v: &[f64], w: usize, h: usize) -> Vec<f64> {
     let mut out = vec![f64::NAN; v.len()];
-    for y in 0..h {
-        for x in 0..w {
-            if v[y * w + x].is_nan() {
-                continue;
-            }
-            let (mut s, mut n) = (0.0, 0usize);
-            for yy in y.saturating_sub(1)..(y + 2).min(h) {
-                for xx in x.saturating_sub(1)..(x + 2).min(w) {
-                    let u = v[yy * w + xx];
-                    if u.is_finite() {
-                        s += u;
-                        n += 1;
+    // Rows in parallel.
+    out.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(y, out)| {
+            for x in 0..w {
+                if v[y * w + x].is_nan() {
+                    continue;
+                }
+                let (mut s, mut n) = (0.0, 0usize);
+                for yy in y.saturating_sub(1)..(y + 2).min(h) {
+                    for xx in x.saturating_sub(1)..(x + 2).min(w) {
+                        let u = v[yy * w + xx];
+                        if u.is_finite() {
+                            s += u;
+                            n += 1;
+                        }
                     }
                 }
+                out[x] = s / n as f64;
             }
-            out[y * w + x] = s / n as f64;
-        }
-    }
+        });
     out
 }
 

@@ -35,11 +35,12 @@ pub use merge::{
     MergeOptions, Weighting, merge, merge_linear_black, merge_linear_u16,
 };
 pub use order::{
-    BracketSignal, bracket_signal, check_bracket_order, check_bracket_order_with_signal,
+    BracketSignal, FLOOR_PIXELS, bracket_signal, check_bracket_order,
+    check_bracket_order_with_signal,
 };
 pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, radial_profile};
 pub use response::{
     CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,
-    MAX_RESPONSE_SAMPLES, ResponseCurve, SamplePixel, TOE_TRUST_HI, TOE_TRUST_LO, forward_toe,
-    gsolve, hat_weight, min_response_samples, recover_response, select_samples,
+    MAX_RESPONSE_SAMPLES, ResponseCurve, SamplePixel, TOE_PIXELS, TOE_TRUST_HI, TOE_TRUST_LO,
+    forward_toe, gsolve, hat_weight, min_response_samples, recover_response, select_samples,
 };

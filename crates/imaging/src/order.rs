@@ -49,10 +49,21 @@ pub struct BracketSignal {
     pub has_signal: Vec<bool>,
 }
 
-/// The regular subsample of value indices that the checks read: at most about 200 000 values per
-/// channel.
+/// The regular subsample of value indices that the order check reads: at most about 200 000 values
+/// per channel.
 fn subsample(n_pixels: usize) -> usize {
     (n_pixels / 200_000).max(1)
+}
+
+/// The pixels [`bracket_signal`] measures the noise floors and the frames' signal on: every s-th
+/// pixel in raster order, s the smallest step that leaves at most this many (every pixel of a
+/// smaller frame). The floor is a quantile (0.99) of the 2 % darkest pixels' codes: over 65 536
+/// pixels that is 1 311 values per frame and channel, its rank known to ±0.3 % of them.
+pub const FLOOR_PIXELS: usize = 65_536;
+
+/// The step of [`FLOOR_PIXELS`]'s subsample for frames of `n_pixels` pixels.
+fn floor_step(n_pixels: usize) -> usize {
+    n_pixels.div_ceil(FLOOR_PIXELS).max(1)
 }
 
 /// Each frame's noise floor per channel and whether it carries signal (see [`BracketSignal`]).
@@ -67,7 +78,7 @@ where
     check_bracket(frames, times_s)?;
     let ch = frames[0].channels();
     let n_px = frames[0].width() * frames[0].height();
-    let step = subsample(n_px);
+    let step = floor_step(n_px);
     let p = frames.len();
     let zero = T::default();
     // The values the checks read (every `step`-th pixel's samples), and per value its codes summed
@@ -80,19 +91,20 @@ where
     let (sums, lit) = {
         let mut sums = vec![0.0f64; sampled.len()];
         let mut lit = vec![false; sampled.len()];
-        for f in frames {
-            let data = f.data();
-            sums.par_chunks_mut(16_384)
-                .zip(lit.par_chunks_mut(16_384))
-                .zip(sampled.par_chunks(16_384))
-                .for_each(|((s, l), ks)| {
+        // One parallel pass: each chunk of values summed over the frames in order.
+        sums.par_chunks_mut(16_384)
+            .zip(lit.par_chunks_mut(16_384))
+            .zip(sampled.par_chunks(16_384))
+            .for_each(|((s, l), ks)| {
+                for f in frames {
+                    let data = f.data();
                     for ((s, l), &k) in s.iter_mut().zip(l.iter_mut()).zip(ks) {
                         let v = data[k];
                         *l |= v > zero;
                         *s += v.into();
                     }
-                });
-        }
+                }
+            });
         (sums, lit)
     };
     // Per channel, per frame (in parallel: every frame's floor is a selection over the channel's

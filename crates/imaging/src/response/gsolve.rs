@@ -1,11 +1,11 @@
 //! Debevec & Malik's least-squares system for one channel (their appendix `gsolve`, with the hat
 //! weight of eq. 4), solved in g alone after eliminating each pixel's ln E.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 use super::curve::LEVELS;
 use super::samples::MAX_RESPONSE_SAMPLES;
-use super::solve::solve_monotone;
+use super::solve::{SparseRows, solve_monotone};
 use crate::error::{ImagingError, Result};
 
 /// The paper's hat weight, Debevec & Malik 1997, eq. (4) with Z_min = 0, Z_max = 255:
@@ -73,10 +73,13 @@ pub fn gsolve(z: &[u8], ln_dt: &[f64], lambda: f64, channel: usize) -> Result<Ch
         });
     }
     let rows = n * p + 1 + (LEVELS - 2);
-    let mut a = DMatrix::<f64>::zeros(rows, LEVELS);
+    let mut a = SparseRows::new(LEVELS);
     let mut b = DVector::<f64>::zeros(rows);
     let mut k = 0;
     let mut w = vec![0.0; p];
+    // One row's values by code, accumulated as a dense row would be, and the codes it touches.
+    let mut row = [0.0f64; LEVELS];
+    let mut touched: Vec<usize> = Vec::with_capacity(p);
     for i in 0..n {
         let zi = &z[i * p..(i + 1) * p];
         for j in 0..p {
@@ -90,34 +93,39 @@ pub fn gsolve(z: &[u8], ln_dt: &[f64], lambda: f64, channel: usize) -> Result<Ch
         // Row block W S g − W ℓ, projected by (I − u uᵀ), u = w/|w|, which removes ln E_i exactly.
         // Projected row j: w_j e_{Z_j} − (w_j/|w|²) Σ_m w_m² e_{Z_m};  rhs likewise with ln Δt.
         let s_rhs: f64 = (0..p).map(|m| w[m] * w[m] * ln_dt[m]).sum::<f64>() / norm2;
+        touched.clear();
+        touched.extend(zi.iter().map(|&v| usize::from(v)));
+        touched.sort_unstable();
+        touched.dedup();
         for j in 0..p {
             if w[j] == 0.0 {
-                // The projected row is zero: skip it.
+                // The projected row is zero.
+                a.push_row([]);
                 k += 1;
                 continue;
             }
-            a[(k, zi[j] as usize)] += w[j];
+            row[usize::from(zi[j])] += w[j];
             let f = w[j] / norm2;
             for m in 0..p {
-                a[(k, zi[m] as usize)] -= f * w[m] * w[m];
+                row[usize::from(zi[m])] -= f * w[m] * w[m];
             }
+            a.push_row(touched.iter().map(|&c| (c, std::mem::take(&mut row[c]))));
             b[k] = w[j] * ln_dt[j] - w[j] * s_rhs;
             k += 1;
         }
     }
     // Gauge g(128) = 0 (appendix: A(k,129) = 1).
-    a[(k, 128)] = 1.0;
+    a.push_row([(128, 1.0)]);
     k += 1;
     // Smoothness, eq. (3): λ w(z) [g(z−1) − 2 g(z) + g(z+1)] = 0, z = 1..=254.
     for zz in 1..LEVELS - 1 {
         let lw = lambda * hat_weight(zz as u8);
-        a[(k, zz - 1)] = lw;
-        a[(k, zz)] = -2.0 * lw;
-        a[(k, zz + 1)] = lw;
+        a.push_row([(zz - 1, lw), (zz, -2.0 * lw), (zz + 1, lw)]);
         k += 1;
     }
     debug_assert_eq!(k, rows);
-    let g_vec = solve_monotone(a, b).ok_or(ImagingError::SolveFailed {
+    debug_assert_eq!(a.nrows(), rows);
+    let g_vec = solve_monotone(&a, b).ok_or(ImagingError::SolveFailed {
         channel,
         reason: "the system is rank deficient (too few distinct code values among the samples?)",
     })?;

@@ -27,4 +27,4 @@ pub use curve::{LEVELS, ResponseCurve};
 pub use gsolve::{ChannelSolution, gsolve, hat_weight};
 pub use recover::{CalibrateOptions, Calibration, MAX_RESPONSE_FALL, recover_response};
 pub use samples::{MAX_RESPONSE_SAMPLES, SamplePixel, min_response_samples, select_samples};
-pub use toe::{TOE_TRUST_HI, TOE_TRUST_LO, forward_toe};
+pub use toe::{TOE_PIXELS, TOE_TRUST_HI, TOE_TRUST_LO, forward_toe};

@@ -22,6 +22,7 @@ pub struct CalibrateOptions {
     samples: usize,
     lambda: f64,
     order_checked: bool,
+    pixels: Option<Vec<Vec<SamplePixel>>>,
 }
 
 impl CalibrateOptions {
@@ -52,6 +53,7 @@ impl CalibrateOptions {
             samples,
             lambda,
             order_checked: false,
+            pixels: None,
         })
     }
 
@@ -62,6 +64,17 @@ impl CalibrateOptions {
     #[must_use]
     pub fn order_checked(mut self) -> Self {
         self.order_checked = true;
+        self
+    }
+
+    /// The same options with the sample pixels given per channel ([`Calibration::samples`] of an
+    /// earlier recovery on the same frames): [`select_samples`] chooses them from the frames' codes
+    /// alone, not from the times, so a caller that recovers the response in rounds with corrected
+    /// times chooses them once. [`recover_response`] refuses pixels outside the frames or a
+    /// channel with fewer than the bracket's minimum.
+    #[must_use]
+    pub fn with_sample_pixels(mut self, pixels: Vec<Vec<SamplePixel>>) -> Self {
+        self.pixels = Some(pixels);
         self
     }
 
@@ -82,6 +95,7 @@ impl Default for CalibrateOptions {
             samples: 100,
             lambda: 10.0,
             order_checked: false,
+            pixels: None,
         }
     }
 }
@@ -185,7 +199,21 @@ fn recover_channel(
     min: usize,
 ) -> Result<RecoveredChannel> {
     let p = frames.len();
-    let picked = select_samples(frames, times_s, c, opts.samples)?;
+    let picked = match opts.pixels.as_ref() {
+        Some(given) => {
+            let (w, h) = (frames[0].width(), frames[0].height());
+            let picked = given.get(c).cloned().unwrap_or_default();
+            if let Some(bad) = picked.iter().find(|s| s.x >= w || s.y >= h) {
+                return Err(ImagingError::InvalidOption {
+                    name: "sample pixel",
+                    value: (bad.y * w + bad.x) as f64,
+                    reason: "the sample pixels given lie outside the frames (chosen on another bracket?)",
+                });
+            }
+            picked
+        }
+        None => select_samples(frames, times_s, c, opts.samples)?,
+    };
     if picked.len() < min {
         return Err(ImagingError::NotEnoughSamples {
             channel: c,

@@ -18,11 +18,12 @@ use super::curve::LEVELS;
 /// unconstrained increments. Monotone by construction: a dip that noise at low codes would make
 /// becomes a flat stretch, and a bracket in the wrong order is found by
 /// [`crate::check_bracket_order`], not by the shape of g.
-pub(super) fn solve_monotone(a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>> {
-    let g = solve_sparse_least_squares(a.clone(), b.clone())?;
+pub(super) fn solve_monotone(a: &SparseRows, b: DVector<f64>) -> Option<DVector<f64>> {
+    let g = solve_sparse_least_squares(a, b.clone())?;
     if g.as_slice().windows(2).all(|w| w[1] >= w[0]) {
         return Some(g);
     }
+    let a = a.to_dense();
     // g = T d: g(z) = Σ_{k=129..=z} d_k above the gauge, −Σ_{k=z+1..=128} d_k below; d_k is
     // column k − 1 (k = 1..=255).
     let n = LEVELS - 1;
@@ -138,6 +139,65 @@ fn nnls(r: &DMatrix<f64>, c: &DVector<f64>, passive: &[bool]) -> Option<DVector<
     Some(x)
 }
 
+/// A matrix stored by rows, each row's non-zeros as (column, value) in increasing column order
+/// (Debevec & Malik's system: a data row holds a pixel's few codes, a smoothness row three).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct SparseRows {
+    /// Row r's non-zeros are `nz[offsets[r]..offsets[r + 1]]`.
+    pub(super) offsets: Vec<usize>,
+    pub(super) nz: Vec<(usize, f64)>,
+    pub(super) ncols: usize,
+}
+
+impl SparseRows {
+    /// An empty matrix of `ncols` columns.
+    pub(super) fn new(ncols: usize) -> Self {
+        Self {
+            offsets: vec![0],
+            nz: Vec::new(),
+            ncols,
+        }
+    }
+
+    /// Appends a row from its (column, value) pairs, in increasing column order; zeros are
+    /// dropped.
+    pub(super) fn push_row(&mut self, row: impl IntoIterator<Item = (usize, f64)>) {
+        self.nz.extend(row.into_iter().filter(|&(_, v)| v != 0.0));
+        self.offsets.push(self.nz.len());
+    }
+
+    /// The number of rows.
+    pub(super) fn nrows(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// The largest |value| (0 for an empty matrix).
+    fn amax(&self) -> f64 {
+        self.nz.iter().fold(0.0f64, |m, &(_, v)| m.max(v.abs()))
+    }
+
+    /// The same matrix, dense (for the active-set solve).
+    fn to_dense(&self) -> DMatrix<f64> {
+        let mut a = DMatrix::<f64>::zeros(self.nrows(), self.ncols);
+        for r in 0..self.nrows() {
+            for &(c, v) in &self.nz[self.offsets[r]..self.offsets[r + 1]] {
+                a[(r, c)] = v;
+            }
+        }
+        a
+    }
+
+    /// The non-zeros of a dense matrix, row by row.
+    #[cfg(test)]
+    fn from_dense(a: &DMatrix<f64>) -> Self {
+        let mut s = Self::new(a.ncols());
+        for r in 0..a.nrows() {
+            s.push_row(a.row(r).iter().copied().enumerate());
+        }
+        s
+    }
+}
+
 /// min |A x − b| for a sparse A (each of Debevec & Malik's rows has a few codes), by the corrected
 /// semi-normal equations (Björck 1996, *Numerical Methods for Least Squares Problems*, §6.6.5):
 /// AᵀA from the rows' non-zeros and its Cholesky factor R (the triangular factor Householder QR
@@ -145,22 +205,10 @@ fn nnls(r: &DMatrix<f64>, c: &DVector<f64>, passive: &[bool]) -> Option<DVector<
 /// RᵀR δ = Aᵀ(b − A x), which bring x to QR's accuracy for any A with κ(A)² well below 1/ε.
 /// Costs a few milliseconds where a dense QR of the (N·P + 255) × 256 system took a tenth of a
 /// second. `None` when A is rank deficient (a pivot of R at or below 10⁻¹² · n · max |A|, as for QR).
-pub(super) fn solve_sparse_least_squares(a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>> {
-    let (m, n) = a.shape();
+pub(super) fn solve_sparse_least_squares(a: &SparseRows, b: DVector<f64>) -> Option<DVector<f64>> {
+    let (m, n) = (a.nrows(), a.ncols);
     let scale = a.amax();
-    let at = a.transpose();
-    // Each row's non-zeros (column, value): AᵀA and A x from them.
-    let mut offsets = Vec::with_capacity(m + 1);
-    let mut nz: Vec<(usize, f64)> = Vec::new();
-    offsets.push(0);
-    for r in 0..m {
-        for (c, &v) in at.column(r).iter().enumerate() {
-            if v != 0.0 {
-                nz.push((c, v));
-            }
-        }
-        offsets.push(nz.len());
-    }
+    let (offsets, nz) = (&a.offsets, &a.nz);
     let mut ata = DMatrix::<f64>::zeros(n, n);
     for r in 0..m {
         let row = &nz[offsets[r]..offsets[r + 1]];
@@ -257,7 +305,7 @@ mod tests {
             k += 1;
         }
         let qr = solve_least_squares(a.clone(), b.clone()).expect("full rank");
-        let sne = solve_sparse_least_squares(a, b).expect("full rank");
+        let sne = solve_sparse_least_squares(&SparseRows::from_dense(&a), b).expect("full rank");
         let worst = (qr - sne).amax();
         assert!(worst < 1e-9, "semi-normal equations off QR by {worst:e}");
     }

@@ -6,8 +6,8 @@ use super::*;
 /// File formats for float radiance maps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RadianceFormat {
-    /// OpenEXR, 32-bit float samples, channels `R,G,B` or `Y`, lossless PIZ compression, the same
-    /// bytes for the same image.
+    /// OpenEXR, 32-bit float samples, channels `R,G,B` or `Y`, uncompressed scan lines (exact, and
+    /// the same bytes for the same image).
     Exr,
     /// Radiance RGBE (`.hdr`): RGB only (a grey map is written as three equal channels), about 1 %
     /// precision (8-bit mantissa, shared exponent).
@@ -212,13 +212,14 @@ pub(super) fn encode_exr(image: &ImageBuf<f32>, path: &Path) -> Result<Vec<u8>, 
         .enumerate()
         .map(|(c, name)| AnyChannel::new(*name, FlatSamples::F32(plane(c))))
         .collect();
-    // PIZ (lossless wavelet + Huffman, 32 scan lines per block) in increasing line order: the blocks
-    // are compressed in parallel but written in order, so the same image gives the same bytes (the
-    // former RLE tiles in `Unspecified` order came out in whatever order the threads finished). On a
-    // noisy 12-MP map PIZ gives 106 MB where RLE gave 144 MB and ZIP 135 MB, and writes faster than
-    // ZIP (BENCHMARKS.md, "EXR output").
+    // Uncompressed scan lines in increasing order: the same image gives the same bytes (the former
+    // RLE tiles in `Unspecified` order came out in whatever order the threads finished), and every
+    // EXR reader reads them. A merged map's low mantissa bits are noise, which no lossless codec
+    // packs: PIZ saved 10 % of the memorial's map and 8 % of a 1-MP twin's at 20–50 times the
+    // write time (0.19 s and 0.45 s against 0.009 s, a fifth of the memorial's whole merge;
+    // BENCHMARKS.md, "EXR output").
     let encoding = Encoding {
-        compression: Compression::PIZ,
+        compression: Compression::Uncompressed,
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };

@@ -3,11 +3,17 @@
 
 use super::*;
 
+/// The pixels [`PairCounts`] counts per frame pair: every s-th pixel in raster order, s the smallest
+/// step that leaves at most this many (every pixel of a smaller frame). A code's scatter is judged
+/// where at least 50 pixels read it; 65 536 pixels of a bracket's pairs give that for the codes
+/// the scene fills.
+pub(crate) const DETECTION_PIXELS: usize = 65_536;
+
 /// The code pairs of consecutive frames that [`detection_codes`] reads, counted once for the
 /// bracket: per channel and pair of frames (j, j + 1), how many pixels read (z_j, z_{j+1}), both
-/// unclipped (neither 0 nor 255); at most about 2.6·10⁵ pixels per frame pair are read (a 24-MP
-/// frame is subsampled). The counts depend on the codes alone, so the response's rounds reuse
-/// them.
+/// unclipped (neither 0 nor 255), over at most [`DETECTION_PIXELS`] pixels per frame pair (every
+/// s-th pixel in raster order). The counts depend on the codes alone, so the response's rounds
+/// reuse them.
 pub(super) struct PairCounts {
     /// Per channel, per pair: the code pairs met and how often, (z_j, z_{j+1}, count), z_j
     /// ascending.
@@ -24,8 +30,7 @@ impl PairCounts {
             .map(|task| {
                 let (c, j) = (task / pairs.max(1), task % pairs.max(1));
                 let (a, b) = (bufs[j].data(), bufs[j + 1].data());
-                // At most ~2.6·10⁵ pixels per pair: plenty for the per-code scatter.
-                let step = (a.len() / ch / 262_144).max(1);
+                let step = (a.len() / ch).div_ceil(DETECTION_PIXELS).max(1);
                 let mut count = vec![0u32; 256 * 256];
                 for i in (c..a.len()).step_by(ch * step) {
                     let (z1, z2) = (a[i], b[i]);

@@ -30,15 +30,22 @@ pub(in crate::hdr) fn merge_8bit(
         .unwrap_or_else(|| default_response_samples(bufs.len()));
     // The recovered response (unbiased for the mean of a pixel's readings: the merge), its
     // first-order toe (unbiased for their median: the exposure estimate's medians), the residuals.
-    let recover = |t: &[f64]| -> Result<(ResponseCurve, ResponseCurve, Vec<f64>)> {
+    // The sample pixels are chosen in the first recovery (from the codes alone, not the times)
+    // and kept for the rounds with corrected times.
+    let mut pixels: Option<Vec<Vec<scatterfit_imaging::SamplePixel>>> = None;
+    let mut recover = |t: &[f64]| -> Result<(ResponseCurve, ResponseCurve, Vec<f64>)> {
         // The order is checked above, once.
-        let opts = CalibrateOptions::new(samples, cx.inputs.lambda)
+        let mut opts = CalibrateOptions::new(samples, cx.inputs.lambda)
             .map_err(imaging("the response recovery's options"))?
             .order_checked();
+        if let Some(p) = pixels.take() {
+            opts = opts.with_sample_pixels(p);
+        }
         let cal = scatterfit_imaging::recover_response(&bufs, t, &opts).map_err(
             imaging("recovering the camera response (or give a known one: --response for merge, camera.response in sample.toml for measure)"),
         )?;
         let rms = cal.solutions.iter().map(|s| s.rms_residual).collect();
+        pixels = Some(cal.samples);
         Ok((cal.response, cal.median_response, rms))
     };
     let (mut response, mut median_response, kind, mut rms) = match &cx.inputs.response {
@@ -58,7 +65,11 @@ pub(in crate::hdr) fn merge_8bit(
     if cx.inputs.exposure_correction != ExposureCorrection::Never {
         let recovered = kind == ResponseKind::Recovered;
         let ch = bufs[0].channels();
-        let n = bufs[0].data().len();
+        // The exposure estimate reads every s-th pixel in raster order, at most EXPOSURE_PIXELS
+        // (index i of the estimate: pixel (i / ch)·s, channel i % ch).
+        let n_px = bufs[0].data().len() / ch;
+        let s = n_px.div_ceil(EXPOSURE_PIXELS).max(1);
+        let n = n_px.div_ceil(s) * ch;
         for round in 0..if recovered { 4 } else { 1 } {
             // The median of the pixels' ratios: the median-unbiased linearisation.
             let lin: Vec<Vec<f64>> = median_response
@@ -78,6 +89,7 @@ pub(in crate::hdr) fn merge_8bit(
                 &|j, i| {
                     let l = &lin[if lin.len() == 1 { 0 } else { i % ch }];
                     let floor = usize::from(det[i % ch]);
+                    let i = (i / ch) * s * ch + i % ch;
                     let z = bufs[j].data()[i];
                     if z == 0 || z > 230 {
                         return None;
@@ -335,6 +347,12 @@ fn longest_frame_below_floor(
         }
     }
 }
+
+/// The pixels the exposure estimate reads ([`crate::camera::estimate_exposures`]): every s-th pixel
+/// in raster order, s the smallest step that leaves at most this many (every pixel of a smaller
+/// frame). Each adjacent pair's median log ratio then comes from up to 2·10⁵ values (three
+/// channels), its standard error from their spread.
+pub const EXPOSURE_PIXELS: usize = 65_536;
 
 /// The pixels the merge's self-consistency is scored on
 /// ([`scatterfit_imaging::self_consistency_sampled`]: a regular subsample of the pixels), and the
