@@ -27,7 +27,7 @@ pub struct Args {
     pub images: Vec<PathBuf>,
     #[command(flatten)]
     pub settings: MergeSettings,
-    /// The radiance map to write (.exr: 32-bit float, PIZ lossless; .hdr: Radiance RGBE); checked
+    /// The radiance map to write (.exr: 32-bit float, uncompressed; .hdr: Radiance RGBE); checked
     /// with --response-out before any work; existing files only with --force.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,

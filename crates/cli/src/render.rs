@@ -115,7 +115,7 @@ pub struct Args {
     #[arg(long, value_name = "MM", value_parser = crate::numeric::parse_finite)]
     pub spot_radius_mm: Option<f64>,
     /// Output files, repeatable: .png (tone-mapped sRGB, with captions when there are several
-    /// panels), .exr (linear radiance, PIZ lossless), and with --profile .csv (rendered vs
+    /// panels), .exr (linear radiance, 32-bit float, uncompressed), and with --profile .csv (rendered vs
     /// measured). Checked before rendering; existing files only with --force.
     #[arg(short, long = "output", value_name = "FILE", required = true)]
     pub output: Vec<PathBuf>,
