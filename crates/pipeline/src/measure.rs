@@ -16,6 +16,7 @@ use crate::checks::evidence::{Evidence, gather};
 use crate::checks::findings::SampleChecks;
 use crate::checks::{image_checks, spot_scale};
 use crate::error::{PipelineError, Result};
+use crate::fit::background::keep_levels_that_fit;
 use crate::fit::{fit_and_propagate, fit_stage, free_fits};
 use crate::hdr::inputs::HdrInputs;
 use crate::hdr::radiance_map::read_radiance_map;
@@ -141,6 +142,8 @@ fn measure_from(
         }
         None => plan,
     };
+    // A level the profile stage subtracted stays subtracted only where exact transport prefers it.
+    let profile = keep_levels_that_fit(profile, &hdr.detection_limit, &spectro, &plan);
     let profile_s = t_profile.elapsed().as_secs_f64();
     let data = profile.rgb_data()?;
     begin(Stage::Fit)?;

@@ -380,6 +380,30 @@ impl ProfileStage {
         }))
     }
 
+    /// The stage with the background level added back to the rings of `channels` (each one's
+    /// detection limit the merge's, `merge_limits`, again, and its level marked not subtracted):
+    /// the profile as measured there ([`crate::fit::background`] decides).
+    #[must_use]
+    pub fn with_levels_restored(&self, channels: &[usize], merge_limits: &[f64]) -> ProfileStage {
+        let mut stage = self.clone();
+        for &c in channels {
+            let Some(b) = stage.background.get_mut(c).filter(|b| b.subtracted) else {
+                continue;
+            };
+            b.subtracted = false;
+            let level = b.level;
+            for ring in &mut stage.profile.rings {
+                if let Some(ch) = ring.channels.get_mut(c) {
+                    ch.mean += level;
+                }
+            }
+            if let Some(limit) = stage.detection_limit.get_mut(c) {
+                *limit = merge_limits.get(c).copied().unwrap_or(f64::NAN);
+            }
+        }
+        stage
+    }
+
     /// The three channels' rings as the fit takes them.
     ///
     /// # Errors

@@ -12,6 +12,7 @@ use crate::anisotropy::record::AlbedoAtG;
 use crate::settings::FitPlan;
 use crate::spectro::SpectroStage;
 
+pub mod background;
 pub mod outcome;
 mod spectro_term;
 
