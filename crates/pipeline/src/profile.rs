@@ -277,7 +277,9 @@ pub fn profile_stage_with(
 /// 10⁻⁵ of its peak). Marked for subtraction when significant: above 3 standard errors and above
 /// the detection limit. A clear sample's real tail reaching the corners can look like a level of a
 /// few 10⁻⁶ of the peak to this far-field model (3.5 % on σa of a quick-twin α′ = 0.99 sample when
-/// subtracted at a tenth of the limit); a lens's glare at 10⁻⁴–10⁻³ is far above the limit.
+/// subtracted at a tenth of the limit); a lens's glare at 10⁻⁴–10⁻³ is far above the limit. A tail
+/// that reaches the corners can also read as a level above the limit: the measurement then lets
+/// exact transport decide ([`crate::fit::background`]).
 ///
 /// # Errors
 /// [`PipelineError::Imaging`] when the rings cannot be made.

@@ -7,7 +7,8 @@
 //! has a diffusion length of 11 mm; a 256-pixel frame at 0.1 mm/px reaches 18 mm), that model
 //! cannot tell the tail at the corners from a level, and subtracting it steepens the profile: the
 //! quick twins of whole milk, marble and apple read σ′s +33, +14 and +12 % in red, `ok`. Exact
-//! transport's profile (the `mc` model) describes the tail: the rings are fitted both ways, and the
+//! transport's profile (the `mc` model) describes the tail: the rings are fitted both ways — σ′s
+//! and σa both free, the profile's own shape, before any port correction of the reading — and the
 //! level is kept subtracted only where the fit of the rings less the level is the better one
 //! (reduced χ² of each, on its own rings). A lens's glare at 10⁻⁴–10⁻³ of the spot's radiance
 //! leaves the far rings flat far above any tail, which the fit of the rings as measured cannot
@@ -38,16 +39,20 @@ pub fn keep_levels_that_fit(
     if subtracted.is_empty() {
         return stage;
     }
-    let Ok(exact) = FitPlan::new(plan.settings.exact()) else {
+    // The profile's own shape decides: σ′s and σa both free (the existing method), so neither
+    // the reading's α′ nor a port's correction of it, which comes after, enters.
+    let mut settings = plan.settings.exact();
+    settings.method = scatterfit_optics::Method::Existing;
+    settings.normalise_with_spectro = false;
+    let Ok(exact) = FitPlan::new(settings) else {
         return stage;
     };
-    let spectro = spectro.with_albedo_model(&exact.albedo);
     let restored = stage.with_levels_restored(&subtracted, merge_limits);
     let (Ok(less), Ok(measured)) = (stage.rgb_data(), restored.rgb_data()) else {
         return stage;
     };
     let chi2 = |data: &Rgb<ProfileData>| -> Rgb<Option<f64>> {
-        fit_stage(data, &spectro, &exact).map(|o: ChannelOutcome| {
+        fit_stage(data, spectro, &exact).map(|o: ChannelOutcome| {
             o.report()
                 .filter(|r| r.converged && r.chi2_reduced.is_finite())
                 .map(|r| r.chi2_reduced)
