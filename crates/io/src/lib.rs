@@ -9,6 +9,7 @@
 pub mod atomic;
 pub mod bracket;
 pub mod budget;
+pub mod csv_dialect;
 pub mod digest;
 pub mod escape;
 pub mod export;

@@ -14,7 +14,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
+use crate::csv_dialect::{CsvDialect, LineCounter};
+use crate::text::{TextError, decode_text, read_text_file};
 
 /// What can go wrong reading or writing a profile CSV.
 #[derive(Debug, thiserror::Error)]
@@ -179,7 +180,7 @@ pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, Profil
     let r_mm_col = find("r_mm").ok_or_else(|| {
         invalid(format!(
             "the header has no `r_mm` column (found `{}`)",
-            crate::text::header_for_message(
+            crate::csv_dialect::header_for_message(
                 names.iter().copied(),
                 &["r_mm", "r_px", "value_r", "value_g", "value_b", "value_y"]
             )
@@ -244,7 +245,7 @@ pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, Profil
                     invalid(format!(
                         "line {line}: `{}` = {} is not a finite number",
                         crate::escape::token(names[col]),
-                        crate::text::cell_for_message(field)
+                        crate::csv_dialect::cell_for_message(field)
                     ))
                 })
         };
@@ -264,7 +265,7 @@ pub fn parse_profile_csv(text: &str, path: &Path) -> Result<ProfileTable, Profil
                 invalid(format!(
                     "line {line}: `{}` = {} is not a pixel count",
                     crate::escape::token(names[*n]),
-                    crate::text::cell_for_message(field)
+                    crate::csv_dialect::cell_for_message(field)
                 ))
             })?);
         }

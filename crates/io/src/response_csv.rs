@@ -13,7 +13,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
+use crate::csv_dialect::{CsvDialect, LineCounter};
+use crate::text::{TextError, decode_text, read_text_file};
 
 /// Most rows a response table may have: one per code value of a 16-bit camera.
 pub const MAX_LEVELS: usize = 1 << 16;
@@ -199,7 +200,7 @@ pub fn parse_response_csv(text: &str, path: &Path) -> Result<ResponseTable, Resp
     let names: Vec<String> = headers.iter().map(str::to_ascii_lowercase).collect();
     let find = |n: &str| names.iter().position(|h| h == n);
     let shown = || {
-        crate::text::header_for_message(
+        crate::csv_dialect::header_for_message(
             names.iter().map(String::as_str),
             &["z", "g", "g_y", "g_r", "g_g", "g_b"],
         )
@@ -262,7 +263,7 @@ pub fn parse_response_csv(text: &str, path: &Path) -> Result<ResponseTable, Resp
                         format!(
                             "`{}` = {} is not a finite number",
                             crate::escape::token(&names[col]),
-                            crate::text::cell_for_message(field)
+                            crate::csv_dialect::cell_for_message(field)
                         ),
                     )
                 })?;

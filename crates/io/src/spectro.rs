@@ -18,7 +18,8 @@ use std::path::{Path, PathBuf};
 
 use scatterfit_optics::spectro::SpectroReading;
 
-use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
+use crate::csv_dialect::{CsvDialect, LineCounter};
+use crate::text::{TextError, decode_text, read_text_file};
 
 /// How far SCI may fall below SCE (absolute reflectance) before the reading is refused: about five
 /// times the repeatability of a d/8 instrument such as the CM-600d (≈ 0.1 % reflectance).
@@ -80,7 +81,7 @@ pub enum SpectroCsvError {
         /// The column's name.
         column: String,
         /// The text of the cell, quoted for the message (`"…"`, shortened and escaped:
-        /// [`crate::text::cell_for_message`]).
+        /// [`crate::csv_dialect::cell_for_message`]).
         value: String,
         /// What is wrong with it and what is expected.
         reason: String,
@@ -228,7 +229,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
         .map(|h| h.to_ascii_lowercase())
         .collect();
     let find = |name: &str| header.iter().position(|h| h == name);
-    let found = crate::text::header_for_message(
+    let found = crate::csv_dialect::header_for_message(
         header.iter().map(String::as_str),
         &["wavelength_nm", "sci", "sce", "sci_pct", "sce_pct"],
     );
@@ -285,7 +286,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 path: p(),
                 line,
                 column: name.to_owned(),
-                value: crate::text::cell_for_message(text),
+                value: crate::csv_dialect::cell_for_message(text),
                 reason,
             };
             let v: f64 = parsed.ok_or_else(|| {
@@ -310,7 +311,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                 path: p(),
                 line,
                 column: "wavelength_nm".into(),
-                value: crate::text::cell_for_message(record.get(wl_col).unwrap_or("")),
+                value: crate::csv_dialect::cell_for_message(record.get(wl_col).unwrap_or("")),
                 reason: "is not a wavelength in nanometres (expected about 360–780)".into(),
             });
         }
@@ -321,7 +322,7 @@ pub fn parse_spectro_csv(text: &str, path: &Path) -> Result<SpectroReading, Spec
                     path: p(),
                     line,
                     column: name.to_owned(),
-                    value: crate::text::cell_for_message(record.get(col).unwrap_or("")),
+                    value: crate::csv_dialect::cell_for_message(record.get(col).unwrap_or("")),
                     reason: format!(
                         "is outside 0..{max}{}",
                         if scale == 1.0 && v > 1.0 && v <= 100.0 {

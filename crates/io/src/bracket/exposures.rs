@@ -79,7 +79,7 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
         return Err(header_err(if headers.is_empty() {
             "an empty file".into()
         } else {
-            crate::text::header_for_message(headers.iter(), &["file", "time_s"])
+            crate::csv_dialect::header_for_message(headers.iter(), &["file", "time_s"])
         }));
     };
     let mut entries = Vec::new();
@@ -135,7 +135,7 @@ pub fn parse_exposures_csv(text: &str, path: &Path) -> Result<Vec<ExposureEntry>
                 format!(
                     "`time_s` = {} for {} is not a number; write seconds as a decimal \
                      (0.0016667) or a fraction (1/600)",
-                    crate::text::cell_for_message(time_text),
+                    crate::csv_dialect::cell_for_message(time_text),
                     crate::escape::token(file)
                 ),
             )

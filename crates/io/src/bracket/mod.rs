@@ -15,8 +15,9 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use crate::csv_dialect::{CsvDialect, LineCounter};
 use crate::image_files::{CameraFrame, ImageFileError, decode_camera_frame, describe_shape};
-use crate::text::{CsvDialect, LineCounter, TextError, decode_text, read_text_file};
+use crate::text::{TextError, decode_text, read_text_file};
 
 mod exposures;
 
