@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::image::{CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, check_dark, check_valid};
+use super::image::{CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, check_dark};
 use super::lut::{Tables, hat_weight_above, merge_row_lut};
 use super::options::{MergeOptions, Weighting};
 use super::refine::{FirstPass, refine_by_expected_signal};
@@ -157,11 +157,5 @@ pub fn merge(
         let refined = refine_by_expected_signal(frames, times_s, &tables, dark, &x_floor, &pass);
         radiance = refined;
     }
-    let clipped = ImageBuf::new(w, h, ch, mask)?;
-    check_valid(&clipped)?;
-    Ok(HdrImage {
-        radiance: ImageBuf::new(w, h, ch, radiance)?,
-        clipped,
-        clipped_count,
-    })
+    HdrImage::from_parts((w, h, ch), radiance, mask, clipped_count)
 }

@@ -57,7 +57,7 @@ pub(super) fn check_dark<T: Copy + PartialOrd>(
 }
 
 /// Refuses a merge in which (nearly) every pixel of a channel is clipped in every exposure.
-pub(super) fn check_valid(mask: &ImageBuf<u8>) -> Result<()> {
+fn check_valid(mask: &ImageBuf<u8>) -> Result<()> {
     let ch = mask.channels();
     let total = mask.width() * mask.height();
     for channel in 0..ch {
@@ -116,6 +116,23 @@ pub struct HdrImage {
 }
 
 impl HdrImage {
+    /// A merge's radiance and clipping mask (`w × h × ch`, interleaved) as the map, refused when
+    /// (nearly) every pixel of a channel is clipped in every exposure ([`MIN_VALID_FRACTION`]).
+    pub(super) fn from_parts(
+        (w, h, ch): (usize, usize, usize),
+        radiance: Vec<f32>,
+        mask: Vec<u8>,
+        clipped_count: usize,
+    ) -> Result<Self> {
+        let clipped = ImageBuf::new(w, h, ch, mask)?;
+        check_valid(&clipped)?;
+        Ok(Self {
+            radiance: ImageBuf::new(w, h, ch, radiance)?,
+            clipped,
+            clipped_count,
+        })
+    }
+
     /// True if pixel-channel `(x, y, c)` has a radiance estimate (not clipped everywhere).
     pub fn is_valid(&self, x: usize, y: usize, c: usize) -> bool {
         self.clipped

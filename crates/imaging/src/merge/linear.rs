@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::image::{CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, check_dark, check_valid};
+use super::image::{CLIPPED_HIGH, CLIPPED_LOW, ClippedFill, HdrImage, check_dark};
 use super::options::LinearMergeOptions;
 use crate::ImageBuf;
 use crate::error::{ImagingError, Result, check_bracket, check_shape};
@@ -86,13 +86,7 @@ pub fn merge_linear_u16(
             count
         })
         .sum();
-    let clipped = ImageBuf::new(w, h, ch, mask)?;
-    check_valid(&clipped)?;
-    Ok(HdrImage {
-        radiance: ImageBuf::new(w, h, ch, radiance)?,
-        clipped,
-        clipped_count,
-    })
+    HdrImage::from_parts((w, h, ch), radiance, mask, clipped_count)
 }
 
 /// Merges a linear bracket whose values carry a black level (raw files, linear 16-bit frames of a
@@ -168,11 +162,5 @@ pub fn merge_linear_black(
             count
         })
         .sum();
-    let clipped = ImageBuf::new(w, h, ch, mask)?;
-    check_valid(&clipped)?;
-    Ok(HdrImage {
-        radiance: ImageBuf::new(w, h, ch, radiance)?,
-        clipped,
-        clipped_count,
-    })
+    HdrImage::from_parts((w, h, ch), radiance, mask, clipped_count)
 }
