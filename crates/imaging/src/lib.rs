@@ -42,5 +42,6 @@ pub use profile::{MAX_RINGS, ProfileOptions, RadialProfile, Ring, RingChannel, r
 pub use response::{
     CalibrateOptions, Calibration, ChannelSolution, LEVELS, MAX_RESPONSE_FALL,
     MAX_RESPONSE_SAMPLES, ResponseCurve, SamplePixel, TOE_PIXELS, TOE_TRUST_HI, TOE_TRUST_LO,
-    forward_toe, gsolve, hat_weight, min_response_samples, recover_response, select_samples,
+    forward_toe, gsolve, hat_weight, min_response_samples, recover_response, refit_response_to_map,
+    select_samples,
 };

@@ -52,6 +52,19 @@ pub struct MergeSummary {
     /// frame's stated time ([`scatterfit_imaging::self_consistency`]); per channel after it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub self_consistency: Option<f64>,
+    /// Per frame (shortest first), the factor on its stated time the merge used when times
+    /// estimated from the frames were applied (empty when the stated times were used).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub time_corrections: Vec<f64>,
+    /// When times estimated from the frames were judged (8-bit frames): the decimated bracket's
+    /// self-consistency merged at the stated times and at the corrected ones, each at its own
+    /// times \[code values\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exposure_judged: Option<[f64; 2]>,
+    /// When the recovered response was refitted to the merged map: the self-consistency of the
+    /// decimated frames' merge before and after \[code values\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub response_refit: Option<[f64; 2]>,
     /// The same per channel.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub self_consistency_per_channel: Vec<f64>,
@@ -107,6 +120,15 @@ impl MergeSummary {
                 .to_string()
             }),
             self_consistency: stage.corrections.self_consistency.as_ref().map(|c| c.rms),
+            response_refit: stage.corrections.response_refit,
+            time_corrections: match (
+                &stage.corrections.exposure,
+                stage.corrections.exposure_applied,
+            ) {
+                (Some(e), true) => e.factor.clone(),
+                _ => Vec::new(),
+            },
+            exposure_judged: stage.corrections.exposure_judged,
             self_consistency_per_channel: stage
                 .corrections
                 .self_consistency
@@ -144,6 +166,33 @@ impl MergeSummary {
         for f in &self.frames {
             let _ = writeln!(s, "  {:>10} s  {}", shutter(f.time_s), f.file.display());
         }
+        if !self.time_corrections.is_empty() {
+            let lo = self
+                .time_corrections
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min);
+            let hi = self.time_corrections.iter().copied().fold(0.0f64, f64::max);
+            let why = self
+                .exposure_judged
+                .map_or(String::new(), |[stated, corrected]| {
+                    format!(
+                        "; they explain the frames better: {corrected:.2} code values RMS against \
+                     {stated:.2} at the stated times"
+                    )
+                });
+            let _ = writeln!(
+                s,
+                "              merged at times estimated from the frames (×{lo:.3} … ×{hi:.3} the \
+                 stated){why}"
+            );
+        } else if let Some([stated, corrected]) = self.exposure_judged {
+            let _ = writeln!(
+                s,
+                "              merged at the stated times: the times estimated from the frames \
+                 explain them no better ({corrected:.2} code values RMS against {stated:.2})"
+            );
+        }
         let rms = if self.response_rms_residual.is_empty() {
             String::new()
         } else {
@@ -155,6 +204,14 @@ impl MergeSummary {
             format!(" (weighted RMS residual {})", v.join(", "))
         };
         let _ = writeln!(s, "response      {}{rms}", self.response);
+        if let Some([before, after]) = self.response_refit {
+            let _ = writeln!(
+                s,
+                "              refitted to the merged map: every pixel's codes against its log \
+                 exposure (self-consistency {before:.2} → {after:.2} code values on the frames \
+                 decimated)"
+            );
+        }
         for f in &self.frames_without_signal {
             let _ = writeln!(
                 s,

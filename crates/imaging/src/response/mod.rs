@@ -12,12 +12,14 @@
 //! the monotone solve by non-negative least squares); `comb` (the spline refit and the comb in log
 //! exposure that remove the bracket-period ripple); `toe` (the forward toe); `samples` (sample
 //! pixel selection); `recover` ([`recover_response`]: all of it per channel, and the check that g
-//! rises).
+//! rises); `refit` ([`refit_response_to_map`]: the curve refitted to a merged map, every pixel's
+//! codes regressed on its log exposure).
 
 mod comb;
 mod curve;
 mod gsolve;
 mod recover;
+mod refit;
 mod samples;
 mod solve;
 mod toe;
@@ -26,5 +28,6 @@ pub use comb::AMBIGUITY_KNOT_STEP;
 pub use curve::{LEVELS, ResponseCurve};
 pub use gsolve::{ChannelSolution, gsolve, hat_weight};
 pub use recover::{CalibrateOptions, Calibration, MAX_RESPONSE_FALL, recover_response};
+pub use refit::refit_response_to_map;
 pub use samples::{MAX_RESPONSE_SAMPLES, SamplePixel, min_response_samples, select_samples};
 pub use toe::{TOE_PIXELS, TOE_TRUST_HI, TOE_TRUST_LO, forward_toe};

@@ -89,6 +89,11 @@ pub struct Corrections {
     pub exposure: Option<ExposureEstimate>,
     /// True when the estimated times were used.
     pub exposure_applied: bool,
+    /// 8-bit merges whose estimated times would have been applied: the decimated bracket's
+    /// self-consistency merged at the stated times and at the corrected ones, each scored at its
+    /// own times \[code values\] (the corrected times kept only when clearly better; not written).
+    #[serde(skip)]
+    pub exposure_judged: Option<[f64; 2]>,
     /// The flat frame divided out, with its smoothed fall-off (min and max of the divisor).
     pub flat: Option<(PathBuf, f64, f64)>,
     /// The codes 16-bit frames use and the saturation found ([`frames::code_range`]; not
@@ -111,6 +116,11 @@ pub struct Corrections {
     /// 8-bit merges: the weighting used ([`HdrInputs::weighting_auto`] chooses it; not written).
     #[serde(skip)]
     pub weighting: Option<Weighting>,
+    /// 8-bit merges: the response refitted to the merged map, with the decimated bracket's
+    /// self-consistency before and after \[code values\] (`None`: the recovered curve kept; not
+    /// written).
+    #[serde(skip)]
+    pub response_refit: Option<[f64; 2]>,
     /// 8-bit merges: how well the merged map and the response explain the frames at their stated
     /// times ([`scatterfit_imaging::self_consistency`]; not written).
     #[serde(skip)]

@@ -62,6 +62,17 @@ pub(in crate::hdr) fn merge_8bit(
     let pair_counts = corrections.timed("detection codes", || PairCounts::new(&bufs));
     // Exposure times from the frames: ratios of linearised codes in the well-exposed range.
     let mut times_used = stated.to_vec();
+    // The decimated frames the weighting is chosen on, and the refit and the corrected times
+    // judged (every d-th pixel of every d-th row, about CONSISTENCY_PIXELS pixels).
+    let n_px = bufs[0].width() * bufs[0].height();
+    let d = ((n_px as f64 / CONSISTENCY_PIXELS as f64).sqrt().ceil() as usize).max(1);
+    let small_frames = if d == 1 {
+        None
+    } else {
+        Some(decimate(&bufs, d)?)
+    };
+    let small: &[ImageBuf<u8>] = small_frames.as_deref().unwrap_or(&bufs);
+    let at_stated = (response.clone(), rms.clone());
     if cx.inputs.exposure_correction != ExposureCorrection::Never {
         let recovered = kind == ResponseKind::Recovered;
         let ch = bufs[0].channels();
@@ -150,6 +161,42 @@ pub(in crate::hdr) fn merge_8bit(
                 break;
             }
         }
+        if corrections.exposure_applied && cx.inputs.exposure_correction == ExposureCorrection::Auto
+        {
+            // Corrected times are kept only where they explain the frames better: the merge at
+            // the corrected times (with the response recovered at them), scored at those times,
+            // against the merge at the stated times. A response recovered from the same frames
+            // trades its own bend against the times; on a processed camera's JPEGs the estimate
+            // moved frames by 10–25 % into maps that explain the frames worse at any times
+            // (BENCHMARKS.md, "Real brackets"), where a shutter's real error (the twin's) leaves
+            // the corrected merge clearly better.
+            let t = Instant::now();
+            let best = |r: &ResponseCurve, t: &[f64]| -> Result<f64> {
+                let mut best = f64::INFINITY;
+                for weighting in [Weighting::NoiseOptimal, Weighting::DebevecHat] {
+                    let opts = MergeOptions {
+                        clipped_fill: cx.inputs.clipped_fill,
+                        weighting,
+                        expected_floor: None,
+                    };
+                    let hdr = scatterfit_imaging::merge(small, t, r, None, &opts)
+                        .map_err(imaging("merging the decimated bracket"))?;
+                    let score = scatterfit_imaging::self_consistency(small, t, r, &hdr)
+                        .map_err(imaging("scoring the decimated merge's self-consistency"))?;
+                    best = best.min(score.rms);
+                }
+                Ok(best)
+            };
+            let stated_score = best(&at_stated.0, stated)?;
+            let corrected_score = best(&response, &times_used)?;
+            corrections.exposure_judged = Some([stated_score, corrected_score]);
+            if !(corrected_score < EXPOSURE_KEEP_MARGIN * stated_score) {
+                corrections.exposure_applied = false;
+                times_used = stated.to_vec();
+                (response, rms) = at_stated;
+            }
+            corrections.time("exposure judged", t.elapsed().as_secs_f64());
+        }
         if corrections.exposure_applied
             && let Some(e) = corrections.exposure.as_mut()
         {
@@ -179,6 +226,7 @@ pub(in crate::hdr) fn merge_8bit(
     }
     corrections.expected_floor = Some(floor);
     let merge_with = |weighting: Weighting,
+                      response: &ResponseCurve,
                       corrections: &mut Corrections|
      -> Result<(HdrImage, SelfConsistency)> {
         let opts = MergeOptions {
@@ -188,7 +236,7 @@ pub(in crate::hdr) fn merge_8bit(
         };
         let hdr = corrections
             .timed("merge", || {
-                scatterfit_imaging::merge(&bufs, &times_used, &response, dark.as_ref(), &opts)
+                scatterfit_imaging::merge(&bufs, &times_used, response, dark.as_ref(), &opts)
             })
             .map_err(imaging("merging the bracket"))?;
         // Scored at the stated times: the map must imply them.
@@ -197,7 +245,7 @@ pub(in crate::hdr) fn merge_8bit(
                 scatterfit_imaging::self_consistency_sampled(
                     &bufs,
                     stated,
-                    &response,
+                    response,
                     &hdr,
                     CONSISTENCY_PIXELS,
                 )
@@ -205,63 +253,70 @@ pub(in crate::hdr) fn merge_8bit(
             .map_err(imaging("scoring the merge's self-consistency"))?;
         Ok((hdr, score))
     };
-    let (mut hdr, score, weighting) = if cx.inputs.weighting_auto && dark.is_none() {
-        // The weighting whose noise model explains the frames: the noise-aware merge (noise
-        // constant in the linear signal, a sensor's) unless the paper's hat, robust to a
-        // processed camera's noise and to the response's errors near the ends, explains them
-        // clearly better.
-        // Chosen on the frames decimated to about CONSISTENCY_PIXELS pixels (every d-th pixel
-        // of every d-th row: both merges and their scores at a fraction of the cost), then the
-        // bracket merged once with the weighting chosen.
-        let n_px = bufs[0].width() * bufs[0].height();
-        let d = ((n_px as f64 / CONSISTENCY_PIXELS as f64).sqrt().ceil() as usize).max(1);
-        if d == 1 {
-            let (a, sa) = merge_with(Weighting::NoiseOptimal, corrections)?;
-            let (b, sb) = merge_with(Weighting::DebevecHat, corrections)?;
-            if sb.rms < AUTO_HAT_MARGIN * sa.rms {
-                (b, sb, Weighting::DebevecHat)
-            } else {
-                (a, sa, Weighting::NoiseOptimal)
-            }
-        } else {
-            let t = Instant::now();
-            let small = decimate(&bufs, d)?;
-            let score_on = |weighting: Weighting| -> Result<f64> {
+    let auto = cx.inputs.weighting_auto && dark.is_none();
+    // The response is refitted to the merged map where it was recovered from these frames (not
+    // given, no dark frame to subtract); the weighting chosen, and the refit judged, on the frames
+    // decimated to about CONSISTENCY_PIXELS pixels (every d-th pixel of every d-th row: the merges
+    // and their scores at a fraction of the cost), then the bracket merged once.
+    let refit = kind == ResponseKind::Recovered && dark.is_none();
+    let weighting = if auto || refit {
+        let t = Instant::now();
+        let merge_small =
+            |weighting: Weighting, response: &ResponseCurve| -> Result<(HdrImage, f64)> {
                 let opts = MergeOptions {
                     clipped_fill: cx.inputs.clipped_fill,
                     weighting,
                     expected_floor: Some(floor),
                 };
-                let hdr = scatterfit_imaging::merge(&small, &times_used, &response, None, &opts)
+                let hdr = scatterfit_imaging::merge(small, &times_used, response, None, &opts)
                     .map_err(imaging("merging the decimated bracket"))?;
-                Ok(
-                    scatterfit_imaging::self_consistency(&small, stated, &response, &hdr)
-                        .map_err(imaging("scoring the decimated merge's self-consistency"))?
-                        .rms,
-                )
+                let rms = scatterfit_imaging::self_consistency(small, stated, response, &hdr)
+                    .map_err(imaging("scoring the decimated merge's self-consistency"))?
+                    .rms;
+                Ok((hdr, rms))
             };
-            let (sa, sb) = (
-                score_on(Weighting::NoiseOptimal)?,
-                score_on(Weighting::DebevecHat)?,
-            );
-            corrections.time("weighting choice", t.elapsed().as_secs_f64());
-            let w = if sb < AUTO_HAT_MARGIN * sa {
-                Weighting::DebevecHat
+        // The weighting whose noise model explains the frames: the noise-aware merge (noise
+        // constant in the linear signal, a sensor's) unless the paper's hat, robust to a
+        // processed camera's noise and to the response's errors near the ends, explains them
+        // clearly better.
+        let (weighting, chosen) = if auto {
+            let a = merge_small(Weighting::NoiseOptimal, &response)?;
+            let b = merge_small(Weighting::DebevecHat, &response)?;
+            if b.1 < AUTO_HAT_MARGIN * a.1 {
+                (Weighting::DebevecHat, b)
             } else {
-                Weighting::NoiseOptimal
-            };
-            let (h, s) = merge_with(w, corrections)?;
-            (h, s, w)
-        }
-    } else {
-        let w = if cx.inputs.weighting_auto {
-            Weighting::NoiseOptimal
+                (Weighting::NoiseOptimal, a)
+            }
         } else {
-            cx.inputs.weighting
+            let w = cx.inputs.weighting;
+            (w, merge_small(w, &response)?)
         };
-        let (h, s) = merge_with(w, corrections)?;
-        (h, s, w)
+        corrections.time("weighting choice", t.elapsed().as_secs_f64());
+        if refit {
+            let t = Instant::now();
+            let (hdr, before) = chosen;
+            let refitted = scatterfit_imaging::refit_response_to_map(
+                small,
+                &times_used,
+                &response,
+                &hdr,
+                usize::MAX,
+            )
+            .map_err(imaging("refitting the response to the merged map"))?;
+            let after = merge_small(weighting, &refitted)?.1;
+            if after < REFIT_MARGIN * before {
+                response = refitted;
+                corrections.response_refit = Some([before, after]);
+            }
+            corrections.time("response refit", t.elapsed().as_secs_f64());
+        }
+        weighting
+    } else if cx.inputs.weighting_auto {
+        Weighting::NoiseOptimal
+    } else {
+        cx.inputs.weighting
     };
+    let (mut hdr, score) = merge_with(weighting, &response, corrections)?;
     if weighting == Weighting::DebevecHat {
         longest_frame_below_floor(
             &mut hdr,
@@ -369,6 +424,20 @@ pub const CONSISTENCY_PIXELS: usize = 65_536;
 /// (processed JPEGs, phones; BENCHMARKS.md, "Real brackets"). On the twin the hat scores within
 /// 2–3 % of it (1.62 against 1.66 code values), on the JPEG brackets of the corpus 5–36 % lower.
 pub const AUTO_HAT_MARGIN: f64 = 0.95;
+
+/// Exposure times corrected from the frames ([`ExposureCorrection::Auto`]) are kept only when the
+/// decimated bracket's merge at them explains the frames better, at those times, than the merge at
+/// the stated times does by more than this factor (the better of the two weightings each).
+pub const EXPOSURE_KEEP_MARGIN: f64 = 0.98;
+
+/// The merge keeps the response refitted to its map
+/// ([`scatterfit_imaging::refit_response_to_map`]) when the refit's merge explains the decimated
+/// frames better than the recovered curve's by more than this factor: the refit sees every pixel
+/// where Debevec & Malik's recovery saw a hundred, and on real brackets it explains the frames
+/// 4–11 % better (BENCHMARKS.md, "Real brackets"); on the twin, whose recovered curve is already
+/// its camera's within the noise, it changes the score by less than 0.1 %, and the recovered curve
+/// is kept.
+pub const REFIT_MARGIN: f64 = 0.98;
 
 /// Every `d`-th pixel of every `d`-th row of each frame (a regular decimation, for choosing the
 /// weighting on a sample of the bracket).
