@@ -10,6 +10,21 @@ use serde::Serialize;
 
 use crate::hdr::{FrameInfo, HdrStage};
 
+/// The weighting's name as `--weighting` spells it, or one per channel (comma-separated) when the
+/// channels were merged differently; `None` when the merge had none (linear frames).
+fn weighting_name(weights: &[scatterfit_imaging::Weighting]) -> Option<String> {
+    let name = |w: &scatterfit_imaging::Weighting| match w {
+        scatterfit_imaging::Weighting::DebevecHat => "debevec-hat",
+        _ => "noise-optimal",
+    };
+    let first = weights.first()?;
+    Some(if weights.iter().all(|w| w == first) {
+        name(first).to_string()
+    } else {
+        weights.iter().map(name).collect::<Vec<_>>().join(", ")
+    })
+}
+
 /// What a merge gave, as `scatterfit merge` prints it (`--json` serialises it as is).
 #[derive(Debug, Clone, Serialize)]
 pub struct MergeSummary {
@@ -112,13 +127,7 @@ impl MergeSummary {
             response_out,
             read_s: stage.read_s,
             merge_s: stage.merge_s,
-            weighting: stage.corrections.weighting.map(|w| {
-                match w {
-                    scatterfit_imaging::Weighting::DebevecHat => "debevec-hat",
-                    _ => "noise-optimal",
-                }
-                .to_string()
-            }),
+            weighting: weighting_name(&stage.corrections.weighting),
             self_consistency: stage.corrections.self_consistency.as_ref().map(|c| c.rms),
             response_refit: stage.corrections.response_refit,
             time_corrections: match (

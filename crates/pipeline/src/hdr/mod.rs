@@ -113,9 +113,10 @@ pub struct Corrections {
     /// ([`scatterfit_imaging::bracket_signal`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub no_signal: Vec<usize>,
-    /// 8-bit merges: the weighting used ([`HdrInputs::weighting_auto`] chooses it; not written).
+    /// 8-bit merges: the weighting used per channel ([`HdrInputs::weighting_auto`] chooses it;
+    /// empty for other merges; not written).
     #[serde(skip)]
-    pub weighting: Option<Weighting>,
+    pub weighting: Vec<Weighting>,
     /// 8-bit merges: the response refitted to the merged map, with the decimated bracket's
     /// self-consistency before and after \[code values\] (`None`: the recovered curve kept; not
     /// written).

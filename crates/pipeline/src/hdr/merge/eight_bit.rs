@@ -225,18 +225,22 @@ pub(in crate::hdr) fn merge_8bit(
             .unwrap_or(det);
     }
     corrections.expected_floor = Some(floor);
-    let merge_with = |weighting: Weighting,
+    let ch = bufs[0].channels();
+    let merge_with = |weights: &[Weighting],
                       response: &ResponseCurve,
                       corrections: &mut Corrections|
      -> Result<(HdrImage, SelfConsistency)> {
-        let opts = MergeOptions {
-            clipped_fill: cx.inputs.clipped_fill,
-            weighting,
-            expected_floor: Some(floor),
-        };
         let hdr = corrections
             .timed("merge", || {
-                scatterfit_imaging::merge(&bufs, &times_used, response, dark.as_ref(), &opts)
+                merge_by_channel(
+                    &bufs,
+                    &times_used,
+                    response,
+                    dark.as_ref(),
+                    cx.inputs.clipped_fill,
+                    floor,
+                    weights,
+                )
             })
             .map_err(imaging("merging the bracket"))?;
         // Scored at the stated times: the map must imply them.
@@ -259,65 +263,90 @@ pub(in crate::hdr) fn merge_8bit(
     // decimated to about CONSISTENCY_PIXELS pixels (every d-th pixel of every d-th row: the merges
     // and their scores at a fraction of the cost), then the bracket merged once.
     let refit = kind == ResponseKind::Recovered && dark.is_none();
-    let weighting = if auto || refit {
+    let weights: Vec<Weighting> = if auto || refit {
         let t = Instant::now();
-        let merge_small =
-            |weighting: Weighting, response: &ResponseCurve| -> Result<(HdrImage, f64)> {
-                let opts = MergeOptions {
-                    clipped_fill: cx.inputs.clipped_fill,
-                    weighting,
-                    expected_floor: Some(floor),
-                };
-                let hdr = scatterfit_imaging::merge(small, &times_used, response, None, &opts)
-                    .map_err(imaging("merging the decimated bracket"))?;
-                let rms = scatterfit_imaging::self_consistency(small, stated, response, &hdr)
-                    .map_err(imaging("scoring the decimated merge's self-consistency"))?
-                    .rms;
-                Ok((hdr, rms))
-            };
-        // The weighting whose noise model explains the frames: the noise-aware merge (noise
-        // constant in the linear signal, a sensor's) unless the paper's hat, robust to a
-        // processed camera's noise and to the response's errors near the ends, explains them
-        // clearly better.
-        let (weighting, chosen) = if auto {
-            let a = merge_small(Weighting::NoiseOptimal, &response)?;
-            let b = merge_small(Weighting::DebevecHat, &response)?;
-            if b.1 < AUTO_HAT_MARGIN * a.1 {
-                (Weighting::DebevecHat, b)
+        let merge_small = |weights: &[Weighting],
+                           response: &ResponseCurve|
+         -> Result<(HdrImage, SelfConsistency)> {
+            let hdr = merge_by_channel(
+                small,
+                &times_used,
+                response,
+                None,
+                cx.inputs.clipped_fill,
+                floor,
+                weights,
+            )
+            .map_err(imaging("merging the decimated bracket"))?;
+            let score = scatterfit_imaging::self_consistency(small, stated, response, &hdr)
+                .map_err(imaging("scoring the decimated merge's self-consistency"))?;
+            Ok((hdr, score))
+        };
+        // Per channel, the weighting whose noise model explains the frames: the noise-aware
+        // merge (noise constant in the linear signal, a sensor's) unless the paper's hat, robust
+        // to a processed camera's noise and to the response's errors near the ends, explains
+        // them clearly better. Per channel, because a camera's processing treats them apart
+        // (JPEG's chroma, a dark channel's gain): on a Canon JPEG bracket the hat explained red
+        // and green 30–50 % better and blue 75 % worse (BENCHMARKS.md, "Real brackets").
+        let (weights, chosen) = if auto {
+            let a = merge_small(&vec![Weighting::NoiseOptimal; ch], &response)?;
+            let b = merge_small(&vec![Weighting::DebevecHat; ch], &response)?;
+            let weights: Vec<Weighting> = (0..ch)
+                .map(|c| {
+                    if b.1.per_channel[c] < AUTO_HAT_MARGIN * a.1.per_channel[c] {
+                        Weighting::DebevecHat
+                    } else {
+                        Weighting::NoiseOptimal
+                    }
+                })
+                .collect();
+            let chosen = if weights.iter().all(|&w| w == Weighting::NoiseOptimal) {
+                a
+            } else if weights.iter().all(|&w| w == Weighting::DebevecHat) {
+                b
             } else {
-                (Weighting::NoiseOptimal, a)
-            }
+                merge_small(&weights, &response)?
+            };
+            (weights, chosen)
         } else {
-            let w = cx.inputs.weighting;
-            (w, merge_small(w, &response)?)
+            let w = vec![cx.inputs.weighting; ch];
+            let chosen = merge_small(&w, &response)?;
+            (w, chosen)
         };
         corrections.time("weighting choice", t.elapsed().as_secs_f64());
         if refit {
+            // Rounds of refit and merge (Robertson et al.'s alternation) while each explains the
+            // frames better by the margin.
             let t = Instant::now();
-            let (hdr, before) = chosen;
-            let refitted = scatterfit_imaging::refit_response_to_map(
-                small,
-                &times_used,
-                &response,
-                &hdr,
-                usize::MAX,
-            )
-            .map_err(imaging("refitting the response to the merged map"))?;
-            let after = merge_small(weighting, &refitted)?.1;
-            if after < REFIT_MARGIN * before {
-                response = refitted;
-                corrections.response_refit = Some([before, after]);
+            let (mut hdr, first) = chosen;
+            let first = first.rms;
+            let mut score = first;
+            for _ in 0..REFIT_ROUNDS {
+                let refitted = scatterfit_imaging::refit_response_to_map(
+                    small,
+                    &times_used,
+                    &response,
+                    &hdr,
+                    usize::MAX,
+                )
+                .map_err(imaging("refitting the response to the merged map"))?;
+                let (next, after) = merge_small(&weights, &refitted)?;
+                if after.rms >= REFIT_MARGIN * score {
+                    break;
+                }
+                (response, hdr, score) = (refitted, next, after.rms);
+                corrections.response_refit = Some([first, score]);
             }
             corrections.time("response refit", t.elapsed().as_secs_f64());
         }
-        weighting
+        weights
     } else if cx.inputs.weighting_auto {
-        Weighting::NoiseOptimal
+        vec![Weighting::NoiseOptimal; ch]
     } else {
-        cx.inputs.weighting
+        vec![cx.inputs.weighting; ch]
     };
-    let (mut hdr, score) = merge_with(weighting, &response, corrections)?;
-    if weighting == Weighting::DebevecHat {
+    let (mut hdr, score) = merge_with(&weights, &response, corrections)?;
+    if weights.contains(&Weighting::DebevecHat) {
         longest_frame_below_floor(
             &mut hdr,
             &bufs,
@@ -325,9 +354,10 @@ pub(in crate::hdr) fn merge_8bit(
             &response,
             dark.as_ref(),
             floor,
+            &weights,
         );
     }
-    corrections.weighting = Some(weighting);
+    corrections.weighting = weights;
     corrections.self_consistency = Some(score);
     if let Some((path, CameraFrame::U8(f))) = cx.flat {
         let lin = linearise_u8(f, &response);
@@ -381,6 +411,7 @@ fn longest_frame_below_floor(
     response: &ResponseCurve,
     dark: Option<&ImageBuf<u8>>,
     floor: [u8; 4],
+    weights: &[Weighting],
 ) {
     let Some((j, &t_max)) = times.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) else {
         return;
@@ -396,7 +427,8 @@ fn longest_frame_below_floor(
     }
     for (i, (e, &z)) in radiance.iter_mut().zip(longest.data()).enumerate() {
         // Flagged pixel-channels (no reading in any frame) keep their fill.
-        if mask[i] == 0 && z < floor[(i % ch).min(3)] {
+        let c = i % ch;
+        if mask[i] == 0 && weights.get(c) == Some(&Weighting::DebevecHat) && z < floor[c.min(3)] {
             let x = f64::from(lin[i]) - dark_lin.as_ref().map_or(0.0, |d| f64::from(d[i]));
             *e = (x.max(0.0) / t_max) as f32;
         }
@@ -425,6 +457,60 @@ pub const CONSISTENCY_PIXELS: usize = 65_536;
 /// 2–3 % of it (1.62 against 1.66 code values), on the JPEG brackets of the corpus 5–36 % lower.
 pub const AUTO_HAT_MARGIN: f64 = 0.95;
 
+/// The bracket merged with a weighting per channel (`weights[c]`; [`MergeOptions::expected_floor`]
+/// for the noise-aware channels): one merge when every channel has the same, else one per
+/// weighting, each channel's radiance and mask taken from its own.
+fn merge_by_channel(
+    frames: &[ImageBuf<u8>],
+    times: &[f64],
+    response: &ResponseCurve,
+    dark: Option<&ImageBuf<u8>>,
+    clipped_fill: scatterfit_imaging::ClippedFill,
+    floor: [u8; 4],
+    weights: &[Weighting],
+) -> std::result::Result<HdrImage, scatterfit_imaging::ImagingError> {
+    let merge = |weighting: Weighting| {
+        let opts = MergeOptions {
+            clipped_fill,
+            weighting,
+            expected_floor: Some(floor),
+        };
+        scatterfit_imaging::merge(frames, times, response, dark, &opts)
+    };
+    let first = weights.first().copied().unwrap_or_default();
+    if weights.iter().all(|&w| w == first) {
+        return merge(first);
+    }
+    let mut out = merge(Weighting::NoiseOptimal)?;
+    let hat = merge(Weighting::DebevecHat)?;
+    let ch = out.radiance.channels();
+    let from_hat = |i: usize| weights.get(i % ch) == Some(&Weighting::DebevecHat);
+    for (i, (e, &h)) in out
+        .radiance
+        .data_mut()
+        .iter_mut()
+        .zip(hat.radiance.data())
+        .enumerate()
+    {
+        if from_hat(i) {
+            *e = h;
+        }
+    }
+    for (i, (m, &h)) in out
+        .clipped
+        .data_mut()
+        .iter_mut()
+        .zip(hat.clipped.data())
+        .enumerate()
+    {
+        if from_hat(i) {
+            *m = h;
+        }
+    }
+    out.clipped_count = out.clipped.data().iter().filter(|&&m| m != 0).count();
+    Ok(out)
+}
+
 /// Exposure times corrected from the frames ([`ExposureCorrection::Auto`]) are kept only when the
 /// decimated bracket's merge at them explains the frames better, at those times, than the merge at
 /// the stated times does by more than this factor (the better of the two weightings each).
@@ -438,6 +524,9 @@ pub const EXPOSURE_KEEP_MARGIN: f64 = 0.98;
 /// its camera's within the noise, it changes the score by less than 0.1 %, and the recovered curve
 /// is kept.
 pub const REFIT_MARGIN: f64 = 0.98;
+
+/// Most rounds of refit and merge ([`REFIT_MARGIN`] ends them sooner).
+pub const REFIT_ROUNDS: usize = 3;
 
 /// Every `d`-th pixel of every `d`-th row of each frame (a regular decimation, for choosing the
 /// weighting on a sample of the bracket).
