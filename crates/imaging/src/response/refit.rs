@@ -31,8 +31,8 @@ const MIN_BIN_COUNT: u32 = 4;
 const MIN_CHANNEL_READINGS: u64 = 1000;
 
 /// The response refitted to the merged map `hdr` (module docs): per channel, the frames' codes at
-/// every s-th pixel in raster order (at most about `max_pixels` pixels) with a radiance (finite,
-/// > 0, not flagged in the map's mask) are binned by u = ln(E·Δt_j) at the times the map was
+/// every s-th pixel in raster order (at most about `max_pixels` pixels) with a radiance (finite
+/// and positive, not flagged in the map's mask) are binned by u = ln(E·Δt_j) at the times the map was
 /// merged with; the bins' mean codes made non-decreasing by pool-adjacent-violators (isotonic
 /// regression weighted by the bins' counts; Barlow et al. 1972); the new g(z) the piecewise-linear
 /// inverse of the pooled points, joined to the old curve (shifted to meet it) beyond the first and

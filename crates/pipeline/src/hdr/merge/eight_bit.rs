@@ -190,7 +190,9 @@ pub(in crate::hdr) fn merge_8bit(
             let stated_score = best(&at_stated.0, stated)?;
             let corrected_score = best(&response, &times_used)?;
             corrections.exposure_judged = Some([stated_score, corrected_score]);
-            if !(corrected_score < EXPOSURE_KEEP_MARGIN * stated_score) {
+            // A score that is not a number (no well-exposed code) keeps the stated times.
+            let better = corrected_score < EXPOSURE_KEEP_MARGIN * stated_score;
+            if !better {
                 corrections.exposure_applied = false;
                 times_used = stated.to_vec();
                 (response, rms) = at_stated;
@@ -556,4 +558,75 @@ fn keeps_the_steps(stated: &[f64], corrected: &[f64]) -> bool {
         let (ls, lc) = ((s[1] / s[0]).ln(), (c[1] / c[0]).ln());
         lc >= 0.5 * ls
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three channels of a ramp bracket merged [noise-aware, hat, noise-aware]: each channel is
+    /// the one its weighting's whole merge gives (the two merges differ, so a channel taken from
+    /// the wrong one fails).
+    #[test]
+    fn each_channel_comes_from_its_own_weighting() {
+        let (w, h, ch) = (64usize, 8usize, 3usize);
+        let times = [0.25, 1.0, 4.0];
+        let frames: Vec<ImageBuf<u8>> = times
+            .iter()
+            .map(|t| {
+                let data = (0..w * h * ch)
+                    .map(|i| {
+                        let x = (i / ch) % w;
+                        let v = 255.0
+                            * (t * (x + 1) as f64 / 64.0 / (1.0 + t * (x + 1) as f64 / 64.0))
+                                .powf(0.45);
+                        // A little per-channel noise-like texture so the weightings disagree.
+                        (v + ((i * 7919) % 5) as f64 - 2.0).clamp(0.0, 255.0) as u8
+                    })
+                    .collect();
+                ImageBuf::new(w, h, ch, data).unwrap()
+            })
+            .collect();
+        let response = ResponseCurve::linear(ch).unwrap();
+        let merge = |weights: &[Weighting]| {
+            merge_by_channel(
+                &frames,
+                &times,
+                &response,
+                None,
+                scatterfit_imaging::ClippedFill::Nan,
+                [1; 4],
+                weights,
+            )
+            .unwrap()
+        };
+        let no = merge(&[Weighting::NoiseOptimal; 3]);
+        let hat = merge(&[Weighting::DebevecHat; 3]);
+        let mixed = merge(&[
+            Weighting::NoiseOptimal,
+            Weighting::DebevecHat,
+            Weighting::NoiseOptimal,
+        ]);
+        let same = |a: f32, b: f32| a == b || (a.is_nan() && b.is_nan());
+        let mut differ = 0;
+        for (i, &e) in mixed.radiance.data().iter().enumerate() {
+            let want = if i % ch == 1 {
+                hat.radiance.data()[i]
+            } else {
+                no.radiance.data()[i]
+            };
+            assert!(
+                same(e, want),
+                "value {i} (channel {}): {e} against {want}",
+                i % ch
+            );
+            differ += usize::from(!same(no.radiance.data()[i], hat.radiance.data()[i]));
+        }
+        assert!(
+            differ > 0,
+            "the two weightings gave the same map: the test shows nothing"
+        );
+        let flagged = mixed.clipped.data().iter().filter(|&&m| m != 0).count();
+        assert_eq!(mixed.clipped_count, flagged);
+    }
 }
