@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use crate::error::{ImagingError, Result, check_bracket, check_shape};
+use crate::error::{Result, check_bracket_map};
 use crate::{HdrImage, ImageBuf, LEVELS, ResponseCurve};
 
 /// The codes a frame's value must lie strictly between to count in [`self_consistency`]: well
@@ -142,15 +142,7 @@ pub fn self_consistency_sampled(
     hdr: &HdrImage,
     max_pixels: usize,
 ) -> Result<SelfConsistency> {
-    check_bracket(frames, times_s)?;
-    check_shape(&frames[0], &hdr.radiance, || "radiance map".to_string())?;
-    let ch = frames[0].channels();
-    if response.channels() != ch && response.channels() != 1 {
-        return Err(ImagingError::ChannelMismatch {
-            response: response.channels(),
-            image: ch,
-        });
-    }
+    let ch = check_bracket_map(frames, times_s, response, hdr)?;
     let g: Vec<[f64; LEVELS]> = (0..ch)
         .map(|c| {
             let mut t = response.tables()[if response.channels() == 1 { 0 } else { c }];

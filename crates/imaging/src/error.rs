@@ -321,6 +321,26 @@ pub(crate) fn check_bracket<T: Copy>(frames: &[crate::ImageBuf<T>], times_s: &[f
     Ok(())
 }
 
+/// Checks a bracket, the radiance map merged from it (its shape) and the response it was merged
+/// with (one curve, or one per channel); returns the frames' channel count.
+pub(crate) fn check_bracket_map(
+    frames: &[crate::ImageBuf<u8>],
+    times_s: &[f64],
+    response: &crate::ResponseCurve,
+    hdr: &crate::HdrImage,
+) -> Result<usize> {
+    check_bracket(frames, times_s)?;
+    check_shape(&frames[0], &hdr.radiance, || "radiance map".to_string())?;
+    let ch = frames[0].channels();
+    if response.channels() != ch && response.channels() != 1 {
+        return Err(ImagingError::ChannelMismatch {
+            response: response.channels(),
+            image: ch,
+        });
+    }
+    Ok(ch)
+}
+
 /// Checks that `other` has the shape of `reference`; `what` names `other` in the error.
 pub(crate) fn check_shape<T: Copy, U: Copy>(
     reference: &crate::ImageBuf<T>,

@@ -16,7 +16,7 @@
 use rayon::prelude::*;
 
 use super::curve::{LEVELS, ResponseCurve};
-use crate::error::{ImagingError, Result, check_bracket, check_shape};
+use crate::error::{Result, check_bracket_map};
 use crate::{HdrImage, ImageBuf};
 
 /// Bins of log exposure the forward curve is averaged in, between g(1) − 0.5 and g(254) + 0.5 of
@@ -49,16 +49,8 @@ pub fn refit_response_to_map(
     hdr: &HdrImage,
     max_pixels: usize,
 ) -> Result<ResponseCurve> {
-    check_bracket(frames, times_s)?;
-    check_shape(&frames[0], &hdr.radiance, || "radiance map".to_string())?;
-    let ch = frames[0].channels();
+    let ch = check_bracket_map(frames, times_s, response, hdr)?;
     let curves = response.channels();
-    if curves != ch && curves != 1 {
-        return Err(ImagingError::ChannelMismatch {
-            response: curves,
-            image: ch,
-        });
-    }
     let curve_of = |c: usize| if curves == 1 { 0 } else { c };
     // Per curve, the bins' range in log exposure.
     let range: Vec<(f64, f64)> = response
