@@ -12,7 +12,9 @@
 //! Each table also gets low-albedo nodes down to α′ 0.01 from a short run of their own
 //! (`scatterfit_mc::LowAlbedoRun`, 160 P photons). `--add-low-albedos` instead gives every table
 //! already in OUT (of the `--g` listed, if given) that lacks them its low-albedo nodes (the shipped tables: seconds each), leaving
-//! the rest of each file as it was.
+//! the rest of each file as it was. `--replace-low-albedos` does the same and also runs again the
+//! low-albedo run of every table whose run traced fewer than 160 P photons (its low rows taken off
+//! first, `McTable::without_low_albedos`); tables already at 160 P are skipped, so it resumes.
 //!
 //! `--spacing reduced` spaces the albedo nodes equally in √(1 − α′) instead of √(1 − a)
 //! (`scatterfit_mc::AlbedoSpacing`), halving the last interval toward α′ → 1 at g = 0.9.
@@ -45,7 +47,9 @@ fn main() {
             .collect()
     };
     let Some(out) = value("--out").map(std::path::PathBuf::from) else {
-        eprintln!("usage: build_g_tables --out DIR [--photons P] [--seed S] [--g G,…] [--eta E,…]");
+        eprintln!(
+            "usage: build_g_tables --out DIR [--photons P] [--seed S] [--g G,…] [--eta E,…] [--add-low-albedos | --replace-low-albedos]"
+        );
         std::process::exit(2);
     };
     let photons = value("--photons").map_or(1e6, |p| p.parse::<f64>().expect("photons")) as u64;
@@ -67,8 +71,9 @@ fn main() {
         list,
     );
     std::fs::create_dir_all(&out).expect("output folder");
-    if args.iter().any(|a| a == "--add-low-albedos") {
-        add_low_albedos(&out, photons, value("--g").map(list));
+    let replace = args.iter().any(|a| a == "--replace-low-albedos");
+    if replace || args.iter().any(|a| a == "--add-low-albedos") {
+        add_low_albedos(&out, photons, value("--g").map(list), replace);
         return;
     }
     for &g in &gs {
@@ -113,8 +118,12 @@ fn main() {
 }
 
 /// Gives every table in `dir` (of the g in `gs`, if given) without low-albedo nodes its nodes down
-/// to α′ 0.01, with `LOW_ALBEDO_PHOTONS_PER_PHOTON` × `photons` in their run, and writes it back in compact form (one line of log per table).
-fn add_low_albedos(dir: &std::path::Path, photons: u64, gs: Option<Vec<f64>>) {
+/// to α′ 0.01, with `LOW_ALBEDO_PHOTONS_PER_PHOTON` × `photons` in their run, and writes it back in
+/// compact form (one line of log per table). With `replace`, a table whose low run traced fewer
+/// photons than that has it taken off (`McTable::without_low_albedos`: the main run's rows as they
+/// were) and run again; tables already at that count are skipped, so an interrupted run resumes.
+fn add_low_albedos(dir: &std::path::Path, photons: u64, gs: Option<Vec<f64>>, replace: bool) {
+    let low_photons = layout::LOW_ALBEDO_PHOTONS_PER_PHOTON * photons;
     let mut paths: Vec<_> = std::fs::read_dir(dir)
         .expect("table folder")
         .map(|e| e.expect("folder entry").path())
@@ -124,7 +133,8 @@ fn add_low_albedos(dir: &std::path::Path, photons: u64, gs: Option<Vec<f64>>) {
     for path in paths {
         let table = McTable::load(&path).expect("a table");
         let g = table.spec().g;
-        if table.spec().low_albedos.is_some()
+        let had = table.spec().low_albedos.as_ref().map(|l| l.photons);
+        if had.is_some_and(|p| !replace || p >= low_photons)
             || g == 0.0
             || gs
                 .as_ref()
@@ -132,11 +142,19 @@ fn add_low_albedos(dir: &std::path::Path, photons: u64, gs: Option<Vec<f64>>) {
         {
             continue;
         }
+        let table = if had.is_some() {
+            match table.without_low_albedos() {
+                Ok(t) => t,
+                Err(e) => {
+                    println!("FAILED {}: {e}", path.display());
+                    continue;
+                }
+            }
+        } else {
+            table
+        };
         let t0 = std::time::Instant::now();
-        let spec = layout::with_low_albedos(
-            table.spec().clone(),
-            layout::LOW_ALBEDO_PHOTONS_PER_PHOTON * photons,
-        );
+        let spec = layout::with_low_albedos(table.spec().clone(), low_photons);
         let low = spec.low_albedos.clone().expect("just set");
         let nodes = low.albedo_count;
         let table = match table.with_low_albedos(low) {
@@ -149,8 +167,12 @@ fn add_low_albedos(dir: &std::path::Path, photons: u64, gs: Option<Vec<f64>>) {
         table.save(&path).expect("write");
         let chi = &table.chi2_per_bin()[..nodes];
         println!(
-            "{}: {nodes} low-albedo nodes in {:.1} s, χ²/bin {:.2}–{:.2}",
+            "{} {}: {nodes} low-albedo nodes ({low_photons} photons{}) in {:.1} s, χ²/bin {:.2}–{:.2}",
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs()),
             path.display(),
+            had.map_or(String::new(), |p| format!(", replacing {p}")),
             t0.elapsed().as_secs_f64(),
             chi.iter().cloned().fold(f64::INFINITY, f64::min),
             chi.iter().cloned().fold(0.0, f64::max),

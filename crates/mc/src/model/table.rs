@@ -353,6 +353,57 @@ impl McTable {
         })
     }
 
+    /// This table as its main run left it: the low-albedo nodes ([`LowAlbedoRun`]) that
+    /// [`McTable::with_low_albedos`] put in front of its rows taken off again (their nodes,
+    /// coefficients, data ranges, totals, χ² and raw profiles), and the spec's `low_albedos`
+    /// cleared. `t.with_low_albedos(low)?.without_low_albedos()?` is `t`, bit for bit; so is the
+    /// compact form's (compacting is per value). The way to replace a table's low run (with more
+    /// photons): this, then [`McTable::with_low_albedos`].
+    ///
+    /// # Errors
+    /// `InvalidParameter` (field `low_albedos`) when the table has no low-albedo nodes, or when
+    /// its vectors are shorter than the nodes its spec names (a defect: the file checks refuse
+    /// such a table).
+    pub fn without_low_albedos(self) -> Result<Self> {
+        check(
+            self.spec.low_albedos.is_some(),
+            "low_albedos",
+            0.0,
+            "the table has no low-albedo nodes to take off",
+        )?;
+        let n = self.spec.low_albedos.as_ref().map_or(0, |l| l.albedo_count);
+        let m = self.knots.len();
+        check(
+            n < self.albedos.len() && n * m < self.coefs.len(),
+            "low_albedos",
+            n as f64,
+            "the table has fewer rows than its low-albedo nodes (a defect)",
+        )?;
+        let tail = |v: Vec<f64>, skip: usize| v[skip..].to_vec();
+        Ok(Self {
+            spec: McTableSpec {
+                low_albedos: None,
+                ..self.spec
+            },
+            albedos: tail(self.albedos, n),
+            coefs: tail(self.coefs, n * m),
+            rho_data_min: tail(self.rho_data_min, n),
+            rho_data_max: tail(self.rho_data_max, n),
+            rd_total: tail(self.rd_total, n),
+            rd_total_stderr: tail(self.rd_total_stderr, n),
+            chi2_per_bin: tail(self.chi2_per_bin, n),
+            raw: self.raw.map(|r| {
+                let bins = r.edges.len().saturating_sub(1);
+                RawProfiles {
+                    rd: tail(r.rd, n * bins),
+                    rd_stderr: tail(r.rd_stderr, n * bins),
+                    edges: r.edges,
+                }
+            }),
+            ..self
+        })
+    }
+
     /// The same table without its raw profiles (what a shipped table needs).
     #[must_use]
     pub fn without_raw(mut self) -> Self {
@@ -545,6 +596,57 @@ mod tests {
         assert_eq!(back.spec(), &extended);
         assert!((back.rd_total(0.3).unwrap() / totals[0] - 1.0).abs() < 1e-6);
         assert!(built.with_low_albedos(low).is_err());
+    }
+
+    /// Low-albedo nodes taken off again ([`McTable::without_low_albedos`]) leave the table the
+    /// main run made, bit for bit, raw and compact; a low run replaced by one with more photons
+    /// changes the low rows only (the main rows and the low nodes stay); a table without low
+    /// nodes, or with fewer rows than its spec's low nodes, is refused with the field named.
+    #[test]
+    fn low_albedo_nodes_taken_off_leave_the_main_run_and_can_be_replaced() {
+        let spec = small_spec_g(1.3, 0.5);
+        let low = |photons| {
+            spec.clone()
+                .with_low_albedos_to(0.3, photons)
+                .unwrap()
+                .low_albedos
+                .unwrap()
+        };
+        let main = McTable::build(&spec, &|_, _| {}).unwrap();
+        let with = main.clone().with_low_albedos(low(200_000)).unwrap();
+        let bytes = |t: &McTable| serde_json::to_vec(t).unwrap();
+        let back = with.clone().without_low_albedos().unwrap();
+        assert_eq!(bytes(&back), bytes(&main));
+        assert_eq!(
+            bytes(&with.clone().compact().without_low_albedos().unwrap()),
+            bytes(&main.clone().compact())
+        );
+        // Through a file: the compact table read back, its low run replaced by a longer one.
+        let text = serde_json::to_string(&with.clone().compact()).unwrap();
+        let replaced = McTable::from_json(&text)
+            .unwrap()
+            .without_low_albedos()
+            .unwrap()
+            .with_low_albedos(low(400_000))
+            .unwrap()
+            .compact();
+        let n = low(1).albedo_count;
+        assert_eq!(replaced.spec().low_albedos, Some(low(400_000)));
+        assert_eq!(replaced.albedos(), with.albedos());
+        assert_ne!(replaced.totals().0[..n], with.totals().0[..n]);
+        assert_eq!(
+            bytes(&replaced.without_low_albedos().unwrap()),
+            bytes(&main.clone().compact())
+        );
+        let err = main.without_low_albedos().unwrap_err().to_string();
+        assert!(
+            err.contains("low_albedos") && err.contains("no low-albedo"),
+            "{err}"
+        );
+        let mut short = with;
+        short.spec.low_albedos.as_mut().unwrap().albedo_count = short.albedos.len();
+        let err = short.without_low_albedos().unwrap_err().to_string();
+        assert!(err.contains("fewer rows"), "{err}");
     }
 
     /// The cache: built once, then loaded; a damaged file is rebuilt; the compact form (no raw
