@@ -115,8 +115,8 @@ impl<'a> CodeLookup<'a> {
 /// maximum first). A response with one channel serves every channel.
 ///
 /// # Errors
-/// Bracket errors, [`ImagingError::ShapeMismatch`] for a map of another shape,
-/// [`ImagingError::ChannelMismatch`].
+/// Bracket errors, [`ImagingError::ShapeMismatch`](crate::ImagingError::ShapeMismatch) for a map of another shape,
+/// [`ImagingError::ChannelMismatch`](crate::ImagingError::ChannelMismatch).
 pub fn self_consistency(
     frames: &[ImageBuf<u8>],
     times_s: &[f64],

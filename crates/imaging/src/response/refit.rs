@@ -40,8 +40,8 @@ const MIN_CHANNEL_READINGS: u64 = 1000;
 /// curve. A one-channel response serves every channel and is refitted on all of them together.
 ///
 /// # Errors
-/// Bracket errors, [`ImagingError::ShapeMismatch`] for a map of another shape,
-/// [`ImagingError::ChannelMismatch`].
+/// Bracket errors, [`ImagingError::ShapeMismatch`](crate::ImagingError::ShapeMismatch) for a map of another shape,
+/// [`ImagingError::ChannelMismatch`](crate::ImagingError::ChannelMismatch).
 pub fn refit_response_to_map(
     frames: &[ImageBuf<u8>],
     times_s: &[f64],
