@@ -63,8 +63,8 @@ macro_rules! g_table {
 /// off in shape and 6.7·10⁻³ in the total, CHANGELOG.md "The g 0.95 node's η layout filled in");
 /// Henyey–Greenstein, 10⁶ full-length photons each, albedo nodes over α′ 0.2–0.99995
 /// (`examples/common/g_tables_layout.rs`), equally spaced in √(1 − α′) but at g = 0.95 (in √(1 − a)),
-/// and below them nodes down to α′ 0.01 from a short run of their own (1.6·10⁷ photons stopped
-/// after a few dozen interactions at g 0.95, 1.6·10⁸ at g 0.15–0.9; [`crate::LowAlbedoRun`], added
+/// and below them nodes down to α′ 0.01 from a short run of their own (1.6·10⁸ photons stopped
+/// after a few dozen interactions; [`crate::LowAlbedoRun`], added
 /// 2026-11-29: 8 nodes, 79 at g = 0.95 where √(1 − a) spreads that range). 5.4 MB in all (the
 /// g = 0 set: 1.5 MB).
 #[rustfmt::skip]
