@@ -522,7 +522,7 @@ pub const EXPOSURE_KEEP_MARGIN: f64 = 0.98;
 /// ([`scatterfit_imaging::refit_response_to_map`]) when the refit's merge explains the decimated
 /// frames better than the recovered curve's by more than this factor: the refit sees every pixel
 /// where Debevec & Malik's recovery saw a hundred, and on real brackets it explains the frames
-/// 4–11 % better (BENCHMARKS.md, "Real brackets"); on the twin, whose recovered curve is already
+/// 2–16 % better (BENCHMARKS.md, "Real brackets"); on the twin, whose recovered curve is already
 /// its camera's within the noise, it changes the score by less than 0.1 %, and the recovered curve
 /// is kept.
 pub const REFIT_MARGIN: f64 = 0.98;
