@@ -55,7 +55,7 @@ use scatterfit_optics::Termination;
 use serde::{Deserialize, Serialize};
 
 pub use error::{FitError, Result};
-pub use model::{Spot, model_profile, node_spacing};
+pub use model::{Spot, model_profile, model_profiles, node_spacing};
 pub use profile::{ProfileData, Ring, RingSelection, Selected, select_rings};
 pub use radial_spot::RadialSpot;
 pub use spot::SpotKernel;

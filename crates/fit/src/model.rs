@@ -44,23 +44,43 @@ pub fn model_profile(
     spot: Spot,
     radii_mm: &[f64],
 ) -> crate::Result<Vec<f64>> {
+    Ok(
+        model_profiles(model, std::slice::from_ref(props), spot, radii_mm)?
+            .pop()
+            .expect("one profile per property set"),
+    )
+}
+
+/// [`model_profile`] for several property sets (a sample's channels) at the same radii and spot:
+/// the spot's convolution map is built once and applied to each.
+///
+/// # Errors
+/// As [`SpotKernel::new`].
+pub fn model_profiles(
+    model: &dyn ModelFamily,
+    props: &[OpticalProperties],
+    spot: Spot,
+    radii_mm: &[f64],
+) -> crate::Result<Vec<Vec<f64>>> {
     let zero = ProfileSample::ZERO;
-    match spot {
-        Spot::Point => {
-            let mut out = vec![zero; radii_mm.len()];
-            model.eval(props, radii_mm, &mut out);
-            Ok(out.iter().map(|s| s.rd).collect())
-        }
-        Spot::Disk { .. } | Spot::Radial(_) => {
-            let kernel = spot_kernel(spot, radii_mm)?.expect("not a point");
-            let mut nodes = vec![zero; kernel.nodes().len()];
-            model.eval(props, kernel.nodes(), &mut nodes);
-            let values: Vec<f64> = nodes.iter().map(|s| s.rd).collect();
-            let mut out = vec![0.0; radii_mm.len()];
-            kernel.apply(&values, &mut out);
-            Ok(out)
-        }
-    }
+    let kernel = spot_kernel(spot, radii_mm)?;
+    let at = kernel.as_ref().map_or(radii_mm, SpotKernel::nodes);
+    let mut samples = vec![zero; at.len()];
+    Ok(props
+        .iter()
+        .map(|p| {
+            model.eval(p, at, &mut samples);
+            let values: Vec<f64> = samples.iter().map(|s| s.rd).collect();
+            match &kernel {
+                None => values,
+                Some(k) => {
+                    let mut out = vec![0.0; radii_mm.len()];
+                    k.apply(&values, &mut out);
+                    out
+                }
+            }
+        })
+        .collect())
 }
 
 /// The spot's convolution map for rings at `radii_mm` (`None` for a point of incidence): a disk's

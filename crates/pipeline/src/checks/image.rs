@@ -366,7 +366,8 @@ pub fn spot_scale(m: &Measurement) -> Option<SpotScale> {
         })
         .collect();
     let r_px: Vec<f64> = rings.iter().map(|r| r.r_px).collect();
-    let mut per_channel: Vec<Vec<f64>> = Vec::with_capacity(3);
+    let mut props = Vec::with_capacity(3);
+    let mut scales = Vec::with_capacity(3);
     for c in Channel::ALL {
         let f = m.fits[c].fit().filter(|f| f.report.converged)?;
         let (s, a, scale) = if exact {
@@ -376,15 +377,21 @@ pub fn spot_scale(m: &Measurement) -> Option<SpotScale> {
             let x = f.exact?;
             (x.sigma_s_prime, x.sigma_a, x.scale)
         };
-        let props = OpticalProperties::new(s, a, m.spectro.eta).ok()?;
-        let values = scatterfit_fit::model_profile(&model, &props, spot, &radii).ok()?;
-        per_channel.push(
+        props.push(OpticalProperties::new(s, a, m.spectro.eta).ok()?);
+        scales.push(scale);
+    }
+    // One spot kernel for the three channels (same rings, same spot).
+    let per_channel: Vec<Vec<f64>> = scatterfit_fit::model_profiles(&model, &props, spot, &radii)
+        .ok()?
+        .into_iter()
+        .zip(scales)
+        .map(|(values, scale)| {
             values
                 .chunks(SUB)
                 .map(|chunk| scale * chunk.iter().sum::<f64>() / SUB as f64)
-                .collect(),
-        );
-    }
+                .collect()
+        })
+        .collect();
     let sum: Vec<f64> = (0..rings.len())
         .map(|k| per_channel.iter().map(|v| v[k]).sum())
         .collect();
