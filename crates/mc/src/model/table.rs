@@ -473,9 +473,15 @@ impl McTable {
         &self.coefs[k * m..(k + 1) * m]
     }
 
-    /// Cubic Hermite weights (and their derivatives in a) of albedo `a` over the nodes, in
-    /// x = −√(1 − a): Catmull-Rom inside, parabolic at the first and last node ([`Ends`]).
+    /// Cubic Hermite weights (and their derivatives in a) of albedo `a` over the nodes for the
+    /// profile's rows, in x = [`albedo_abscissa`]: Catmull-Rom inside, parabolic at the first and
+    /// last node ([`Ends`]).
     pub(super) fn albedo_weights(&self, a: f64) -> Result<(usize, [f64; 4], [f64; 4])> {
+        self.albedo_weights_in(a, ALBEDO_LOG_WEIGHT)
+    }
+
+    /// The weights in x = −√(1 − a) + `log_weight`·ln a.
+    fn albedo_weights_in(&self, a: f64, log_weight: f64) -> Result<(usize, [f64; 4], [f64; 4])> {
         let al = &self.albedos;
         let (lo, hi) = (al[0], al[al.len() - 1]);
         // An end reached through a round trip (α′ ↔ a at g: a table's first node mapped to α′
@@ -491,9 +497,13 @@ impl McTable {
         if !(a >= lo && a <= hi) {
             return Err(crate::error::out_of_table("albedo (σs/σt)", a, lo, hi));
         }
-        let x = |v: f64| -(1.0 - v).sqrt();
-        let (i, w, dw_dx) = hermite_weights(al.len(), |k| x(al[k]), x(a), Ends::Parabola);
-        let dx_da = 0.5 / (1.0 - a).sqrt();
+        let (i, w, dw_dx) = hermite_weights(
+            al.len(),
+            |k| albedo_abscissa(al[k], log_weight),
+            albedo_abscissa(a, log_weight),
+            Ends::Parabola,
+        );
+        let dx_da = 0.5 / (1.0 - a).sqrt() + log_weight / a;
         Ok((i, w, dw_dx.map(|d| d * dx_da)))
     }
 
@@ -507,13 +517,26 @@ impl McTable {
     /// # Errors
     /// `OutOfTable` for a outside the tabulated albedos.
     pub fn rd_total(&self, a: f64) -> Result<f64> {
-        let (i, w, _) = self.albedo_weights(a)?;
+        // In √(1 − a) alone: ln(Rd/a) = ln(R₁ + aR₂ + …) is smooth in a at low albedo.
+        let (i, w, _) = self.albedo_weights_in(a, 0.0)?;
         let al = &self.albedos;
         // An end reached through a round trip is that end (as in the weights), so that the
         // totals at the ends are the nodes' own, bit for bit.
         let a = a.clamp(al[0], al[al.len() - 1]);
         Ok(a * dot4(&w, |k| (self.rd_total[i + k - 1] / al[i + k - 1]).ln()).exp())
     }
+}
+
+/// The weight of ln a in [`albedo_abscissa`].
+const ALBEDO_LOG_WEIGHT: f64 = 0.03;
+
+/// The abscissa the albedo interpolation is cubic in: x = −√(1 − a) + c·ln a (c =
+/// [`ALBEDO_LOG_WEIGHT`]). Toward a → 1 the square root dominates (the diffusion regime, where
+/// 1 − R̂ and κ₀ go as √(1 − a)); at low albedo ln a does: light reaching ρ after n scatterings
+/// carries aⁿ, so ln(R̂/a) bends like (n − 1) ln a across the first nodes, which a cubic in
+/// √(1 − a) — nearly linear in a there — cannot follow.
+fn albedo_abscissa(a: f64, log_weight: f64) -> f64 {
+    -(1.0 - a).sqrt() + log_weight * a.ln()
 }
 
 impl McTable {
