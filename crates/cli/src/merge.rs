@@ -67,11 +67,9 @@ fn read_and_merge(args: &Args, quiet: bool) -> anyhow::Result<HdrStage> {
         read.decoded_bytes() + read.samples_per_frame() * (4 + 1 + 4),
         budget,
     )?;
-    inputs.samples = Some(
-        args.settings
-            .samples
-            .unwrap_or_else(|| hdr::default_response_samples(read.frames.len())),
-    );
+    // Unset, the merge takes the default for the frames it keeps (a frame without signal is
+    // left out first, and fewer frames need more sample pixels).
+    inputs.samples = args.settings.samples;
     Ok(hdr::merge_frames(read, &inputs)?)
 }
 

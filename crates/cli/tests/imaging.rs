@@ -66,6 +66,73 @@ fn write_bracket(dir: &Path) -> Vec<String> {
     names
 }
 
+/// A frame without signal (clipped everywhere) is left out, and the response recovery's default
+/// sample count is then the one for the frames kept: three frames need ⌈256/2⌉ = 128 sample pixels,
+/// where the default for four (100) would leave its equations short (refused before).
+#[test]
+fn a_frame_left_out_sets_the_default_sample_count() {
+    let dir = temp_dir();
+    let mut csv = String::from("file,time_s\n");
+    for (j, t) in [1.0 / 16.0, 0.25, 1.0, 4096.0].into_iter().enumerate() {
+        let name = format!("shot_{j}.png");
+        write_camera_frame(&dir.path().join(&name), &CameraFrame::U8(frame(t))).unwrap();
+        csv.push_str(&format!("{name},{t}\n"));
+    }
+    std::fs::write(dir.path().join("exposures.csv"), csv).unwrap();
+    assert!(
+        frame(4096.0).data().iter().all(|&z| z == u8::MAX),
+        "the longest frame is clipped everywhere"
+    );
+    let out = run(
+        dir.path(),
+        &[
+            "merge",
+            "--exposures",
+            "exposures.csv",
+            "-o",
+            "radiance.exr",
+        ],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stdout.contains("shot_3.png carries no signal"),
+        "{}",
+        out.stdout
+    );
+}
+
+/// A bracket in which no frame carries signal (black all over: a capped lens) is refused with
+/// that reason, not with the response recovery's count of usable pixels.
+#[test]
+fn a_bracket_without_signal_is_refused_as_such() {
+    let dir = temp_dir();
+    let mut csv = String::from("file,time_s\n");
+    for (j, t) in [0.25, 1.0, 4.0].into_iter().enumerate() {
+        let name = format!("shot_{j}.png");
+        let black = ImageBuf::new(W, H, 3, vec![0u8; W * H * 3]).unwrap();
+        write_camera_frame(&dir.path().join(&name), &CameraFrame::U8(black)).unwrap();
+        csv.push_str(&format!("{name},{t}\n"));
+    }
+    std::fs::write(dir.path().join("exposures.csv"), csv).unwrap();
+    let out = run(
+        dir.path(),
+        &[
+            "merge",
+            "--exposures",
+            "exposures.csv",
+            "-o",
+            "radiance.exr",
+        ],
+    );
+    assert_ne!(out.code, 0);
+    assert!(
+        out.stderr.contains("none of the 3 frames carries signal"),
+        "{}",
+        out.stderr
+    );
+    assert!(!dir.path().join("radiance.exr").exists());
+}
+
 #[test]
 fn merge_then_profile_end_to_end() {
     let dir = temp_dir();

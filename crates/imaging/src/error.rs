@@ -213,6 +213,17 @@ pub enum ImagingError {
         /// Pixels in the image.
         total: usize,
     },
+    /// No frame of the bracket carries signal: every value of every frame is at its noise floor or
+    /// clipped ([`crate::bracket_signal`]).
+    #[error(
+        "none of the {frames} frames carries signal: every value is at its noise floor or clipped \
+         (black, or white all over) — was the lens capped or the light off, or is every exposure \
+         far too short or too long? Check the frames and their exposure times"
+    )]
+    NoSignal {
+        /// Frames in the bracket.
+        frames: usize,
+    },
     /// (Nearly) every pixel of a channel is clipped in every exposure: the merge has no radiance to
     /// give.
     #[error(

@@ -46,7 +46,8 @@ pub(super) fn imaging(
 
 /// Leaves out of the merge the frames that carry no signal ([`scatterfit_imaging::bracket_signal`]:
 /// fewer than 0.1 % of their values above their noise floor and below the clip), noting them in
-/// `corrections.no_signal` (indices by time); all frames are kept when fewer than two would remain.
+/// `corrections.no_signal` (indices by time); all frames are kept when fewer than two would remain,
+/// and a bracket in which no frame carries signal is refused ([`scatterfit_imaging::ImagingError::NoSignal`]).
 /// Returns the frames and times kept, and their signal when every frame was kept (for the order
 /// check; a frame left out changes the others' noise floors, measured from the frames kept).
 #[allow(clippy::type_complexity)]
@@ -68,6 +69,9 @@ where
 {
     let signal = scatterfit_imaging::bracket_signal(&bufs, times, max)?;
     let kept = signal.has_signal.iter().filter(|&&s| s).count();
+    if kept == 0 {
+        return Err(scatterfit_imaging::ImagingError::NoSignal { frames: bufs.len() });
+    }
     if kept == bufs.len() || kept < 2 {
         return Ok((bufs, times.to_vec(), Some(signal)));
     }
