@@ -1036,6 +1036,21 @@ r_max_px = 300
         }
     }
 
+    /// A mistake under a table header that carries a comment (as `scatterfit synth` writes them:
+    /// `[fit]   # every key optional`) is named by its dotted key, not by the header's line.
+    #[test]
+    fn a_commented_table_header_names_the_key() {
+        let text = GOOD.replace(
+            "[fit]",
+            "[fit]                         # every key optional",
+        );
+        let err = parse(&text.replace("model = \"dipole\"", "model = \"mcx\""))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`fit.model`"), "{err}");
+        assert!(!err.contains("every key"), "{err}");
+    }
+
     /// A recognised manifest's mistakes quote the key and value, shortened and escaped.
     #[test]
     fn recognised_mistakes_quote_short_escaped_tokens() {

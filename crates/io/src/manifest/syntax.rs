@@ -85,7 +85,8 @@ pub(super) fn key_at(text: &str, offset: usize) -> Option<String> {
         .rev()
         .map(|l| l.trim())
         .find(|l| l.starts_with('[') && !l.starts_with("[["))
-        .map(|l| l.trim_matches(['[', ']']).trim());
+        // The name between the brackets (a comment may follow the header).
+        .and_then(|l| l[1..].split_once(']').map(|(name, _)| name.trim()));
     Some(crate::escape::token(&match table {
         Some(t) => format!("{t}.{key}"),
         None => key.to_string(),
