@@ -134,8 +134,9 @@ fn add_low_albedos(dir: &std::path::Path, photons: u64, gs: Option<Vec<f64>>, re
         let table = McTable::load(&path).expect("a table");
         let g = table.spec().g;
         let had = table.spec().low_albedos.as_ref().map(|l| l.photons);
+        // g = 0 tables (crates/mc/tables) only when `--g 0` names them.
         if had.is_some_and(|p| !replace || p >= low_photons)
-            || g == 0.0
+            || (g == 0.0 && !gs.as_ref().is_some_and(|gs| gs.contains(&0.0)))
             || gs
                 .as_ref()
                 .is_some_and(|gs| !gs.iter().any(|&x| (x - g).abs() < 1e-9))

@@ -117,7 +117,8 @@ impl McTableSpec {
     /// (α′ 0.99935–0.9999) Catmull-Rom put the far field 1–2 % low beyond 30 mean free paths — the
     /// light a spectrophotometer's port loses, and the g ≠ 0 model's continuation past its join
     /// ([`crate::model::McProfile::far_field_join`]) — and the full-length stratum's 2·10⁶ photons,
-    /// one seed for every η, left the totals near α′ = 1 a few 10⁻⁴ off together.
+    /// one seed for every η, left the totals near α′ = 1 a few 10⁻⁴ off together. Below its first
+    /// node (α′ 0.02) one more at 0.01 from a low-albedo run ([`LowAlbedoRun`], 6.4·10⁸ photons).
     ///
     /// # Errors
     /// `InvalidParameter` for η < 1.
@@ -131,7 +132,10 @@ impl McTableSpec {
         spec.albedo_count = 128;
         spec.seed = 1000 + (100.0 * eta).round() as u64;
         spec.white()?;
-        Ok(spec)
+        // A node at α′ 0.01 below the main run's first (0.02), from a short run of its own with
+        // 160 photons per full-length photon, as the g ≠ 0 tables' low runs (added 2026-11-29: a
+        // channel darker than α′ 0.02 failed at g = 0 and so, with g unknown, everywhere).
+        spec.with_low_albedos_to(0.01, 160 * 4_000_000)
     }
 
     /// The default layout with explicit strata (`photons[k]` photons, separated at `bounds`).

@@ -176,10 +176,11 @@ fn check_against_mcml_in(
 }
 
 /// The g ≠ 0 tables' low-albedo nodes (α′ 0.01 up to their main run's 0.2; a run of their own,
-/// `LowAlbedoRun`): the `mc` family's totals against adding-doubling's at g 0.5, 0.8, 0.9, 0.95 ×
-/// η 1.0, 1.4, 2.0 × α′ 0.01–0.15 (`iad_totals_low_g.csv`) within 1 % ⊕ twice the quadrature
-/// uncertainty, and its profiles against MCML's (10⁷ photons, `mcml_profiles_low_g.csv`) at
-/// g 0.8, 0.9 × η 1.0, 1.4, 2.0 × α′ 0.01, 0.05, 0.15 over reduced radii 0.1–10, within
+/// `LowAlbedoRun`) and the g = 0 tables' (α′ 0.01, below their main run's 0.02): the `mc` family's
+/// totals against adding-doubling's at g 0.5, 0.8, 0.9, 0.95 × η 1.0, 1.4, 2.0 × α′ 0.01–0.15 and
+/// g 0 × α′ 0.01–0.02 (`iad_totals_low_g.csv`) within 1 % ⊕ twice the quadrature uncertainty, and
+/// its profiles against MCML's (`mcml_profiles_low_g.csv`) at g 0.8, 0.9 × η 1.0, 1.4, 2.0 × α′
+/// 0.01, 0.05, 0.15 (10⁷ photons) and g 0 × α′ 0.015 (10⁸) over reduced radii 0.1–10, within
 /// 4 s.e. ⊕ 1 %. Not inside 0.1: the tables hold Rd constant below ρ = 0.01 mean free paths, and at
 /// these albedos the backscattering cusp there carries 10–28 % of the light of MCML's first 0.05 mm
 /// bin, which the model puts 8–13 % low (1–3.5 % of the total; BENCHMARKS.md, "Low albedo at
@@ -196,6 +197,10 @@ fn low_albedo_g_nodes_match_adding_doubling_and_mcml() {
                 check_against_mcml_in(csv, &edges, 1, 40_000, mc, g, eta, ap, 0.01);
             }
         }
+    }
+    // g = 0 between its tables' low node (α′ 0.01) and their main run's first (0.02).
+    for eta in [1.0, 1.4, 2.0] {
+        check_against_mcml_in(csv, &edges, 1, 40_000, mc, 0.0, eta, 0.015, 0.01);
     }
     let mut bad = Vec::new();
     for line in include_str!("../../../data/reference/iad_totals_low_g.csv")

@@ -40,7 +40,7 @@ pub enum ModelName {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Monte Carlo tables shipped with scatterfit (exact transport; the default). Henyey–Greenstein g 0–0.95 with --g or `[fit] g`; η 1.0–2.5; α′ 0.02–0.9999 at g = 0, 0.01–0.9999 at g ≠ 0"
+            help = "Monte Carlo tables shipped with scatterfit (exact transport; the default). Henyey–Greenstein g 0–0.95 with --g or `[fit] g`; η 1.0–2.5; α′ 0.01–0.9999"
         )
     )]
     Mc,

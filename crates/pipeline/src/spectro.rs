@@ -321,8 +321,7 @@ fn beyond_the_totals(rd: f64, e: &scatterfit_optics::OpticsError) -> Option<Stri
     Some(if rd < min {
         format!(
             "Rd is below {min:.4}, the lowest total its tables hold (at their lowest α′): the \
-             channel absorbs more than they cover (the g ≠ 0 tables start at α′ 0.01, g = 0's at \
-             0.02) — use an albedo model without tables (`--albedo-model dipole`)"
+             channel absorbs more than they cover (the tables start at α′ 0.01) — use an albedo model without tables (`--albedo-model dipole`)"
         )
     } else {
         format!(

@@ -258,8 +258,7 @@ fn a_strongly_absorbing_forward_scatterer_is_measured() {
     }
 }
 
-/// A material darker than every table (α′ 0.008 and 0.002 in G and B, below the g ≠ 0 tables'
-/// 0.01 and g = 0's 0.02): with g unknown (read at g = 0) both fail, with g = 0.8 given B does,
+/// A material darker than every table (α′ 0.008 and 0.002 in G and B, below the tables' α′ 0.01): with g unknown (read at g = 0) both fail, with g = 0.8 given B does,
 /// each with a message that says the reading lies below the tables' lowest total and what to do,
 /// not a bare table bound.
 #[test]

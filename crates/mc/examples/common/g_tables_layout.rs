@@ -9,7 +9,7 @@ use scatterfit_mc::model::McTableSpec;
 pub const ALBEDO_PRIME_RANGE: (f64, f64) = (0.2, 0.99995);
 
 /// Smallest reduced albedo α′ of the low-albedo nodes ([`scatterfit_mc::LowAlbedoRun`]) below
-/// [`ALBEDO_PRIME_RANGE`]: every channel the g = 0 tables answer (from α′ 0.02; a food's green and
+/// [`ALBEDO_PRIME_RANGE`]: every channel the g = 0 tables answer (from α′ 0.01; a food's green and
 /// blue, such as ketchup's 0.07 and 0.02) then has its g ≠ 0 tables too.
 pub const LOW_ALBEDO_PRIME: f64 = 0.01;
 
