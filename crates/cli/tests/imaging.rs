@@ -49,15 +49,16 @@ fn frame(t: f64) -> ImageBuf<u8> {
     ImageBuf::new(W, H, 3, data).unwrap()
 }
 
-/// Writes the bracket as PNGs and `exposures.csv`; returns the frame names.
-fn write_bracket(dir: &Path) -> Vec<String> {
+/// Writes `frames` (8-bit, with their times) as `shot_<j>.png` and `exposures.csv`; returns the
+/// frame names.
+fn write_frames(dir: &Path, frames: impl IntoIterator<Item = (ImageBuf<u8>, f64)>) -> Vec<String> {
     let mut csv = String::from("file,time_s\n");
-    let names: Vec<String> = times()
-        .iter()
+    let names = frames
+        .into_iter()
         .enumerate()
-        .map(|(j, &t)| {
+        .map(|(j, (frame, t))| {
             let name = format!("shot_{j}.png");
-            write_camera_frame(&dir.join(&name), &CameraFrame::U8(frame(t))).unwrap();
+            write_camera_frame(&dir.join(&name), &CameraFrame::U8(frame)).unwrap();
             csv.push_str(&format!("{name},{t}\n"));
             name
         })
@@ -66,25 +67,15 @@ fn write_bracket(dir: &Path) -> Vec<String> {
     names
 }
 
-/// A frame without signal (clipped everywhere) is left out, and the response recovery's default
-/// sample count is then the one for the frames kept: three frames need ⌈256/2⌉ = 128 sample pixels,
-/// where the default for four (100) would leave its equations short (refused before).
-#[test]
-fn a_frame_left_out_sets_the_default_sample_count() {
-    let dir = temp_dir();
-    let mut csv = String::from("file,time_s\n");
-    for (j, t) in [1.0 / 16.0, 0.25, 1.0, 4096.0].into_iter().enumerate() {
-        let name = format!("shot_{j}.png");
-        write_camera_frame(&dir.path().join(&name), &CameraFrame::U8(frame(t))).unwrap();
-        csv.push_str(&format!("{name},{t}\n"));
-    }
-    std::fs::write(dir.path().join("exposures.csv"), csv).unwrap();
-    assert!(
-        frame(4096.0).data().iter().all(|&z| z == u8::MAX),
-        "the longest frame is clipped everywhere"
-    );
-    let out = run(
-        dir.path(),
+/// Writes the bracket as PNGs and `exposures.csv`; returns the frame names.
+fn write_bracket(dir: &Path) -> Vec<String> {
+    write_frames(dir, times().into_iter().map(|t| (frame(t), t)))
+}
+
+/// `scatterfit merge --exposures exposures.csv -o radiance.exr` in `dir`.
+fn merge_listed(dir: &Path) -> common::Run {
+    run(
+        dir,
         &[
             "merge",
             "--exposures",
@@ -92,7 +83,24 @@ fn a_frame_left_out_sets_the_default_sample_count() {
             "-o",
             "radiance.exr",
         ],
+    )
+}
+
+/// A frame without signal (clipped everywhere) is left out, and the response recovery's default
+/// sample count is then the one for the frames kept: three frames need ⌈256/2⌉ = 128 sample pixels,
+/// where the default for four (100) would leave its equations short (refused before).
+#[test]
+fn a_frame_left_out_sets_the_default_sample_count() {
+    let dir = temp_dir();
+    write_frames(
+        dir.path(),
+        [1.0 / 16.0, 0.25, 1.0, 4096.0].map(|t| (frame(t), t)),
     );
+    assert!(
+        frame(4096.0).data().iter().all(|&z| z == u8::MAX),
+        "the longest frame is clipped everywhere"
+    );
+    let out = merge_listed(dir.path());
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(
         out.stdout.contains("shot_3.png carries no signal"),
@@ -106,24 +114,9 @@ fn a_frame_left_out_sets_the_default_sample_count() {
 #[test]
 fn a_bracket_without_signal_is_refused_as_such() {
     let dir = temp_dir();
-    let mut csv = String::from("file,time_s\n");
-    for (j, t) in [0.25, 1.0, 4.0].into_iter().enumerate() {
-        let name = format!("shot_{j}.png");
-        let black = ImageBuf::new(W, H, 3, vec![0u8; W * H * 3]).unwrap();
-        write_camera_frame(&dir.path().join(&name), &CameraFrame::U8(black)).unwrap();
-        csv.push_str(&format!("{name},{t}\n"));
-    }
-    std::fs::write(dir.path().join("exposures.csv"), csv).unwrap();
-    let out = run(
-        dir.path(),
-        &[
-            "merge",
-            "--exposures",
-            "exposures.csv",
-            "-o",
-            "radiance.exr",
-        ],
-    );
+    let black = || ImageBuf::new(W, H, 3, vec![0u8; W * H * 3]).unwrap();
+    write_frames(dir.path(), [0.25, 1.0, 4.0].map(|t| (black(), t)));
+    let out = merge_listed(dir.path());
     assert_ne!(out.code, 0);
     assert!(
         out.stderr.contains("none of the 3 frames carries signal"),
