@@ -426,29 +426,34 @@ fn between_g_nodes_matches_a_fresh_engine_run() {
 /// g = 0 shape beyond 25) fails: −2.55 % at 40–60 (z −5).
 #[test]
 fn the_far_field_at_weak_absorption_matches_mcml() {
-    let (g, eta, ap) = (0.8, 1.0, 0.9999);
     let edges = [0.0, 10.0, 25.0, 40.0, 60.0, 97.5];
+    far_field_against_mcml((0.8, 1.0, 0.9999), &edges, 1, 100_000, 0.003);
+}
+
+/// The model's windows between `edges` (from window `first` on) against MCML's far-field case
+/// (g, η, α′) of `mcml_far_field_g.csv` (39 bins of 2.5 reduced mean free paths), within
+/// 3 √(s.e.² + (δ·model)²), MCML's s.e. estimated from an engine run of `n` photons.
+fn far_field_against_mcml(case: (f64, f64, f64), edges: &[f64], first: usize, n: u64, delta: f64) {
+    let (g, eta, ap) = case;
     let csv = include_str!("../../../data/reference/mcml_far_field_g.csv");
-    let rows = csv
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.starts_with('g'));
-    assert!(
-        rows.clone().count() == 39 && rows.clone().all(|l| l.starts_with("0.8,1.0,0.9999,")),
-        "one case in the file, 39 bins"
+    let key = format!("{g},{eta:.1},{ap},");
+    assert_eq!(
+        csv.lines().filter(|l| l.starts_with(&key)).count(),
+        39,
+        "the case's 39 bins ({key})"
     );
-    let (reference, n_mcml) = mcml_in(csv, &edges, g, eta, ap);
-    let n = 100_000;
-    let (short, _) = engine_in(&edges, g, eta, ap, n, 7);
+    let (reference, n_mcml) = mcml_in(csv, edges, g, eta, ap);
+    let (short, _) = engine_in(edges, g, eta, ap, n, 7);
     let m = family(ModelName::Mc)
         .unwrap()
         .profile(&props(g, eta, ap))
         .unwrap();
-    for k in 1..edges.len() - 1 {
+    for k in first..edges.len() - 1 {
         let se = short[k].1 * (n as f64 / n_mcml).sqrt();
         let ours = window(m.as_ref(), edges[k], edges[k + 1]);
-        let tol = (se * se + (0.003 * ours).powi(2)).sqrt();
+        let tol = (se * se + (delta * ours).powi(2)).sqrt();
         eprintln!(
-            "[{}, {}): model {ours:.6}, MCML {:.6} ± {se:.6} ({:+.2} %, z {:+.1})",
+            "g {g} [{}, {}): model {ours:.6}, MCML {:.6} ± {se:.6} ({:+.2} %, z {:+.1})",
             edges[k],
             edges[k + 1],
             reference[k],
@@ -457,7 +462,7 @@ fn the_far_field_at_weak_absorption_matches_mcml() {
         );
         assert!(
             (ours - reference[k]).abs() < 3.0 * tol,
-            "window [{}, {}): model {ours} vs MCML {} ± {se}",
+            "g {g} window [{}, {}): model {ours} vs MCML {} ± {se}",
             edges[k],
             edges[k + 1],
             reference[k]
