@@ -647,3 +647,13 @@ fn between_the_first_low_albedo_nodes_the_profile_follows_mcml() {
         100.0 * mean
     );
 }
+
+/// The g 0.95 node's corner at weak absorption (η 1.0, α′ 0.9999; its tables keep albedo nodes
+/// equally spaced in √(1 − a), two above α′ 0.998): the model against MCML's profile
+/// (`mcml_far_field_g.csv`, 10⁶ photons) over 2.5–97.5 reduced mean free paths, as the g 0.8 case
+/// above. Measured (2026-11-29): −0.14, −0.83, −0.53, +1.19, +1.99 % (z −1.9 … +1.7).
+#[test]
+fn the_g_0_95_corner_at_weak_absorption_matches_mcml() {
+    let edges = [0.0, 2.5, 10.0, 25.0, 40.0, 60.0, 97.5];
+    far_field_against_mcml((0.95, 1.0, 0.9999), &edges, 1, 20_000, 0.003);
+}
