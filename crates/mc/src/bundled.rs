@@ -3,7 +3,8 @@
 //! where total internal reflection sets in; with 0.2 spacing Catmull-Rom in η was measured up to
 //! 0.7 % off a table built at η = 1.33 itself, BENCHMARKS.md), each with the layout of
 //! [`McTableSpec::shipped`] (128 albedo nodes, 4·10⁶ full-length photons and 1.6·10⁷ / 3.2·10⁷ in
-//! the shorter strata, a seed per η), in compact form ([`McTable::compact`]). Made by
+//! the shorter strata, a seed per η; since 2026-11-29 one more node at a = 0.01 from a low-albedo
+//! run of 6.4·10⁸ photons, [`crate::LowAlbedoRun`]), in compact form ([`McTable::compact`]). Made by
 //! `cargo run --release -p scatterfit-mc --example build_mc_tables -- crates/mc/tables <η…>`
 //! (rebuilt 2026-11-27 from 64 nodes and 2·10⁶ photons: CHANGELOG.md, "The g = 0 tables rebuilt").
 //!
